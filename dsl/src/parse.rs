@@ -1,0 +1,663 @@
+//! Text -> syntax tree: runs the pest grammar and lowers its pairs by hand into the typed tree
+//! of `syntax.rs`. Parsing knows nothing of compilation; it only reports text that is not a
+//! `.clay` file (syntax errors, number literals that overflow, nesting too deep to parse).
+
+use pest::Parser;
+use pest::error::{ErrorVariant, InputLocation};
+use pest::iterators::Pair;
+
+use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::syntax::*;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "grammar.pest"]
+struct ClayParser;
+
+/// Deepest nesting of brackets and block comments accepted. Deeper input is rejected before
+/// pest sees it, because pest recurses once per nested block comment.
+pub const MAX_NESTING: usize = 256;
+
+/// Stable diagnostic codes emitted by the parser.
+pub mod codes {
+    /// The text does not follow the grammar.
+    pub const SYNTAX: &str = "E001";
+    /// Brackets or block comments nested deeper than [`super::MAX_NESTING`].
+    pub const TOO_DEEP: &str = "E002";
+    /// A number literal too large for a 64-bit float.
+    pub const NON_FINITE: &str = "E012";
+}
+
+/// Human words for a grammar rule, used in "expected ..." messages. The match is exhaustive
+/// on purpose: adding a rule to the grammar forces choosing its words here.
+pub fn describe(rule: Rule) -> &'static str {
+    match rule {
+        Rule::EOI => "end of file",
+        Rule::WHITESPACE | Rule::COMMENT | Rule::line_comment | Rule::block_comment => "whitespace",
+        Rule::ident_char => "a letter, digit or `_`",
+        Rule::item => "`solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`",
+        Rule::piece_stmt => "a piece statement",
+        Rule::state_stmt => "a state statement",
+        Rule::stretch_stmt => "`min` or `variants`",
+        Rule::model_stmt => "an instance or a `dock`",
+        Rule::name => "a name",
+        Rule::number => "a number",
+        Rule::integer => "a whole number",
+        Rule::colour => "a colour like `#b5651d`",
+        Rule::point => "a point `(x, y)`",
+        Rule::kw_solver => "`solver`",
+        Rule::kw_site => "`site`",
+        Rule::kw_type => "`type`",
+        Rule::kw_docks => "`docks`",
+        Rule::kw_piece => "`piece`",
+        Rule::kw_vertex => "`vertex`",
+        Rule::kw_edges => "`edges`",
+        Rule::kw_out => "`out`",
+        Rule::kw_axis => "`axis`",
+        Rule::kw_polygon => "`polygon`",
+        Rule::kw_polyline => "`polyline`",
+        Rule::kw_rigid => "`rigid`",
+        Rule::kw_skinned => "`skinned`",
+        Rule::kw_fill => "`fill`",
+        Rule::kw_width => "`width`",
+        Rule::kw_hole => "`hole`",
+        Rule::kw_state => "`state`",
+        Rule::kw_stretch => "`stretch`",
+        Rule::kw_from => "`from`",
+        Rule::kw_to => "`to`",
+        Rule::kw_min => "`min`",
+        Rule::kw_variants => "`variants`",
+        Rule::kw_merge => "`merge`",
+        Rule::kw_onto => "`onto`",
+        Rule::kw_into => "`into`",
+        Rule::kw_within => "`within`",
+        Rule::kw_cut => "`cut`",
+        Rule::kw_model => "`model`",
+        Rule::kw_chain => "`chain`",
+        Rule::kw_x => "`x`",
+        Rule::kw_along => "`along`",
+        Rule::kw_at => "`at`",
+        Rule::kw_rotate => "`rotate`",
+        Rule::kw_dock => "`dock`",
+        Rule::kw_last => "`last`",
+        Rule::lbrace => "`{`",
+        Rule::rbrace => "`}`",
+        Rule::lparen => "`(`",
+        Rule::rparen => "`)`",
+        Rule::lbracket => "`[`",
+        Rule::rbracket => "`]`",
+        Rule::comma => "`,`",
+        Rule::colon => "`:`",
+        Rule::equals => "`=`",
+        Rule::arrow => "`->`",
+        Rule::dash => "`-`",
+        Rule::dot => "`.`",
+        Rule::file => "a clay file",
+        Rule::solver_block => "a `solver` block",
+        Rule::solver_entry => "a solver parameter `NAME = NUMBER`",
+        Rule::site_type_decl => "a `site type` declaration",
+        Rule::piece_decl => "a `piece`",
+        Rule::vertex_decl => "a `vertex`",
+        Rule::edges_decl => "`edges`",
+        Rule::edge_path => "an edge path `a-b-c`",
+        Rule::site_decl => "a `site`",
+        Rule::vertex_list => "a vertex list `[a, b]`",
+        Rule::axis_decl => "an `axis`",
+        Rule::binding => "`rigid` or `skinned`",
+        Rule::polygon_decl => "a `polygon`",
+        Rule::hole => "a `hole`",
+        Rule::polyline_decl => "a `polyline`",
+        Rule::point_list => "points",
+        Rule::state_decl => "a `state`",
+        Rule::state_position => "a vertex position `NAME (x, y)`",
+        Rule::stretch_decl => "a `stretch` rule",
+        Rule::min_decl => "`min`",
+        Rule::variants_decl => "`variants`",
+        Rule::variant => "a variant `PIECE FREQUENCY`",
+        Rule::merge_decl => "a `merge` rule",
+        Rule::site_path => "a site `PIECE.SITE`",
+        Rule::cut_decl => "a `cut` rule",
+        Rule::model_block => "a `model` block",
+        Rule::dock_decl => "a `dock`",
+        Rule::instance_site => "an instance site `INSTANCE.SITE`",
+        Rule::element_index => "an element index `[N]`",
+        Rule::chain_decl => "a `chain`",
+        Rule::along => "`along`",
+        Rule::instance_decl => "an instance `NAME = PIECE`",
+        Rule::at => "`at`",
+        Rule::rotate => "`rotate`",
+    }
+}
+
+/// Parses a whole file. Errors are returned as diagnostics; the tree is only returned for text
+/// that follows the grammar and whose numbers are all finite.
+pub fn parse(source: &str) -> Result<File, Diagnostics> {
+    if let Some(d) = check_nesting(source) {
+        return Err(d.into());
+    }
+    let mut pairs = match ClayParser::parse(Rule::file, source) {
+        Ok(p) => p,
+        Err(e) => return Err(syntax_error(source, e).into()),
+    };
+    let Some(file) = pairs.next() else {
+        return Err(Diagnostic::error(codes::SYNTAX, "empty parse", Span::new(0, 0), "here").into());
+    };
+    let mut lower = Lower { diags: Diagnostics::new() };
+    let tree = lower.file(file);
+    if lower.diags.has_errors() { Err(lower.diags) } else { Ok(tree) }
+}
+
+/// Rejects input nested deeper than [`MAX_NESTING`] (brackets of any kind and block comments)
+/// with one scan, before the recursive parser runs.
+fn check_nesting(source: &str) -> Option<Diagnostic> {
+    let bytes = source.as_bytes();
+    let mut brackets = 0usize;
+    let mut comments = 0usize;
+    let mut i = 0;
+    while i < bytes.len() {
+        let b = bytes[i];
+        let next = bytes.get(i + 1).copied();
+        if comments > 0 {
+            if b == b'/' && next == Some(b'*') {
+                comments += 1;
+                i += 1;
+            } else if b == b'*' && next == Some(b'/') {
+                comments -= 1;
+                i += 1;
+            }
+        } else if b == b'/' && next == Some(b'/') {
+            while i < bytes.len() && bytes[i] != b'\n' {
+                i += 1;
+            }
+        } else if b == b'/' && next == Some(b'*') {
+            comments = 1;
+            i += 1;
+        } else if matches!(b, b'(' | b'[' | b'{') {
+            brackets += 1;
+        } else if matches!(b, b')' | b']' | b'}') {
+            brackets = brackets.saturating_sub(1);
+        }
+        if brackets > MAX_NESTING || comments > MAX_NESTING {
+            let what = if comments > MAX_NESTING { "block comments" } else { "brackets" };
+            return Some(
+                Diagnostic::error(
+                    codes::TOO_DEEP,
+                    format!("{what} nested more than {MAX_NESTING} deep"),
+                    Span::new(i, i + 1),
+                    format!("nesting level {} starts here", MAX_NESTING + 1),
+                )
+                .with_hint("a clay file never needs more than three levels of brackets; look for an unclosed bracket or comment"),
+            );
+        }
+        i += 1;
+    }
+    None
+}
+
+/// The span of the token starting at `pos` (after whitespace), and words for it.
+fn found_token(source: &str, pos: usize) -> (Span, String) {
+    let mut pos = pos.min(source.len());
+    while !source.is_char_boundary(pos) {
+        pos -= 1;
+    }
+    let rest = &source[pos..];
+    let trimmed = rest.trim_start();
+    let start = pos + (rest.len() - trimmed.len());
+    let Some(c) = trimmed.chars().next() else {
+        return (Span::new(source.len(), source.len()), "end of file".to_string());
+    };
+    let len = if c.is_ascii_alphanumeric() || c == '_' {
+        trimmed.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.')).unwrap_or(trimmed.len())
+    } else {
+        c.len_utf8()
+    };
+    let text = &trimmed[..len];
+    let words = if c.is_ascii_digit() || c == '-' && len == 1 && false {
+        format!("`{text}`")
+    } else if c.is_control() {
+        format!("character {:?}", c)
+    } else {
+        format!("`{text}`")
+    };
+    (Span::new(start, start + len), words)
+}
+
+/// Joins words as "a, b or c".
+fn one_of(words: &[&str]) -> String {
+    match words {
+        [] => "something else".to_string(),
+        [w] => (*w).to_string(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}
+
+fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
+    let pos = match e.location {
+        InputLocation::Pos(p) => p,
+        InputLocation::Span((s, _)) => s,
+    };
+    let (span, found) = found_token(source, pos);
+    match &e.variant {
+        ErrorVariant::ParsingError { positives, .. } => {
+            let mut words: Vec<&str> = Vec::new();
+            for r in positives {
+                let w = describe(*r);
+                if !words.contains(&w) {
+                    words.push(w);
+                }
+            }
+            let expected = one_of(&words);
+            let mut d = Diagnostic::error(
+                codes::SYNTAX,
+                format!("expected {expected}, found {found}"),
+                span,
+                format!("expected {expected}"),
+            );
+            if let Some(hint) = syntax_hint(source, span, positives) {
+                d = d.with_hint(hint);
+            }
+            d
+        }
+        ErrorVariant::CustomError { message } => {
+            Diagnostic::error(codes::SYNTAX, message.clone(), span, "here")
+        }
+    }
+}
+
+/// A hint for common slips, judged from what was expected and what is there.
+fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
+    let text = source.get(span.start..span.end).unwrap_or("");
+    if positives.contains(&Rule::colour) && text.starts_with('#') {
+        return Some("colours are `#` followed by 6 or 8 hexadecimal digits, like `#b5651d` or `#b5651d80`".into());
+    }
+    if positives.contains(&Rule::comma) && positives.contains(&Rule::rparen) {
+        return Some("points are written `(x, y)`".into());
+    }
+    if positives.contains(&Rule::kw_piece) && positives.contains(&Rule::kw_model) {
+        return Some("a file is a list of `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` and `model` items".into());
+    }
+    None
+}
+
+/// The lowering pass: pest pairs -> syntax tree.
+struct Lower {
+    diags: Diagnostics,
+}
+
+fn span_of(p: &Pair<Rule>) -> Span {
+    let s = p.as_span();
+    Span::new(s.start(), s.end())
+}
+
+/// Children that carry meaning: punctuation is dropped.
+fn kids(p: Pair<Rule>) -> Vec<Pair<Rule>> {
+    p.into_inner()
+        .filter(|c| {
+            !matches!(
+                c.as_rule(),
+                Rule::lbrace
+                    | Rule::rbrace
+                    | Rule::lparen
+                    | Rule::rparen
+                    | Rule::lbracket
+                    | Rule::rbracket
+                    | Rule::comma
+                    | Rule::colon
+                    | Rule::equals
+                    | Rule::arrow
+                    | Rule::dash
+                    | Rule::dot
+                    | Rule::EOI
+            )
+        })
+        .collect()
+}
+
+/// Children of one rule, in order.
+fn of<'i>(children: &[Pair<'i, Rule>], rule: Rule) -> Vec<Pair<'i, Rule>> {
+    children.iter().filter(|c| c.as_rule() == rule).cloned().collect()
+}
+
+fn first<'i>(children: &[Pair<'i, Rule>], rule: Rule) -> Option<Pair<'i, Rule>> {
+    children.iter().find(|c| c.as_rule() == rule).cloned()
+}
+
+impl Lower {
+    fn ident(&self, p: Pair<Rule>) -> Ident {
+        Ident { name: p.as_str().to_string(), span: span_of(&p) }
+    }
+
+    fn idents(&self, children: &[Pair<Rule>]) -> Vec<Ident> {
+        of(children, Rule::name).into_iter().map(|p| self.ident(p)).collect()
+    }
+
+    fn number(&mut self, p: Pair<Rule>) -> Number {
+        let span = span_of(&p);
+        // The grammar only admits decimal literals, which Rust's float parser accepts; a
+        // literal beyond f64's range parses to infinity and is reported here.
+        let value = p.as_str().parse::<f64>().unwrap_or(f64::NAN);
+        if !value.is_finite() {
+            self.diags.push(
+                Diagnostic::error(codes::NON_FINITE, "number is too large", span, "does not fit in a 64-bit float")
+                    .with_hint("numbers must be finite; the largest is about 1.8e308"),
+            );
+            return Number { value: 0.0, span };
+        }
+        Number { value, span }
+    }
+
+    fn point(&mut self, p: Pair<Rule>) -> Point {
+        let span = span_of(&p);
+        let mut nums = of(&kids(p), Rule::number).into_iter();
+        let x = nums.next().map(|n| self.number(n)).unwrap_or(Number { value: 0.0, span });
+        let y = nums.next().map(|n| self.number(n)).unwrap_or(Number { value: 0.0, span });
+        Point { x, y, span }
+    }
+
+    fn points(&mut self, p: Pair<Rule>) -> Vec<Point> {
+        of(&kids(p), Rule::point).into_iter().map(|q| self.point(q)).collect()
+    }
+
+    fn colour(&self, p: Pair<Rule>) -> Colour {
+        let span = span_of(&p);
+        let hex = p.as_str().trim_start_matches('#');
+        let byte = |i: usize| hex.get(i..i + 2).and_then(|h| u8::from_str_radix(h, 16).ok()).unwrap_or(255);
+        let alpha = if hex.len() == 8 { byte(6) } else { 255 };
+        Colour { rgba: [byte(0), byte(2), byte(4), alpha], span }
+    }
+
+    fn file(&mut self, p: Pair<Rule>) -> File {
+        let span = span_of(&p);
+        let mut items = Vec::new();
+        for c in kids(p) {
+            let item = match c.as_rule() {
+                Rule::solver_block => Item::Solver(self.solver(c)),
+                Rule::site_type_decl => Item::SiteType(self.site_type(c)),
+                Rule::piece_decl => Item::Piece(self.piece(c)),
+                Rule::stretch_decl => Item::Stretch(self.stretch(c)),
+                Rule::merge_decl => Item::Merge(self.merge(c)),
+                Rule::cut_decl => Item::Cut(self.cut(c)),
+                Rule::model_block => Item::Model(self.model(c)),
+                _ => continue,
+            };
+            items.push(item);
+        }
+        File { items, span }
+    }
+
+    fn solver(&mut self, p: Pair<Rule>) -> SolverBlock {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let keyword = first(&ch, Rule::kw_solver).map_or(span, |k| span_of(&k));
+        let mut entries = Vec::new();
+        for e in of(&ch, Rule::solver_entry) {
+            let espan = span_of(&e);
+            let ec = kids(e);
+            let (Some(n), Some(v)) = (first(&ec, Rule::name), first(&ec, Rule::number)) else { continue };
+            let name = self.ident(n);
+            let value = self.number(v);
+            entries.push(SolverEntry { name, value, span: espan });
+        }
+        SolverBlock { entries, keyword, span }
+    }
+
+    fn site_type(&mut self, p: Pair<Rule>) -> SiteTypeDecl {
+        let span = span_of(&p);
+        let mut names = self.idents(&kids(p)).into_iter();
+        let name = names.next().unwrap_or(Ident { name: String::new(), span });
+        SiteTypeDecl { name, docks: names.collect(), span }
+    }
+
+    fn piece(&mut self, p: Pair<Rule>) -> PieceDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let mut stmts = Vec::new();
+        for c in ch {
+            let stmt = match c.as_rule() {
+                Rule::vertex_decl => PieceStmt::Vertex(self.vertex(c)),
+                Rule::edges_decl => PieceStmt::Edges(self.edges(c)),
+                Rule::site_decl => PieceStmt::Site(self.site(c)),
+                Rule::axis_decl => {
+                    let aspan = span_of(&c);
+                    let names = self.idents(&kids(c));
+                    let (Some(from), Some(to)) = (names.first(), names.get(1)) else { continue };
+                    PieceStmt::Axis(AxisDecl { from: from.clone(), to: to.clone(), span: aspan })
+                }
+                Rule::polygon_decl | Rule::polyline_decl => PieceStmt::Geometry(self.geometry(c)),
+                Rule::state_decl => PieceStmt::State(self.state(c)),
+                _ => continue,
+            };
+            stmts.push(stmt);
+        }
+        PieceDecl { name, stmts, span }
+    }
+
+    fn vertex(&mut self, p: Pair<Rule>) -> VertexDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let pos = first(&ch, Rule::point).map(|q| self.point(q));
+        let zero = Number { value: 0.0, span };
+        VertexDecl { name, pos: pos.unwrap_or(Point { x: zero, y: zero, span }), span }
+    }
+
+    fn edges(&mut self, p: Pair<Rule>) -> EdgesDecl {
+        let span = span_of(&p);
+        let paths = of(&kids(p), Rule::edge_path).into_iter().map(|path| self.idents(&kids(path))).collect();
+        EdgesDecl { paths, span }
+    }
+
+    fn site(&mut self, p: Pair<Rule>) -> SiteDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let names = self.idents(&ch);
+        let empty = Ident { name: String::new(), span };
+        let list = first(&ch, Rule::vertex_list);
+        let vertices_span = list.as_ref().map_or(span, span_of);
+        let vertices = list.map(|l| self.idents(&kids(l))).unwrap_or_default();
+        let out = first(&ch, Rule::point).map(|q| self.point(q));
+        let zero = Number { value: 0.0, span };
+        SiteDecl {
+            name: names.first().cloned().unwrap_or(empty.clone()),
+            site_type: names.get(1).cloned().unwrap_or(empty),
+            vertices,
+            vertices_span,
+            out: out.unwrap_or(Point { x: zero, y: zero, span }),
+            span,
+        }
+    }
+
+    fn geometry(&mut self, p: Pair<Rule>) -> GeometryDecl {
+        let span = span_of(&p);
+        let is_polygon = p.as_rule() == Rule::polygon_decl;
+        let ch = kids(p);
+        let keyword = ch.first().map_or(span, span_of);
+        let binding = first(&ch, Rule::binding).map(|b| {
+            let bspan = span_of(&b);
+            let kind = if b.as_str().starts_with("skinned") { BindingKw::Skinned } else { BindingKw::Rigid };
+            (kind, bspan)
+        });
+        let fill = first(&ch, Rule::colour).map_or(Colour { rgba: [255; 4], span }, |c| self.colour(c));
+        let points = first(&ch, Rule::point_list).map(|l| self.points(l)).unwrap_or_default();
+        let shape = if is_polygon {
+            let holes = of(&ch, Rule::hole)
+                .into_iter()
+                .map(|h| {
+                    let hspan = span_of(&h);
+                    let points = first(&kids(h), Rule::point_list).map(|l| self.points(l)).unwrap_or_default();
+                    HoleDecl { points, span: hspan }
+                })
+                .collect();
+            ShapeDecl::Polygon { outer: points, holes }
+        } else {
+            let width = first(&ch, Rule::number).map_or(Number { value: 0.0, span }, |n| self.number(n));
+            ShapeDecl::Polyline { width, points }
+        };
+        GeometryDecl { shape, binding, fill, keyword, span }
+    }
+
+    fn state(&mut self, p: Pair<Rule>) -> StateDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let mut positions = Vec::new();
+        let mut edges = Vec::new();
+        let mut geometry = Vec::new();
+        for c in ch {
+            match c.as_rule() {
+                Rule::state_position => positions.push(self.vertex(c)),
+                Rule::edges_decl => edges.push(self.edges(c)),
+                Rule::polygon_decl | Rule::polyline_decl => geometry.push(self.geometry(c)),
+                _ => {}
+            }
+        }
+        StateDecl { name, positions, edges, geometry, span }
+    }
+
+    fn stretch(&mut self, p: Pair<Rule>) -> StretchDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let names = self.idents(&ch);
+        let empty = Ident { name: String::new(), span };
+        let min = of(&ch, Rule::min_decl)
+            .into_iter()
+            .filter_map(|m| first(&kids(m), Rule::number))
+            .map(|n| self.number(n))
+            .collect();
+        let variants = of(&ch, Rule::variants_decl)
+            .into_iter()
+            .map(|v| {
+                let vspan = span_of(&v);
+                let entries = of(&kids(v), Rule::variant)
+                    .into_iter()
+                    .map(|e| {
+                        let espan = span_of(&e);
+                        let ec = kids(e);
+                        let piece = first(&ec, Rule::name).map_or(Ident { name: String::new(), span: espan }, |n| self.ident(n));
+                        let frequency = first(&ec, Rule::number).map_or(Number { value: 0.0, span: espan }, |n| self.number(n));
+                        VariantEntry { piece, frequency, span: espan }
+                    })
+                    .collect();
+                VariantsDecl { entries, span: vspan }
+            })
+            .collect();
+        StretchDecl {
+            piece: names.first().cloned().unwrap_or(empty.clone()),
+            from: names.get(1).cloned().unwrap_or(empty.clone()),
+            to: names.get(2).cloned().unwrap_or(empty),
+            min,
+            variants,
+            span,
+        }
+    }
+
+    fn site_path(&self, p: Pair<Rule>) -> SitePath {
+        let span = span_of(&p);
+        let names = self.idents(&kids(p));
+        let empty = Ident { name: String::new(), span };
+        SitePath { piece: names.first().cloned().unwrap_or(empty.clone()), site: names.get(1).cloned().unwrap_or(empty), span }
+    }
+
+    fn merge(&mut self, p: Pair<Rule>) -> MergeDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let mut paths = of(&ch, Rule::site_path).into_iter().map(|s| self.site_path(s));
+        let empty = SitePath { piece: Ident { name: String::new(), span }, site: Ident { name: String::new(), span }, span };
+        let mover = paths.next().unwrap_or(empty.clone());
+        let target = paths.next().unwrap_or(empty);
+        let junction = paths.next();
+        let within = first(&ch, Rule::number).map(|n| self.number(n));
+        MergeDecl { mover, target, junction, within, span }
+    }
+
+    fn cut(&mut self, p: Pair<Rule>) -> CutDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let empty = Ident { name: String::new(), span };
+        let junction = first(&ch, Rule::site_path)
+            .map(|s| self.site_path(s))
+            .unwrap_or(SitePath { piece: empty.clone(), site: empty.clone(), span });
+        let into = first(&ch, Rule::name).map_or(empty, |n| self.ident(n));
+        CutDecl { junction, into, span }
+    }
+
+    fn model(&mut self, p: Pair<Rule>) -> ModelBlock {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let keyword = first(&ch, Rule::kw_model).map_or(span, |k| span_of(&k));
+        let mut stmts = Vec::new();
+        for c in ch {
+            let cspan = span_of(&c);
+            match c.as_rule() {
+                Rule::dock_decl => {
+                    let mut sites = of(&kids(c), Rule::instance_site).into_iter().map(|s| self.instance_site(s));
+                    let (Some(a), Some(b)) = (sites.next(), sites.next()) else { continue };
+                    stmts.push(ModelStmt::Dock(DockDecl { a, b, span: cspan }));
+                }
+                Rule::chain_decl => {
+                    let cc = kids(c);
+                    let names = self.idents(&cc);
+                    let empty = Ident { name: String::new(), span: cspan };
+                    let count = first(&cc, Rule::number).map_or(Number { value: 0.0, span: cspan }, |n| self.number(n));
+                    let along = first(&cc, Rule::along).and_then(|a| {
+                        let n = self.idents(&kids(a));
+                        Some((n.first()?.clone(), n.get(1)?.clone()))
+                    });
+                    let (at, rotate) = self.placement(&cc);
+                    stmts.push(ModelStmt::Chain(ChainDecl {
+                        name: names.first().cloned().unwrap_or(empty.clone()),
+                        piece: names.get(1).cloned().unwrap_or(empty),
+                        count,
+                        along,
+                        at,
+                        rotate,
+                        span: cspan,
+                    }));
+                }
+                Rule::instance_decl => {
+                    let cc = kids(c);
+                    let names = self.idents(&cc);
+                    let empty = Ident { name: String::new(), span: cspan };
+                    let (at, rotate) = self.placement(&cc);
+                    stmts.push(ModelStmt::Instance(InstanceDecl {
+                        name: names.first().cloned().unwrap_or(empty.clone()),
+                        piece: names.get(1).cloned().unwrap_or(empty),
+                        at,
+                        rotate,
+                        span: cspan,
+                    }));
+                }
+                _ => {}
+            }
+        }
+        ModelBlock { stmts, keyword, span }
+    }
+
+    fn placement(&mut self, ch: &[Pair<Rule>]) -> (Option<Point>, Option<Number>) {
+        let at = first(ch, Rule::at).and_then(|a| first(&kids(a), Rule::point)).map(|p| self.point(p));
+        let rotate = first(ch, Rule::rotate).and_then(|r| first(&kids(r), Rule::number)).map(|n| self.number(n));
+        (at, rotate)
+    }
+
+    fn instance_site(&self, p: Pair<Rule>) -> InstanceSitePath {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let names = self.idents(&ch);
+        let empty = Ident { name: String::new(), span };
+        let index = first(&ch, Rule::element_index).map(|e| {
+            let espan = span_of(&e);
+            let index = match first(&kids(e), Rule::integer) {
+                // Absurdly long indices saturate; they are out of range either way.
+                Some(i) => ElementIndexKind::At(i.as_str().parse().unwrap_or(u64::MAX)),
+                None => ElementIndexKind::Last,
+            };
+            ElementIndex { index, span: espan }
+        });
+        InstanceSitePath {
+            instance: names.first().cloned().unwrap_or(empty.clone()),
+            index,
+            site: names.get(1).cloned().unwrap_or(empty),
+            span,
+        }
+    }
+}

@@ -1,0 +1,324 @@
+//! The typed syntax tree of a `.clay` file: exactly what was written, with a byte span on every
+//! node. It knows nothing of compilation; `parse.rs` builds it and `compile` reads it.
+
+use serde::{Deserialize, Serialize};
+
+/// A byte range `start..end` in the source text.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Span {
+    pub start: usize,
+    pub end: usize,
+}
+
+impl Span {
+    pub fn new(start: usize, end: usize) -> Self {
+        Self { start, end }
+    }
+
+    /// The smallest span covering both.
+    pub fn to(self, other: Span) -> Span {
+        Span { start: self.start.min(other.start), end: self.end.max(other.end) }
+    }
+}
+
+/// A name as written.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ident {
+    pub name: String,
+    pub span: Span,
+}
+
+/// A number literal. `value` is finite: the parser rejects literals that overflow f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Number {
+    pub value: f64,
+    pub span: Span,
+}
+
+/// `(x, y)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    pub x: Number,
+    pub y: Number,
+    pub span: Span,
+}
+
+/// A whole file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct File {
+    pub items: Vec<Item>,
+    pub span: Span,
+}
+
+/// A top-level item.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Item {
+    Solver(SolverBlock),
+    SiteType(SiteTypeDecl),
+    Piece(PieceDecl),
+    Stretch(StretchDecl),
+    Merge(MergeDecl),
+    Cut(CutDecl),
+    Model(ModelBlock),
+}
+
+impl Item {
+    pub fn span(&self) -> Span {
+        match self {
+            Item::Solver(x) => x.span,
+            Item::SiteType(x) => x.span,
+            Item::Piece(x) => x.span,
+            Item::Stretch(x) => x.span,
+            Item::Merge(x) => x.span,
+            Item::Cut(x) => x.span,
+            Item::Model(x) => x.span,
+        }
+    }
+}
+
+/// `solver { NAME = NUMBER ... }`; `keyword` is the span of `solver`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverBlock {
+    pub entries: Vec<SolverEntry>,
+    pub keyword: Span,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverEntry {
+    pub name: Ident,
+    pub value: Number,
+    pub span: Span,
+}
+
+/// `site type NAME [docks A, B, ...]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SiteTypeDecl {
+    pub name: Ident,
+    pub docks: Vec<Ident>,
+    pub span: Span,
+}
+
+/// `piece NAME { ... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PieceDecl {
+    pub name: Ident,
+    pub stmts: Vec<PieceStmt>,
+    pub span: Span,
+}
+
+/// A statement inside a piece.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PieceStmt {
+    Vertex(VertexDecl),
+    Edges(EdgesDecl),
+    Site(SiteDecl),
+    Axis(AxisDecl),
+    Geometry(GeometryDecl),
+    State(StateDecl),
+}
+
+/// `vertex NAME (x, y)`, or `NAME (x, y)` inside a state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VertexDecl {
+    pub name: Ident,
+    pub pos: Point,
+    pub span: Span,
+}
+
+/// `edges a-b-c, d-e`: each path is a list of at least two names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgesDecl {
+    pub paths: Vec<Vec<Ident>>,
+    pub span: Span,
+}
+
+/// `site NAME: TYPE [v1, v2, ...] out (dx, dy)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SiteDecl {
+    pub name: Ident,
+    pub site_type: Ident,
+    pub vertices: Vec<Ident>,
+    /// Span of the `[...]` list.
+    pub vertices_span: Span,
+    pub out: Point,
+    pub span: Span,
+}
+
+/// `axis FROM -> TO`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisDecl {
+    pub from: Ident,
+    pub to: Ident,
+    pub span: Span,
+}
+
+/// `rigid` or `skinned`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKw {
+    Rigid,
+    Skinned,
+}
+
+/// A `polygon` or `polyline` of proxy geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeometryDecl {
+    pub shape: ShapeDecl,
+    /// The binding keyword and its span, when written.
+    pub binding: Option<(BindingKw, Span)>,
+    pub fill: Colour,
+    /// Span of the `polygon`/`polyline` keyword.
+    pub keyword: Span,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeDecl {
+    Polygon { outer: Vec<Point>, holes: Vec<HoleDecl> },
+    Polyline { width: Number, points: Vec<Point> },
+}
+
+/// `hole { POINT... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoleDecl {
+    pub points: Vec<Point>,
+    pub span: Span,
+}
+
+/// `#rrggbb` or `#rrggbbaa`, already decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Colour {
+    pub rgba: [u8; 4],
+    pub span: Span,
+}
+
+/// `state NAME { ... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateDecl {
+    pub name: Ident,
+    pub positions: Vec<VertexDecl>,
+    pub edges: Vec<EdgesDecl>,
+    pub geometry: Vec<GeometryDecl>,
+    pub span: Span,
+}
+
+/// `stretch PIECE from SITE to SITE { ... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StretchDecl {
+    pub piece: Ident,
+    pub from: Ident,
+    pub to: Ident,
+    /// Every `min N` written (more than one is reported).
+    pub min: Vec<Number>,
+    /// Every `variants { ... }` written (more than one is reported).
+    pub variants: Vec<VariantsDecl>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantsDecl {
+    pub entries: Vec<VariantEntry>,
+    pub span: Span,
+}
+
+/// `PIECE FREQ`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantEntry {
+    pub piece: Ident,
+    pub frequency: Number,
+    pub span: Span,
+}
+
+/// `PIECE.SITE`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SitePath {
+    pub piece: Ident,
+    pub site: Ident,
+    pub span: Span,
+}
+
+/// `merge A.s onto B.t [into J.u] [within D]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MergeDecl {
+    pub mover: SitePath,
+    pub target: SitePath,
+    pub junction: Option<SitePath>,
+    pub within: Option<Number>,
+    pub span: Span,
+}
+
+/// `cut J.u into PIECE`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CutDecl {
+    pub junction: SitePath,
+    pub into: Ident,
+    pub span: Span,
+}
+
+/// `model { ... }`; `keyword` is the span of `model`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelBlock {
+    pub stmts: Vec<ModelStmt>,
+    pub keyword: Span,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelStmt {
+    Instance(InstanceDecl),
+    Chain(ChainDecl),
+    Dock(DockDecl),
+}
+
+/// `NAME = PIECE [at (x, y)] [rotate DEG]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDecl {
+    pub name: Ident,
+    pub piece: Ident,
+    pub at: Option<Point>,
+    pub rotate: Option<Number>,
+    pub span: Span,
+}
+
+/// `NAME = chain PIECE x N [along S -> T] [at (x, y)] [rotate DEG]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChainDecl {
+    pub name: Ident,
+    pub piece: Ident,
+    pub count: Number,
+    pub along: Option<(Ident, Ident)>,
+    pub at: Option<Point>,
+    pub rotate: Option<Number>,
+    pub span: Span,
+}
+
+/// `dock A.s to B.t`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DockDecl {
+    pub a: InstanceSitePath,
+    pub b: InstanceSitePath,
+    pub span: Span,
+}
+
+/// `INSTANCE.SITE` or `CHAIN[INDEX].SITE`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceSitePath {
+    pub instance: Ident,
+    pub index: Option<ElementIndex>,
+    pub site: Ident,
+    pub span: Span,
+}
+
+/// `[3]` or `[last]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ElementIndex {
+    pub index: ElementIndexKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementIndexKind {
+    /// A written index; saturates at `u64::MAX` for absurd literals.
+    At(u64),
+    Last,
+}

@@ -1,0 +1,2 @@
+//! The Clay editor binary (a shell for now).
+fn main() {}

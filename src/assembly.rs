@@ -1,0 +1,343 @@
+//! The live assembly: the compiled grammar, the current [`AssemblyData`] (positions, instances,
+//! docks, chains, parts), per-part rotations, and the handles the user holds.
+//!
+//! The solver reads the parts and handles and writes positions, rotations and active states.
+//! Rules (paper 5.1) rewrite `data` between frames and then call [`Assembly::topology_changed`],
+//! which bumps [`Assembly::generation`]; the solver rebuilds its sparsity pattern and symbolic
+//! factorisation only when the generation changes.
+
+use std::sync::Arc;
+
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
+use glam::DVec2;
+
+/// Identity of a handle; never reused within one assembly.
+pub type HandleId = u64;
+
+/// Whether a handle follows the user or stays put.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HandleKind {
+    /// The part the user is dragging or rotating.
+    Grab,
+    /// A part fixed where it was when pinned.
+    Pin,
+}
+
+/// A handle (paper Eq. 3): a set of vertices with a target rigid placement. The target of
+/// vertex `k` is `centre + translation + rot(angle) * (anchor[k] - centre)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Handle {
+    pub id: HandleId,
+    pub kind: HandleKind,
+    /// The part the handle was made from, if any (informative; parts are renumbered by rules).
+    pub part: Option<usize>,
+    /// Global vertex indices the handle holds.
+    pub vertices: Vec<usize>,
+    /// Positions of `vertices` when the handle was made.
+    pub anchor: Vec<DVec2>,
+    /// Centroid of `anchor`; rotations turn about it.
+    pub centre: DVec2,
+    pub translation: DVec2,
+    /// Rotation in radians, counter-clockwise.
+    pub angle: f64,
+}
+
+impl Handle {
+    /// Target position of the handle's `k`-th vertex.
+    pub fn target(&self, k: usize) -> DVec2 {
+        let rot = DVec2::from_angle(self.angle);
+        self.centre + self.translation + rot.rotate(self.anchor[k] - self.centre)
+    }
+
+    /// Where the handle's centroid currently wants to be.
+    pub fn target_centre(&self) -> DVec2 {
+        self.centre + self.translation
+    }
+}
+
+/// A compass direction for picking the part reaching furthest that way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compass {
+    East,
+    West,
+    North,
+    South,
+}
+
+impl Compass {
+    pub fn direction(self) -> DVec2 {
+        match self {
+            Compass::East => DVec2::X,
+            Compass::West => -DVec2::X,
+            Compass::North => DVec2::Y,
+            Compass::South => -DVec2::Y,
+        }
+    }
+}
+
+/// The live assembly being sculpted.
+#[derive(Clone, Debug)]
+pub struct Assembly {
+    grammar: Arc<CompiledGrammar>,
+    /// The contract data; rules rewrite it and then call [`Assembly::topology_changed`].
+    pub data: AssemblyData,
+    /// Per part: the rotation of its active rest state onto the current pose, as a unit
+    /// complex number `(cos, sin)`.
+    rotations: Vec<DVec2>,
+    handles: Vec<Handle>,
+    next_handle: HandleId,
+    generation: u64,
+}
+
+impl Assembly {
+    /// The grammar's initial assembly. Parts are derived from the grammar when the compiled
+    /// assembly lists none.
+    pub fn new(grammar: Arc<CompiledGrammar>) -> Self {
+        let data = grammar.assembly.clone();
+        Self::from_data(grammar, data)
+    }
+
+    /// An assembly over given data (session files, synthetic benchmarks).
+    pub fn from_data(grammar: Arc<CompiledGrammar>, mut data: AssemblyData) -> Self {
+        if data.parts.is_empty() && !data.instances.is_empty() {
+            data.parts = grammar.parts(&data);
+        }
+        let rotations = vec![DVec2::X; data.parts.len()];
+        Self { grammar, data, rotations, handles: Vec::new(), next_handle: 0, generation: 0 }
+    }
+
+    pub fn grammar(&self) -> &CompiledGrammar {
+        &self.grammar
+    }
+
+    pub fn grammar_arc(&self) -> &Arc<CompiledGrammar> {
+        &self.grammar
+    }
+
+    /// Structural generation: changes whenever parts, vertices or edges may have changed.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Rules call this after rewriting `data` (parts, vertices, docks). Bumps the generation so
+    /// the solver rebuilds its pattern, resizes the rotations, and drops handles whose vertices
+    /// no longer exist (rules that renumber vertices should remap handles first, through
+    /// [`Assembly::handles_mut`]).
+    pub fn topology_changed(&mut self) {
+        self.generation += 1;
+        self.rotations.resize(self.data.parts.len(), DVec2::X);
+        let n = self.data.positions.len();
+        self.handles.retain(|h| h.vertices.iter().all(|&v| v < n));
+    }
+
+    /// Per-part rotations (unit complex numbers) from the last solver frame.
+    pub fn rotations(&self) -> &[DVec2] {
+        &self.rotations
+    }
+
+    pub fn rotations_mut(&mut self) -> &mut [DVec2] {
+        &mut self.rotations
+    }
+
+    pub fn handles(&self) -> &[Handle] {
+        &self.handles
+    }
+
+    pub fn handles_mut(&mut self) -> &mut Vec<Handle> {
+        &mut self.handles
+    }
+
+    pub fn handle(&self, id: HandleId) -> Option<&Handle> {
+        self.handles.iter().find(|h| h.id == id)
+    }
+
+    pub fn handle_mut(&mut self, id: HandleId) -> Option<&mut Handle> {
+        self.handles.iter_mut().find(|h| h.id == id)
+    }
+
+    /// Makes a handle over a part's vertices at their current positions. `None` if the part
+    /// does not exist.
+    pub fn hold_part(&mut self, part: usize, kind: HandleKind) -> Option<HandleId> {
+        let vertices = self.data.parts.get(part)?.vertices.clone();
+        let id = self.hold_vertices(vertices, kind)?;
+        if let Some(h) = self.handle_mut(id) {
+            h.part = Some(part);
+        }
+        Some(id)
+    }
+
+    /// Makes a handle over arbitrary vertices (e.g. a column of a grid). `None` if the list is
+    /// empty or names a vertex that does not exist.
+    pub fn hold_vertices(&mut self, vertices: Vec<usize>, kind: HandleKind) -> Option<HandleId> {
+        let n = self.data.positions.len();
+        if vertices.is_empty() || vertices.iter().any(|&v| v >= n) {
+            return None;
+        }
+        let anchor: Vec<DVec2> = vertices.iter().map(|&v| self.data.positions[v]).collect();
+        let centre = anchor.iter().copied().sum::<DVec2>() / anchor.len() as f64;
+        let id = self.next_handle;
+        self.next_handle += 1;
+        self.handles.push(Handle {
+            id,
+            kind,
+            part: None,
+            vertices,
+            anchor,
+            centre,
+            translation: DVec2::ZERO,
+            angle: 0.0,
+        });
+        Some(id)
+    }
+
+    /// Removes a handle; returns whether it existed.
+    pub fn release(&mut self, id: HandleId) -> bool {
+        let before = self.handles.len();
+        self.handles.retain(|h| h.id != id);
+        before != self.handles.len()
+    }
+
+    /// Centroid of a part's current vertex positions.
+    pub fn part_centroid(&self, part: usize) -> DVec2 {
+        let p = &self.data.parts[part];
+        if p.vertices.is_empty() {
+            return DVec2::ZERO;
+        }
+        p.vertices.iter().map(|&v| self.data.positions[v]).sum::<DVec2>() / p.vertices.len() as f64
+    }
+
+    /// The part whose centroid is nearest `point` (ties: lowest index). `None` without parts.
+    pub fn part_nearest(&self, point: DVec2) -> Option<usize> {
+        (0..self.data.parts.len())
+            .filter(|&i| !self.data.parts[i].vertices.is_empty())
+            .map(|i| (i, self.part_centroid(i).distance_squared(point)))
+            .filter(|(_, d)| d.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// The part with the vertex reaching furthest in `dir` (ties broken by the centroid, then
+    /// the lowest index). `None` without parts.
+    pub fn part_extreme(&self, dir: Compass) -> Option<usize> {
+        let d = dir.direction();
+        let key = |i: usize| {
+            let p = &self.data.parts[i];
+            let reach =
+                p.vertices.iter().map(|&v| self.data.positions[v].dot(d)).fold(f64::MIN, f64::max);
+            (reach, self.part_centroid(i).dot(d))
+        };
+        (0..self.data.parts.len())
+            .filter(|&i| !self.data.parts[i].vertices.is_empty())
+            .map(|i| (i, key(i)))
+            .max_by(|a, b| a.1.0.total_cmp(&b.1.0).then(a.1.1.total_cmp(&b.1.1)).then(b.0.cmp(&a.0)))
+            .map(|(i, _)| i)
+    }
+
+    /// Checks indices and invariants of the data, the rotations and the handles. Returns every
+    /// problem found, one line each.
+    pub fn validate(&self) -> Result<(), Vec<String>> {
+        let mut errors = Vec::new();
+        let d = &self.data;
+        let g = &self.grammar;
+        let n = d.positions.len();
+        for (i, p) in d.positions.iter().enumerate() {
+            if !p.is_finite() {
+                errors.push(format!("vertex {i}: position {p} is not finite"));
+            }
+        }
+        for (ii, inst) in d.instances.iter().enumerate() {
+            let Some(piece) = g.pieces.get(inst.piece) else {
+                errors.push(format!("instance {ii}: piece {} does not exist", inst.piece));
+                continue;
+            };
+            if inst.vertices.len() != piece.vertices.len() {
+                errors.push(format!(
+                    "instance {ii}: {} vertices, piece `{}` has {}",
+                    inst.vertices.len(),
+                    piece.name,
+                    piece.vertices.len()
+                ));
+            }
+            if inst.vertices.iter().any(|&v| v >= n) {
+                errors.push(format!("instance {ii}: vertex index out of range"));
+            }
+            if inst.state >= piece.states.len() {
+                errors.push(format!("instance {ii}: state {} out of range", inst.state));
+            }
+            if inst.id >= d.next_id {
+                errors.push(format!("instance {ii}: id {} not below next_id {}", inst.id, d.next_id));
+            }
+        }
+        for (di, dock) in d.docks.iter().enumerate() {
+            for s in [dock.a, dock.b] {
+                let ok = d
+                    .instances
+                    .get(s.instance)
+                    .and_then(|inst| g.pieces.get(inst.piece))
+                    .is_some_and(|piece| s.site < piece.sites.len());
+                if !ok {
+                    errors.push(format!("dock {di}: site {:?} does not exist", s));
+                }
+            }
+        }
+        for (ci, chain) in d.chains.iter().enumerate() {
+            if chain.rule >= g.stretch_rules.len() {
+                errors.push(format!("chain {ci}: stretch rule {} does not exist", chain.rule));
+            }
+            if chain.instances.iter().any(|&i| i >= d.instances.len()) {
+                errors.push(format!("chain {ci}: instance index out of range"));
+            }
+        }
+        for (pi, part) in d.parts.iter().enumerate() {
+            let m = part.vertices.len();
+            if part.vertices.iter().any(|&v| v >= n) {
+                errors.push(format!("part {pi}: vertex index out of range"));
+            }
+            if part.edges.iter().any(|e| e[0] >= m || e[1] >= m || e[0] == e[1]) {
+                errors.push(format!("part {pi}: edge index out of range or a loop"));
+            }
+            if part.states.is_empty() {
+                errors.push(format!("part {pi}: no rest state"));
+            }
+            if part.active >= part.states.len().max(1) {
+                errors.push(format!("part {pi}: active state {} out of range", part.active));
+            }
+            for s in &part.states {
+                if s.positions.len() != m {
+                    errors.push(format!(
+                        "part {pi}: state `{}` has {} positions for {m} vertices",
+                        s.name,
+                        s.positions.len()
+                    ));
+                }
+                if s.positions.iter().any(|p| !p.is_finite()) {
+                    errors.push(format!("part {pi}: state `{}` has a non-finite position", s.name));
+                }
+            }
+            match part.kind {
+                PartKind::Piece { instance } if instance >= d.instances.len() => {
+                    errors.push(format!("part {pi}: instance {instance} does not exist"));
+                }
+                PartKind::Stretch { chain, first }
+                    if d.chains.get(chain).is_none_or(|c| first + 1 >= c.instances.len()) =>
+                {
+                    errors.push(format!("part {pi}: chain {chain} has no elements {first}, {}", first + 1));
+                }
+                _ => {}
+            }
+        }
+        if self.rotations.len() != d.parts.len() {
+            errors.push(format!(
+                "{} rotations for {} parts (topology_changed not called?)",
+                self.rotations.len(),
+                d.parts.len()
+            ));
+        }
+        for h in &self.handles {
+            if h.vertices.iter().any(|&v| v >= n) || h.anchor.len() != h.vertices.len() {
+                errors.push(format!("handle {}: vertices out of range", h.id));
+            }
+        }
+        if errors.is_empty() { Ok(()) } else { Err(errors) }
+    }
+}

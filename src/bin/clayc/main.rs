@@ -1,0 +1,55 @@
+//! `clayc`: the command-line edge of Clay. Each subcommand lives in its own module; this file
+//! only parses arguments and maps results to exit codes (0 ok, 1 the input has errors, 2 usage
+//! or I/O errors).
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod bench;
+mod check;
+mod render;
+mod run;
+
+#[derive(Parser)]
+#[command(name = "clayc", version, about = "Check, build, run and render Clay grammars")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check grammars and print diagnostics.
+    Check(check::CheckArgs),
+    /// Compile a grammar to JSON.
+    Build(check::BuildArgs),
+    /// Replay a scripted sculpting session headlessly.
+    Run(run::RunArgs),
+    /// Benchmark the solver on a synthetic assembly.
+    Bench(bench::BenchArgs),
+    /// Render an assembly to PNG (or SVG).
+    Render(render::RenderArgs),
+    /// Render every piece and rest state of a grammar side by side.
+    Sheet(render::SheetArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            // clap's own exit code is 2 for usage errors and 0 for --help / --version.
+            return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
+        }
+    };
+    let code = match cli.command {
+        Command::Check(args) => check::check(args),
+        Command::Build(args) => check::build(args),
+        Command::Run(args) => run::run(args),
+        Command::Bench(args) => bench::bench(args),
+        Command::Render(args) => render::render(args),
+        Command::Sheet(args) => render::sheet(args),
+    };
+    ExitCode::from(code)
+}

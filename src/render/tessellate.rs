@@ -1,0 +1,376 @@
+//! Tessellation of proxy geometry (paper 5.2) into plain triangle meshes in the piece's
+//! geometry-frame coordinates, computed once per piece and rest state.
+//!
+//! Polygons (concave, with holes) go through spade's constrained Delaunay triangulation: every
+//! ring is inserted as constraint edges and the triangles whose centroid lies inside by the
+//! even-odd rule are kept. Thick polylines become a strip of quads with miter joins (bevel joins
+//! past the miter limit). Degenerate shapes are skipped, never a panic: a picture with one
+//! missing shape beats a crashed editor.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use clay_dsl::compiled::{Binding, CompiledGrammar, Proxy, ProxyShape, Rgba};
+use glam::DVec2;
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+/// Rings whose shoelace area is below this (square metres) have no inside worth drawing.
+const MIN_RING_AREA: f64 = 1e-12;
+/// Miter joins longer than this many half-widths become bevels (SVG's default limit of 4).
+const MITER_LIMIT: f64 = 4.0;
+
+/// One tessellated proxy: triangles in the coordinates of the rest state the geometry was
+/// authored against ([`clay_dsl::compiled::RestState::geometry_frame`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    pub vertices: Vec<DVec2>,
+    /// Vertex indices, counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+    /// Boundary edges of the shape (edges used by exactly one triangle), for outlines.
+    pub outline: Vec<[u32; 2]>,
+    pub fill: Rgba,
+    pub binding: Binding,
+}
+
+impl Mesh {
+    /// The sum of the triangles' areas.
+    pub fn area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| triangle_area(self.corners(*t)))
+            .sum()
+    }
+
+    fn corners(&self, t: [u32; 3]) -> [DVec2; 3] {
+        t.map(|i| self.vertices[i as usize])
+    }
+}
+
+/// Tessellates one proxy; `None` when its shape is degenerate (too few distinct points, zero
+/// area, non-finite coordinates or width).
+pub fn tessellate_proxy(proxy: &Proxy) -> Option<Mesh> {
+    let (vertices, triangles) = match &proxy.shape {
+        ProxyShape::Polygon { outer, holes } => tessellate_polygon(outer, holes)?,
+        ProxyShape::Polyline { points, width } => tessellate_polyline(points, *width)?,
+    };
+    let outline = boundary_edges(&triangles);
+    Some(Mesh {
+        vertices,
+        triangles,
+        outline,
+        fill: proxy.fill,
+        binding: proxy.binding,
+    })
+}
+
+/// Triangulates a polygon with holes; triangles are counter-clockwise. Holes that are
+/// degenerate are ignored; a degenerate outer ring gives `None`. Self-intersecting rings do not
+/// panic: a constraint that would cross another is left out and the even-odd test decides.
+pub fn tessellate_polygon(
+    outer: &[DVec2],
+    holes: &[Vec<DVec2>],
+) -> Option<(Vec<DVec2>, Vec<[u32; 3]>)> {
+    let outer = clean_ring(outer)?;
+    let rings: Vec<Vec<DVec2>> = std::iter::once(outer)
+        .chain(holes.iter().filter_map(|h| clean_ring(h)))
+        .collect();
+
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+    for ring in &rings {
+        let mut handles = Vec::with_capacity(ring.len());
+        for p in ring {
+            // Coordinates spade cannot represent (e.g. 1e-300) make the whole shape unusable.
+            handles.push(cdt.insert(Point2::new(p.x, p.y)).ok()?);
+        }
+        for i in 0..handles.len() {
+            let (a, b) = (handles[i], handles[(i + 1) % handles.len()]);
+            if a != b {
+                // try_add_constraint leaves crossing constraints out instead of panicking.
+                let _ = cdt.try_add_constraint(a, b);
+            }
+        }
+    }
+
+    let mut index_of: HashMap<usize, u32> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for face in cdt.inner_faces() {
+        let corners = face.vertices().map(|v| {
+            let p = v.position();
+            (v.fix().index(), DVec2::new(p.x, p.y))
+        });
+        let pts = corners.map(|(_, p)| p);
+        let area = signed_area(pts);
+        if area.abs() <= f64::EPSILON * scale_of(pts) {
+            continue;
+        }
+        let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
+        if !inside_even_odd(centroid, &rings) {
+            continue;
+        }
+        let mut tri = corners.map(|(handle, p)| {
+            *index_of.entry(handle).or_insert_with(|| {
+                vertices.push(p);
+                (vertices.len() - 1) as u32
+            })
+        });
+        if area < 0.0 {
+            tri.swap(1, 2);
+        }
+        triangles.push(tri);
+    }
+    (!triangles.is_empty()).then_some((vertices, triangles))
+}
+
+/// A thick open polyline as a strip of quads, counter-clockwise triangles. Consecutive duplicate
+/// points are dropped; fewer than two distinct points or a non-positive width gives `None`.
+pub fn tessellate_polyline(points: &[DVec2], width: f64) -> Option<(Vec<DVec2>, Vec<[u32; 3]>)> {
+    if !(width.is_finite() && width > 0.0) {
+        return None;
+    }
+    let mut pts: Vec<DVec2> = Vec::with_capacity(points.len());
+    for &p in points {
+        if p.is_finite() && pts.last().is_none_or(|q: &DVec2| q.distance(p) > 1e-12) {
+            pts.push(p);
+        }
+    }
+    if pts.len() < 2 {
+        return None;
+    }
+    let h = width / 2.0;
+    let normals: Vec<DVec2> = pts
+        .windows(2)
+        .map(|w| (w[1] - w[0]).normalize().perp())
+        .collect();
+
+    let mut vertices: Vec<DVec2> = Vec::new();
+    let mut triangles = Vec::new();
+    let push = |p: DVec2, vertices: &mut Vec<DVec2>| {
+        vertices.push(p);
+        (vertices.len() - 1) as u32
+    };
+    // The left/right offset vertices where the current segment starts.
+    let mut left = push(pts[0] + normals[0] * h, &mut vertices);
+    let mut right = push(pts[0] - normals[0] * h, &mut vertices);
+    for s in 0..normals.len() {
+        let n = normals[s];
+        let end = pts[s + 1];
+        let next = normals.get(s + 1).copied();
+        // A miter join shares its two offset points between both segments: no overlap, no gap.
+        let miter = next.and_then(|m| {
+            let bisector = (n + m).normalize_or_zero();
+            let cos_half = bisector.dot(n);
+            (cos_half > 1.0 / MITER_LIMIT).then(|| bisector * (h / cos_half))
+        });
+        let (end_left, end_right) = match miter {
+            Some(offset) => (
+                push(end + offset, &mut vertices),
+                push(end - offset, &mut vertices),
+            ),
+            None => (
+                push(end + n * h, &mut vertices),
+                push(end - n * h, &mut vertices),
+            ),
+        };
+        let corners = [left, right, end_right, end_left];
+        triangles.push(ccw(&vertices, [corners[0], corners[1], corners[2]]));
+        triangles.push(ccw(&vertices, [corners[0], corners[2], corners[3]]));
+        match (next, miter) {
+            (Some(m), None) => {
+                // Bevel: both segments keep their own ends; a triangle closes the outer wedge.
+                let centre = push(end, &mut vertices);
+                let next_left = push(end + m * h, &mut vertices);
+                let next_right = push(end - m * h, &mut vertices);
+                let turn_left = n.perp_dot(m) > 0.0;
+                let wedge = if turn_left {
+                    [centre, end_right, next_right]
+                } else {
+                    [centre, end_left, next_left]
+                };
+                triangles.push(ccw(&vertices, wedge));
+                left = next_left;
+                right = next_right;
+            }
+            _ => {
+                left = end_left;
+                right = end_right;
+            }
+        }
+    }
+    let triangles: Vec<[u32; 3]> = triangles
+        .into_iter()
+        .filter(|t| signed_area(t.map(|i| vertices[i as usize])).abs() > f64::EPSILON)
+        .collect();
+    (!triangles.is_empty()).then_some((vertices, triangles))
+}
+
+/// Tessellated geometry of every (piece, rest state) asked for so far. Tessellation is the only
+/// costly step of drawing; posing reuses these meshes every frame. Make a new cache (or call
+/// [`TessellationCache::clear`]) when the grammar changes.
+#[derive(Clone, Debug, Default)]
+pub struct TessellationCache {
+    meshes: HashMap<(usize, usize), Arc<[Mesh]>>,
+}
+
+impl TessellationCache {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn clear(&mut self) {
+        self.meshes.clear();
+    }
+
+    /// The meshes shown while `piece` is in rest state `state` (the state's own geometry, or the
+    /// geometry of its geometry frame when it has none). Unknown indices give no meshes.
+    pub fn meshes(&mut self, grammar: &CompiledGrammar, piece: usize, state: usize) -> Arc<[Mesh]> {
+        self.meshes
+            .entry((piece, state))
+            .or_insert_with(|| {
+                shown_geometry(grammar, piece, state)
+                    .map(|(proxies, _)| proxies.iter().filter_map(tessellate_proxy).collect())
+                    .unwrap_or_else(|| Arc::from(Vec::new()))
+            })
+            .clone()
+    }
+}
+
+/// The proxies shown for a piece in a rest state, and the index of the state whose positions
+/// they are authored against.
+pub fn shown_geometry(
+    grammar: &CompiledGrammar,
+    piece: usize,
+    state: usize,
+) -> Option<(&[Proxy], usize)> {
+    let states = &grammar.pieces.get(piece)?.states;
+    let rest = states.get(state)?;
+    let frame = if rest.geometry_frame < states.len() {
+        rest.geometry_frame
+    } else {
+        state
+    };
+    if rest.geometry.is_empty() && frame != state {
+        return Some((&states[frame].geometry, frame));
+    }
+    Some((&rest.geometry, frame))
+}
+
+/// Signed area of a closed ring (positive when counter-clockwise).
+pub fn shoelace_area(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    (0..n)
+        .map(|i| ring[i].perp_dot(ring[(i + 1) % n]))
+        .sum::<f64>()
+        / 2.0
+}
+
+fn triangle_area(p: [DVec2; 3]) -> f64 {
+    signed_area(p).abs()
+}
+
+fn signed_area(p: [DVec2; 3]) -> f64 {
+    (p[1] - p[0]).perp_dot(p[2] - p[0]) / 2.0
+}
+
+fn scale_of(p: [DVec2; 3]) -> f64 {
+    p.iter().map(|q| q.length_squared()).fold(1.0, f64::max)
+}
+
+fn ccw(vertices: &[DVec2], t: [u32; 3]) -> [u32; 3] {
+    if signed_area(t.map(|i| vertices[i as usize])) < 0.0 {
+        [t[0], t[2], t[1]]
+    } else {
+        t
+    }
+}
+
+/// Drops non-finite points and consecutive duplicates (including a repeated first point);
+/// `None` when fewer than three points or no area remain.
+fn clean_ring(ring: &[DVec2]) -> Option<Vec<DVec2>> {
+    let mut out: Vec<DVec2> = Vec::with_capacity(ring.len());
+    for &p in ring {
+        if p.is_finite() && out.last() != Some(&p) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out.first() == out.last() {
+        out.pop();
+    }
+    (out.len() >= 3 && shoelace_area(&out).abs() > MIN_RING_AREA).then_some(out)
+}
+
+/// Even-odd rule over all rings: inside the outer ring and outside every hole.
+fn inside_even_odd(p: DVec2, rings: &[Vec<DVec2>]) -> bool {
+    let mut inside = false;
+    for ring in rings {
+        let n = ring.len();
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Edges that belong to exactly one triangle, oriented as in that triangle.
+fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut count: HashMap<[u32; 2], usize> = HashMap::new();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
+        }
+    }
+    let mut out = Vec::new();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if count[&[a.min(b), a.max(b)]] == 1 {
+                out.push([a, b]);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn square_becomes_two_triangles_of_unit_area() {
+        let sq = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let (v, t) = tessellate_polygon(&sq, &[]).unwrap();
+        assert_eq!(t.len(), 2);
+        let area: f64 = t
+            .iter()
+            .map(|t| signed_area(t.map(|i| v[i as usize])))
+            .sum();
+        assert!((area - 1.0).abs() < 1e-12, "area {area}");
+    }
+
+    #[test]
+    fn degenerate_rings_are_skipped() {
+        let line = [DVec2::ZERO, DVec2::X, DVec2::X * 2.0];
+        assert!(tessellate_polygon(&line, &[]).is_none());
+        let dup = [DVec2::ZERO, DVec2::ZERO, DVec2::ZERO];
+        assert!(tessellate_polygon(&dup, &[]).is_none());
+        let nan = [DVec2::ZERO, DVec2::X, DVec2::new(f64::NAN, 1.0)];
+        assert!(tessellate_polygon(&nan, &[]).is_none());
+        assert!(tessellate_polyline(&[DVec2::ZERO, DVec2::ZERO], 1.0).is_none());
+        assert!(tessellate_polyline(&[DVec2::ZERO, DVec2::X], 0.0).is_none());
+    }
+
+    #[test]
+    fn straight_polyline_covers_length_times_width() {
+        let (v, t) =
+            tessellate_polyline(&[DVec2::ZERO, DVec2::X * 2.0, DVec2::X * 3.0], 0.5).unwrap();
+        let area: f64 = t
+            .iter()
+            .map(|t| signed_area(t.map(|i| v[i as usize])))
+            .sum();
+        assert!((area - 1.5).abs() < 1e-9, "area {area}");
+    }
+}

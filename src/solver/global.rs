@@ -1,0 +1,151 @@
+//! The global step (paper 4.1, Eq. 4 and 7): with rotations and active states fixed the energy
+//! is quadratic, its normal matrix a weighted graph Laplacian plus a diagonal (handles and the
+//! proximal term), the same for x and y. This module owns the sparsity pattern (lower triangle,
+//! compressed sparse columns, built once per assembly generation), fills its values and the
+//! two-column right-hand side in place, and multiplies by the matrix.
+
+use clay_dsl::compiled::Part;
+use glam::DVec2;
+
+/// One edge of one part, resolved to global vertices and its slot in the matrix values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeSlot {
+    pub part: usize,
+    /// Index of the edge within the part's edge list.
+    pub edge: usize,
+    /// Part-local vertex indices of the edge's ends.
+    pub local: [usize; 2],
+    /// Global vertex indices `x`, `y`.
+    pub x: usize,
+    pub y: usize,
+    /// Index of the `(max(x, y), min(x, y))` entry in the values, or `None` for an edge whose
+    /// ends are one global vertex (it contributes nothing to the matrix).
+    pub slot: Option<usize>,
+}
+
+/// The sparsity pattern of the normal matrix for one assembly generation.
+#[derive(Clone, Debug, Default)]
+pub struct Pattern {
+    pub n: usize,
+    pub col_ptr: Vec<usize>,
+    /// Row indices, sorted within each column; the first entry of column `j` is `j` itself.
+    pub row_idx: Vec<usize>,
+    /// Every edge of every part, part by part.
+    pub edges: Vec<EdgeSlot>,
+}
+
+impl Pattern {
+    /// Builds the pattern for `n` vertices and the parts' edges (all rest states of a part share
+    /// its edges, so the pattern does not depend on the active states or on handles).
+    pub fn build(n: usize, parts: &[Part]) -> Self {
+        let mut below: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for part in parts {
+            for e in &part.edges {
+                let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
+                if x != y {
+                    below[x.min(y)].push(x.max(y));
+                }
+            }
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        for (j, rows) in below.iter_mut().enumerate() {
+            rows.sort_unstable();
+            rows.dedup();
+            row_idx.push(j);
+            row_idx.extend_from_slice(rows);
+            col_ptr.push(row_idx.len());
+        }
+        let mut edges = Vec::new();
+        for (pi, part) in parts.iter().enumerate() {
+            for (ei, e) in part.edges.iter().enumerate() {
+                let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
+                let slot = (x != y).then(|| {
+                    let (lo, hi) = (x.min(y), x.max(y));
+                    let col = &row_idx[col_ptr[lo]..col_ptr[lo + 1]];
+                    // present by construction
+                    col_ptr[lo] + col.binary_search(&hi).unwrap_or(0)
+                });
+                edges.push(EdgeSlot { part: pi, edge: ei, local: *e, x, y, slot });
+            }
+        }
+        Self { n, col_ptr, row_idx, edges }
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Fills `values` with the weighted Laplacian of the edges plus `diagonal`.
+    pub fn fill_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
+        values.clear();
+        values.resize(self.nnz(), 0.0);
+        for (e, &w) in self.edges.iter().zip(weights) {
+            if let Some(slot) = e.slot {
+                values[self.col_ptr[e.x]] += w;
+                values[self.col_ptr[e.y]] += w;
+                values[slot] -= w;
+            }
+        }
+        for (j, &d) in diagonal.iter().enumerate() {
+            values[self.col_ptr[j]] += d;
+        }
+    }
+
+    /// `out = A * x` for the symmetric matrix stored as its lower triangle; `x` and `out` are
+    /// column-major with `ncols` columns.
+    pub fn multiply(&self, values: &[f64], x: &[f64], out: &mut [f64], ncols: usize) {
+        let n = self.n;
+        out[..n * ncols].fill(0.0);
+        for c in 0..ncols {
+            let (xc, oc) = (&x[c * n..(c + 1) * n], &mut out[c * n..(c + 1) * n]);
+            for j in 0..n {
+                let xj = xc[j];
+                let mut acc = 0.0;
+                for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                    let i = self.row_idx[k];
+                    let v = values[k];
+                    oc[i] += v * xj;
+                    if i != j {
+                        acc += v * xc[i];
+                    }
+                }
+                oc[j] += acc;
+            }
+        }
+    }
+}
+
+/// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` into row x and its negation
+/// into row y, plus `extra` (handle and proximal terms), for the x column then the y column.
+pub fn fill_rhs(edges: &[EdgeSlot], weights: &[f64], targets: &[DVec2], extra: &[DVec2], rhs: &mut Vec<f64>) {
+    let n = extra.len();
+    rhs.clear();
+    rhs.resize(2 * n, 0.0);
+    for (i, e) in extra.iter().enumerate() {
+        rhs[i] = e.x;
+        rhs[n + i] = e.y;
+    }
+    for ((e, &w), &t) in edges.iter().zip(weights).zip(targets) {
+        if e.slot.is_some() {
+            let c = w * t;
+            rhs[e.x] += c.x;
+            rhs[n + e.x] += c.y;
+            rhs[e.y] -= c.x;
+            rhs[n + e.y] -= c.y;
+        }
+    }
+}
+
+/// Relative residual `|b - A x| / |b|` over both columns.
+pub fn relative_residual(pattern: &Pattern, values: &[f64], x: &[f64], b: &[f64], scratch: &mut Vec<f64>) -> f64 {
+    scratch.resize(b.len(), 0.0);
+    pattern.multiply(values, x, scratch, 2);
+    let (mut num, mut den) = (0.0, 0.0);
+    for (ax, bi) in scratch.iter().zip(b) {
+        num += (bi - ax) * (bi - ax);
+        den += bi * bi;
+    }
+    if den > 0.0 { (num / den).sqrt() } else { num.sqrt() }
+}

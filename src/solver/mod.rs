@@ -1,0 +1,577 @@
+//! The mutable elastic solver (paper 4.1-4.3, 5.2): one frame of alternating local steps
+//! (rotations and rest-state choice with hysteresis) and global steps (a sparse linear solve),
+//! warm-started from the previous positions. Pass 1 reweights edges for the sub-quadratic
+//! norm (IRLS) and decides the active rest states; pass 2 is plain least squares with the
+//! states fixed, and its positions are what the user sees.
+
+pub mod cg;
+pub mod cholesky;
+pub mod global;
+pub mod local;
+
+use std::time::Instant;
+
+use clay_dsl::compiled::{Part, PartKind, SolverParams};
+use glam::DVec2;
+
+use crate::assembly::{Assembly, Handle};
+use cholesky::{NumericFactor, SymbolicFactor};
+use global::Pattern;
+
+/// Which linear solver the global step uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Sparse supernodal Cholesky, symbolic analysis reused per assembly generation.
+    #[default]
+    Cholesky,
+    /// Unpreconditioned conjugate gradients warm-started from the previous positions (the
+    /// paper's own solver; the baseline).
+    Cg,
+}
+
+/// Solver parameters. The first four mirror the grammar's [`SolverParams`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverConfig {
+    pub kind: SolverKind,
+    /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
+    pub hysteresis: f64,
+    /// Exponent p of the IRLS pass (2 = least squares).
+    pub norm: f64,
+    /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
+    pub irls_epsilon: f64,
+    /// Most IRLS (pass 1) iterations per frame; each is a local and a global step.
+    pub irls_iterations: usize,
+    /// Most least-squares (pass 2) iterations per frame.
+    pub l2_iterations: usize,
+    /// Handle weight relative to the mean edge weight (Eq. 3): large, so handles are hard.
+    pub handle_weight: f64,
+    /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
+    /// current iterate; keeps components without handles well-posed.
+    pub proximal_weight: f64,
+    /// A pass stops early once no vertex moved more than this fraction of the model's size
+    /// (and, in pass 1, no state switched).
+    pub tolerance: f64,
+    /// Relative residual each CG solve reaches (`SolverKind::Cg`).
+    pub cg_tolerance: f64,
+    /// Cap on CG iterations per solve.
+    pub cg_max_iterations: usize,
+    /// Compute the relative residual of every linear solve into the report (one extra matrix
+    /// product per solve).
+    pub measure_residual: bool,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        Self::from_params(&SolverParams::default())
+    }
+}
+
+impl SolverConfig {
+    /// The defaults with the grammar's parameters.
+    pub fn from_params(params: &SolverParams) -> Self {
+        Self {
+            kind: SolverKind::Cholesky,
+            hysteresis: params.hysteresis,
+            norm: params.norm,
+            irls_epsilon: params.irls_epsilon,
+            irls_iterations: 6,
+            l2_iterations: 3,
+            handle_weight: 1e6,
+            proximal_weight: 1e-8,
+            tolerance: 1e-6,
+            cg_tolerance: 1e-6,
+            cg_max_iterations: 20_000,
+            measure_residual: false,
+        }
+    }
+}
+
+/// A part's active rest state changed during a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StateSwitch {
+    pub part: usize,
+    pub from: usize,
+    pub to: usize,
+}
+
+/// What one frame did.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct FrameReport {
+    /// IRLS (pass 1) iterations run.
+    pub irls_iterations: usize,
+    /// Least-squares (pass 2) iterations run.
+    pub l2_iterations: usize,
+    /// Pass-2 elastic energy (Eq. 4 with the final states and rotations), handles excluded.
+    pub energy: f64,
+    /// Pass-2 objective: `energy` plus the handle terms.
+    pub objective: f64,
+    /// The pass-2 objective of the warm start (the previous frame's positions, with this frame's
+    /// handle targets and final states); `objective <= warm_objective` always.
+    pub warm_objective: f64,
+    /// Rest-state switches, in the order they happened.
+    pub switches: Vec<StateSwitch>,
+    /// Wall time of the frame in milliseconds.
+    pub ms: f64,
+    /// Both passes stopped on the tolerance rather than the iteration cap.
+    pub converged: bool,
+    /// Numeric Cholesky factorisations done this frame.
+    pub factorizations: usize,
+    /// CG iterations summed over all solves this frame.
+    pub cg_iterations: usize,
+    /// Largest relative residual `|b - A x| / |b|` of the frame's linear solves, when
+    /// [`SolverConfig::measure_residual`] is set.
+    pub linear_residual: Option<f64>,
+}
+
+/// Why a frame could not be solved (left the positions unchanged).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverError(pub String);
+
+impl std::fmt::Display for SolverError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SolverError {}
+
+/// Buffers sized once per generation and reused every frame.
+#[derive(Debug, Default)]
+struct Work {
+    rotations: Vec<DVec2>,
+    sums: Vec<DVec2>,
+    /// Per part-edge: `R_xy (x0 - y0)`.
+    targets: Vec<DVec2>,
+    weights: Vec<f64>,
+    ones: Vec<f64>,
+    /// Per vertex: number of handle targets, and their sum.
+    handle_count: Vec<f64>,
+    handle_sum: Vec<DVec2>,
+    diagonal: Vec<f64>,
+    extra: Vec<DVec2>,
+    values: Vec<f64>,
+    l2_values: Vec<f64>,
+    l2_diagonal: Vec<f64>,
+    rhs: Vec<f64>,
+    solution: Vec<f64>,
+    scratch: Vec<f64>,
+    cg: cg::CgWork,
+}
+
+/// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
+/// and all buffers between frames; rebuilds them when the assembly's generation changes.
+#[derive(Debug)]
+pub struct Solver {
+    pub config: SolverConfig,
+    generation: Option<u64>,
+    pattern: Pattern,
+    symbolic: Option<SymbolicFactor>,
+    irls_factor: NumericFactor,
+    l2_factor: NumericFactor,
+    work: Work,
+}
+
+impl Solver {
+    pub fn new(config: SolverConfig) -> Self {
+        Self {
+            config,
+            generation: None,
+            pattern: Pattern::default(),
+            symbolic: None,
+            irls_factor: NumericFactor::default(),
+            l2_factor: NumericFactor::default(),
+            work: Work::default(),
+        }
+    }
+
+    /// Number of stored entries of the normal matrix's lower triangle (after the first frame).
+    pub fn matrix_nonzeros(&self) -> usize {
+        self.pattern.nnz()
+    }
+
+    /// Rebuilds the pattern and symbolic factorisation if the assembly changed structurally.
+    fn prepare(&mut self, asm: &Assembly) -> Result<(), SolverError> {
+        let n = asm.data.positions.len();
+        let edge_count: usize = asm.data.parts.iter().map(|p| p.edges.len()).sum();
+        let stale = self.generation != Some(asm.generation())
+            || self.pattern.n != n
+            || self.pattern.edges.len() != edge_count;
+        if !stale {
+            return Ok(());
+        }
+        for (i, p) in asm.data.parts.iter().enumerate() {
+            let m = p.vertices.len();
+            if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m) {
+                return Err(SolverError(format!("part {i} refers to a vertex that does not exist")));
+            }
+        }
+        self.pattern = Pattern::build(n, &asm.data.parts);
+        self.symbolic = match self.config.kind {
+            SolverKind::Cholesky if n > 0 => Some(
+                SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
+                    .map_err(|e| SolverError(e.0))?,
+            ),
+            _ => None,
+        };
+        self.irls_factor.invalidate();
+        self.l2_factor.invalidate();
+        self.work.l2_diagonal.clear();
+        self.generation = Some(asm.generation());
+        Ok(())
+    }
+
+    /// Runs one frame on `asm`: moves its positions, active states and rotations.
+    pub fn frame(&mut self, asm: &mut Assembly) -> Result<FrameReport, SolverError> {
+        let start = Instant::now();
+        self.prepare(asm)?;
+        let mut report = FrameReport::default();
+        let n = asm.data.positions.len();
+        if n == 0 || asm.data.parts.is_empty() {
+            report.converged = true;
+            report.ms = start.elapsed().as_secs_f64() * 1e3;
+            return Ok(report);
+        }
+        let cfg = self.config;
+        self.gather_handles(asm.handles(), n);
+        let warm: Vec<DVec2> = asm.data.positions.clone();
+        if warm.iter().any(|p| !p.is_finite()) {
+            return Err(SolverError("the warm start has non-finite positions".into()));
+        }
+        let scale = bbox_diagonal(&warm).max(1e-9);
+        let step_tolerance = cfg.tolerance * scale;
+        let mut f = warm.clone();
+        let mut next = vec![DVec2::ZERO; n];
+        let mut pass1_converged = false;
+
+        // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
+        for _ in 0..cfg.irls_iterations {
+            report.irls_iterations += 1;
+            let switched_before = report.switches.len();
+            self.local_step_switching(&mut asm.data.parts, &f, cfg.hysteresis, &mut report.switches);
+            self.edge_targets(&asm.data.parts, n);
+            let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
+            let w = &mut self.work;
+            w.weights.clear();
+            for (e, &t) in self.pattern.edges.iter().zip(&w.targets) {
+                let r = (t - (f[e.x] - f[e.y])).length();
+                let weight = (r + eps).powf(p - 2.0);
+                w.weights.push(if weight.is_finite() { weight } else { eps.powf(p - 2.0) });
+            }
+            let mean = mean_or_one(&w.weights);
+            self.solve_global(&f, &mut next, mean, Pass::Irls, &mut report)?;
+            let delta = max_move(&f, &next);
+            std::mem::swap(&mut f, &mut next);
+            if delta <= step_tolerance && report.switches.len() == switched_before {
+                pass1_converged = true;
+                break;
+            }
+        }
+        if cfg.irls_iterations == 0 {
+            pass1_converged = true;
+        }
+
+        // Pass 2: least squares, states fixed. Start from whichever of the pass-1 result and
+        // the warm start is better, and never accept an iterate that raises the objective, so
+        // the frame cannot end worse than it started.
+        let handles = asm.handles();
+        let warm_terms = self.objective(&asm.data.parts, handles, &warm);
+        let mut terms = self.objective(&asm.data.parts, handles, &f);
+        report.warm_objective = warm_terms.total();
+        if warm_terms.total() < terms.total() {
+            f.copy_from_slice(&warm);
+            terms = self.objective(&asm.data.parts, handles, &f);
+        }
+        let mut pass2_converged = cfg.l2_iterations == 0;
+        for _ in 0..cfg.l2_iterations {
+            report.l2_iterations += 1;
+            // objective() left the rotations and edge targets of `f` in the work buffers.
+            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
+            let new_terms = self.objective(&asm.data.parts, handles, &next);
+            if !(new_terms.total() <= terms.total()) {
+                // restore rotations of the kept iterate
+                terms = self.objective(&asm.data.parts, handles, &f);
+                pass2_converged = true;
+                break;
+            }
+            let delta = max_move(&f, &next);
+            std::mem::swap(&mut f, &mut next);
+            terms = new_terms;
+            if delta <= step_tolerance {
+                pass2_converged = true;
+                break;
+            }
+        }
+
+        if f.iter().any(|p| !p.is_finite()) {
+            return Err(SolverError("the solve produced non-finite positions".into()));
+        }
+        asm.data.positions.copy_from_slice(&f);
+        let rot = asm.rotations_mut();
+        if rot.len() == self.work.rotations.len() {
+            rot.copy_from_slice(&self.work.rotations);
+        }
+        sync_instance_states(asm);
+        report.energy = terms.elastic;
+        report.objective = terms.total();
+        report.converged = pass1_converged && pass2_converged;
+        report.ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(report)
+    }
+
+    fn gather_handles(&mut self, handles: &[Handle], n: usize) {
+        let w = &mut self.work;
+        w.handle_count.clear();
+        w.handle_count.resize(n, 0.0);
+        w.handle_sum.clear();
+        w.handle_sum.resize(n, DVec2::ZERO);
+        for h in handles {
+            for (k, &v) in h.vertices.iter().enumerate() {
+                if v < n {
+                    let t = h.target(k);
+                    if t.is_finite() {
+                        w.handle_count[v] += 1.0;
+                        w.handle_sum[v] += t;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Local step with state switching; fills `work.rotations`.
+    fn local_step_switching(&mut self, parts: &mut [Part], f: &[DVec2], hysteresis: f64, switches: &mut Vec<StateSwitch>) {
+        let w = &mut self.work;
+        w.rotations.clear();
+        for (i, part) in parts.iter_mut().enumerate() {
+            let (state, r) = local::choose_state(part, f, hysteresis);
+            if state != part.active {
+                switches.push(StateSwitch { part: i, from: part.active, to: state });
+                part.active = state;
+            }
+            w.rotations.push(r);
+        }
+    }
+
+    /// `R_xy (x0 - y0)` for every part-edge from `work.rotations` and the active states.
+    fn edge_targets(&mut self, parts: &[Part], n: usize) {
+        let w = &mut self.work;
+        local::vertex_rotation_sums(parts, &w.rotations, n, &mut w.sums);
+        w.targets.clear();
+        for e in &self.pattern.edges {
+            let part = &parts[e.part];
+            let rest = part.states.get(part.active).map(|s| s.positions.as_slice()).unwrap_or(&[]);
+            let d0 = match (rest.get(e.local[0]), rest.get(e.local[1])) {
+                (Some(&a), Some(&b)) => a - b,
+                _ => DVec2::ZERO,
+            };
+            let r = local::edge_rotation(&w.sums, e.x, e.y, w.rotations[e.part]);
+            w.targets.push(r.rotate(d0));
+        }
+    }
+
+    /// Pass-2 objective at `f` with the states fixed; leaves `f`'s rotations and edge targets
+    /// in the work buffers.
+    fn objective(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
+        self.work.rotations.clear();
+        for part in parts {
+            self.work.rotations.push(local::part_rotation(part, f));
+        }
+        self.edge_targets(parts, f.len());
+        let mut elastic = 0.0;
+        for (e, &t) in self.pattern.edges.iter().zip(&self.work.targets) {
+            elastic += (t - (f[e.x] - f[e.y])).length_squared();
+        }
+        let mut handle = 0.0;
+        for h in handles {
+            for (k, &v) in h.vertices.iter().enumerate() {
+                if let Some(&p) = f.get(v) {
+                    let t = h.target(k);
+                    if t.is_finite() {
+                        handle += (p - t).length_squared();
+                    }
+                }
+            }
+        }
+        Terms { elastic, handle: self.config.handle_weight * handle }
+    }
+
+    /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
+    fn solve_global(
+        &mut self,
+        f: &[DVec2],
+        next: &mut [DVec2],
+        mean_weight: f64,
+        pass: Pass,
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let n = f.len();
+        let w = &mut self.work;
+        let lambda = cfg.handle_weight * mean_weight;
+        let mu = cfg.proximal_weight * mean_weight;
+        w.diagonal.clear();
+        w.extra.clear();
+        for v in 0..n {
+            w.diagonal.push(lambda * w.handle_count[v] + mu);
+            w.extra.push(lambda * w.handle_sum[v] + mu * f[v]);
+        }
+        let weights: &[f64] = match pass {
+            Pass::Irls => &w.weights,
+            Pass::LeastSquares => {
+                w.ones.clear();
+                w.ones.resize(self.pattern.edges.len(), 1.0);
+                &w.ones
+            }
+        };
+        global::fill_rhs(&self.pattern.edges, weights, &w.targets, &w.extra, &mut w.rhs);
+        // The least-squares matrix depends only on the handles' vertices: reuse its values and
+        // factor while they stay the same.
+        let l2_reusable = pass == Pass::LeastSquares && w.l2_diagonal == w.diagonal && !w.l2_values.is_empty();
+        if !l2_reusable {
+            let target = if pass == Pass::LeastSquares { &mut w.l2_values } else { &mut w.values };
+            self.pattern.fill_values(weights, &w.diagonal, target);
+            if pass == Pass::LeastSquares {
+                w.l2_diagonal.clone_from(&w.diagonal);
+                self.l2_factor.invalidate();
+            }
+        }
+        let values = if pass == Pass::LeastSquares { &w.l2_values } else { &w.values };
+        w.solution.clear();
+        w.solution.extend(f.iter().map(|p| p.x));
+        w.solution.extend(f.iter().map(|p| p.y));
+        match (cfg.kind, self.symbolic.as_mut()) {
+            (SolverKind::Cholesky, Some(symbolic)) => {
+                let factor = if pass == Pass::LeastSquares { &mut self.l2_factor } else { &mut self.irls_factor };
+                if pass == Pass::Irls || !factor.is_valid() {
+                    symbolic
+                        .factorize(factor, &self.pattern.col_ptr, &self.pattern.row_idx, values)
+                        .map_err(|e| SolverError(e.0))?;
+                    report.factorizations += 1;
+                }
+                w.solution.copy_from_slice(&w.rhs);
+                symbolic.solve_in_place(factor, &mut w.solution, 2);
+            }
+            _ => {
+                let outcome = cg::solve(
+                    &self.pattern,
+                    values,
+                    &w.rhs,
+                    &mut w.solution,
+                    cfg.cg_tolerance,
+                    cfg.cg_max_iterations,
+                    None,
+                    &mut w.cg,
+                );
+                report.cg_iterations += outcome.iterations;
+            }
+        }
+        if cfg.measure_residual {
+            let r = global::relative_residual(&self.pattern, values, &w.solution, &w.rhs, &mut w.scratch);
+            report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
+        }
+        for (v, p) in next.iter_mut().enumerate() {
+            *p = DVec2::new(w.solution[v], w.solution[n + v]);
+        }
+        Ok(())
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pass {
+    Irls,
+    LeastSquares,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Terms {
+    elastic: f64,
+    handle: f64,
+}
+
+impl Terms {
+    fn total(self) -> f64 {
+        self.elastic + self.handle
+    }
+}
+
+fn mean_or_one(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 1.0;
+    }
+    let m = values.iter().sum::<f64>() / values.len() as f64;
+    if m.is_finite() && m > 0.0 { m } else { 1.0 }
+}
+
+fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
+    a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max)
+}
+
+/// Length of the diagonal of the positions' bounding box (0 for no or non-finite positions).
+pub fn bbox_diagonal(positions: &[DVec2]) -> f64 {
+    match bbox(positions) {
+        Some((lo, hi)) => (hi - lo).length(),
+        None => 0.0,
+    }
+}
+
+/// Bounding box `(min, max)` of the positions, `None` when there are none.
+pub fn bbox(positions: &[DVec2]) -> Option<(DVec2, DVec2)> {
+    let first = *positions.first()?;
+    Some(positions.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+}
+
+/// Piece parts carry their active state to their instance (that is the replacement rule).
+fn sync_instance_states(asm: &mut Assembly) {
+    let data = &mut asm.data;
+    for part in &data.parts {
+        if let PartKind::Piece { instance } = part.kind
+            && let Some(inst) = data.instances.get_mut(instance)
+        {
+            inst.state = part.active;
+        }
+    }
+}
+
+/// Elastic energy (Eq. 4, unit weights) of the assembly's current positions and active states,
+/// with each part's rotation fitted to the current pose.
+pub fn elastic_energy(asm: &Assembly) -> f64 {
+    let parts = &asm.data.parts;
+    let f = &asm.data.positions;
+    let rotations: Vec<DVec2> = parts.iter().map(|p| local::part_rotation(p, f)).collect();
+    let mut sums = Vec::new();
+    local::vertex_rotation_sums(parts, &rotations, f.len(), &mut sums);
+    let mut energy = 0.0;
+    for (part, &own) in parts.iter().zip(&rotations) {
+        let Some(rest) = part.states.get(part.active) else { continue };
+        for e in &part.edges {
+            let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
+            let d0 = rest.positions[e[0]] - rest.positions[e[1]];
+            let r = local::edge_rotation(&sums, x, y, own);
+            energy += (r.rotate(d0) - (f[x] - f[y])).length_squared();
+        }
+    }
+    energy
+}
+
+/// Largest `|length / rest length - 1|` over the edges of every part's active state (edges
+/// of zero rest length are skipped).
+pub fn max_edge_strain(asm: &Assembly) -> f64 {
+    edge_strains(asm).into_iter().fold(0.0, f64::max)
+}
+
+/// `length / rest length - 1` (signed) of every edge of every part's active state, part by
+/// part; edges of zero rest length are skipped.
+pub fn edge_strains(asm: &Assembly) -> Vec<f64> {
+    let f = &asm.data.positions;
+    let mut out = Vec::new();
+    for part in &asm.data.parts {
+        let Some(rest) = part.states.get(part.active) else { continue };
+        for e in &part.edges {
+            let rest_len = (rest.positions[e[0]] - rest.positions[e[1]]).length();
+            if rest_len > 1e-12 {
+                let len = (f[part.vertices[e[0]]] - f[part.vertices[e[1]]]).length();
+                out.push(len / rest_len - 1.0);
+            }
+        }
+    }
+    out
+}
