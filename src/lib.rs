@@ -1,4 +1,8 @@
 //! Clay: live assemblies, the mutable elastic solver, rules and rendering.
 pub mod assembly;
 pub mod solver;
+pub mod rules;
 pub mod render;
+pub mod synthetic;
+pub mod script;
+pub mod summary;

@@ -9,3 +9,7 @@ pub use compiled::{AssemblyData, CompiledGrammar};
 pub mod diagnostic;
 pub mod parse;
 pub mod syntax;
+pub mod compile;
+
+pub use compile::{Compiled, compile, compile_bytes};
+pub use diagnostic::{Diagnostic, Diagnostics, Severity, line_col, render, to_json};

@@ -55,13 +55,21 @@ pub struct SheetArgs {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{s}`"))?;
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got `{s}`"))?;
     let side = |v: &str| -> Result<u32, String> {
-        let n: u32 = v.trim().parse().map_err(|_| format!("`{v}` is not a whole number of pixels"))?;
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{v}` is not a whole number of pixels"))?;
         if (1..=clay::render::raster::MAX_SIDE).contains(&n) {
             Ok(n)
         } else {
-            Err(format!("{n} is not between 1 and {}", clay::render::raster::MAX_SIDE))
+            Err(format!(
+                "{n} is not between 1 and {}",
+                clay::render::raster::MAX_SIDE
+            ))
         }
     };
     Ok((side(w)?, side(h)?))
@@ -77,7 +85,10 @@ fn load(path: &Path) -> Result<CompiledGrammar, u8> {
         eprintln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
     })?;
-    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
         return serde_json::from_str(&source).map_err(|e| {
             eprintln!("error: {} is not a compiled grammar: {e}", path.display());
             INPUT_ERROR
@@ -86,14 +97,30 @@ fn load(path: &Path) -> Result<CompiledGrammar, u8> {
     compile(&source, path)
 }
 
-fn compile(_source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
-    // The .clay compiler has not landed in clay_dsl yet; compiled .json grammars work already.
-    eprintln!("error: {}: compiling .clay is not available yet; pass a compiled .json", path.display());
-    Err(IO_ERROR)
+fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
+    let name = path.display().to_string();
+    // Colour only on a terminal that has not opted out.
+    let color = std::io::IsTerminal::is_terminal(&std::io::stderr())
+        && std::env::var_os("NO_COLOR").is_none();
+    match clay_dsl::compile(source, &name) {
+        Ok(compiled) => {
+            eprint!(
+                "{}",
+                clay_dsl::render(&compiled.warnings, source, &name, color)
+            );
+            Ok(compiled.grammar)
+        }
+        Err(diagnostics) => {
+            eprint!("{}", clay_dsl::render(&diagnostics, source, &name, color));
+            Err(INPUT_ERROR)
+        }
+    }
 }
 
 fn wants_svg(output: &Path, flag: bool) -> bool {
-    flag || output.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+    flag || output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
 }
 
 fn write(output: &Path, bytes: &[u8]) -> u8 {
@@ -126,13 +153,28 @@ pub fn render(args: RenderArgs) -> u8 {
         sites: has(OverlayKind::Sites),
         strain: has(OverlayKind::Strain),
         states: has(OverlayKind::States),
-        handles: if has(OverlayKind::Handles) { handles } else { Vec::new() },
-        pins: if has(OverlayKind::Handles) { pins } else { Vec::new() },
+        handles: if has(OverlayKind::Handles) {
+            handles
+        } else {
+            Vec::new()
+        },
+        pins: if has(OverlayKind::Handles) {
+            pins
+        } else {
+            Vec::new()
+        },
     };
-    let options =
-        RenderOptions { width: args.size.0, height: args.size.1, overlays, ..RenderOptions::default() };
+    let options = RenderOptions {
+        width: args.size.0,
+        height: args.size.1,
+        overlays,
+        ..RenderOptions::default()
+    };
     if wants_svg(&args.output, args.svg) {
-        return write(&args.output, render_svg(&grammar, &assembly, &options).as_bytes());
+        return write(
+            &args.output,
+            render_svg(&grammar, &assembly, &options).as_bytes(),
+        );
     }
     match render_png(&grammar, &assembly, &options) {
         Ok(png) => write(&args.output, &png),

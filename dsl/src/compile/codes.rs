@@ -1,0 +1,64 @@
+//! The stable diagnostic codes of the compiler, one constant per kind of problem. The table in
+//! docs/language.md lists them; codes are never reused for a different meaning.
+
+pub use crate::parse::codes::{NON_FINITE, SYNTAX, TOO_DEEP};
+
+/// The file is not valid UTF-8.
+pub const NOT_UTF8: &str = "E003";
+/// A name declared twice in the same scope.
+pub const DUPLICATE: &str = "E010";
+/// A name that refers to nothing (piece, site type, site, vertex, instance, parameter).
+pub const UNKNOWN: &str = "E011";
+/// A parameter or number outside its allowed range.
+pub const OUT_OF_RANGE: &str = "E013";
+/// The model would have more instances than the limit.
+pub const TOO_MANY: &str = "E014";
+/// A chain element index that is missing or out of range.
+pub const BAD_ELEMENT: &str = "E015";
+/// An alternative rest state whose vertices differ from its piece's.
+pub const STATE_VERTICES: &str = "E020";
+/// An alternative rest state whose restated edges differ from its piece's.
+pub const STATE_EDGES: &str = "E021";
+/// An edge whose two ends are at the same place.
+pub const ZERO_EDGE: &str = "E022";
+/// Two vertices of a rest state at the same place.
+pub const COINCIDENT: &str = "E023";
+/// A site `out` direction of zero length.
+pub const ZERO_OUT: &str = "E025";
+/// Proxy geometry with too few points, or a piece with no vertices.
+pub const DEGENERATE: &str = "E026";
+/// Skinned geometry in a piece that has no axis.
+pub const NO_AXIS: &str = "E027";
+/// Two sites whose types may not dock.
+pub const INCOMPATIBLE: &str = "E030";
+/// Two docked sites with different vertex counts.
+pub const SITE_COUNT: &str = "E031";
+/// Docked vertices that do not meet after placement.
+pub const NOT_COINCIDENT: &str = "E032";
+/// An instance the compiler cannot place.
+pub const UNPLACED: &str = "E033";
+/// A site docked more than once.
+pub const DOCKED_TWICE: &str = "E034";
+/// A site docked to itself.
+pub const SELF_DOCK: &str = "E035";
+/// A stretch piece (or axis) without two opposite sites.
+pub const NOT_OPPOSITE: &str = "E040";
+/// A stretch variant whose vertices, edges or sites differ from the rule's piece.
+pub const VARIANT_SHAPE: &str = "E041";
+/// Variant frequencies that do not sum to 1.
+pub const FREQUENCIES: &str = "E042";
+/// A merge junction (or cut target) that lacks sites it must take over.
+pub const JUNCTION_SITES: &str = "E043";
+/// A piece named by two stretch rules.
+pub const TWO_STRETCH: &str = "E045";
+/// A chain with no `along` whose piece has no stretch rule.
+pub const CHAIN_SITES: &str = "E046";
+
+/// A piece that nothing uses.
+pub const UNUSED_PIECE: &str = "W001";
+/// A rule that can never fire.
+pub const DEAD_RULE: &str = "W002";
+/// A repeated edge.
+pub const REPEATED_EDGE: &str = "W003";
+/// `rotate` on an instance placed through its dock, where it has no effect.
+pub const IGNORED_ROTATE: &str = "W004";

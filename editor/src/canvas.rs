@@ -1,0 +1,458 @@
+//! The canvas: draws the posed assembly (the renderer's world triangles as egui meshes) with the
+//! hovered, grabbed and pinned parts marked, finds the part or connection under the cursor, and
+//! turns pointer and key input into [`Command`]s. It never changes the model itself.
+
+use std::collections::HashSet;
+
+use clay::render::{TessellationCache, WorldMesh, pose_assembly};
+use clay_dsl::compiled::{AssemblyData, PartKind};
+use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
+use glam::DVec2;
+
+use crate::camera::Camera;
+use crate::sculpt::{Command, Sculpt};
+
+/// Pointer distance (screen points) within which an edge or connection counts as under it.
+const PICK_RADIUS: f64 = 10.0;
+const HOVER: Color32 = Color32::from_rgba_premultiplied(120, 90, 0, 90);
+const GRABBED: Color32 = Color32::from_rgb(220, 30, 60);
+const PINNED: Color32 = Color32::from_rgb(30, 80, 220);
+const CUT: Color32 = Color32::from_rgb(230, 40, 160);
+const EDGES: Color32 = Color32::from_rgb(70, 70, 90);
+
+/// What a drag on the canvas is doing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Drag {
+    Pan,
+    /// Moving the grabbed part: world point where the drag started.
+    Move { start: DVec2 },
+    /// Turning the grabbed part about `centre`; `start` is the pointer's initial angle.
+    Rotate { centre: DVec2, start: f64 },
+}
+
+/// View state of the canvas, kept between frames.
+pub struct Canvas {
+    pub camera: Camera,
+    cache: TessellationCache,
+    meshes: Vec<WorldMesh>,
+    drag: Option<Drag>,
+    /// Fit the view to the model at the next frame.
+    fit_pending: bool,
+    /// The part under the cursor in the last frame.
+    pub hovered: Option<usize>,
+    /// The connection (dock index) that Ctrl + click would cut.
+    pub cut_target: Option<usize>,
+    /// The canvas rectangle of the last frame (screen points).
+    pub rect: Rect,
+}
+
+impl Default for Canvas {
+    fn default() -> Self {
+        Self {
+            camera: Camera::default(),
+            cache: TessellationCache::new(),
+            meshes: Vec::new(),
+            drag: None,
+            fit_pending: true,
+            hovered: None,
+            cut_target: None,
+            rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
+        }
+    }
+}
+
+fn dv(p: Pos2) -> DVec2 {
+    DVec2::new(p.x as f64, p.y as f64)
+}
+
+fn pos(p: DVec2) -> Pos2 {
+    Pos2::new(p.x as f32, p.y as f32)
+}
+
+impl Canvas {
+    /// Fit the view at the next frame.
+    pub fn request_fit(&mut self) {
+        self.fit_pending = true;
+    }
+
+    /// The grammar changed: cached tessellations are stale.
+    pub fn grammar_changed(&mut self) {
+        self.cache.clear();
+    }
+
+    /// Screen position of a world point in the last frame's canvas.
+    pub fn to_screen(&self, p: DVec2) -> Pos2 {
+        pos(self.camera.to_screen(p, dv(self.rect.center())))
+    }
+
+    pub fn to_world(&self, p: Pos2) -> DVec2 {
+        self.camera.to_world(dv(p), dv(self.rect.center()))
+    }
+
+    /// Draws the sculpt and collects the user's commands.
+    pub fn show(&mut self, ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command>) {
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+        self.rect = response.rect;
+        let data = sculpt.data();
+        self.meshes = pose_assembly(sculpt.grammar(), data, &mut self.cache);
+        if self.fit_pending {
+            self.fit(data);
+            self.fit_pending = false;
+        }
+        let mid = dv(self.rect.center());
+        let (modifiers, space, pointer, press_origin) = ui.input(|i| {
+            (
+                i.modifiers,
+                i.key_down(Key::Space),
+                i.pointer.hover_pos(),
+                i.pointer.press_origin(),
+            )
+        });
+        let pointer = pointer.filter(|p| self.rect.contains(*p));
+        let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
+
+        // Zoom toward the cursor: wheel, pinch or Ctrl + wheel.
+        if let Some(p) = pointer {
+            let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            let factor = zoom as f64 * (scroll as f64 * 0.0025).exp();
+            if (factor - 1.0).abs() > 1e-6 {
+                self.camera.zoom_at(factor, dv(p), mid);
+            }
+        }
+        if keyboard_free && ui.input(|i| i.key_pressed(Key::F)) {
+            self.fit(data);
+        }
+
+        let world = pointer.map(|p| self.camera.to_world(dv(p), mid));
+        let tolerance = PICK_RADIUS / self.camera.scale;
+        self.hovered = match sculpt.grabbed() {
+            Some(g) => Some(g),
+            None => world.and_then(|w| part_at(w, &self.meshes, data, tolerance)),
+        };
+        let cutting = modifiers.command || modifiers.ctrl;
+        self.cut_target = if cutting && self.drag.is_none() {
+            world.and_then(|w| dock_at(w, &sculpt.dock_centres(), tolerance * 1.5))
+        } else {
+            None
+        };
+
+        // Gestures.
+        if response.drag_started() {
+            let origin = press_origin.unwrap_or_else(|| pointer.unwrap_or(self.rect.center()));
+            let w0 = self.camera.to_world(dv(origin), mid);
+            let middle = response.drag_started_by(PointerButton::Middle);
+            let secondary = response.drag_started_by(PointerButton::Secondary);
+            let primary = response.drag_started_by(PointerButton::Primary);
+            self.drag = if middle || (primary && space) {
+                Some(Drag::Pan)
+            } else if (primary || secondary) && !cutting {
+                match part_at(w0, &self.meshes, data, tolerance) {
+                    Some(part) => {
+                        commands.push(Command::Grab { part });
+                        if secondary || modifiers.shift {
+                            let centre = sculpt.assembly().part_centroid(part);
+                            let d = w0 - centre;
+                            Some(Drag::Rotate {
+                                centre,
+                                start: d.y.atan2(d.x),
+                            })
+                        } else {
+                            Some(Drag::Move { start: w0 })
+                        }
+                    }
+                    // Dragging empty space pans too.
+                    None if primary => Some(Drag::Pan),
+                    None => None,
+                }
+            } else {
+                None
+            };
+        }
+        if let Some(drag) = self.drag {
+            let still = ui.input(|i| i.pointer.any_down());
+            match drag {
+                Drag::Pan => self.camera.pan(DVec2::new(
+                    response.drag_delta().x as f64,
+                    response.drag_delta().y as f64,
+                )),
+                Drag::Move { start } => {
+                    if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
+                        let w = self.camera.to_world(dv(p), mid);
+                        commands.push(Command::MoveGrab {
+                            translation: w - start,
+                            angle: 0.0,
+                        });
+                    }
+                }
+                Drag::Rotate { centre, start } => {
+                    if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
+                        let d = self.camera.to_world(dv(p), mid) - centre;
+                        if d.length() > 1e-9 {
+                            commands.push(Command::MoveGrab {
+                                translation: DVec2::ZERO,
+                                angle: d.y.atan2(d.x) - start,
+                            });
+                        }
+                    }
+                }
+            }
+            if response.drag_stopped() || !still {
+                if !matches!(drag, Drag::Pan) {
+                    commands.push(Command::Release);
+                }
+                self.drag = None;
+            }
+        }
+        if response.clicked()
+            && cutting
+            && let Some(w) = world
+        {
+            commands.push(Command::Cut { point: w });
+        }
+        if keyboard_free
+            && ui.input(|i| i.key_pressed(Key::P))
+            && let Some(part) = self.hovered
+        {
+            commands.push(Command::TogglePin { part });
+        }
+
+        self.paint(&painter, sculpt);
+        self.label_parts(ui, sculpt);
+    }
+
+    fn fit(&mut self, data: &AssemblyData) {
+        let (min, max) = clay::render::draw::bounds(&self.meshes, data);
+        let size = DVec2::new(self.rect.width() as f64, self.rect.height() as f64);
+        self.camera.fit(min, max, size, 24.0);
+    }
+
+    fn paint(&self, painter: &egui::Painter, sculpt: &Sculpt) {
+        let data = sculpt.data();
+        let mid = dv(self.rect.center());
+        let screen = |p: DVec2| pos(self.camera.to_screen(p, mid));
+        painter.rect_filled(self.rect, 0.0, Color32::from_rgb(246, 243, 236));
+        for m in &self.meshes {
+            painter.add(Shape::mesh(mesh_of(m, |p| screen(p), colour(m.fill))));
+        }
+        for m in &self.meshes {
+            let stroke = Stroke::new(1.0, darker(colour(m.fill)));
+            let pts: Vec<Pos2> = m.positions.iter().map(|&p| screen(world_of(p))).collect();
+            for &[a, b] in &m.outline {
+                if let (Some(&pa), Some(&pb)) = (pts.get(a as usize), pts.get(b as usize)) {
+                    painter.line_segment([pa, pb], stroke);
+                }
+            }
+        }
+        // A grammar without proxy geometry still shows its parts, as edges.
+        if self.meshes.is_empty() {
+            for p in 0..data.parts.len() {
+                self.paint_part_edges(painter, data, p, Stroke::new(1.0, EDGES));
+            }
+        }
+        for part in 0..data.parts.len() {
+            if sculpt.is_pinned(part) {
+                self.paint_part_edges(painter, data, part, Stroke::new(1.5, PINNED));
+                for &v in &data.parts[part].vertices {
+                    if let Some(&p) = data.positions.get(v) {
+                        painter.rect_filled(
+                            Rect::from_center_size(screen(p), Vec2::splat(6.0)),
+                            0.0,
+                            PINNED,
+                        );
+                    }
+                }
+            }
+        }
+        if let Some(part) = self.hovered {
+            let instances = instances_of(data, part);
+            for m in self.meshes.iter().filter(|m| instances.contains(&m.instance)) {
+                painter.add(Shape::mesh(mesh_of(m, |p| screen(p), HOVER)));
+            }
+            let colour = if sculpt.grabbed() == Some(part) {
+                GRABBED
+            } else {
+                Color32::from_rgb(200, 140, 0)
+            };
+            self.paint_part_edges(painter, data, part, Stroke::new(1.5, colour));
+        }
+        if let Some((centre, _)) = sculpt.grab_target() {
+            painter.circle_stroke(screen(centre), 7.0, Stroke::new(2.0, GRABBED));
+        }
+        if let Some(dock) = self.cut_target
+            && let Some(&c) = sculpt.dock_centres().get(dock)
+        {
+            painter.circle_stroke(screen(c), 9.0, Stroke::new(3.0, CUT));
+            painter.circle_filled(screen(c), 3.0, CUT);
+        }
+    }
+
+    fn paint_part_edges(
+        &self,
+        painter: &egui::Painter,
+        data: &AssemblyData,
+        part: usize,
+        stroke: Stroke,
+    ) {
+        let mid = dv(self.rect.center());
+        let Some(p) = data.parts.get(part) else {
+            return;
+        };
+        for &[a, b] in &p.edges {
+            let ends = [a, b].map(|k| {
+                p.vertices
+                    .get(k)
+                    .and_then(|&v| data.positions.get(v))
+                    .map(|&w| pos(self.camera.to_screen(w, mid)))
+            });
+            if let [Some(pa), Some(pb)] = ends {
+                painter.line_segment([pa, pb], stroke);
+            }
+        }
+    }
+
+    /// Gives every part an accessible label (`part 3`) at its centre, so tests and screen
+    /// readers can find it; hover-only, so it never takes the canvas's drags.
+    fn label_parts(&self, ui: &mut egui::Ui, sculpt: &Sculpt) {
+        const MOST: usize = 2000;
+        let asm = sculpt.assembly();
+        for part in 0..asm.data.parts.len().min(MOST) {
+            let at = self.to_screen(asm.part_centroid(part));
+            if !self.rect.contains(at) {
+                continue;
+            }
+            let id = ui.id().with(("part", part));
+            let r = ui.interact(Rect::from_center_size(at, Vec2::splat(4.0)), id, Sense::hover());
+            r.widget_info(|| {
+                egui::WidgetInfo::labeled(egui::Role::GraphicsObject, true, format!("part {part}"))
+            });
+        }
+    }
+}
+
+fn world_of([x, y]: [f32; 2]) -> DVec2 {
+    DVec2::new(x as f64, y as f64)
+}
+
+fn colour(c: clay_dsl::compiled::Rgba) -> Color32 {
+    let [r, g, b, a] = c.0;
+    Color32::from_rgba_unmultiplied(r, g, b, a)
+}
+
+fn darker(c: Color32) -> Color32 {
+    let f = |v: u8| (v as f32 * 0.55) as u8;
+    Color32::from_rgba_premultiplied(f(c.r()), f(c.g()), f(c.b()), c.a())
+}
+
+fn mesh_of(m: &WorldMesh, screen: impl Fn(DVec2) -> Pos2, fill: Color32) -> egui::Mesh {
+    let mut mesh = egui::Mesh::default();
+    for &p in &m.positions {
+        mesh.colored_vertex(screen(world_of(p)), fill);
+    }
+    let n = m.positions.len() as u32;
+    for &[a, b, c] in &m.triangles {
+        if a < n && b < n && c < n {
+            mesh.add_triangle(a, b, c);
+        }
+    }
+    mesh
+}
+
+/// The instances a part covers.
+fn instances_of(data: &AssemblyData, part: usize) -> HashSet<usize> {
+    match data.parts.get(part).map(|p| p.kind) {
+        Some(PartKind::Piece { instance }) => HashSet::from([instance]),
+        Some(PartKind::Stretch { chain, first }) => data
+            .chains
+            .get(chain)
+            .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
+            .unwrap_or_default(),
+        None => HashSet::new(),
+    }
+}
+
+/// The part under world point `w`: the part covering the top-most instance whose geometry
+/// contains `w` (of several, the one whose centre is nearest), else the part with an edge
+/// within `tolerance`.
+pub fn part_at(w: DVec2, meshes: &[WorldMesh], data: &AssemblyData, tolerance: f64) -> Option<usize> {
+    let centre = |part: &clay_dsl::compiled::Part| {
+        let pts: Vec<DVec2> = part
+            .vertices
+            .iter()
+            .filter_map(|&v| data.positions.get(v).copied())
+            .collect();
+        pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64
+    };
+    let hit = meshes.iter().rev().find(|m| mesh_contains(m, w));
+    if let Some(m) = hit {
+        let best = data
+            .parts
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| instances_of(data, *i).contains(&m.instance))
+            .min_by(|a, b| {
+                centre(a.1)
+                    .distance_squared(w)
+                    .total_cmp(&centre(b.1).distance_squared(w))
+            });
+        if let Some((i, _)) = best {
+            return Some(i);
+        }
+    }
+    let mut best: Option<(usize, f64)> = None;
+    for (i, part) in data.parts.iter().enumerate() {
+        for &[a, b] in &part.edges {
+            let (Some(&va), Some(&vb)) = (part.vertices.get(a), part.vertices.get(b)) else {
+                continue;
+            };
+            let (Some(&pa), Some(&pb)) = (data.positions.get(va), data.positions.get(vb)) else {
+                continue;
+            };
+            let d = segment_distance(w, pa, pb);
+            if d <= tolerance && best.is_none_or(|(_, bd)| d < bd) {
+                best = Some((i, d));
+            }
+        }
+    }
+    best.map(|(i, _)| i)
+}
+
+/// The connection whose centre is nearest `w`, within `tolerance`.
+pub fn dock_at(w: DVec2, centres: &[DVec2], tolerance: f64) -> Option<usize> {
+    centres
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_finite())
+        .map(|(i, c)| (i, c.distance(w)))
+        .filter(|(_, d)| *d <= tolerance)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+fn mesh_contains(m: &WorldMesh, w: DVec2) -> bool {
+    m.triangles.iter().any(|t| {
+        let [a, b, c] = t.map(|i| m.positions.get(i as usize).map(|&p| world_of(p)));
+        match (a, b, c) {
+            (Some(a), Some(b), Some(c)) => triangle_contains(a, b, c, w),
+            _ => false,
+        }
+    })
+}
+
+fn triangle_contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
+    let d1 = (b - a).perp_dot(p - a);
+    let d2 = (c - b).perp_dot(p - b);
+    let d3 = (a - c).perp_dot(p - c);
+    let neg = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
+    let pos = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
+    !(neg && pos)
+}
+
+fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + ab * t)
+}

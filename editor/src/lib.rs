@@ -1,0 +1,12 @@
+//! The Clay editor: sculpt a grammar's model live with the mouse. The state (sculpt, sessions,
+//! camera) is separate from the drawing so it is tested without a window.
+pub mod app;
+pub mod camera;
+pub mod canvas;
+pub mod compile;
+pub mod panels;
+pub mod sculpt;
+pub mod session;
+pub mod watch;
+
+pub use app::EditorApp;

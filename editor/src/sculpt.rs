@@ -1,0 +1,579 @@
+//! The sculpt: the live assembly, its solver, the user's grab and pins, and the undo history of
+//! whole gestures. Everything the canvas and panels change goes through [`Command`]s applied
+//! here, so it is tested without a window.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use clay::assembly::{Assembly, HandleId, HandleKind};
+use clay::solver::local::align;
+use clay::solver::{FrameReport, Solver, SolverConfig};
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
+use glam::DVec2;
+
+use crate::session::{Pin, Settings};
+
+/// What the user asks of the model. The UI emits these; [`Sculpt::apply`] applies them after
+/// the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// Start a gesture: `part` becomes the handle.
+    Grab { part: usize },
+    /// Move the grabbed part: its target is its start pose moved by `translation` and turned by
+    /// `angle` radians about its centre.
+    MoveGrab { translation: DVec2, angle: f64 },
+    /// End the gesture.
+    Release,
+    /// Pin the part, or unpin it if pinned.
+    TogglePin { part: usize },
+    /// Cut the connection nearest `point` (world coordinates).
+    Cut { point: DVec2 },
+    Undo,
+    Redo,
+    /// Back to the grammar's initial model (undoable).
+    Reset,
+    /// New solver and rule settings, applied live.
+    Settings(Settings),
+}
+
+/// An entry of the rule log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogEntry {
+    /// The solver frame it happened in.
+    pub frame: u64,
+    pub message: String,
+    /// Where it happened (world coordinates), if anywhere in particular.
+    pub at: Option<DVec2>,
+}
+
+/// The model as it was before a gesture.
+#[derive(Clone, Debug)]
+struct Snapshot {
+    grammar: Arc<CompiledGrammar>,
+    data: AssemblyData,
+    pins: Vec<Pin>,
+}
+
+#[derive(Clone, Debug)]
+struct Grab {
+    handle: HandleId,
+    part: usize,
+    /// The pin the part had, released while it is held and put back where it is dropped.
+    was_pinned: bool,
+}
+
+/// Why a part is in the state it is in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartReport {
+    pub part: usize,
+    /// `tower`, or `wall` for a stretch part.
+    pub piece: String,
+    /// `t1`, or `wall[3] + wall[4]` for a stretch part.
+    pub covers: String,
+    pub active: usize,
+    /// Every rest state with its shape-space distance (squared, after the best rotation) to the
+    /// current pose.
+    pub states: Vec<(String, f64)>,
+    pub hysteresis: f64,
+    /// Another state becomes active once its distance drops below this.
+    pub switch_below: f64,
+    pub pinned: bool,
+}
+
+/// Most log entries kept; older ones are dropped.
+const LOG_LIMIT: usize = 500;
+/// Most gestures kept for undo.
+const UNDO_LIMIT: usize = 200;
+
+/// The live sculpt.
+pub struct Sculpt {
+    assembly: Assembly,
+    solver: Solver,
+    settings: Settings,
+    grab: Option<Grab>,
+    undo: Vec<Snapshot>,
+    redo: Vec<Snapshot>,
+    /// Changed since the last save or open.
+    pub dirty: bool,
+    /// Whether the solver still has work: a moved handle, or a frame that did not converge.
+    unsettled: bool,
+    /// Solver frames run so far.
+    frame: u64,
+    last_report: Option<FrameReport>,
+    /// Solver frames run in the last UI frame.
+    pub frames_last_step: usize,
+    error: Option<String>,
+    log: Vec<LogEntry>,
+}
+
+impl Sculpt {
+    /// The grammar's initial model.
+    pub fn new(grammar: Arc<CompiledGrammar>) -> Self {
+        let settings = Settings {
+            hysteresis: grammar.solver.hysteresis,
+            norm: grammar.solver.norm,
+            merge_distance: grammar.solver.merge_distance,
+        };
+        let assembly = Assembly::new(grammar);
+        let mut sculpt = Self {
+            solver: Solver::new(SolverConfig::default()),
+            assembly,
+            settings,
+            grab: None,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            dirty: false,
+            unsettled: true,
+            frame: 0,
+            last_report: None,
+            frames_last_step: 0,
+            error: None,
+            log: Vec::new(),
+        };
+        sculpt.configure_solver();
+        sculpt
+    }
+
+    /// A saved sculpt over `grammar`. Fails, in words, when the data does not fit the grammar.
+    pub fn from_saved(
+        grammar: Arc<CompiledGrammar>,
+        data: AssemblyData,
+        pins: Vec<Pin>,
+        settings: Option<Settings>,
+    ) -> Result<Self, String> {
+        data.check(&grammar)
+            .map_err(|e| format!("the session does not fit the grammar: {e}"))?;
+        let mut sculpt = Self::new(grammar.clone());
+        if let Some(s) = settings {
+            sculpt.settings = s;
+            sculpt.configure_solver();
+        }
+        sculpt.restore(Snapshot {
+            grammar,
+            data,
+            pins,
+        });
+        sculpt
+            .assembly
+            .validate()
+            .map_err(|e| format!("the session does not fit the grammar: {}", e.join("; ")))?;
+        Ok(sculpt)
+    }
+
+    pub fn assembly(&self) -> &Assembly {
+        &self.assembly
+    }
+
+    pub fn data(&self) -> &AssemblyData {
+        &self.assembly.data
+    }
+
+    pub fn grammar(&self) -> &Arc<CompiledGrammar> {
+        self.assembly.grammar_arc()
+    }
+
+    pub fn settings(&self) -> Settings {
+        self.settings
+    }
+
+    pub fn last_report(&self) -> Option<&FrameReport> {
+        self.last_report.as_ref()
+    }
+
+    /// Solver frames run so far.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// The last solver failure, if the model is stuck.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    pub fn log(&self) -> &[LogEntry] {
+        &self.log
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// The part being dragged, if any.
+    pub fn grabbed(&self) -> Option<usize> {
+        self.grab.as_ref().map(|g| g.part)
+    }
+
+    /// The grabbed handle's current target centre and angle.
+    pub fn grab_target(&self) -> Option<(DVec2, f64)> {
+        let g = self.grab.as_ref()?;
+        let h = self.assembly.handle(g.handle)?;
+        Some((h.target_centre(), h.angle))
+    }
+
+    /// Whether the solver has work left; the app keeps repainting while it has.
+    pub fn needs_work(&self) -> bool {
+        self.unsettled && self.error.is_none()
+    }
+
+    /// The pins, with where they hold their vertices.
+    pub fn pins(&self) -> Vec<Pin> {
+        let mut pins: Vec<Pin> = self
+            .assembly
+            .handles()
+            .iter()
+            .filter(|h| h.kind == HandleKind::Pin)
+            .map(|h| Pin {
+                vertices: h.vertices.clone(),
+                at: (0..h.vertices.len()).map(|k| h.target(k)).collect(),
+            })
+            .collect();
+        if let Some(g) = &self.grab
+            && g.was_pinned
+            && let Some(h) = self.assembly.handle(g.handle)
+        {
+            pins.push(Pin {
+                vertices: h.vertices.clone(),
+                at: (0..h.vertices.len()).map(|k| h.target(k)).collect(),
+            });
+        }
+        pins
+    }
+
+    /// Whether `part` is held by a pin (its vertex set is a pin's).
+    pub fn is_pinned(&self, part: usize) -> bool {
+        self.pin_of(part).is_some()
+            || self
+                .grab
+                .as_ref()
+                .is_some_and(|g| g.part == part && g.was_pinned)
+    }
+
+    fn pin_of(&self, part: usize) -> Option<HandleId> {
+        let vertices = &self.assembly.data.parts.get(part)?.vertices;
+        self.assembly
+            .handles()
+            .iter()
+            .find(|h| h.kind == HandleKind::Pin && &h.vertices == vertices)
+            .map(|h| h.id)
+    }
+
+    /// Applies one command.
+    pub fn apply(&mut self, command: Command) {
+        match command {
+            Command::Grab { part } => self.grab(part),
+            Command::MoveGrab { translation, angle } => {
+                if !(translation.is_finite() && angle.is_finite()) {
+                    return;
+                }
+                if let Some(g) = &self.grab
+                    && let Some(h) = self.assembly.handle_mut(g.handle)
+                    && (h.translation != translation || h.angle != angle)
+                {
+                    h.translation = translation;
+                    h.angle = angle;
+                    self.unsettled = true;
+                }
+            }
+            Command::Release => self.release(),
+            Command::TogglePin { part } => {
+                if part >= self.assembly.data.parts.len() {
+                    return;
+                }
+                self.release();
+                self.checkpoint();
+                match self.pin_of(part) {
+                    Some(id) => {
+                        self.assembly.release(id);
+                        self.note(format!("unpinned part {part}"), None);
+                    }
+                    None => {
+                        self.assembly.hold_part(part, HandleKind::Pin);
+                        self.note(format!("pinned part {part}"), None);
+                    }
+                }
+                self.unsettled = true;
+            }
+            Command::Cut { point } => {
+                self.release();
+                self.cut(point);
+            }
+            Command::Undo => {
+                self.release();
+                if let Some(s) = self.undo.pop() {
+                    self.redo.push(self.snapshot());
+                    self.restore(s);
+                    self.dirty = true;
+                }
+            }
+            Command::Redo => {
+                self.release();
+                if let Some(s) = self.redo.pop() {
+                    self.undo.push(self.snapshot());
+                    self.restore(s);
+                    self.dirty = true;
+                }
+            }
+            Command::Reset => {
+                self.release();
+                self.checkpoint();
+                let grammar = self.grammar().clone();
+                self.restore(Snapshot {
+                    data: grammar.assembly.clone(),
+                    grammar,
+                    pins: Vec::new(),
+                });
+                self.note("reset to the initial model".to_string(), None);
+            }
+            Command::Settings(s) => {
+                let valid = s.hysteresis.is_finite()
+                    && (0.0..1.0).contains(&s.hysteresis)
+                    && s.norm.is_finite()
+                    && s.norm > 0.0
+                    && s.merge_distance.is_finite()
+                    && s.merge_distance >= 0.0;
+                if valid && s != self.settings {
+                    self.settings = s;
+                    self.configure_solver();
+                    self.unsettled = true;
+                }
+            }
+        }
+    }
+
+    /// Replaces the grammar (hot reload): the new grammar's initial model, as one undoable step.
+    pub fn replace_grammar(&mut self, grammar: Arc<CompiledGrammar>) {
+        self.release();
+        self.checkpoint();
+        self.settings = Settings {
+            hysteresis: grammar.solver.hysteresis,
+            norm: grammar.solver.norm,
+            merge_distance: grammar.solver.merge_distance,
+        };
+        self.configure_solver();
+        self.restore(Snapshot {
+            data: grammar.assembly.clone(),
+            grammar,
+            pins: Vec::new(),
+        });
+        self.note("grammar reloaded".to_string(), None);
+    }
+
+    /// Runs solver frames until the model settles or `budget` is spent (at least one frame when
+    /// there is work). Returns whether work remains.
+    pub fn step(&mut self, budget: Duration) -> bool {
+        let start = Instant::now();
+        self.frames_last_step = 0;
+        while self.needs_work() {
+            match self.solver.frame(&mut self.assembly) {
+                Ok(report) => {
+                    self.frame += 1;
+                    self.frames_last_step += 1;
+                    for s in &report.switches {
+                        let at = (s.part < self.assembly.data.parts.len())
+                            .then(|| self.assembly.part_centroid(s.part));
+                        let names = &self.assembly.data.parts.get(s.part).map(|p| {
+                            let n = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str());
+                            (n(s.from).to_string(), n(s.to).to_string())
+                        });
+                        let (from, to) = names.clone().unwrap_or_default();
+                        self.note(
+                            format!("state switch: part {} {from} -> {to}", s.part),
+                            at,
+                        );
+                    }
+                    // Rules (stretch, shrink, merge) run here once clay::rules exists.
+                    if report.converged {
+                        self.unsettled = false;
+                    }
+                    self.last_report = Some(report);
+                }
+                Err(e) => {
+                    self.error = Some(e.to_string());
+                }
+            }
+            if start.elapsed() >= budget {
+                break;
+            }
+        }
+        self.needs_work()
+    }
+
+    /// Why `part` is in the state it is in.
+    pub fn inspect(&self, part: usize) -> Option<PartReport> {
+        let data = &self.assembly.data;
+        let grammar = self.assembly.grammar();
+        let p = data.parts.get(part)?;
+        let name = |i: usize| data.instances.get(i).map_or("?", |x| x.name.as_str());
+        let (piece, covers) = match p.kind {
+            PartKind::Piece { instance } => {
+                let piece = data
+                    .instances
+                    .get(instance)
+                    .and_then(|x| grammar.pieces.get(x.piece))
+                    .map_or("?".to_string(), |pc| pc.name.clone());
+                (piece, name(instance).to_string())
+            }
+            PartKind::Stretch { chain, first } => {
+                let c = data.chains.get(chain)?;
+                let piece = grammar
+                    .stretch_rules
+                    .get(c.rule)
+                    .and_then(|r| grammar.pieces.get(r.piece))
+                    .map_or("?".to_string(), |pc| pc.name.clone());
+                let a = c.instances.get(first).copied().map_or("?", name);
+                let b = c.instances.get(first + 1).copied().map_or("?", name);
+                (piece, format!("{a} + {b}"))
+            }
+        };
+        let states: Vec<(String, f64)> = p
+            .states
+            .iter()
+            .map(|s| {
+                let d = align(&s.positions, &p.vertices, &data.positions).distance;
+                (s.name.clone(), d)
+            })
+            .collect();
+        let active = p.active.min(states.len().saturating_sub(1));
+        let d_active = states.get(active).map_or(0.0, |s| s.1);
+        Some(PartReport {
+            part,
+            piece,
+            covers,
+            active,
+            hysteresis: self.settings.hysteresis,
+            switch_below: (1.0 - self.settings.hysteresis) * d_active,
+            states,
+            pinned: self.is_pinned(part),
+        })
+    }
+
+    /// Where each dock (connection) is: the centre of its shared vertices.
+    pub fn dock_centres(&self) -> Vec<DVec2> {
+        let data = &self.assembly.data;
+        let grammar = self.assembly.grammar();
+        data.docks
+            .iter()
+            .map(|d| {
+                let vs = data.site_vertices(grammar, d.a).unwrap_or_default();
+                let pts: Vec<DVec2> = vs
+                    .iter()
+                    .filter_map(|&v| data.positions.get(v).copied())
+                    .collect();
+                if pts.is_empty() {
+                    DVec2::splat(f64::NAN)
+                } else {
+                    pts.iter().copied().sum::<DVec2>() / pts.len() as f64
+                }
+            })
+            .collect()
+    }
+
+    fn grab(&mut self, part: usize) {
+        self.release();
+        if part >= self.assembly.data.parts.len() {
+            return;
+        }
+        self.checkpoint();
+        let was_pinned = match self.pin_of(part) {
+            Some(id) => self.assembly.release(id),
+            None => false,
+        };
+        if let Some(handle) = self.assembly.hold_part(part, HandleKind::Grab) {
+            self.grab = Some(Grab {
+                handle,
+                part,
+                was_pinned,
+            });
+        }
+    }
+
+    /// Ends the gesture: a pinned part stays pinned where it was dropped.
+    fn release(&mut self) {
+        let Some(g) = self.grab.take() else {
+            return;
+        };
+        if let Some(h) = self.assembly.handle_mut(g.handle) {
+            if g.was_pinned {
+                h.kind = HandleKind::Pin;
+            } else {
+                self.assembly.release(g.handle);
+            }
+        }
+        self.unsettled = true;
+    }
+
+    /// Records the model before a gesture.
+    fn checkpoint(&mut self) {
+        let s = self.snapshot();
+        self.undo.push(s);
+        if self.undo.len() > UNDO_LIMIT {
+            self.undo.remove(0);
+        }
+        self.redo.clear();
+        self.dirty = true;
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            grammar: self.grammar().clone(),
+            data: self.assembly.data.clone(),
+            pins: self.pins(),
+        }
+    }
+
+    fn restore(&mut self, s: Snapshot) {
+        self.assembly = Assembly::from_data(s.grammar, s.data);
+        for pin in s.pins {
+            if let Some(id) = self.assembly.hold_vertices(pin.vertices, HandleKind::Pin)
+                && let Some(h) = self.assembly.handle_mut(id)
+                && pin.at.len() == h.anchor.len()
+            {
+                h.centre = pin.at.iter().copied().sum::<DVec2>() / pin.at.len().max(1) as f64;
+                h.anchor = pin.at;
+            }
+        }
+        // A fresh solver: the old one's pattern belongs to another topology.
+        self.solver = Solver::new(self.solver.config);
+        self.error = None;
+        self.unsettled = true;
+    }
+
+    fn configure_solver(&mut self) {
+        let mut config = SolverConfig::from_params(&self.grammar().solver);
+        config.hysteresis = self.settings.hysteresis;
+        config.norm = self.settings.norm;
+        self.solver.config = config;
+    }
+
+    fn cut(&mut self, point: DVec2) {
+        let centres = self.dock_centres();
+        let nearest = centres
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.is_finite())
+            .min_by(|a, b| a.1.distance_squared(point).total_cmp(&b.1.distance_squared(point)));
+        match nearest {
+            Some((dock, &at)) => self.note(
+                format!("cut of connection {dock} asked, but this build has no cut rule (clay::rules)"),
+                Some(at),
+            ),
+            None => self.note("nothing to cut here".to_string(), Some(point)),
+        }
+    }
+
+    fn note(&mut self, message: String, at: Option<DVec2>) {
+        self.log.push(LogEntry {
+            frame: self.frame,
+            message,
+            at,
+        });
+        if self.log.len() > LOG_LIMIT {
+            let extra = self.log.len() - LOG_LIMIT;
+            self.log.drain(..extra);
+        }
+    }
+}

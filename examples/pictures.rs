@@ -1,0 +1,95 @@
+//! Writes the documentation pictures: for every grammar `grammars/NAME.clay`, its sheet
+//! (`docs/pictures/NAME-sheet.png`) and a render of its initial assembly
+//! (`docs/pictures/NAME.png`); with a demo script `grammars/NAME.script.json` and script replay
+//! available, also the assembly after the script (`docs/pictures/NAME-after.png`).
+//!
+//! Run with `cargo run --release --example pictures`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clay::render::{Overlays, RenderOptions, render_png, sheet_png};
+use clay_dsl::compiled::CompiledGrammar;
+
+fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
+    let name = path.display().to_string();
+    clay_dsl::compile(source, &name)
+        .map(|c| c.grammar)
+        .map_err(|d| clay_dsl::render(&d, source, &name, false))
+}
+
+fn main() -> ExitCode {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = root.join("docs/pictures");
+    if let Err(e) = std::fs::create_dir_all(&out) {
+        eprintln!("error: cannot create {}: {e}", out.display());
+        return ExitCode::from(2);
+    }
+    let mut grammars: Vec<PathBuf> = match std::fs::read_dir(root.join("grammars")) {
+        Ok(dir) => dir
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "clay"))
+            .collect(),
+        Err(e) => {
+            eprintln!("error: cannot list grammars/: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    grammars.sort();
+
+    let mut failures = 0;
+    for path in &grammars {
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("grammar");
+        let grammar = match std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|s| compile(&s, path))
+        {
+            Ok(g) => g,
+            Err(e) => {
+                eprintln!("skipped {name}: {e}");
+                failures += 1;
+                continue;
+            }
+        };
+        let overlays = Overlays {
+            sites: true,
+            ..Overlays::default()
+        };
+        let options = RenderOptions {
+            width: 1200,
+            height: 800,
+            overlays,
+            ..RenderOptions::default()
+        };
+        let pictures = [
+            (format!("{name}-sheet.png"), sheet_png(&grammar)),
+            (
+                format!("{name}.png"),
+                render_png(&grammar, &grammar.assembly, &options),
+            ),
+        ];
+        for (file, png) in pictures {
+            match png
+                .map_err(|e| e.to_string())
+                .and_then(|b| std::fs::write(out.join(&file), b).map_err(|e| e.to_string()))
+            {
+                Ok(()) => println!("wrote docs/pictures/{file}"),
+                Err(e) => {
+                    eprintln!("error: docs/pictures/{file}: {e}");
+                    failures += 1;
+                }
+            }
+        }
+        if path.with_extension("script.json").exists() {
+            println!("{name}: demo script found, but script replay is not available yet");
+        }
+    }
+    if failures > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

@@ -1,0 +1,125 @@
+//! Fitting maps from rest coordinates to the current pose: the best rigid motion (placing a
+//! junction over the instance it replaces) and the best affine map (laying new chain elements
+//! into a deformed pose). Both are least-squares fits over corresponding point pairs.
+
+use glam::{DMat2, DVec2};
+
+/// A map `p -> linear * p + offset`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointMap {
+    pub linear: DMat2,
+    pub offset: DVec2,
+}
+
+impl PointMap {
+    pub const IDENTITY: Self = Self {
+        linear: DMat2::IDENTITY,
+        offset: DVec2::ZERO,
+    };
+
+    pub fn apply(&self, p: DVec2) -> DVec2 {
+        self.linear * p + self.offset
+    }
+}
+
+fn centroids(from: &[DVec2], to: &[DVec2]) -> (DVec2, DVec2) {
+    let n = from.len().min(to.len()).max(1) as f64;
+    let a = from.iter().copied().sum::<DVec2>() / n;
+    let b = to.iter().copied().sum::<DVec2>() / n;
+    (a, b)
+}
+
+/// Best rotation + translation taking `from[i]` to `to[i]` (2D Procrustes). With fewer than
+/// two distinct points the rotation is the identity.
+pub fn rigid(from: &[DVec2], to: &[DVec2]) -> PointMap {
+    let m = from.len().min(to.len());
+    if m == 0 {
+        return PointMap::IDENTITY;
+    }
+    let (cf, ct) = centroids(&from[..m], &to[..m]);
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for (p, q) in from[..m].iter().zip(&to[..m]) {
+        let (p, q) = (*p - cf, *q - ct);
+        dot += p.dot(q);
+        cross += p.perp_dot(q);
+    }
+    let len = dot.hypot(cross);
+    let (c, s) = if len > 1e-12 && len.is_finite() {
+        (dot / len, cross / len)
+    } else {
+        (1.0, 0.0)
+    };
+    let linear = DMat2::from_cols(DVec2::new(c, s), DVec2::new(-s, c));
+    PointMap {
+        linear,
+        offset: ct - linear * cf,
+    }
+}
+
+/// Best affine map taking `from[i]` to `to[i]`; falls back to [`rigid`] when the source
+/// points are (nearly) collinear, where an affine fit is not determined.
+pub fn affine(from: &[DVec2], to: &[DVec2]) -> PointMap {
+    let m = from.len().min(to.len());
+    if m < 3 {
+        return rigid(from, to);
+    }
+    let (cf, ct) = centroids(&from[..m], &to[..m]);
+    // M = (sum q p^T) (sum p p^T)^-1 over centred pairs.
+    let mut pp = DMat2::ZERO;
+    let mut qp = DMat2::ZERO;
+    let mut scale = 0.0;
+    for (p, q) in from[..m].iter().zip(&to[..m]) {
+        let (p, q) = (*p - cf, *q - ct);
+        pp += DMat2::from_cols(p * p.x, p * p.y);
+        qp += DMat2::from_cols(q * p.x, q * p.y);
+        scale += p.length_squared();
+    }
+    let det = pp.determinant();
+    // Relative test: det is of order scale^2 for well-spread points.
+    if !(det.abs() > 1e-9 * scale * scale) {
+        return rigid(from, to);
+    }
+    let linear = qp * pp.inverse();
+    let map = PointMap {
+        linear,
+        offset: ct - linear * cf,
+    };
+    if map.linear.is_finite() && map.offset.is_finite() {
+        map
+    } else {
+        rigid(from, to)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rigid_recovers_a_rotation_and_translation() {
+        let from = [DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.0), DVec2::new(0.0, 1.0)];
+        let rot = DVec2::from_angle(0.7);
+        let to: Vec<DVec2> = from.iter().map(|p| rot.rotate(*p) + DVec2::new(3.0, -1.0)).collect();
+        let m = rigid(&from, &to);
+        for (p, q) in from.iter().zip(&to) {
+            assert!(m.apply(*p).distance(*q) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn affine_recovers_a_stretch_and_degenerates_to_rigid() {
+        let from = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 0.5),
+            DVec2::new(0.0, 0.5),
+        ];
+        let to: Vec<DVec2> = from.iter().map(|p| DVec2::new(2.0 * p.x + 1.0, p.y)).collect();
+        let m = affine(&from, &to);
+        assert!(m.apply(DVec2::new(0.5, 0.25)).distance(DVec2::new(2.0, 0.25)) < 1e-12);
+        let line = [DVec2::ZERO, DVec2::X, DVec2::X * 2.0];
+        let shifted: Vec<DVec2> = line.iter().map(|p| *p + DVec2::Y).collect();
+        let m = affine(&line, &shifted);
+        assert!(m.apply(DVec2::X).distance(DVec2::new(1.0, 1.0)) < 1e-12);
+    }
+}

@@ -1,0 +1,402 @@
+//! The smart-clay rules (paper 5.1): replacement, stretch/shrink, merge and cut, as pure
+//! rewrites of `(&CompiledGrammar, &mut AssemblyData)` that each yield a [`RuleEvent`], and
+//! [`Rules`], which runs them on a live [`Assembly`] after every solver frame.
+//!
+//! Every rewrite is a transaction: it either leaves an `AssemblyData` that passes
+//! [`AssemblyData::check`] (with parts rebuilt from the grammar, untouched parts keeping their
+//! active state, and untouched instances keeping their ids) or restores the data and returns
+//! an error. Per-frame cost of finding rule applications is linear in the number of parts and
+//! free sites; a rewrite itself costs O(instances + docks + vertices) and happens rarely.
+
+pub mod cut;
+pub mod fit;
+pub mod merge;
+pub mod proximity;
+pub mod replace;
+pub mod stretch;
+
+use std::collections::{HashMap, HashSet};
+
+use clay_dsl::compiled::{AssemblyData, Chain, CompiledGrammar, InstanceSite, Part, PartKind};
+use glam::DVec2;
+use serde::Serialize;
+
+use crate::assembly::Assembly;
+use crate::solver::FrameReport;
+
+/// What kind of rule fired.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RuleKind {
+    Replace,
+    Stretch,
+    Shrink,
+    Merge,
+    Cut,
+}
+
+/// One application of a rule.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RuleEvent {
+    pub kind: RuleKind,
+    /// The frame after which the rule ran (set by [`Rules`]; 0 from the pure rewrites).
+    pub frame: u64,
+    /// Where it happened (the centre of the rewritten region), in metres.
+    pub at: DVec2,
+    /// Stable ids of the instances involved: for stretch the kept ones then the new one; for
+    /// shrink the kept one then the removed one; for merge the mover, the replaced target and
+    /// the junction (or the target for a weld); for cut the two sides and any new instance.
+    pub instances: Vec<u64>,
+    /// A short human description (`chain 0 at element 3: 2 -> 3 elements`).
+    pub detail: String,
+}
+
+/// A structural rewrite: its event, and how old indices map to new ones so that callers can
+/// carry per-vertex and per-part data (handles, rotations) across it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rewrite {
+    pub event: RuleEvent,
+    /// Old global vertex index -> new one (`None`: the vertex was removed).
+    pub vertex_map: Vec<Option<usize>>,
+    /// Old part index -> new part index (`None`: the part was removed or rebuilt).
+    pub part_map: Vec<Option<usize>>,
+}
+
+/// Identity of a part in terms of stable instance ids, so that parts can be matched across a
+/// rewrite that renumbers instances, chains and parts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum PartKey {
+    Piece(u64),
+    Stretch(u64, u64),
+}
+
+fn part_key(data: &AssemblyData, part: &Part) -> Option<PartKey> {
+    match part.kind {
+        PartKind::Piece { instance } => data.instances.get(instance).map(|i| PartKey::Piece(i.id)),
+        PartKind::Stretch { chain, first } => {
+            let c = data.chains.get(chain)?;
+            let a = data.instances.get(*c.instances.get(first)?)?.id;
+            let b = data.instances.get(*c.instances.get(first + 1)?)?.id;
+            Some(PartKey::Stretch(a, b))
+        }
+    }
+}
+
+/// The old parts' keys and active states, recorded before a rewrite changes indices.
+pub(crate) struct PartsBefore {
+    keys: Vec<Option<PartKey>>,
+    active: Vec<usize>,
+}
+
+impl PartsBefore {
+    pub(crate) fn record(data: &AssemblyData) -> Self {
+        Self {
+            keys: data.parts.iter().map(|p| part_key(data, p)).collect(),
+            active: data.parts.iter().map(|p| p.active).collect(),
+        }
+    }
+}
+
+/// Rebuilds every part from the grammar after a rewrite. Parts over the same instances as
+/// before keep their active state unless they cover an instance whose id is in `touched`
+/// (those restart in their default state: `two` for stretch parts, the instance's state for
+/// piece parts). Returns the old -> new part map (rebuilt parts map to `None`).
+pub(crate) fn rebuild_parts(
+    grammar: &CompiledGrammar,
+    data: &mut AssemblyData,
+    before: &PartsBefore,
+    touched: &HashSet<u64>,
+) -> Vec<Option<usize>> {
+    let mut old_by_key: HashMap<PartKey, usize> = HashMap::new();
+    for (i, k) in before.keys.iter().enumerate() {
+        if let Some(k) = k {
+            old_by_key.insert(*k, i);
+        }
+    }
+    let mut parts = grammar.parts(data);
+    let mut part_map = vec![None; before.keys.len()];
+    for (ni, part) in parts.iter_mut().enumerate() {
+        let Some(key) = part_key(data, part) else {
+            continue;
+        };
+        let hit = match key {
+            PartKey::Piece(a) => touched.contains(&a),
+            PartKey::Stretch(a, b) => touched.contains(&a) || touched.contains(&b),
+        };
+        if hit {
+            continue;
+        }
+        if let Some(&oi) = old_by_key.get(&key) {
+            if matches!(part.kind, PartKind::Stretch { .. }) && before.active[oi] < part.states.len()
+            {
+                part.active = before.active[oi];
+            }
+            part_map[oi] = Some(ni);
+        }
+    }
+    data.parts = parts;
+    part_map
+}
+
+/// Removes the instances at the given indices, renumbering docks (docks touching a removed
+/// instance are dropped) and chains (removed elements are dropped; empty chains vanish).
+pub(crate) fn remove_instances(data: &mut AssemblyData, removed: &HashSet<usize>) {
+    if removed.is_empty() {
+        return;
+    }
+    let mut map = vec![None; data.instances.len()];
+    let mut next = 0;
+    for (i, slot) in map.iter_mut().enumerate() {
+        if !removed.contains(&i) {
+            *slot = Some(next);
+            next += 1;
+        }
+    }
+    let mut i = 0;
+    data.instances.retain(|_| {
+        let keep = !removed.contains(&i);
+        i += 1;
+        keep
+    });
+    let remap = |s: InstanceSite| {
+        map[s.instance].map(|instance| InstanceSite {
+            instance,
+            site: s.site,
+        })
+    };
+    data.docks = data
+        .docks
+        .iter()
+        .filter_map(|d| {
+            Some(clay_dsl::compiled::Dock {
+                a: remap(d.a)?,
+                b: remap(d.b)?,
+            })
+        })
+        .collect();
+    for chain in &mut data.chains {
+        chain.instances = chain.instances.iter().filter_map(|&i| map[i]).collect();
+    }
+    data.chains.retain(|c| !c.instances.is_empty());
+    // Parts are rebuilt by the caller; drop them now so no stale index survives.
+    data.parts.clear();
+}
+
+/// Drops vertices no instance uses and renumbers the rest (order kept). Returns the old -> new
+/// vertex map. Parts must be rebuilt afterwards.
+pub(crate) fn compact_vertices(data: &mut AssemblyData) -> Vec<Option<usize>> {
+    let n = data.positions.len();
+    let mut used = vec![false; n];
+    for inst in &data.instances {
+        for &v in &inst.vertices {
+            used[v] = true;
+        }
+    }
+    let mut map = vec![None; n];
+    let mut positions = Vec::with_capacity(n);
+    for (v, &u) in used.iter().enumerate() {
+        if u {
+            map[v] = Some(positions.len());
+            positions.push(data.positions[v]);
+        }
+    }
+    data.positions = positions;
+    for inst in &mut data.instances {
+        for v in &mut inst.vertices {
+            *v = map[*v].expect("used vertices are kept");
+        }
+    }
+    map
+}
+
+/// Which stretch rule (if any) an instance's piece is an element of.
+fn stretch_rule_of(grammar: &CompiledGrammar, piece: usize) -> Option<usize> {
+    grammar.stretch_rules.iter().position(|r| {
+        r.piece == piece || r.variants.iter().any(|v| v.piece == piece)
+    })
+}
+
+/// Derives the chains from the docks: maximal runs of elements of one stretch rule docked
+/// `to` -> `from`. Used after merges and cuts, which split and join chains. Existing chains
+/// come first in their old order (by their first element), so indices move little.
+pub(crate) fn derive_chains(grammar: &CompiledGrammar, data: &mut AssemblyData) {
+    let n = data.instances.len();
+    let rule: Vec<Option<usize>> = data
+        .instances
+        .iter()
+        .map(|i| stretch_rule_of(grammar, i.piece))
+        .collect();
+    let mut next = vec![None; n];
+    let mut has_prev = vec![false; n];
+    for d in &data.docks {
+        for (x, y) in [(d.a, d.b), (d.b, d.a)] {
+            let (Some(rx), Some(ry)) = (rule[x.instance], rule[y.instance]) else {
+                continue;
+            };
+            let r = &grammar.stretch_rules[rx];
+            if rx == ry && x.site == r.to && y.site == r.from && x.instance != y.instance {
+                next[x.instance] = Some(y.instance);
+                has_prev[y.instance] = true;
+            }
+        }
+    }
+    let mut visited = vec![false; n];
+    let mut chains = Vec::new();
+    let mut walk = |start: usize, visited: &mut Vec<bool>, chains: &mut Vec<Chain>| {
+        let mut list = Vec::new();
+        let mut at = Some(start);
+        while let Some(i) = at {
+            if visited[i] {
+                break;
+            }
+            visited[i] = true;
+            list.push(i);
+            at = next[i];
+        }
+        if let Some(r) = rule[start] {
+            chains.push(Chain {
+                rule: r,
+                instances: list,
+            });
+        }
+    };
+    // Start walks at old chain heads first (keeps the old chain order), then any other head,
+    // then cycles (closed rings of elements) at their lowest index.
+    let old_heads: Vec<usize> = data.chains.iter().filter_map(|c| c.instances.first().copied()).collect();
+    for &h in &old_heads {
+        if h < n && rule[h].is_some() && !has_prev[h] && !visited[h] {
+            walk(h, &mut visited, &mut chains);
+        }
+    }
+    for i in 0..n {
+        if rule[i].is_some() && !has_prev[i] && !visited[i] {
+            walk(i, &mut visited, &mut chains);
+        }
+    }
+    for i in 0..n {
+        if rule[i].is_some() && !visited[i] {
+            walk(i, &mut visited, &mut chains);
+        }
+    }
+    data.chains = chains;
+}
+
+/// Centre of an instance site's current vertex positions.
+pub fn site_centre(grammar: &CompiledGrammar, data: &AssemblyData, s: InstanceSite) -> Option<DVec2> {
+    let vs = data.site_vertices(grammar, s)?;
+    if vs.is_empty() {
+        return None;
+    }
+    Some(vs.iter().map(|&v| data.positions[v]).sum::<DVec2>() / vs.len() as f64)
+}
+
+/// Runs `body` as a transaction: on error, or when the result fails [`AssemblyData::check`],
+/// the data is restored and the error returned.
+pub(crate) fn transaction<T>(
+    grammar: &CompiledGrammar,
+    data: &mut AssemblyData,
+    body: impl FnOnce(&mut AssemblyData) -> Result<T, String>,
+) -> Result<T, String> {
+    let backup = data.clone();
+    let result = body(data).and_then(|t| {
+        data.check(grammar)
+            .map(|()| t)
+            .map_err(|e| format!("the rewrite broke the assembly ({e}); undone"))
+    });
+    if result.is_err() {
+        *data = backup;
+    }
+    result
+}
+
+/// A name for an instance a rule inserts: the base of a related name plus the new id
+/// (`wall[3]` -> `wall#17`).
+pub(crate) fn generated_name(base: &str, id: u64) -> String {
+    let stem = base.split(['[', '#']).next().unwrap_or(base);
+    format!("{stem}#{id}")
+}
+
+/// Runs the rules on a live assembly after each solver frame, and the cut operation.
+#[derive(Clone, Debug, Default)]
+pub struct Rules {
+    /// Frames seen so far (stamped on events).
+    pub frame: u64,
+    /// Every event so far, in order.
+    pub log: Vec<RuleEvent>,
+}
+
+impl Rules {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Applies the rules after one solver frame: replacement events for the piece parts that
+    /// switched state, at most one stretch or shrink per chain (parts left in `three`/`one`),
+    /// and at most one merge. Bumps the assembly's generation if the structure changed, and
+    /// carries rotations and handles across the renumbering.
+    pub fn after_frame(&mut self, asm: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent> {
+        self.frame += 1;
+        let grammar = asm.grammar_arc().clone();
+        let mut events = replace::replacement_events(&grammar, &mut asm.data, &report.switches);
+        let mut rewrites = Vec::new();
+        for (chain, first) in stretch::candidates(&grammar, &asm.data) {
+            // Earlier rewrites in this loop never renumber chains, and elements only within
+            // their own chain, so (chain, first) is still valid here.
+            if let Ok(r) = stretch::rewrite_part(&grammar, &mut asm.data, chain, first) {
+                self.carry(asm, &r);
+                rewrites.push(r.event);
+            }
+        }
+        if let Some(found) = merge::find(&grammar, &asm.data)
+            && let Ok(r) = merge::apply(&grammar, &mut asm.data, &found)
+        {
+            self.carry(asm, &r);
+            rewrites.push(r.event);
+        }
+        events.extend(rewrites);
+        for e in &mut events {
+            e.frame = self.frame;
+        }
+        debug_assert!(asm.data.check(&grammar).is_ok(), "{:?}", asm.data.check(&grammar));
+        self.log.extend(events.iter().cloned());
+        events
+    }
+
+    /// Cuts the dock nearest `point` (see [`cut::cut_at`]).
+    pub fn cut(&mut self, asm: &mut Assembly, point: DVec2) -> Result<RuleEvent, String> {
+        let grammar = asm.grammar_arc().clone();
+        let r = cut::cut_at(&grammar, &mut asm.data, point)?;
+        self.carry(asm, &r);
+        let mut e = r.event;
+        e.frame = self.frame;
+        self.log.push(e.clone());
+        Ok(e)
+    }
+
+    /// Carries per-part rotations and handle vertices across a rewrite and bumps the
+    /// assembly's generation.
+    fn carry(&self, asm: &mut Assembly, r: &Rewrite) {
+        let old_rot = asm.rotations().to_vec();
+        for h in asm.handles_mut().iter_mut() {
+            let mut vertices = Vec::with_capacity(h.vertices.len());
+            let mut anchor = Vec::with_capacity(h.anchor.len());
+            for (k, &v) in h.vertices.iter().enumerate() {
+                if let Some(Some(nv)) = r.vertex_map.get(v) {
+                    vertices.push(*nv);
+                    anchor.push(h.anchor[k]);
+                }
+            }
+            h.vertices = vertices;
+            h.anchor = anchor;
+        }
+        asm.topology_changed();
+        let rot = asm.rotations_mut();
+        for (old, new) in r.part_map.iter().enumerate() {
+            if let (Some(new), Some(&q)) = (new, old_rot.get(old))
+                && let Some(slot) = rot.get_mut(*new)
+            {
+                *slot = q;
+            }
+        }
+    }
+}

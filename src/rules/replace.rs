@@ -1,0 +1,63 @@
+//! Replacement (paper 5.1, Fig. 7a): when a piece part's active rest state changes, its
+//! instance shows that state's geometry. The solver's pass 1 decides the states (and already
+//! copies them to the instances); this rule makes sure the instance follows and reports one
+//! `replace` event per instance whose state changed this frame (not one per IRLS switch).
+
+use std::collections::BTreeMap;
+
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
+use glam::DVec2;
+
+use super::{RuleEvent, RuleKind};
+use crate::solver::StateSwitch;
+
+/// Sets each piece part's instance to the part's active state and returns one event per
+/// instance that ends the frame in a different state than it started. `switches` are the
+/// solver's state switches of the frame (several per part are possible within one frame).
+pub fn replacement_events(
+    grammar: &CompiledGrammar,
+    data: &mut AssemblyData,
+    switches: &[StateSwitch],
+) -> Vec<RuleEvent> {
+    // First `from` per part: the state it had when the frame began.
+    let mut began: BTreeMap<usize, usize> = BTreeMap::new();
+    for s in switches {
+        began.entry(s.part).or_insert(s.from);
+    }
+    let mut events = Vec::new();
+    for (&pi, &from) in &began {
+        let Some(part) = data.parts.get(pi) else {
+            continue;
+        };
+        let PartKind::Piece { instance } = part.kind else {
+            continue;
+        };
+        let to = part.active;
+        let Some(inst) = data.instances.get_mut(instance) else {
+            continue;
+        };
+        inst.state = to;
+        if from == to {
+            continue;
+        }
+        let piece = &grammar.pieces[inst.piece];
+        let name = |s: usize| piece.states.get(s).map_or("?", |st| st.name.as_str());
+        let at = centroid(&data.positions, &data.instances[instance].vertices);
+        let inst = &data.instances[instance];
+        events.push(RuleEvent {
+            kind: RuleKind::Replace,
+            frame: 0,
+            at,
+            instances: vec![inst.id],
+            detail: format!("{} ({}): {} -> {}", inst.name, piece.name, name(from), name(to)),
+        });
+    }
+    events
+}
+
+fn centroid(positions: &[DVec2], vertices: &[usize]) -> DVec2 {
+    if vertices.is_empty() {
+        return DVec2::ZERO;
+    }
+    vertices.iter().map(|&v| positions[v]).sum::<DVec2>() / vertices.len() as f64
+}

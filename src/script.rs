@@ -1,0 +1,451 @@
+//! Scripted sculpting sessions (issue 3): the JSON script format, its validation with messages
+//! that name the offending step, and headless replay of a script on a live assembly through the
+//! solver, with a hook where rules run after every frame.
+
+use std::collections::BTreeMap;
+
+use glam::DVec2;
+use serde_json::Value;
+
+use crate::assembly::{Assembly, Compass, HandleId, HandleKind};
+use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
+use crate::summary::{Summary, summarize};
+use clay_dsl::compiled::PartKind;
+
+/// Largest frame count a single step may ask for (keeps a typo from running for hours).
+pub const MAX_FRAMES: u64 = 100_000;
+
+/// How a step picks a part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Selector {
+    /// The part whose centroid is nearest the point.
+    At(DVec2),
+    /// The part reaching furthest in a compass direction.
+    Extreme(Compass),
+}
+
+/// Where a drag takes the current handle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Motion {
+    /// Move by this offset.
+    By(DVec2),
+    /// Move the handle's centroid to this point.
+    To(DVec2),
+}
+
+/// One step of a script.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    /// Make the selected part the current handle (releasing the previous grab; pins stay).
+    Grab(Selector),
+    /// Fix the selected part where it is.
+    Pin(Selector),
+    /// Move the current handle linearly over `frames` frames (0: jump, no frame).
+    Drag { motion: Motion, frames: u64 },
+    /// Turn the current handle about its centroid over `frames` frames.
+    Rotate { degrees: f64, frames: u64 },
+    /// Let go of the current handle (pins stay).
+    Release,
+    /// Run frames without moving anything.
+    Hold { frames: u64 },
+    /// Cut the connection nearest the point (needs the rules hook).
+    Cut { at: DVec2 },
+}
+
+/// A parsed script.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Script {
+    pub steps: Vec<Step>,
+}
+
+/// A malformed script: which step (if any) and what is wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScriptError {
+    /// Index of the offending step in `steps`, `None` for the document as a whole.
+    pub step: Option<usize>,
+    pub message: String,
+}
+
+impl std::fmt::Display for ScriptError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.step {
+            Some(i) => write!(f, "step {i}: {}", self.message),
+            None => f.write_str(&self.message),
+        }
+    }
+}
+
+impl std::error::Error for ScriptError {}
+
+fn number(v: &Value, what: &str) -> Result<f64, String> {
+    match v.as_f64() {
+        Some(x) if x.is_finite() => Ok(x),
+        _ => Err(format!("{what} must be a finite number, found {v}")),
+    }
+}
+
+fn point(v: &Value, what: &str) -> Result<DVec2, String> {
+    match v.as_array().map(Vec::as_slice) {
+        Some([x, y]) => Ok(DVec2::new(number(x, what)?, number(y, what)?)),
+        _ => Err(format!("{what} must be an array of two numbers [x, y], found {v}")),
+    }
+}
+
+fn frames(obj: &serde_json::Map<String, Value>, kind: &str) -> Result<u64, String> {
+    let v = obj.get("frames").ok_or_else(|| format!("{kind} needs \"frames\""))?;
+    match v.as_u64() {
+        Some(n) if n <= MAX_FRAMES => Ok(n),
+        _ => Err(format!("{kind}: \"frames\" must be an integer from 0 to {MAX_FRAMES}, found {v}")),
+    }
+}
+
+fn object<'a>(v: &'a Value, kind: &str) -> Result<&'a serde_json::Map<String, Value>, String> {
+    v.as_object().ok_or_else(|| format!("{kind} takes an object, found {v}"))
+}
+
+fn only_keys(obj: &serde_json::Map<String, Value>, kind: &str, allowed: &[&str]) -> Result<(), String> {
+    for k in obj.keys() {
+        if !allowed.contains(&k.as_str()) {
+            return Err(format!("{kind}: unknown field \"{k}\" (expected {})", allowed.join(", ")));
+        }
+    }
+    Ok(())
+}
+
+fn selector(v: &Value, kind: &str) -> Result<Selector, String> {
+    let obj = object(v, kind)?;
+    match (obj.get("at"), obj.get("extreme"), obj.len()) {
+        (Some(at), None, 1) => Ok(Selector::At(point(at, &format!("{kind}: \"at\""))?)),
+        (None, Some(dir), 1) => match dir.as_str() {
+            Some("east") => Ok(Selector::Extreme(Compass::East)),
+            Some("west") => Ok(Selector::Extreme(Compass::West)),
+            Some("north") => Ok(Selector::Extreme(Compass::North)),
+            Some("south") => Ok(Selector::Extreme(Compass::South)),
+            _ => Err(format!("{kind}: \"extreme\" must be \"east\", \"west\", \"north\" or \"south\", found {dir}")),
+        },
+        _ => Err(format!("{kind} takes {{\"at\": [x, y]}} or {{\"extreme\": \"east\"|\"west\"|\"north\"|\"south\"}}")),
+    }
+}
+
+fn step(v: &Value) -> Result<Step, String> {
+    let obj = v.as_object().ok_or_else(|| format!("a step must be an object, found {v}"))?;
+    if obj.len() != 1 {
+        return Err(format!(
+            "a step must have exactly one key (grab, pin, drag, rotate, release, hold, cut), found {}",
+            if obj.is_empty() { "none".to_string() } else { obj.keys().cloned().collect::<Vec<_>>().join(", ") }
+        ));
+    }
+    let (kind, body) = obj.iter().next().ok_or("empty step")?;
+    match kind.as_str() {
+        "grab" => Ok(Step::Grab(selector(body, "grab")?)),
+        "pin" => Ok(Step::Pin(selector(body, "pin")?)),
+        "drag" => {
+            let o = object(body, "drag")?;
+            only_keys(o, "drag", &["by", "to", "frames"])?;
+            let motion = match (o.get("by"), o.get("to")) {
+                (Some(by), None) => Motion::By(point(by, "drag: \"by\"")?),
+                (None, Some(to)) => Motion::To(point(to, "drag: \"to\"")?),
+                _ => return Err("drag needs exactly one of \"by\" or \"to\"".into()),
+            };
+            Ok(Step::Drag { motion, frames: frames(o, "drag")? })
+        }
+        "rotate" => {
+            let o = object(body, "rotate")?;
+            only_keys(o, "rotate", &["degrees", "frames"])?;
+            let degrees = number(o.get("degrees").ok_or("rotate needs \"degrees\"")?, "rotate: \"degrees\"")?;
+            Ok(Step::Rotate { degrees, frames: frames(o, "rotate")? })
+        }
+        "release" => {
+            let o = object(body, "release")?;
+            only_keys(o, "release", &[])?;
+            Ok(Step::Release)
+        }
+        "hold" => {
+            let o = object(body, "hold")?;
+            only_keys(o, "hold", &["frames"])?;
+            Ok(Step::Hold { frames: frames(o, "hold")? })
+        }
+        "cut" => {
+            let o = object(body, "cut")?;
+            only_keys(o, "cut", &["at"])?;
+            Ok(Step::Cut { at: point(o.get("at").ok_or("cut needs \"at\"")?, "cut: \"at\"")? })
+        }
+        other => Err(format!("unknown step \"{other}\" (expected grab, pin, drag, rotate, release, hold or cut)")),
+    }
+}
+
+impl Script {
+    /// Parses and validates a script; every error names the step index and what is wrong.
+    pub fn parse(json: &str) -> Result<Self, ScriptError> {
+        let doc: Value = serde_json::from_str(json)
+            .map_err(|e| ScriptError { step: None, message: format!("the script is not valid JSON: {e}") })?;
+        let whole = |message: String| ScriptError { step: None, message };
+        let obj = doc.as_object().ok_or_else(|| whole("the script must be an object {\"steps\": [...]}".into()))?;
+        if let Some(k) = obj.keys().find(|k| *k != "steps") {
+            return Err(whole(format!("unknown top-level field \"{k}\" (expected \"steps\")")));
+        }
+        let steps = obj
+            .get("steps")
+            .ok_or_else(|| whole("the script needs \"steps\": [...]".into()))?
+            .as_array()
+            .ok_or_else(|| whole("\"steps\" must be an array".into()))?;
+        let steps = steps
+            .iter()
+            .enumerate()
+            .map(|(i, v)| step(v).map_err(|message| ScriptError { step: Some(i), message }))
+            .collect::<Result<_, _>>()?;
+        Ok(Self { steps })
+    }
+
+    /// Total solver frames the script runs.
+    pub fn frame_count(&self) -> u64 {
+        self.steps
+            .iter()
+            .map(|s| match s {
+                Step::Drag { frames, .. } | Step::Rotate { frames, .. } | Step::Hold { frames } => *frames,
+                _ => 0,
+            })
+            .sum()
+    }
+}
+
+/// The kinds of rule (paper 5.1), as counted in the summary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum RuleKind {
+    Replace,
+    Stretch,
+    Shrink,
+    Merge,
+    Cut,
+}
+
+impl RuleKind {
+    pub const ALL: [RuleKind; 5] = [RuleKind::Replace, RuleKind::Stretch, RuleKind::Shrink, RuleKind::Merge, RuleKind::Cut];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RuleKind::Replace => "replace",
+            RuleKind::Stretch => "stretch",
+            RuleKind::Shrink => "shrink",
+            RuleKind::Merge => "merge",
+            RuleKind::Cut => "cut",
+        }
+    }
+}
+
+/// A rule that fired.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuleEvent {
+    pub kind: RuleKind,
+    /// What happened, for logs (`"wall[3] split into 2"`).
+    pub detail: String,
+}
+
+/// Where rules plug into a session: called after every solver frame, and for cut requests.
+/// An implementation that changes parts, vertices or edges must call
+/// [`Assembly::topology_changed`] before returning.
+pub trait FrameHook {
+    /// Runs the rules after a frame; returns those that fired.
+    fn after_frame(&mut self, assembly: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent>;
+
+    /// Cuts the connection nearest `at`. `None` means cutting is not available.
+    fn cut(&mut self, assembly: &mut Assembly, at: DVec2) -> Option<Vec<RuleEvent>> {
+        let _ = (assembly, at);
+        None
+    }
+}
+
+/// The hook used until rules exist: nothing fires, cuts are unavailable.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoRules;
+
+impl FrameHook for NoRules {
+    fn after_frame(&mut self, _: &mut Assembly, _: &FrameReport) -> Vec<RuleEvent> {
+        Vec::new()
+    }
+}
+
+/// A session being replayed step by step (the editor and `clayc render --script` drive it;
+/// [`replay`] runs a whole script).
+#[derive(Debug)]
+pub struct Replay {
+    pub solver: Solver,
+    /// The handle `drag`, `rotate` and `release` act on.
+    pub current: Option<HandleId>,
+    /// Wall time of every frame so far (solver and rules), in milliseconds.
+    pub frame_ms: Vec<f64>,
+    /// Rules fired so far, per kind.
+    pub rules_fired: BTreeMap<RuleKind, usize>,
+    /// Remarks about steps that did nothing (grab on an empty model, cut without rules).
+    pub notes: Vec<String>,
+    pub last_report: Option<FrameReport>,
+}
+
+/// A frame failed to solve during replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReplayError {
+    pub step: Option<usize>,
+    pub error: SolverError,
+}
+
+impl std::fmt::Display for ReplayError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.step {
+            Some(i) => write!(f, "step {i}: {}", self.error),
+            None => write!(f, "{}", self.error),
+        }
+    }
+}
+
+impl std::error::Error for ReplayError {}
+
+impl Replay {
+    pub fn new(config: SolverConfig) -> Self {
+        Self {
+            solver: Solver::new(config),
+            current: None,
+            frame_ms: Vec::new(),
+            rules_fired: RuleKind::ALL.iter().map(|&k| (k, 0)).collect(),
+            notes: Vec::new(),
+            last_report: None,
+        }
+    }
+
+    /// Runs one solver frame, then the rules; counts piece-part state switches as `replace`.
+    pub fn frame(&mut self, asm: &mut Assembly, hook: &mut dyn FrameHook) -> Result<FrameReport, SolverError> {
+        let start = std::time::Instant::now();
+        let report = self.solver.frame(asm)?;
+        for s in &report.switches {
+            if matches!(asm.data.parts.get(s.part).map(|p| p.kind), Some(PartKind::Piece { .. })) {
+                *self.rules_fired.entry(RuleKind::Replace).or_default() += 1;
+            }
+        }
+        for event in hook.after_frame(asm, &report) {
+            *self.rules_fired.entry(event.kind).or_default() += 1;
+        }
+        self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        self.last_report = Some(report.clone());
+        Ok(report)
+    }
+
+    fn select(&self, asm: &Assembly, sel: Selector) -> Option<usize> {
+        match sel {
+            Selector::At(p) => asm.part_nearest(p),
+            Selector::Extreme(dir) => asm.part_extreme(dir),
+        }
+    }
+
+    /// Moves the current handle by `offset` and turns it by `angle` over `frames` frames.
+    fn move_handle(
+        &mut self,
+        asm: &mut Assembly,
+        hook: &mut dyn FrameHook,
+        offset: DVec2,
+        angle: f64,
+        frames: u64,
+    ) -> Result<(), SolverError> {
+        let Some(id) = self.current.filter(|&id| asm.handle(id).is_some()) else {
+            self.current = None;
+            return (0..frames).try_for_each(|_| self.frame(asm, hook).map(drop));
+        };
+        let Some(h) = asm.handle(id) else { return Ok(()) };
+        let (t0, a0) = (h.translation, h.angle);
+        if frames == 0 {
+            if let Some(h) = asm.handle_mut(id) {
+                h.translation = t0 + offset;
+                h.angle = a0 + angle;
+            }
+            return Ok(());
+        }
+        for k in 1..=frames {
+            let s = k as f64 / frames as f64;
+            // The handle may vanish when rules drop its vertices; the drag then just holds.
+            if let Some(h) = asm.handle_mut(id) {
+                h.translation = t0 + offset * s;
+                h.angle = a0 + angle * s;
+            }
+            self.frame(asm, hook)?;
+        }
+        Ok(())
+    }
+
+    /// Runs one step (step index `index` is only used in notes).
+    pub fn step(&mut self, asm: &mut Assembly, index: usize, step: &Step, hook: &mut dyn FrameHook) -> Result<(), SolverError> {
+        match *step {
+            Step::Grab(sel) | Step::Pin(sel) => {
+                let Some(part) = self.select(asm, sel) else {
+                    self.notes.push(format!("step {index}: no part to select (the model is empty)"));
+                    return Ok(());
+                };
+                if let Step::Grab(_) = step {
+                    if let Some(old) = self.current.take() {
+                        asm.release(old);
+                    }
+                    self.current = asm.hold_part(part, HandleKind::Grab);
+                } else {
+                    asm.hold_part(part, HandleKind::Pin);
+                }
+            }
+            Step::Drag { motion, frames } => {
+                if self.current.is_none() {
+                    self.notes.push(format!("step {index}: drag without a grabbed part only holds"));
+                }
+                let offset = match (motion, self.current.and_then(|id| asm.handle(id))) {
+                    (Motion::By(d), _) => d,
+                    (Motion::To(p), Some(h)) => p - h.target_centre(),
+                    (Motion::To(_), None) => DVec2::ZERO,
+                };
+                self.move_handle(asm, hook, offset, 0.0, frames)?;
+            }
+            Step::Rotate { degrees, frames } => {
+                if self.current.is_none() {
+                    self.notes.push(format!("step {index}: rotate without a grabbed part only holds"));
+                }
+                self.move_handle(asm, hook, DVec2::ZERO, degrees.to_radians(), frames)?;
+            }
+            Step::Release => {
+                if let Some(id) = self.current.take() {
+                    asm.release(id);
+                } else {
+                    self.notes.push(format!("step {index}: release without a grabbed part"));
+                }
+            }
+            Step::Hold { frames } => {
+                for _ in 0..frames {
+                    self.frame(asm, hook)?;
+                }
+            }
+            Step::Cut { at } => match hook.cut(asm, at) {
+                Some(events) => {
+                    for e in events {
+                        *self.rules_fired.entry(e.kind).or_default() += 1;
+                    }
+                }
+                None => self.notes.push(format!(
+                    "step {index}: cut at [{}, {}] does nothing: cutting arrives with the rules (issue 4)",
+                    at.x, at.y
+                )),
+            },
+        }
+        Ok(())
+    }
+
+    /// The summary of the session so far.
+    pub fn summary(&self, asm: &Assembly) -> Summary {
+        summarize(asm, &self.frame_ms, &self.rules_fired, self.last_report.as_ref())
+    }
+}
+
+/// Replays a whole script on `asm` and summarises the result.
+pub fn replay(
+    asm: &mut Assembly,
+    script: &Script,
+    config: &SolverConfig,
+    hook: &mut dyn FrameHook,
+) -> Result<(Summary, Replay), ReplayError> {
+    let mut session = Replay::new(*config);
+    for (i, s) in script.steps.iter().enumerate() {
+        session.step(asm, i, s, hook).map_err(|error| ReplayError { step: Some(i), error })?;
+    }
+    Ok((session.summary(asm), session))
+}

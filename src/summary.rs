@@ -1,0 +1,163 @@
+//! The summary of a session (issue 3's `clayc run --json` object): counts of pieces, states and
+//! rules, connectivity, extent, strain, energy and frame times, all finite or reported as not.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::assembly::Assembly;
+use crate::script::RuleKind;
+use crate::solver::{FrameReport, bbox, elastic_energy, max_edge_strain};
+
+/// Median and largest frame time in milliseconds (0 when no frame ran).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FrameMs {
+    pub median: f64,
+    pub max: f64,
+}
+
+/// The state of an assembly at the end of a session.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    pub frames: usize,
+    pub vertices: usize,
+    pub parts: usize,
+    /// Instance count per piece name.
+    pub pieces: BTreeMap<String, usize>,
+    /// Per piece name, per rest-state name: how many instances have it active
+    /// (`instance.state`, also for instances covered by stretch parts).
+    pub states: BTreeMap<String, BTreeMap<String, usize>>,
+    /// Rules fired per kind: replace, stretch, shrink, merge, cut.
+    pub rules_fired: BTreeMap<String, usize>,
+    /// Connected components of the part graph (parts sharing a vertex are connected).
+    pub components: usize,
+    /// `[min x, min y, max x, max y]` of all vertices (zeros for an empty assembly).
+    pub bbox: [f64; 4],
+    /// Largest `|length / rest length - 1|` over all edges of the active states.
+    pub max_edge_strain: f64,
+    /// Pass-2 elastic energy of the last frame (of the initial assembly when no frame ran).
+    pub energy: f64,
+    pub frame_ms: FrameMs,
+    /// Every coordinate is finite.
+    pub finite: bool,
+}
+
+fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) }
+}
+
+/// Connected components of the part graph.
+pub fn components(asm: &Assembly) -> usize {
+    let n = asm.data.positions.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for part in &asm.data.parts {
+        let mut vs = part.vertices.iter().copied().filter(|&v| v < n);
+        if let Some(first) = vs.next() {
+            for v in vs {
+                let (a, b) = (root(&mut parent, first), root(&mut parent, v));
+                if a != b {
+                    parent[a] = b;
+                }
+            }
+        }
+    }
+    let mut roots: Vec<usize> = asm
+        .data
+        .parts
+        .iter()
+        .filter_map(|p| p.vertices.iter().copied().find(|&v| v < n))
+        .map(|v| root(&mut parent, v))
+        .collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
+}
+
+/// Summarises `asm` after a session with these frame times, rule counts and last frame.
+pub fn summarize(
+    asm: &Assembly,
+    frame_ms: &[f64],
+    rules_fired: &BTreeMap<RuleKind, usize>,
+    last: Option<&FrameReport>,
+) -> Summary {
+    let g = asm.grammar();
+    let mut pieces = BTreeMap::new();
+    let mut states: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
+    for inst in &asm.data.instances {
+        let Some(piece) = g.pieces.get(inst.piece) else { continue };
+        *pieces.entry(piece.name.clone()).or_insert(0) += 1;
+        let state = piece.states.get(inst.state).map_or("?", |s| s.name.as_str());
+        *states.entry(piece.name.clone()).or_default().entry(state.to_string()).or_insert(0) += 1;
+    }
+    let finite = asm.data.positions.iter().all(|p| p.is_finite());
+    let bbox = match bbox(&asm.data.positions) {
+        Some((lo, hi)) => [lo.x, lo.y, hi.x, hi.y],
+        None => [0.0; 4],
+    };
+    let energy = match last {
+        Some(r) => r.energy,
+        None => elastic_energy(asm),
+    };
+    Summary {
+        frames: frame_ms.len(),
+        vertices: asm.data.positions.len(),
+        parts: asm.data.parts.len(),
+        pieces,
+        states,
+        rules_fired: RuleKind::ALL
+            .iter()
+            .map(|&k| (k.name().to_string(), rules_fired.get(&k).copied().unwrap_or(0)))
+            .collect(),
+        components: components(asm),
+        bbox,
+        max_edge_strain: max_edge_strain(asm),
+        energy,
+        frame_ms: FrameMs { median: median(frame_ms), max: frame_ms.iter().copied().fold(0.0, f64::max) },
+        finite,
+    }
+}
+
+impl Summary {
+    /// A few lines for people.
+    pub fn human(&self) -> String {
+        let list = |m: &BTreeMap<String, usize>| m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ");
+        let states = self
+            .states
+            .iter()
+            .map(|(p, s)| format!("{p}: {}", list(s)))
+            .collect::<Vec<_>>()
+            .join("; ");
+        format!(
+            "{} frames, {} vertices, {} parts, {} component(s)\npieces: {}\nstates: {}\nrules fired: {}\nbbox [{:.3}, {:.3}, {:.3}, {:.3}], max edge strain {:.4}, energy {:.6}\nframe time median {:.2} ms, max {:.2} ms{}\n",
+            self.frames,
+            self.vertices,
+            self.parts,
+            self.components,
+            list(&self.pieces),
+            states,
+            list(&self.rules_fired),
+            self.bbox[0],
+            self.bbox[1],
+            self.bbox[2],
+            self.bbox[3],
+            self.max_edge_strain,
+            self.energy,
+            self.frame_ms.median,
+            self.frame_ms.max,
+            if self.finite { "" } else { "\nWARNING: some coordinates are not finite" }
+        )
+    }
+}
