@@ -9,13 +9,33 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clay::render::{Overlays, RenderOptions, render_png, sheet_png};
-use clay_dsl::compiled::CompiledGrammar;
+use std::sync::Arc;
+
+use clay::assembly::Assembly;
+use clay::rules::Rules;
+use clay::script::{Script, replay};
+use clay::solver::SolverConfig;
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
 fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
     let name = path.display().to_string();
     clay_dsl::compile(source, &name)
         .map(|c| c.grammar)
         .map_err(|d| clay_dsl::render(&d, source, &name, false))
+}
+
+/// The grammar and the assembly its demo script ends with (solver and rules, as `clayc run`).
+fn after(
+    grammar: CompiledGrammar,
+    script: &Path,
+) -> Result<(CompiledGrammar, AssemblyData), String> {
+    let text = std::fs::read_to_string(script).map_err(|e| e.to_string())?;
+    let script = Script::parse(&text).map_err(|e| e.to_string())?;
+    let config = SolverConfig::from_params(&grammar.solver);
+    let grammar = Arc::new(grammar);
+    let mut assembly = Assembly::new(grammar.clone());
+    replay(&mut assembly, &script, &config, &mut Rules::new()).map_err(|e| e.to_string())?;
+    Ok(((*grammar).clone(), assembly.data))
 }
 
 fn main() -> ExitCode {
@@ -83,8 +103,19 @@ fn main() -> ExitCode {
                 }
             }
         }
-        if path.with_extension("script.json").exists() {
-            println!("{name}: demo script found, but script replay is not available yet");
+        let script = path.with_extension("script.json");
+        if script.exists() {
+            let file = format!("{name}-after.png");
+            let written = after(grammar, &script)
+                .and_then(|(g, a)| render_png(&g, &a, &options).map_err(|e| e.to_string()))
+                .and_then(|b| std::fs::write(out.join(&file), b).map_err(|e| e.to_string()));
+            match written {
+                Ok(()) => println!("wrote docs/pictures/{file}"),
+                Err(e) => {
+                    eprintln!("error: docs/pictures/{file}: {e}");
+                    failures += 1;
+                }
+            }
         }
     }
     if failures > 0 {

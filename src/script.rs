@@ -432,7 +432,7 @@ impl Replay {
 
     /// The summary of the session so far.
     pub fn summary(&self, asm: &Assembly) -> Summary {
-        summarize(asm, &self.frame_ms, &self.rules_fired, self.last_report.as_ref())
+        summarize(asm, &self.frame_ms, &self.rules_fired, self.last_report.as_ref(), &self.solver.config)
     }
 }
 

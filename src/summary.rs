@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use crate::assembly::Assembly;
 use crate::script::RuleKind;
-use crate::solver::{FrameReport, bbox, elastic_energy, max_edge_strain};
+use crate::solver::{FrameReport, SolverConfig, bbox, elastic_energy, max_edge_strain};
 
 /// Median and largest frame time in milliseconds (0 when no frame ran).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -92,6 +92,7 @@ pub fn summarize(
     frame_ms: &[f64],
     rules_fired: &BTreeMap<RuleKind, usize>,
     last: Option<&FrameReport>,
+    config: &SolverConfig,
 ) -> Summary {
     let g = asm.grammar();
     let mut pieces = BTreeMap::new();
@@ -109,7 +110,7 @@ pub fn summarize(
     };
     let energy = match last {
         Some(r) => r.energy,
-        None => elastic_energy(asm),
+        None => elastic_energy(asm, config),
     };
     Summary {
         frames: frame_ms.len(),

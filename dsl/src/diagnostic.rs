@@ -38,20 +38,39 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
-    pub fn error(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+    pub fn error(
+        code: &'static str,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
         Self::new(Severity::Error, code, message, span, label)
     }
 
-    pub fn warning(code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+    pub fn warning(
+        code: &'static str,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
         Self::new(Severity::Warning, code, message, span, label)
     }
 
-    fn new(severity: Severity, code: &'static str, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+    fn new(
+        severity: Severity,
+        code: &'static str,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
         Self {
             severity,
             code,
             message: message.into(),
-            primary: Label { span, message: label.into() },
+            primary: Label {
+                span,
+                message: label.into(),
+            },
             secondary: Vec::new(),
             hints: Vec::new(),
         }
@@ -59,7 +78,10 @@ impl Diagnostic {
 
     /// Adds a secondary span with its label.
     pub fn with_secondary(mut self, span: Span, label: impl Into<String>) -> Self {
-        self.secondary.push(Label { span, message: label.into() });
+        self.secondary.push(Label {
+            span,
+            message: label.into(),
+        });
         self
     }
 
@@ -99,10 +121,13 @@ impl Diagnostic {
             Severity::Error => cs::Severity::Error,
             Severity::Warning => cs::Severity::Warning,
         };
-        let mut labels = vec![cs::Label::primary((), self.primary.span.start..self.primary.span.end)
-            .with_message(&self.primary.message)];
+        let mut labels = vec![
+            cs::Label::primary((), self.primary.span.start..self.primary.span.end)
+                .with_message(&self.primary.message),
+        ];
         for l in &self.secondary {
-            labels.push(cs::Label::secondary((), l.span.start..l.span.end).with_message(&l.message));
+            labels
+                .push(cs::Label::secondary((), l.span.start..l.span.end).with_message(&l.message));
         }
         cs::Diagnostic::new(severity)
             .with_code(self.code)
@@ -198,7 +223,11 @@ fn term_config() -> term::Config {
 /// labels, help notes). `color` adds ANSI colours; the caller decides (terminal, NO_COLOR).
 pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) -> String {
     let file = SimpleFile::new(path, source);
-    let mut buffer = if color { Buffer::ansi() } else { Buffer::no_color() };
+    let mut buffer = if color {
+        Buffer::ansi()
+    } else {
+        Buffer::no_color()
+    };
     let config = term_config();
     for d in diagnostics {
         let d = d.clamped(source);
@@ -206,7 +235,15 @@ pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) 
         // back to a plain line so the diagnostic is not lost.
         if term::emit(&mut buffer, &config, &file, &d.to_codespan()).is_err() {
             let (line, col) = line_col(source, d.primary.span.start);
-            buffer_push(&mut buffer, &format!("{}[{}]: {}\n --> {path}:{line}:{col}\n", sev_word(d.severity), d.code, d.message));
+            buffer_push(
+                &mut buffer,
+                &format!(
+                    "{}[{}]: {}\n --> {path}:{line}:{col}\n",
+                    sev_word(d.severity),
+                    d.code,
+                    d.message
+                ),
+            );
         }
     }
     String::from_utf8_lossy(buffer.as_slice()).into_owned()
@@ -227,7 +264,11 @@ fn sev_word(s: Severity) -> &'static str {
 /// Writes diagnostics straight to stderr, coloured when `color` (the caller checks for a
 /// terminal and NO_COLOR).
 pub fn emit_to_stderr(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) {
-    let choice = if color { ColorChoice::Always } else { ColorChoice::Never };
+    let choice = if color {
+        ColorChoice::Always
+    } else {
+        ColorChoice::Never
+    };
     let mut stream = StandardStream::stderr(choice);
     let file = SimpleFile::new(path, source);
     let config = term_config();

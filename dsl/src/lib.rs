@@ -6,10 +6,11 @@
 pub mod compiled;
 
 pub use compiled::{AssemblyData, CompiledGrammar};
+pub mod compile;
 pub mod diagnostic;
+pub mod format;
 pub mod parse;
 pub mod syntax;
-pub mod compile;
 
 pub use compile::{Compiled, compile, compile_bytes};
 pub use diagnostic::{Diagnostic, Diagnostics, Severity, line_col, render, to_json};

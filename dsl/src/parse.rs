@@ -91,7 +91,9 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::arrow => "`->`",
         Rule::dash => "`-`",
         Rule::dot => "`.`",
-        Rule::file => "a clay file",
+        Rule::file => {
+            "`solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
+        }
         Rule::solver_block => "a `solver` block",
         Rule::solver_entry => "a solver parameter `NAME = NUMBER`",
         Rule::site_type_decl => "a `site type` declaration",
@@ -139,11 +141,19 @@ pub fn parse(source: &str) -> Result<File, Diagnostics> {
         Err(e) => return Err(syntax_error(source, e).into()),
     };
     let Some(file) = pairs.next() else {
-        return Err(Diagnostic::error(codes::SYNTAX, "empty parse", Span::new(0, 0), "here").into());
+        return Err(
+            Diagnostic::error(codes::SYNTAX, "empty parse", Span::new(0, 0), "here").into(),
+        );
     };
-    let mut lower = Lower { diags: Diagnostics::new() };
+    let mut lower = Lower {
+        diags: Diagnostics::new(),
+    };
     let tree = lower.file(file);
-    if lower.diags.has_errors() { Err(lower.diags) } else { Ok(tree) }
+    if lower.diags.has_errors() {
+        Err(lower.diags)
+    } else {
+        Ok(tree)
+    }
 }
 
 /// Rejects input nested deeper than [`MAX_NESTING`] (brackets of any kind and block comments)
@@ -177,7 +187,11 @@ fn check_nesting(source: &str) -> Option<Diagnostic> {
             brackets = brackets.saturating_sub(1);
         }
         if brackets > MAX_NESTING || comments > MAX_NESTING {
-            let what = if comments > MAX_NESTING { "block comments" } else { "brackets" };
+            let what = if comments > MAX_NESTING {
+                "block comments"
+            } else {
+                "brackets"
+            };
             return Some(
                 Diagnostic::error(
                     codes::TOO_DEEP,
@@ -203,18 +217,21 @@ fn found_token(source: &str, pos: usize) -> (Span, String) {
     let trimmed = rest.trim_start();
     let start = pos + (rest.len() - trimmed.len());
     let Some(c) = trimmed.chars().next() else {
-        return (Span::new(source.len(), source.len()), "end of file".to_string());
+        return (
+            Span::new(source.len(), source.len()),
+            "end of file".to_string(),
+        );
     };
     let len = if c.is_ascii_alphanumeric() || c == '_' {
-        trimmed.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.')).unwrap_or(trimmed.len())
+        trimmed
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.'))
+            .unwrap_or(trimmed.len())
     } else {
         c.len_utf8()
     };
     let text = &trimmed[..len];
-    let words = if c.is_ascii_digit() || c == '-' && len == 1 && false {
-        format!("`{text}`")
-    } else if c.is_control() {
-        format!("character {:?}", c)
+    let words = if c.is_control() {
+        format!("character {c:?}")
     } else {
         format!("`{text}`")
     };
@@ -255,6 +272,22 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
             if let Some(hint) = syntax_hint(source, span, positives) {
                 d = d.with_hint(hint);
             }
+            // A misspelt keyword: suggest the closest one that would fit here.
+            let text = source.get(span.start..span.end).unwrap_or("");
+            // Backticked words in the expectation (`site type` offers `site`).
+            let keywords = words
+                .iter()
+                .flat_map(|w| w.split('`').skip(1).step_by(2))
+                .filter_map(|k| k.split_whitespace().next())
+                .filter(|k| k.chars().all(|c| c.is_ascii_alphabetic()));
+            if let Some(k) = crate::compile::closest(text, keywords) {
+                d = d.with_hint(format!("did you mean `{k}`?"));
+            }
+            if span.start >= source.len() {
+                if let Some(open) = unclosed(source) {
+                    d = d.with_secondary(open, "this bracket is never closed");
+                }
+            }
             d
         }
         ErrorVariant::CustomError { message } => {
@@ -263,11 +296,47 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
     }
 }
 
+/// The innermost bracket left open at the end of the source (comments skipped).
+fn unclosed(source: &str) -> Option<Span> {
+    let bytes = source.as_bytes();
+    let mut open: Vec<usize> = Vec::new();
+    let mut i = 0;
+    let mut comments = 0usize;
+    while i < bytes.len() {
+        let (b, next) = (bytes[i], bytes.get(i + 1).copied());
+        if comments > 0 {
+            if b == b'/' && next == Some(b'*') {
+                comments += 1;
+                i += 1;
+            } else if b == b'*' && next == Some(b'/') {
+                comments -= 1;
+                i += 1;
+            }
+        } else if b == b'/' && next == Some(b'/') {
+            while i < bytes.len() && bytes[i] != b'\n' {
+                i += 1;
+            }
+        } else if b == b'/' && next == Some(b'*') {
+            comments = 1;
+            i += 1;
+        } else if matches!(b, b'(' | b'[' | b'{') {
+            open.push(i);
+        } else if matches!(b, b')' | b']' | b'}') {
+            open.pop();
+        }
+        i += 1;
+    }
+    open.last().map(|&i| Span::new(i, i + 1))
+}
+
 /// A hint for common slips, judged from what was expected and what is there.
 fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
     let text = source.get(span.start..span.end).unwrap_or("");
     if positives.contains(&Rule::colour) && text.starts_with('#') {
-        return Some("colours are `#` followed by 6 or 8 hexadecimal digits, like `#b5651d` or `#b5651d80`".into());
+        return Some(
+            "colours are `#` followed by 6 or 8 hexadecimal digits, like `#b5651d` or `#b5651d80`"
+                .into(),
+        );
     }
     if positives.contains(&Rule::comma) && positives.contains(&Rule::rparen) {
         return Some("points are written `(x, y)`".into());
@@ -283,9 +352,15 @@ struct Lower {
     diags: Diagnostics,
 }
 
+/// The span of a pair without the trailing whitespace and comments pest includes when an
+/// optional tail was tried and not found: it ends where its last token ends.
 fn span_of(p: &Pair<Rule>) -> Span {
-    let s = p.as_span();
-    Span::new(s.start(), s.end())
+    let start = p.as_span().start();
+    let mut last = p.clone();
+    while let Some(child) = last.clone().into_inner().last() {
+        last = child;
+    }
+    Span::new(start, last.as_span().end().max(start))
 }
 
 /// Children that carry meaning: punctuation is dropped.
@@ -314,7 +389,11 @@ fn kids(p: Pair<Rule>) -> Vec<Pair<Rule>> {
 
 /// Children of one rule, in order.
 fn of<'i>(children: &[Pair<'i, Rule>], rule: Rule) -> Vec<Pair<'i, Rule>> {
-    children.iter().filter(|c| c.as_rule() == rule).cloned().collect()
+    children
+        .iter()
+        .filter(|c| c.as_rule() == rule)
+        .cloned()
+        .collect()
 }
 
 fn first<'i>(children: &[Pair<'i, Rule>], rule: Rule) -> Option<Pair<'i, Rule>> {
@@ -323,11 +402,17 @@ fn first<'i>(children: &[Pair<'i, Rule>], rule: Rule) -> Option<Pair<'i, Rule>> 
 
 impl Lower {
     fn ident(&self, p: Pair<Rule>) -> Ident {
-        Ident { name: p.as_str().to_string(), span: span_of(&p) }
+        Ident {
+            name: p.as_str().to_string(),
+            span: span_of(&p),
+        }
     }
 
     fn idents(&self, children: &[Pair<Rule>]) -> Vec<Ident> {
-        of(children, Rule::name).into_iter().map(|p| self.ident(p)).collect()
+        of(children, Rule::name)
+            .into_iter()
+            .map(|p| self.ident(p))
+            .collect()
     }
 
     fn number(&mut self, p: Pair<Rule>) -> Number {
@@ -337,8 +422,13 @@ impl Lower {
         let value = p.as_str().parse::<f64>().unwrap_or(f64::NAN);
         if !value.is_finite() {
             self.diags.push(
-                Diagnostic::error(codes::NON_FINITE, "number is too large", span, "does not fit in a 64-bit float")
-                    .with_hint("numbers must be finite; the largest is about 1.8e308"),
+                Diagnostic::error(
+                    codes::NON_FINITE,
+                    "number is too large",
+                    span,
+                    "does not fit in a 64-bit float",
+                )
+                .with_hint("numbers must be finite; the largest is about 1.8e308"),
             );
             return Number { value: 0.0, span };
         }
@@ -348,21 +438,37 @@ impl Lower {
     fn point(&mut self, p: Pair<Rule>) -> Point {
         let span = span_of(&p);
         let mut nums = of(&kids(p), Rule::number).into_iter();
-        let x = nums.next().map(|n| self.number(n)).unwrap_or(Number { value: 0.0, span });
-        let y = nums.next().map(|n| self.number(n)).unwrap_or(Number { value: 0.0, span });
+        let x = nums
+            .next()
+            .map(|n| self.number(n))
+            .unwrap_or(Number { value: 0.0, span });
+        let y = nums
+            .next()
+            .map(|n| self.number(n))
+            .unwrap_or(Number { value: 0.0, span });
         Point { x, y, span }
     }
 
     fn points(&mut self, p: Pair<Rule>) -> Vec<Point> {
-        of(&kids(p), Rule::point).into_iter().map(|q| self.point(q)).collect()
+        of(&kids(p), Rule::point)
+            .into_iter()
+            .map(|q| self.point(q))
+            .collect()
     }
 
     fn colour(&self, p: Pair<Rule>) -> Colour {
         let span = span_of(&p);
         let hex = p.as_str().trim_start_matches('#');
-        let byte = |i: usize| hex.get(i..i + 2).and_then(|h| u8::from_str_radix(h, 16).ok()).unwrap_or(255);
+        let byte = |i: usize| {
+            hex.get(i..i + 2)
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .unwrap_or(255)
+        };
         let alpha = if hex.len() == 8 { byte(6) } else { 255 };
-        Colour { rgba: [byte(0), byte(2), byte(4), alpha], span }
+        Colour {
+            rgba: [byte(0), byte(2), byte(4), alpha],
+            span,
+        }
     }
 
     fn file(&mut self, p: Pair<Rule>) -> File {
@@ -392,25 +498,48 @@ impl Lower {
         for e in of(&ch, Rule::solver_entry) {
             let espan = span_of(&e);
             let ec = kids(e);
-            let (Some(n), Some(v)) = (first(&ec, Rule::name), first(&ec, Rule::number)) else { continue };
+            let (Some(n), Some(v)) = (first(&ec, Rule::name), first(&ec, Rule::number)) else {
+                continue;
+            };
             let name = self.ident(n);
             let value = self.number(v);
-            entries.push(SolverEntry { name, value, span: espan });
+            entries.push(SolverEntry {
+                name,
+                value,
+                span: espan,
+            });
         }
-        SolverBlock { entries, keyword, span }
+        SolverBlock {
+            entries,
+            keyword,
+            span,
+        }
     }
 
     fn site_type(&mut self, p: Pair<Rule>) -> SiteTypeDecl {
         let span = span_of(&p);
         let mut names = self.idents(&kids(p)).into_iter();
-        let name = names.next().unwrap_or(Ident { name: String::new(), span });
-        SiteTypeDecl { name, docks: names.collect(), span }
+        let name = names.next().unwrap_or(Ident {
+            name: String::new(),
+            span,
+        });
+        SiteTypeDecl {
+            name,
+            docks: names.collect(),
+            span,
+        }
     }
 
     fn piece(&mut self, p: Pair<Rule>) -> PieceDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let name = first(&ch, Rule::name).map_or(
+            Ident {
+                name: String::new(),
+                span,
+            },
+            |n| self.ident(n),
+        );
         let mut stmts = Vec::new();
         for c in ch {
             let stmt = match c.as_rule() {
@@ -420,8 +549,14 @@ impl Lower {
                 Rule::axis_decl => {
                     let aspan = span_of(&c);
                     let names = self.idents(&kids(c));
-                    let (Some(from), Some(to)) = (names.first(), names.get(1)) else { continue };
-                    PieceStmt::Axis(AxisDecl { from: from.clone(), to: to.clone(), span: aspan })
+                    let (Some(from), Some(to)) = (names.first(), names.get(1)) else {
+                        continue;
+                    };
+                    PieceStmt::Axis(AxisDecl {
+                        from: from.clone(),
+                        to: to.clone(),
+                        span: aspan,
+                    })
                 }
                 Rule::polygon_decl | Rule::polyline_decl => PieceStmt::Geometry(self.geometry(c)),
                 Rule::state_decl => PieceStmt::State(self.state(c)),
@@ -435,15 +570,32 @@ impl Lower {
     fn vertex(&mut self, p: Pair<Rule>) -> VertexDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let name = first(&ch, Rule::name).map_or(
+            Ident {
+                name: String::new(),
+                span,
+            },
+            |n| self.ident(n),
+        );
         let pos = first(&ch, Rule::point).map(|q| self.point(q));
         let zero = Number { value: 0.0, span };
-        VertexDecl { name, pos: pos.unwrap_or(Point { x: zero, y: zero, span }), span }
+        VertexDecl {
+            name,
+            pos: pos.unwrap_or(Point {
+                x: zero,
+                y: zero,
+                span,
+            }),
+            span,
+        }
     }
 
     fn edges(&mut self, p: Pair<Rule>) -> EdgesDecl {
         let span = span_of(&p);
-        let paths = of(&kids(p), Rule::edge_path).into_iter().map(|path| self.idents(&kids(path))).collect();
+        let paths = of(&kids(p), Rule::edge_path)
+            .into_iter()
+            .map(|path| self.idents(&kids(path)))
+            .collect();
         EdgesDecl { paths, span }
     }
 
@@ -451,7 +603,10 @@ impl Lower {
         let span = span_of(&p);
         let ch = kids(p);
         let names = self.idents(&ch);
-        let empty = Ident { name: String::new(), span };
+        let empty = Ident {
+            name: String::new(),
+            span,
+        };
         let list = first(&ch, Rule::vertex_list);
         let vertices_span = list.as_ref().map_or(span, span_of);
         let vertices = list.map(|l| self.idents(&kids(l))).unwrap_or_default();
@@ -462,7 +617,11 @@ impl Lower {
             site_type: names.get(1).cloned().unwrap_or(empty),
             vertices,
             vertices_span,
-            out: out.unwrap_or(Point { x: zero, y: zero, span }),
+            out: out.unwrap_or(Point {
+                x: zero,
+                y: zero,
+                span,
+            }),
             span,
         }
     }
@@ -474,32 +633,65 @@ impl Lower {
         let keyword = ch.first().map_or(span, span_of);
         let binding = first(&ch, Rule::binding).map(|b| {
             let bspan = span_of(&b);
-            let kind = if b.as_str().starts_with("skinned") { BindingKw::Skinned } else { BindingKw::Rigid };
+            let kind = if b.as_str().starts_with("skinned") {
+                BindingKw::Skinned
+            } else {
+                BindingKw::Rigid
+            };
             (kind, bspan)
         });
-        let fill = first(&ch, Rule::colour).map_or(Colour { rgba: [255; 4], span }, |c| self.colour(c));
-        let points = first(&ch, Rule::point_list).map(|l| self.points(l)).unwrap_or_default();
+        let fill = first(&ch, Rule::colour).map_or(
+            Colour {
+                rgba: [255; 4],
+                span,
+            },
+            |c| self.colour(c),
+        );
+        let points = first(&ch, Rule::point_list)
+            .map(|l| self.points(l))
+            .unwrap_or_default();
         let shape = if is_polygon {
             let holes = of(&ch, Rule::hole)
                 .into_iter()
                 .map(|h| {
                     let hspan = span_of(&h);
-                    let points = first(&kids(h), Rule::point_list).map(|l| self.points(l)).unwrap_or_default();
-                    HoleDecl { points, span: hspan }
+                    let points = first(&kids(h), Rule::point_list)
+                        .map(|l| self.points(l))
+                        .unwrap_or_default();
+                    HoleDecl {
+                        points,
+                        span: hspan,
+                    }
                 })
                 .collect();
-            ShapeDecl::Polygon { outer: points, holes }
+            ShapeDecl::Polygon {
+                outer: points,
+                holes,
+            }
         } else {
-            let width = first(&ch, Rule::number).map_or(Number { value: 0.0, span }, |n| self.number(n));
+            let width =
+                first(&ch, Rule::number).map_or(Number { value: 0.0, span }, |n| self.number(n));
             ShapeDecl::Polyline { width, points }
         };
-        GeometryDecl { shape, binding, fill, keyword, span }
+        GeometryDecl {
+            shape,
+            binding,
+            fill,
+            keyword,
+            span,
+        }
     }
 
     fn state(&mut self, p: Pair<Rule>) -> StateDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(Ident { name: String::new(), span }, |n| self.ident(n));
+        let name = first(&ch, Rule::name).map_or(
+            Ident {
+                name: String::new(),
+                span,
+            },
+            |n| self.ident(n),
+        );
         let mut positions = Vec::new();
         let mut edges = Vec::new();
         let mut geometry = Vec::new();
@@ -511,14 +703,23 @@ impl Lower {
                 _ => {}
             }
         }
-        StateDecl { name, positions, edges, geometry, span }
+        StateDecl {
+            name,
+            positions,
+            edges,
+            geometry,
+            span,
+        }
     }
 
     fn stretch(&mut self, p: Pair<Rule>) -> StretchDecl {
         let span = span_of(&p);
         let ch = kids(p);
         let names = self.idents(&ch);
-        let empty = Ident { name: String::new(), span };
+        let empty = Ident {
+            name: String::new(),
+            span,
+        };
         let min = of(&ch, Rule::min_decl)
             .into_iter()
             .filter_map(|m| first(&kids(m), Rule::number))
@@ -533,12 +734,31 @@ impl Lower {
                     .map(|e| {
                         let espan = span_of(&e);
                         let ec = kids(e);
-                        let piece = first(&ec, Rule::name).map_or(Ident { name: String::new(), span: espan }, |n| self.ident(n));
-                        let frequency = first(&ec, Rule::number).map_or(Number { value: 0.0, span: espan }, |n| self.number(n));
-                        VariantEntry { piece, frequency, span: espan }
+                        let piece = first(&ec, Rule::name).map_or(
+                            Ident {
+                                name: String::new(),
+                                span: espan,
+                            },
+                            |n| self.ident(n),
+                        );
+                        let frequency = first(&ec, Rule::number).map_or(
+                            Number {
+                                value: 0.0,
+                                span: espan,
+                            },
+                            |n| self.number(n),
+                        );
+                        VariantEntry {
+                            piece,
+                            frequency,
+                            span: espan,
+                        }
                     })
                     .collect();
-                VariantsDecl { entries, span: vspan }
+                VariantsDecl {
+                    entries,
+                    span: vspan,
+                }
             })
             .collect();
         StretchDecl {
@@ -554,31 +774,67 @@ impl Lower {
     fn site_path(&self, p: Pair<Rule>) -> SitePath {
         let span = span_of(&p);
         let names = self.idents(&kids(p));
-        let empty = Ident { name: String::new(), span };
-        SitePath { piece: names.first().cloned().unwrap_or(empty.clone()), site: names.get(1).cloned().unwrap_or(empty), span }
+        let empty = Ident {
+            name: String::new(),
+            span,
+        };
+        SitePath {
+            piece: names.first().cloned().unwrap_or(empty.clone()),
+            site: names.get(1).cloned().unwrap_or(empty),
+            span,
+        }
     }
 
     fn merge(&mut self, p: Pair<Rule>) -> MergeDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let mut paths = of(&ch, Rule::site_path).into_iter().map(|s| self.site_path(s));
-        let empty = SitePath { piece: Ident { name: String::new(), span }, site: Ident { name: String::new(), span }, span };
+        let mut paths = of(&ch, Rule::site_path)
+            .into_iter()
+            .map(|s| self.site_path(s));
+        let empty = SitePath {
+            piece: Ident {
+                name: String::new(),
+                span,
+            },
+            site: Ident {
+                name: String::new(),
+                span,
+            },
+            span,
+        };
         let mover = paths.next().unwrap_or(empty.clone());
         let target = paths.next().unwrap_or(empty);
         let junction = paths.next();
         let within = first(&ch, Rule::number).map(|n| self.number(n));
-        MergeDecl { mover, target, junction, within, span }
+        MergeDecl {
+            mover,
+            target,
+            junction,
+            within,
+            span,
+        }
     }
 
     fn cut(&mut self, p: Pair<Rule>) -> CutDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let empty = Ident { name: String::new(), span };
+        let empty = Ident {
+            name: String::new(),
+            span,
+        };
         let junction = first(&ch, Rule::site_path)
             .map(|s| self.site_path(s))
-            .unwrap_or(SitePath { piece: empty.clone(), site: empty.clone(), span });
+            .unwrap_or(SitePath {
+                piece: empty.clone(),
+                site: empty.clone(),
+                span,
+            });
         let into = first(&ch, Rule::name).map_or(empty, |n| self.ident(n));
-        CutDecl { junction, into, span }
+        CutDecl {
+            junction,
+            into,
+            span,
+        }
     }
 
     fn model(&mut self, p: Pair<Rule>) -> ModelBlock {
@@ -590,15 +846,28 @@ impl Lower {
             let cspan = span_of(&c);
             match c.as_rule() {
                 Rule::dock_decl => {
-                    let mut sites = of(&kids(c), Rule::instance_site).into_iter().map(|s| self.instance_site(s));
-                    let (Some(a), Some(b)) = (sites.next(), sites.next()) else { continue };
+                    let mut sites = of(&kids(c), Rule::instance_site)
+                        .into_iter()
+                        .map(|s| self.instance_site(s));
+                    let (Some(a), Some(b)) = (sites.next(), sites.next()) else {
+                        continue;
+                    };
                     stmts.push(ModelStmt::Dock(DockDecl { a, b, span: cspan }));
                 }
                 Rule::chain_decl => {
                     let cc = kids(c);
                     let names = self.idents(&cc);
-                    let empty = Ident { name: String::new(), span: cspan };
-                    let count = first(&cc, Rule::number).map_or(Number { value: 0.0, span: cspan }, |n| self.number(n));
+                    let empty = Ident {
+                        name: String::new(),
+                        span: cspan,
+                    };
+                    let count = first(&cc, Rule::number).map_or(
+                        Number {
+                            value: 0.0,
+                            span: cspan,
+                        },
+                        |n| self.number(n),
+                    );
                     let along = first(&cc, Rule::along).and_then(|a| {
                         let n = self.idents(&kids(a));
                         Some((n.first()?.clone(), n.get(1)?.clone()))
@@ -617,7 +886,10 @@ impl Lower {
                 Rule::instance_decl => {
                     let cc = kids(c);
                     let names = self.idents(&cc);
-                    let empty = Ident { name: String::new(), span: cspan };
+                    let empty = Ident {
+                        name: String::new(),
+                        span: cspan,
+                    };
                     let (at, rotate) = self.placement(&cc);
                     stmts.push(ModelStmt::Instance(InstanceDecl {
                         name: names.first().cloned().unwrap_or(empty.clone()),
@@ -630,12 +902,20 @@ impl Lower {
                 _ => {}
             }
         }
-        ModelBlock { stmts, keyword, span }
+        ModelBlock {
+            stmts,
+            keyword,
+            span,
+        }
     }
 
     fn placement(&mut self, ch: &[Pair<Rule>]) -> (Option<Point>, Option<Number>) {
-        let at = first(ch, Rule::at).and_then(|a| first(&kids(a), Rule::point)).map(|p| self.point(p));
-        let rotate = first(ch, Rule::rotate).and_then(|r| first(&kids(r), Rule::number)).map(|n| self.number(n));
+        let at = first(ch, Rule::at)
+            .and_then(|a| first(&kids(a), Rule::point))
+            .map(|p| self.point(p));
+        let rotate = first(ch, Rule::rotate)
+            .and_then(|r| first(&kids(r), Rule::number))
+            .map(|n| self.number(n));
         (at, rotate)
     }
 
@@ -643,7 +923,10 @@ impl Lower {
         let span = span_of(&p);
         let ch = kids(p);
         let names = self.idents(&ch);
-        let empty = Ident { name: String::new(), span };
+        let empty = Ident {
+            name: String::new(),
+            span,
+        };
         let index = first(&ch, Rule::element_index).map(|e| {
             let espan = span_of(&e);
             let index = match first(&kids(e), Rule::integer) {

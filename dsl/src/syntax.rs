@@ -17,7 +17,10 @@ impl Span {
 
     /// The smallest span covering both.
     pub fn to(self, other: Span) -> Span {
-        Span { start: self.start.min(other.start), end: self.end.max(other.end) }
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
     }
 }
 
@@ -174,8 +177,14 @@ pub struct GeometryDecl {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeDecl {
-    Polygon { outer: Vec<Point>, holes: Vec<HoleDecl> },
-    Polyline { width: Number, points: Vec<Point> },
+    Polygon {
+        outer: Vec<Point>,
+        holes: Vec<HoleDecl>,
+    },
+    Polyline {
+        width: Number,
+        points: Vec<Point>,
+    },
 }
 
 /// `hole { POINT... }`.

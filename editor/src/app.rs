@@ -240,12 +240,16 @@ impl EditorApp {
                 self.problems = c.warnings;
                 let first_good = self.stale && self.sculpt.data().parts.is_empty();
                 self.stale = false;
-                self.sculpt.replace_grammar(c.grammar);
+                let kept = self.sculpt.replace_grammar(c.grammar);
                 self.canvas.grammar_changed();
                 if first_good {
                     self.canvas.request_fit();
                 }
-                self.message = Some(format!("reloaded {shown}"));
+                self.message = Some(if kept {
+                    format!("reloaded {shown}; sculpt kept")
+                } else {
+                    format!("reloaded {shown}; model rebuilt")
+                });
             }
             Err(problems) => {
                 self.problems = problems;
@@ -425,7 +429,7 @@ impl EditorApp {
     fn dialogs(&mut self, ctx: &egui::Context) {
         if let Some(d) = &mut self.dialog {
             let mut done = None;
-            let r = egui::Modal::new(egui::Id::new("path dialog")).show(ctx, |ui| {
+            let r = egui::Modal::new(egui::Id::unique("path dialog")).show(ctx, |ui| {
                 ui.heading(d.kind.title());
                 ui.label("Path:");
                 let edit = ui.text_edit_singleline(&mut d.text);
@@ -455,7 +459,7 @@ impl EditorApp {
         }
         if let Some(action) = self.confirm.clone() {
             let mut answer = None;
-            egui::Modal::new(egui::Id::new("confirm")).show(ctx, |ui| {
+            egui::Modal::new(egui::Id::unique("confirm")).show(ctx, |ui| {
                 ui.heading("Unsaved changes");
                 let what = match &action {
                     Action::Quit => "quitting",

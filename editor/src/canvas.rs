@@ -131,7 +131,7 @@ impl Canvas {
         };
         let cutting = modifiers.command || modifiers.ctrl;
         self.cut_target = if cutting && self.drag.is_none() {
-            world.and_then(|w| dock_at(w, &sculpt.dock_centres(), tolerance * 1.5))
+            world.and_then(|w| sculpt.cut_target(w))
         } else {
             None
         };
@@ -320,7 +320,7 @@ impl Canvas {
             if !self.rect.contains(at) {
                 continue;
             }
-            let id = ui.id().with(("part", part));
+            let id = ui.scope_id().with(("part", part));
             let r = ui.interact(Rect::from_center_size(at, Vec2::splat(4.0)), id, Sense::hover());
             r.widget_info(|| {
                 egui::WidgetInfo::labeled(egui::Role::GraphicsObject, true, format!("part {part}"))
@@ -414,18 +414,6 @@ pub fn part_at(w: DVec2, meshes: &[WorldMesh], data: &AssemblyData, tolerance: f
         }
     }
     best.map(|(i, _)| i)
-}
-
-/// The connection whose centre is nearest `w`, within `tolerance`.
-pub fn dock_at(w: DVec2, centres: &[DVec2], tolerance: f64) -> Option<usize> {
-    centres
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.is_finite())
-        .map(|(i, c)| (i, c.distance(w)))
-        .filter(|(_, d)| *d <= tolerance)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
 }
 
 fn mesh_contains(m: &WorldMesh, w: DVec2) -> bool {

@@ -73,7 +73,7 @@ pub struct Compiled {
 /// Compiles grammar text. `path` is used in messages and recorded in the grammar.
 ///
 /// Besides `.clay` text this accepts a compiled grammar in JSON (what `clayc compile` writes),
-/// recognised by its leading `{`.
+/// recognised by its leading `{` (a `.clay` file starts with a keyword or comment).
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     if source.trim_start().starts_with('{') {
         return compile_json(source, path);
@@ -104,16 +104,62 @@ fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     })
 }
 
-fn compile_clay(_source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
-    Err(vec![Problem::whole_file(
-        path,
-        "this build has no .clay compiler yet (clay_dsl::compile); open a compiled grammar (.json)",
-    )])
+fn compile_clay(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
+    match clay_dsl::compile(source, path) {
+        Ok(c) => Ok(Compiled {
+            grammar: Arc::new(c.grammar),
+            warnings: problems(&c.warnings, source, path),
+        }),
+        Err(diagnostics) => Err(problems(&diagnostics, source, path)),
+    }
+}
+
+/// The compiler's diagnostics located by line and column of their primary span.
+fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Vec<Problem> {
+    diagnostics
+        .iter()
+        .map(|d| {
+            let (line, col) = clay_dsl::line_col(source, d.primary.span.start);
+            let mut message = d.message.clone();
+            if !d.primary.message.is_empty() {
+                message = format!("{message} ({})", d.primary.message);
+            }
+            Problem {
+                severity: if d.is_error() {
+                    Severity::Error
+                } else {
+                    Severity::Warning
+                },
+                code: d.code.to_string(),
+                file: path.to_string(),
+                line,
+                col,
+                message,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bundled_castle_compiles() {
+        let c = compile(CASTLE_SOURCE, CASTLE_PATH).unwrap();
+        assert!(!c.grammar.assembly.instances.is_empty());
+    }
+
+    #[test]
+    fn clay_errors_carry_line_and_column() {
+        let source = "solver {\n    hysteresis = 0.15\n}\npiece {\n";
+        let problems = compile(source, "bad.clay").unwrap_err();
+        assert!(!problems.is_empty());
+        let p = &problems[0];
+        assert_eq!(p.severity, Severity::Error);
+        assert!(p.line >= 4, "error should point at the broken piece, got {p}");
+        assert!(p.to_string().starts_with("bad.clay:"));
+    }
 
     #[test]
     fn malformed_json_grammar_is_located() {

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use clay::assembly::{Assembly, HandleId, HandleKind};
+use clay::rules::{Rules, cut::CUT_REACH, site_centre};
 use clay::solver::local::align;
 use clay::solver::{FrameReport, Solver, SolverConfig};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
@@ -82,6 +83,9 @@ pub struct PartReport {
 
 /// Most log entries kept; older ones are dropped.
 const LOG_LIMIT: usize = 500;
+/// Largest vertex move in a frame, relative to the model's size, for which the model counts
+/// as at rest.
+const SETTLED_MOVE: f64 = 1e-6;
 /// Most gestures kept for undo.
 const UNDO_LIMIT: usize = 200;
 
@@ -89,6 +93,7 @@ const UNDO_LIMIT: usize = 200;
 pub struct Sculpt {
     assembly: Assembly,
     solver: Solver,
+    rules: Rules,
     settings: Settings,
     grab: Option<Grab>,
     undo: Vec<Snapshot>,
@@ -117,6 +122,7 @@ impl Sculpt {
         let assembly = Assembly::new(grammar);
         let mut sculpt = Self {
             solver: Solver::new(SolverConfig::default()),
+            rules: Rules::new(),
             assembly,
             settings,
             grab: None,
@@ -344,22 +350,61 @@ impl Sculpt {
         }
     }
 
-    /// Replaces the grammar (hot reload): the new grammar's initial model, as one undoable step.
-    pub fn replace_grammar(&mut self, grammar: Arc<CompiledGrammar>) {
+    /// Replaces the grammar (hot reload), as one undoable step. When the grammar's model is
+    /// unchanged and the sculpt still fits the new pieces, the sculpt is kept (positions, active
+    /// states, pins) with the parts rebuilt from the new rest states, so editing a piece's
+    /// shape or colours shows on the sculpted model; otherwise the new grammar's initial model.
+    /// Returns whether the sculpt was kept.
+    pub fn replace_grammar(&mut self, grammar: Arc<CompiledGrammar>) -> bool {
         self.release();
+        // A reload alone is not unsaved work: the session file would restore the same sculpt.
+        let dirty = self.dirty;
         self.checkpoint();
+        self.dirty = dirty;
         self.settings = Settings {
             hysteresis: grammar.solver.hysteresis,
             norm: grammar.solver.norm,
             merge_distance: grammar.solver.merge_distance,
         };
         self.configure_solver();
-        self.restore(Snapshot {
-            data: grammar.assembly.clone(),
-            grammar,
-            pins: Vec::new(),
-        });
-        self.note("grammar reloaded".to_string(), None);
+        let same_model = self.grammar().assembly.positions == grammar.assembly.positions
+            && self.grammar().assembly.instances == grammar.assembly.instances
+            && self.grammar().assembly.docks == grammar.assembly.docks
+            && self.grammar().assembly.chains == grammar.assembly.chains;
+        let mut data = self.assembly.data.clone();
+        let keep = same_model && data.check(&grammar).is_ok();
+        if keep {
+            let old = std::mem::take(&mut data.parts);
+            data.parts = grammar.parts(&data);
+            for (new, old) in data.parts.iter_mut().zip(&old) {
+                if new.kind == old.kind && old.active < new.states.len() {
+                    new.active = old.active;
+                }
+            }
+        }
+        let snapshot = if keep && data.check(&grammar).is_ok() {
+            Snapshot {
+                grammar,
+                data,
+                pins: self.pins(),
+            }
+        } else {
+            Snapshot {
+                data: grammar.assembly.clone(),
+                grammar,
+                pins: Vec::new(),
+            }
+        };
+        self.restore(snapshot);
+        self.note(
+            if keep {
+                "grammar reloaded; sculpt kept".to_string()
+            } else {
+                "grammar reloaded; model rebuilt".to_string()
+            },
+            None,
+        );
+        keep
     }
 
     /// Runs solver frames until the model settles or `budget` is spent (at least one frame when
@@ -368,8 +413,17 @@ impl Sculpt {
         let start = Instant::now();
         self.frames_last_step = 0;
         while self.needs_work() {
+            let before = self.assembly.data.positions.clone();
             match self.solver.frame(&mut self.assembly) {
                 Ok(report) => {
+                    // The solver's own flag stays false when IRLS oscillates while pass 2
+                    // keeps the positions, so a frame that moved nothing also counts as settled.
+                    let scale = clay::solver::bbox_diagonal(&before).max(1e-9);
+                    let still = before.len() == self.assembly.data.positions.len()
+                        && before
+                            .iter()
+                            .zip(&self.assembly.data.positions)
+                            .all(|(a, b)| a.distance(*b) <= SETTLED_MOVE * scale);
                     self.frame += 1;
                     self.frames_last_step += 1;
                     for s in &report.switches {
@@ -385,8 +439,17 @@ impl Sculpt {
                             at,
                         );
                     }
-                    // Rules (stretch, shrink, merge) run here once clay::rules exists.
-                    if report.converged {
+                    // Stretch, shrink, merge and replacement after every frame (paper 5.1).
+                    let events = self.rules.after_frame(&mut self.assembly, &report);
+                    self.rules.log.clear();
+                    let changed = !events.is_empty();
+                    for e in events {
+                        self.note(format!("{:?}: {}", e.kind, e.detail).to_lowercase(), Some(e.at));
+                    }
+                    if changed && self.grab.is_some() {
+                        self.follow_grab();
+                    }
+                    if (report.converged || (still && report.switches.is_empty())) && !changed {
                         self.unsettled = false;
                     }
                     self.last_report = Some(report);
@@ -451,24 +514,13 @@ impl Sculpt {
         })
     }
 
-    /// Where each dock (connection) is: the centre of its shared vertices.
+    /// Where each dock (connection) is: the centre of its docked site.
     pub fn dock_centres(&self) -> Vec<DVec2> {
         let data = &self.assembly.data;
         let grammar = self.assembly.grammar();
         data.docks
             .iter()
-            .map(|d| {
-                let vs = data.site_vertices(grammar, d.a).unwrap_or_default();
-                let pts: Vec<DVec2> = vs
-                    .iter()
-                    .filter_map(|&v| data.positions.get(v).copied())
-                    .collect();
-                if pts.is_empty() {
-                    DVec2::splat(f64::NAN)
-                } else {
-                    pts.iter().copied().sum::<DVec2>() / pts.len() as f64
-                }
-            })
+            .map(|d| site_centre(grammar, data, d.a).unwrap_or(DVec2::NAN))
             .collect()
     }
 
@@ -550,19 +602,49 @@ impl Sculpt {
     }
 
     fn cut(&mut self, point: DVec2) {
-        let centres = self.dock_centres();
-        let nearest = centres
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| c.is_finite())
-            .min_by(|a, b| a.1.distance_squared(point).total_cmp(&b.1.distance_squared(point)));
-        match nearest {
-            Some((dock, &at)) => self.note(
-                format!("cut of connection {dock} asked, but this build has no cut rule (clay::rules)"),
-                Some(at),
-            ),
-            None => self.note("nothing to cut here".to_string(), Some(point)),
+        self.checkpoint();
+        match self.rules.cut(&mut self.assembly, point) {
+            Ok(e) => {
+                self.rules.log.clear();
+                self.note(format!("cut: {}", e.detail), Some(e.at));
+                self.unsettled = true;
+            }
+            Err(message) => {
+                // Nothing changed: the gesture leaves no undo step.
+                self.undo.pop();
+                self.note(format!("cut failed: {message}"), Some(point));
+            }
         }
+    }
+
+    /// After a rule renumbered the parts, the grabbed part is the one the handle still holds.
+    fn follow_grab(&mut self) {
+        let Some(g) = &mut self.grab else {
+            return;
+        };
+        let Some(h) = self.assembly.handle(g.handle) else {
+            self.grab = None;
+            return;
+        };
+        let held: std::collections::HashSet<usize> = h.vertices.iter().copied().collect();
+        if let Some(p) = self
+            .assembly
+            .data
+            .parts
+            .iter()
+            .position(|p| p.vertices.iter().all(|v| held.contains(v)))
+        {
+            g.part = p;
+        }
+    }
+
+    /// The connection a cut at `point` would cut, if any is within the cut's reach.
+    pub fn cut_target(&self, point: DVec2) -> Option<usize> {
+        let grammar = self.assembly.grammar();
+        let reach = CUT_REACH.max(2.0 * grammar.solver.merge_distance);
+        clay::rules::cut::nearest_dock(grammar, &self.assembly.data, point)
+            .filter(|(_, d)| *d <= reach)
+            .map(|(i, _)| i)
     }
 
     fn note(&mut self, message: String, at: Option<DVec2>) {

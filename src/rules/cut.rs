@@ -11,7 +11,7 @@ use glam::DVec2;
 
 use super::merge::take_over;
 use super::{
-    PartsBefore, RuleEvent, RuleKind, Rewrite, compact_vertices, derive_chains, rebuild_parts,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, derive_chains, rebuild_parts,
     remove_instances, site_centre, transaction,
 };
 
@@ -120,7 +120,8 @@ pub fn cut_dock(
             }
         };
         derive_chains(grammar, data);
-        let vertex_map = compact_vertices(data);
+        let mut vertex_map = compact_vertices(data);
+        vertex_map.truncate(before.vertices);
         let part_map = rebuild_parts(grammar, data, &before, &touched);
         Ok(Rewrite {
             event: RuleEvent {

@@ -97,9 +97,16 @@ mod tests {
 
     #[test]
     fn rigid_recovers_a_rotation_and_translation() {
-        let from = [DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.0), DVec2::new(0.0, 1.0)];
+        let from = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(2.0, 0.0),
+            DVec2::new(0.0, 1.0),
+        ];
         let rot = DVec2::from_angle(0.7);
-        let to: Vec<DVec2> = from.iter().map(|p| rot.rotate(*p) + DVec2::new(3.0, -1.0)).collect();
+        let to: Vec<DVec2> = from
+            .iter()
+            .map(|p| rot.rotate(*p) + DVec2::new(3.0, -1.0))
+            .collect();
         let m = rigid(&from, &to);
         for (p, q) in from.iter().zip(&to) {
             assert!(m.apply(*p).distance(*q) < 1e-12);
@@ -114,9 +121,16 @@ mod tests {
             DVec2::new(1.0, 0.5),
             DVec2::new(0.0, 0.5),
         ];
-        let to: Vec<DVec2> = from.iter().map(|p| DVec2::new(2.0 * p.x + 1.0, p.y)).collect();
+        let to: Vec<DVec2> = from
+            .iter()
+            .map(|p| DVec2::new(2.0 * p.x + 1.0, p.y))
+            .collect();
         let m = affine(&from, &to);
-        assert!(m.apply(DVec2::new(0.5, 0.25)).distance(DVec2::new(2.0, 0.25)) < 1e-12);
+        assert!(
+            m.apply(DVec2::new(0.5, 0.25))
+                .distance(DVec2::new(2.0, 0.25))
+                < 1e-12
+        );
         let line = [DVec2::ZERO, DVec2::X, DVec2::X * 2.0];
         let shifted: Vec<DVec2> = line.iter().map(|p| *p + DVec2::Y).collect();
         let m = affine(&line, &shifted);

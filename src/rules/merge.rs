@@ -11,7 +11,7 @@ use glam::DVec2;
 
 use super::proximity::SiteGrid;
 use super::{
-    PartsBefore, RuleEvent, RuleKind, Rewrite, compact_vertices, derive_chains, fit,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, derive_chains, fit,
     generated_name, rebuild_parts, remove_instances, site_centre, transaction,
 };
 
@@ -51,8 +51,10 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
         ) else {
             continue;
         };
-        let (Some(ms), Some(ts)) = (mp.sites.get(rule.mover.site), tp.sites.get(rule.target.site))
-        else {
+        let (Some(ms), Some(ts)) = (
+            mp.sites.get(rule.mover.site),
+            tp.sites.get(rule.target.site),
+        ) else {
             continue;
         };
         if !grammar.types_dock(ms.site_type, ts.site_type) || ms.vertices.len() != ts.vertices.len()
@@ -61,7 +63,10 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
         }
         let mut grid = SiteGrid::new(rule.distance);
         for (i, inst) in data.instances.iter().enumerate() {
-            let s = InstanceSite { instance: i, site: rule.target.site };
+            let s = InstanceSite {
+                instance: i,
+                site: rule.target.site,
+            };
             if inst.piece == rule.target.piece
                 && !docked.contains(&s)
                 && let Some(c) = site_centre(grammar, data, s)
@@ -70,14 +75,18 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
             }
         }
         for (i, inst) in data.instances.iter().enumerate() {
-            let m = InstanceSite { instance: i, site: rule.mover.site };
+            let m = InstanceSite {
+                instance: i,
+                site: rule.mover.site,
+            };
             if inst.piece != rule.mover.piece || docked.contains(&m) {
                 continue;
             }
             let Some(c) = site_centre(grammar, data, m) else {
                 continue;
             };
-            let accept = |t: InstanceSite| t.instance != i && !neighbours.contains(&(i, t.instance));
+            let accept =
+                |t: InstanceSite| t.instance != i && !neighbours.contains(&(i, t.instance));
             if let Some((t, d)) = grid.nearest(c, rule.distance, accept)
                 && best.is_none_or(|b| d < b.distance)
             {
@@ -175,7 +184,10 @@ pub(crate) fn take_over(
                         np.name, op.sites[s.site].name
                     )
                 })?;
-                *s = InstanceSite { instance: ni, site: ns };
+                *s = InstanceSite {
+                    instance: ni,
+                    site: ns,
+                };
             }
         }
     }
@@ -224,7 +236,10 @@ pub fn apply(
                 let at = site_centre(grammar, data, m.target).unwrap_or(DVec2::ZERO);
                 let opposite: Vec<usize> = tv.iter().rev().copied().collect();
                 weld_vertices(data, &mv, &opposite);
-                data.docks.push(Dock { a: m.mover, b: m.target });
+                data.docks.push(Dock {
+                    a: m.mover,
+                    b: m.target,
+                });
                 (
                     vec![mover_id, target_id],
                     HashSet::from([mover_id, target_id]),
@@ -236,7 +251,10 @@ pub fn apply(
                 let ji = take_over(grammar, data, m.target.instance, j.piece)?;
                 let junction_id = data.instances[ji].id;
                 let junction_name = data.instances[ji].name.clone();
-                let stem = InstanceSite { instance: ji, site: j.site };
+                let stem = InstanceSite {
+                    instance: ji,
+                    site: j.site,
+                };
                 let sv = data
                     .site_vertices(grammar, stem)
                     .ok_or("the junction's stem site does not exist")?;
@@ -246,20 +264,22 @@ pub fn apply(
                 let at = site_centre(grammar, data, stem).unwrap_or(DVec2::ZERO);
                 let opposite: Vec<usize> = sv.iter().rev().copied().collect();
                 weld_vertices(data, &mv, &opposite);
-                data.docks.push(Dock { a: m.mover, b: stem });
+                data.docks.push(Dock {
+                    a: m.mover,
+                    b: stem,
+                });
                 remove_instances(data, &HashSet::from([m.target.instance]));
                 (
                     vec![mover_id, target_id, junction_id],
                     HashSet::from([mover_id, target_id, junction_id]),
-                    format!(
-                        "{mover_name} merged onto {target_name}, replaced by {junction_name}"
-                    ),
+                    format!("{mover_name} merged onto {target_name}, replaced by {junction_name}"),
                     at,
                 )
             }
         };
         derive_chains(grammar, data);
-        let vertex_map = compact_vertices(data);
+        let mut vertex_map = compact_vertices(data);
+        vertex_map.truncate(before.vertices);
         let part_map = rebuild_parts(grammar, data, &before, &touched);
         Ok(Rewrite {
             event: RuleEvent {

@@ -86,6 +86,8 @@ fn part_key(data: &AssemblyData, part: &Part) -> Option<PartKey> {
 pub(crate) struct PartsBefore {
     keys: Vec<Option<PartKey>>,
     active: Vec<usize>,
+    /// Global vertex count before the rewrite (vertex maps cover these only).
+    pub(crate) vertices: usize,
 }
 
 impl PartsBefore {
@@ -93,6 +95,7 @@ impl PartsBefore {
         Self {
             keys: data.parts.iter().map(|p| part_key(data, p)).collect(),
             active: data.parts.iter().map(|p| p.active).collect(),
+            vertices: data.positions.len(),
         }
     }
 }
@@ -127,7 +130,8 @@ pub(crate) fn rebuild_parts(
             continue;
         }
         if let Some(&oi) = old_by_key.get(&key) {
-            if matches!(part.kind, PartKind::Stretch { .. }) && before.active[oi] < part.states.len()
+            if matches!(part.kind, PartKind::Stretch { .. })
+                && before.active[oi] < part.states.len()
             {
                 part.active = before.active[oi];
             }
@@ -211,9 +215,10 @@ pub(crate) fn compact_vertices(data: &mut AssemblyData) -> Vec<Option<usize>> {
 
 /// Which stretch rule (if any) an instance's piece is an element of.
 fn stretch_rule_of(grammar: &CompiledGrammar, piece: usize) -> Option<usize> {
-    grammar.stretch_rules.iter().position(|r| {
-        r.piece == piece || r.variants.iter().any(|v| v.piece == piece)
-    })
+    grammar
+        .stretch_rules
+        .iter()
+        .position(|r| r.piece == piece || r.variants.iter().any(|v| v.piece == piece))
 }
 
 /// Derives the chains from the docks: maximal runs of elements of one stretch rule docked
@@ -242,7 +247,7 @@ pub(crate) fn derive_chains(grammar: &CompiledGrammar, data: &mut AssemblyData) 
     }
     let mut visited = vec![false; n];
     let mut chains = Vec::new();
-    let mut walk = |start: usize, visited: &mut Vec<bool>, chains: &mut Vec<Chain>| {
+    let walk = |start: usize, visited: &mut Vec<bool>, chains: &mut Vec<Chain>| {
         let mut list = Vec::new();
         let mut at = Some(start);
         while let Some(i) = at {
@@ -262,7 +267,11 @@ pub(crate) fn derive_chains(grammar: &CompiledGrammar, data: &mut AssemblyData) 
     };
     // Start walks at old chain heads first (keeps the old chain order), then any other head,
     // then cycles (closed rings of elements) at their lowest index.
-    let old_heads: Vec<usize> = data.chains.iter().filter_map(|c| c.instances.first().copied()).collect();
+    let old_heads: Vec<usize> = data
+        .chains
+        .iter()
+        .filter_map(|c| c.instances.first().copied())
+        .collect();
     for &h in &old_heads {
         if h < n && rule[h].is_some() && !has_prev[h] && !visited[h] {
             walk(h, &mut visited, &mut chains);
@@ -282,7 +291,11 @@ pub(crate) fn derive_chains(grammar: &CompiledGrammar, data: &mut AssemblyData) 
 }
 
 /// Centre of an instance site's current vertex positions.
-pub fn site_centre(grammar: &CompiledGrammar, data: &AssemblyData, s: InstanceSite) -> Option<DVec2> {
+pub fn site_centre(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    s: InstanceSite,
+) -> Option<DVec2> {
     let vs = data.site_vertices(grammar, s)?;
     if vs.is_empty() {
         return None;
@@ -323,6 +336,8 @@ pub struct Rules {
     pub frame: u64,
     /// Every event so far, in order.
     pub log: Vec<RuleEvent>,
+    /// Why requested operations did nothing (a cut with nothing near), in order.
+    pub notes: Vec<String>,
 }
 
 impl Rules {
@@ -357,7 +372,11 @@ impl Rules {
         for e in &mut events {
             e.frame = self.frame;
         }
-        debug_assert!(asm.data.check(&grammar).is_ok(), "{:?}", asm.data.check(&grammar));
+        debug_assert!(
+            asm.data.check(&grammar).is_ok(),
+            "{:?}",
+            asm.data.check(&grammar)
+        );
         self.log.extend(events.iter().cloned());
         events
     }
@@ -396,6 +415,53 @@ impl Rules {
                 && let Some(slot) = rot.get_mut(*new)
             {
                 *slot = q;
+            }
+        }
+    }
+}
+
+impl From<RuleKind> for crate::script::RuleKind {
+    fn from(k: RuleKind) -> Self {
+        match k {
+            RuleKind::Replace => Self::Replace,
+            RuleKind::Stretch => Self::Stretch,
+            RuleKind::Shrink => Self::Shrink,
+            RuleKind::Merge => Self::Merge,
+            RuleKind::Cut => Self::Cut,
+        }
+    }
+}
+
+impl From<&RuleEvent> for crate::script::RuleEvent {
+    fn from(e: &RuleEvent) -> Self {
+        Self {
+            kind: e.kind.into(),
+            detail: e.detail.clone(),
+        }
+    }
+}
+
+/// The replay hook (`clayc run`, the editor). The replay counts `replace` itself from the
+/// solver's state switches, so replacement events are not passed on (no double counting).
+impl crate::script::FrameHook for Rules {
+    fn after_frame(
+        &mut self,
+        assembly: &mut Assembly,
+        report: &FrameReport,
+    ) -> Vec<crate::script::RuleEvent> {
+        Rules::after_frame(self, assembly, report)
+            .iter()
+            .filter(|e| e.kind != RuleKind::Replace)
+            .map(Into::into)
+            .collect()
+    }
+
+    fn cut(&mut self, assembly: &mut Assembly, at: DVec2) -> Option<Vec<crate::script::RuleEvent>> {
+        match Rules::cut(self, assembly, at) {
+            Ok(e) => Some(vec![(&e).into()]),
+            Err(message) => {
+                self.notes.push(message);
+                Some(Vec::new())
             }
         }
     }

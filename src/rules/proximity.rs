@@ -19,7 +19,11 @@ impl SiteGrid {
     /// A grid for queries of radius up to `cell` (non-positive or non-finite cells are
     /// clamped to a millimetre so that lookups stay finite).
     pub fn new(cell: f64) -> Self {
-        let cell = if cell.is_finite() && cell > 1e-3 { cell } else { 1e-3 };
+        let cell = if cell.is_finite() && cell > 1e-3 {
+            cell
+        } else {
+            1e-3
+        };
         Self {
             cell,
             cells: HashMap::new(),
@@ -28,7 +32,10 @@ impl SiteGrid {
 
     fn key(&self, p: DVec2) -> (i64, i64) {
         // Saturating float -> int casts keep far-away points from wrapping.
-        ((p.x / self.cell).floor() as i64, (p.y / self.cell).floor() as i64)
+        (
+            (p.x / self.cell).floor() as i64,
+            (p.y / self.cell).floor() as i64,
+        )
     }
 
     pub fn insert(&mut self, site: InstanceSite, at: DVec2) {
@@ -52,7 +59,9 @@ impl SiteGrid {
         let mut best: Option<(InstanceSite, f64)> = None;
         for dx in -1..=1 {
             for dy in -1..=1 {
-                let Some(list) = self.cells.get(&(cx.saturating_add(dx), cy.saturating_add(dy)))
+                let Some(list) = self
+                    .cells
+                    .get(&(cx.saturating_add(dx), cy.saturating_add(dy)))
                 else {
                     continue;
                 };
@@ -75,7 +84,10 @@ mod tests {
     #[test]
     fn finds_the_nearest_site_within_the_radius_only() {
         let mut g = SiteGrid::new(0.5);
-        let s = |i| InstanceSite { instance: i, site: 0 };
+        let s = |i| InstanceSite {
+            instance: i,
+            site: 0,
+        };
         g.insert(s(0), DVec2::new(0.0, 0.0));
         g.insert(s(1), DVec2::new(0.3, 0.0));
         g.insert(s(2), DVec2::new(5.0, 5.0));

@@ -49,7 +49,13 @@ pub fn replacement_events(
             frame: 0,
             at,
             instances: vec![inst.id],
-            detail: format!("{} ({}): {} -> {}", inst.name, piece.name, name(from), name(to)),
+            detail: format!(
+                "{} ({}): {} -> {}",
+                inst.name,
+                piece.name,
+                name(from),
+                name(to)
+            ),
         });
     }
     events

@@ -19,7 +19,7 @@ use glam::DVec2;
 
 use super::fit::{self, PointMap};
 use super::{
-    PartsBefore, RuleEvent, RuleKind, Rewrite, compact_vertices, generated_name, rebuild_parts,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, generated_name, rebuild_parts,
     remove_instances, transaction,
 };
 
@@ -60,7 +60,10 @@ fn variants(rule: &StretchRule) -> Vec<(usize, f64)> {
     if rule.variants.is_empty() {
         vec![(rule.piece, 1.0)]
     } else {
-        rule.variants.iter().map(|v| (v.piece, v.frequency)).collect()
+        rule.variants
+            .iter()
+            .map(|v| (v.piece, v.frequency))
+            .collect()
     }
 }
 
@@ -226,7 +229,9 @@ pub fn rewrite_part(
     match part.active {
         THREE => stretch(grammar, data, chain, first),
         ONE => shrink(grammar, data, chain, first),
-        s => Err(format!("chain {chain} element {first}: part is in state {s}, nothing to do")),
+        s => Err(format!(
+            "chain {chain} element {first}: part is in state {s}, nothing to do"
+        )),
     }
 }
 
@@ -262,9 +267,15 @@ pub fn stretch(
         let rule = &grammar.stretch_rules[c.rule];
         let (ia, ib) = match (c.instances.get(first), c.instances.get(first + 1)) {
             (Some(&a), Some(&b)) => (a, b),
-            _ => return Err(format!("chain {chain} has no elements {first}, {}", first + 1)),
+            _ => {
+                return Err(format!(
+                    "chain {chain} has no elements {first}, {}",
+                    first + 1
+                ));
+            }
         };
-        let states = part_states(data, chain, first).ok_or("the stretch part has no three states")?;
+        let states =
+            part_states(data, chain, first).ok_or("the stretch part has no three states")?;
         let layout = Layout::new(grammar, rule);
         let (va, vb) = (
             data.instances[ia].vertices.clone(),
@@ -272,18 +283,25 @@ pub fn stretch(
         );
         let place = Placement::new(&layout, &states, THREE, 3, [&va, &vb], &data.positions)
             .ok_or("the stretch rule's part does not describe an axis")?;
-        let pieces: Vec<usize> = c.instances.iter().map(|&i| data.instances[i].piece).collect();
+        let pieces: Vec<usize> = c
+            .instances
+            .iter()
+            .map(|&i| data.instances[i].piece)
+            .collect();
         let piece = variants(rule)
             .into_iter()
             .map(|(p, _)| p)
             .min_by(|&p, &q| {
-                histogram_error(rule, &pieces, (p, 1))
-                    .total_cmp(&histogram_error(rule, &pieces, (q, 1)))
+                histogram_error(rule, &pieces, (p, 1)).total_cmp(&histogram_error(
+                    rule,
+                    &pieces,
+                    (q, 1),
+                ))
             })
             .unwrap_or(rule.piece);
         let n = layout.from_site.len();
         let nv = va.len();
-        let mut fresh = |data: &mut AssemblyData, p: DVec2| {
+        let fresh = |data: &mut AssemblyData, p: DVec2| {
             data.positions.push(p);
             data.positions.len() - 1
         };
@@ -326,15 +344,28 @@ pub fn stretch(
             vertices: n_vertices,
             state: 0,
         });
-        let a_to = InstanceSite { instance: ia, site: rule.to };
-        let b_from = InstanceSite { instance: ib, site: rule.from };
+        let a_to = InstanceSite {
+            instance: ia,
+            site: rule.to,
+        };
+        let b_from = InstanceSite {
+            instance: ib,
+            site: rule.from,
+        };
         let di = find_dock(data, a_to, b_from).ok_or("the two elements are not docked")?;
-        let n_to = InstanceSite { instance: ni, site: rule.to };
-        let n_from = InstanceSite { instance: ni, site: rule.from };
+        let n_to = InstanceSite {
+            instance: ni,
+            site: rule.to,
+        };
+        let n_from = InstanceSite {
+            instance: ni,
+            site: rule.from,
+        };
         data.docks[di] = Dock { a: n_to, b: b_from };
         data.docks.push(Dock { a: a_to, b: n_from });
         data.chains[chain].instances.insert(first + 1, ni);
-        let vertex_map = compact_vertices(data);
+        let mut vertex_map = compact_vertices(data);
+        vertex_map.truncate(before.vertices);
         let (ida, idb) = (data.instances[ia].id, data.instances[ib].id);
         let touched: HashSet<u64> = [ida, idb, id].into();
         let part_map = rebuild_parts(grammar, data, &before, &touched);
@@ -378,7 +409,12 @@ pub fn shrink(
         }
         let (ia, ib) = match (c.instances.get(first), c.instances.get(first + 1)) {
             (Some(&a), Some(&b)) => (a, b),
-            _ => return Err(format!("chain {chain} has no elements {first}, {}", first + 1)),
+            _ => {
+                return Err(format!(
+                    "chain {chain} has no elements {first}, {}",
+                    first + 1
+                ));
+            }
         };
         let states = part_states(data, chain, first).ok_or("the stretch part has no one state")?;
         let layout = Layout::new(grammar, rule);
@@ -388,18 +424,32 @@ pub fn shrink(
         );
         let place = Placement::new(&layout, &states, ONE, 1, [&va, &vb], &data.positions)
             .ok_or("the stretch rule's part does not describe an axis")?;
-        let pieces: Vec<usize> = c.instances.iter().map(|&i| data.instances[i].piece).collect();
+        let pieces: Vec<usize> = c
+            .instances
+            .iter()
+            .map(|&i| data.instances[i].piece)
+            .collect();
         let (pa, pb) = (data.instances[ia].piece, data.instances[ib].piece);
         let keep_b = histogram_error(rule, &pieces, (pa, -1))
             < histogram_error(rule, &pieces, (pb, -1)) - 1e-12;
         let (keep, gone) = if keep_b { (ib, ia) } else { (ia, ib) };
         // Only the chain docks may touch the removed element: anything else would be lost.
-        let a_to = InstanceSite { instance: ia, site: rule.to };
-        let b_from = InstanceSite { instance: ib, site: rule.from };
+        let a_to = InstanceSite {
+            instance: ia,
+            site: rule.to,
+        };
+        let b_from = InstanceSite {
+            instance: ib,
+            site: rule.from,
+        };
         let inner = find_dock(data, a_to, b_from).ok_or("the two elements are not docked")?;
         let gone_site_ok =
             |s: InstanceSite| s.instance != gone || s.site == rule.from || s.site == rule.to;
-        if data.docks.iter().any(|d| !gone_site_ok(d.a) || !gone_site_ok(d.b)) {
+        if data
+            .docks
+            .iter()
+            .any(|d| !gone_site_ok(d.a) || !gone_site_ok(d.b))
+        {
             return Err("the element to remove is docked at a side site; not shrinking".into());
         }
         let nv = va.len();
@@ -426,7 +476,8 @@ pub fn shrink(
         let (kid, gid) = (data.instances[keep].id, data.instances[gone].id);
         let gone_name = data.instances[gone].name.clone();
         remove_instances(data, &HashSet::from([gone]));
-        let vertex_map = compact_vertices(data);
+        let mut vertex_map = compact_vertices(data);
+        vertex_map.truncate(before.vertices);
         let touched: HashSet<u64> = [kid, gid].into();
         let part_map = rebuild_parts(grammar, data, &before, &touched);
         let ki = data

@@ -79,24 +79,67 @@ pub fn part_rotation(part: &Part, positions: &[DVec2]) -> DVec2 {
     }
 }
 
-/// Sums the rotations of the parts containing each vertex into `sums` (resized to
-/// `vertex_count`), for [`edge_rotation`].
-pub fn vertex_rotation_sums(parts: &[Part], rotations: &[DVec2], vertex_count: usize, sums: &mut Vec<DVec2>) {
-    sums.clear();
-    sums.resize(vertex_count, DVec2::ZERO);
-    for (part, &r) in parts.iter().zip(rotations) {
-        for &v in &part.vertices {
-            sums[v] += r;
+/// For every vertex, the parts containing it (compressed rows; built once per generation).
+#[derive(Clone, Debug, Default)]
+pub struct VertexParts {
+    start: Vec<usize>,
+    parts: Vec<usize>,
+}
+
+impl VertexParts {
+    pub fn build(parts: &[Part], vertex_count: usize) -> Self {
+        let mut count = vec![0usize; vertex_count + 1];
+        for part in parts {
+            for &v in &part.vertices {
+                count[v + 1] += 1;
+            }
         }
+        for i in 0..vertex_count {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut list = vec![0; count[vertex_count]];
+        for (pi, part) in parts.iter().enumerate() {
+            for &v in &part.vertices {
+                list[fill[v]] = pi;
+                fill[v] += 1;
+            }
+        }
+        Self { start: count, parts: list }
+    }
+
+    pub fn of(&self, v: usize) -> &[usize] {
+        &self.parts[self.start[v]..self.start[v + 1]]
     }
 }
 
-/// `R_xy`: the average of the rotations of the parts containing `x` or `y`, as a normalised
-/// sum of unit complex numbers (never an average of angles). Parts containing both count
-/// twice, which keeps this O(1) per edge. Falls back to the part's own rotation when the
-/// rotations cancel out.
-pub fn edge_rotation(sums: &[DVec2], x: usize, y: usize, own: DVec2) -> DVec2 {
-    let s = sums[x] + sums[y];
+/// `R_xy` for an edge of part `own_part`: the average of the rotations of the parts containing
+/// `x` or `y`, as a normalised sum of unit complex numbers (never an average of angles).
+///
+/// Only parts whose rotation lies within the cone `cos_cone` of the part's own rotation take
+/// part: every part's rest states live in its own piece frame, so two parts meeting at a
+/// corner (a wall turning 90 degrees at a tower) have rotations 90 degrees apart even at rest,
+/// and averaging them would leave a rest assembly with non-zero energy. Parts containing both
+/// ends count twice. Falls back to the part's own rotation when the average vanishes.
+pub fn edge_rotation(
+    vertex_parts: &VertexParts,
+    rotations: &[DVec2],
+    x: usize,
+    y: usize,
+    own_part: usize,
+    cos_cone: f64,
+) -> DVec2 {
+    let own = rotations[own_part];
+    if cos_cone >= 1.0 {
+        return own;
+    }
+    let mut s = DVec2::ZERO;
+    for &j in vertex_parts.of(x).iter().chain(vertex_parts.of(y)) {
+        let r = rotations[j];
+        if r.dot(own) >= cos_cone {
+            s += r;
+        }
+    }
     let len = s.length();
     if len > 1e-9 && len.is_finite() { s / len } else { own }
 }
@@ -124,9 +167,37 @@ mod tests {
         assert!(a.distance.is_finite());
     }
 
+    fn two_parts(rotations: &[DVec2]) -> (Vec<Part>, VertexParts) {
+        let part = |v: Vec<usize>| Part {
+            kind: clay_dsl::compiled::PartKind::Piece { instance: 0 },
+            vertices: v,
+            edges: vec![[0, 1]],
+            states: vec![],
+            active: 0,
+        };
+        let parts = vec![part(vec![0, 1]), part(vec![1, 2])];
+        let vp = VertexParts::build(&parts, 3);
+        assert_eq!(rotations.len(), 2);
+        (parts, vp)
+    }
+
     #[test]
-    fn opposite_rotations_fall_back_to_own() {
-        let sums = [DVec2::X, -DVec2::X];
-        assert_eq!(edge_rotation(&sums, 0, 1, DVec2::Y), DVec2::Y);
+    fn edge_rotation_averages_nearby_rotations_as_unit_complex_numbers() {
+        let rotations = [DVec2::from_angle(0.1), DVec2::from_angle(0.3)];
+        let (_, vp) = two_parts(&rotations);
+        let r = edge_rotation(&vp, &rotations, 0, 1, 0, 0.5);
+        // part 0 counts twice (it holds both ends), part 1 once
+        let expected = (2.0 * rotations[0] + rotations[1]).normalize();
+        assert!((r - expected).length() < 1e-12);
+    }
+
+    #[test]
+    fn rotations_outside_the_cone_are_left_out() {
+        let rotations = [DVec2::X, DVec2::Y];
+        let (_, vp) = two_parts(&rotations);
+        assert_eq!(edge_rotation(&vp, &rotations, 0, 1, 0, 0.9), DVec2::X);
+        // with the cone wide open, opposite rotations may cancel: fall back to our own
+        let opposite = [DVec2::X, -DVec2::X];
+        assert_eq!(edge_rotation(&vp, &opposite, 1, 1, 0, -1.0), DVec2::X);
     }
 }

@@ -48,6 +48,10 @@ pub struct SolverConfig {
     /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
     /// current iterate; keeps components without handles well-posed.
     pub proximal_weight: f64,
+    /// Parts whose rotations differ by more than this many degrees do not average into each
+    /// other's `R_xy` (pieces at a corner sit in different frames even at rest). 180 gives the
+    /// paper's plain average, 0 each part's own rotation.
+    pub rotation_cone_degrees: f64,
     /// A pass stops early once no vertex moved more than this fraction of the model's size
     /// (and, in pass 1, no state switched).
     pub tolerance: f64,
@@ -77,6 +81,7 @@ impl SolverConfig {
             irls_iterations: 6,
             l2_iterations: 3,
             handle_weight: 1e6,
+            rotation_cone_degrees: 20.0,
             proximal_weight: 1e-8,
             tolerance: 1e-6,
             cg_tolerance: 1e-6,
@@ -139,7 +144,7 @@ impl std::error::Error for SolverError {}
 #[derive(Debug, Default)]
 struct Work {
     rotations: Vec<DVec2>,
-    sums: Vec<DVec2>,
+    vertex_parts: local::VertexParts,
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
     weights: Vec<f64>,
@@ -156,6 +161,10 @@ struct Work {
     solution: Vec<f64>,
     scratch: Vec<f64>,
     cg: cg::CgWork,
+    warm: Vec<DVec2>,
+    warm_held: Vec<DVec2>,
+    f: Vec<DVec2>,
+    next: Vec<DVec2>,
 }
 
 /// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
@@ -206,6 +215,7 @@ impl Solver {
             }
         }
         self.pattern = Pattern::build(n, &asm.data.parts);
+        self.work.vertex_parts = local::VertexParts::build(&asm.data.parts, n);
         self.symbolic = match self.config.kind {
             SolverKind::Cholesky if n > 0 => Some(
                 SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
@@ -233,22 +243,44 @@ impl Solver {
         }
         let cfg = self.config;
         self.gather_handles(asm.handles(), n);
-        let warm: Vec<DVec2> = asm.data.positions.clone();
+        // Position buffers live in `work` between frames (taken here, put back at the end; an
+        // error path just drops them and the next frame reallocates).
+        let mut warm = std::mem::take(&mut self.work.warm);
+        warm.clear();
+        warm.extend_from_slice(&asm.data.positions);
         if warm.iter().any(|p| !p.is_finite()) {
             return Err(SolverError("the warm start has non-finite positions".into()));
         }
         let scale = bbox_diagonal(&warm).max(1e-9);
         let step_tolerance = cfg.tolerance * scale;
-        let mut f = warm.clone();
-        let mut next = vec![DVec2::ZERO; n];
+        // Handle vertices start at their targets: the gap then opens where the handle meets the
+        // rest of the model, and the sub-quadratic norm keeps it there (paper 5.2: handles are
+        // the "outliers" and gaps first appear near them).
+        let mut warm_held = std::mem::take(&mut self.work.warm_held);
+        warm_held.clone_from(&warm);
+        for (v, p) in warm_held.iter_mut().enumerate() {
+            let count = self.work.handle_count[v];
+            if count > 0.0 {
+                *p = self.work.handle_sum[v] / count;
+            }
+        }
+        let mut f = std::mem::take(&mut self.work.f);
+        f.clone_from(&warm_held);
+        let mut next = std::mem::take(&mut self.work.next);
+        next.clear();
+        next.resize(n, DVec2::ZERO);
         let mut pass1_converged = false;
 
         // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
-        for _ in 0..cfg.irls_iterations {
+        for it in 0..cfg.irls_iterations {
             report.irls_iterations += 1;
             let switched_before = report.switches.len();
-            self.local_step_switching(&mut asm.data.parts, &f, cfg.hysteresis, &mut report.switches);
-            self.edge_targets(&asm.data.parts, n);
+            // The first local step looks at the last displayed pose: judged on the warm start
+            // with only the handles moved, the parts next to a handle look rotated and the
+            // first solve would bend a model that should just follow rigidly.
+            let pose = if it == 0 { &warm } else { &f };
+            self.local_step_switching(&mut asm.data.parts, pose, cfg.hysteresis, &mut report.switches);
+            self.edge_targets(&asm.data.parts);
             let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
             let w = &mut self.work;
             w.weights.clear();
@@ -274,13 +306,26 @@ impl Solver {
         // the warm start is better, and never accept an iterate that raises the objective, so
         // the frame cannot end worse than it started.
         let handles = asm.handles();
-        let warm_terms = self.objective(&asm.data.parts, handles, &warm);
+        // Candidates: the pass-1 result, the warm start with the handles carried to their
+        // targets (continues last frame's least-squares pose), and the plain warm start.
         let mut terms = self.objective(&asm.data.parts, handles, &f);
+        let held_terms = self.objective(&asm.data.parts, handles, &warm_held);
+        let warm_terms = self.objective(&asm.data.parts, handles, &warm);
         report.warm_objective = warm_terms.total();
-        if warm_terms.total() < terms.total() {
-            f.copy_from_slice(&warm);
-            terms = self.objective(&asm.data.parts, handles, &f);
+        let mut chosen = 0;
+        for (k, t) in [(1, held_terms), (2, warm_terms)] {
+            if t.total() < terms.total() {
+                (chosen, terms) = (k, t);
+            }
         }
+        if chosen != 0 {
+            f.copy_from_slice(if chosen == 1 { &warm_held } else { &warm });
+        }
+        // objective() leaves the rotations the first solve uses in the work buffers: those of
+        // the start, or for the handles-moved warm start those of the last displayed pose
+        // (see pass 1).
+        let rotations_from = if chosen == 0 { &f } else { &warm };
+        self.objective(&asm.data.parts, handles, rotations_from);
         let mut pass2_converged = cfg.l2_iterations == 0;
         for _ in 0..cfg.l2_iterations {
             report.l2_iterations += 1;
@@ -315,6 +360,7 @@ impl Solver {
         report.objective = terms.total();
         report.converged = pass1_converged && pass2_converged;
         report.ms = start.elapsed().as_secs_f64() * 1e3;
+        (self.work.warm, self.work.warm_held, self.work.f, self.work.next) = (warm, warm_held, f, next);
         Ok(report)
     }
 
@@ -352,9 +398,9 @@ impl Solver {
     }
 
     /// `R_xy (x0 - y0)` for every part-edge from `work.rotations` and the active states.
-    fn edge_targets(&mut self, parts: &[Part], n: usize) {
+    fn edge_targets(&mut self, parts: &[Part]) {
         let w = &mut self.work;
-        local::vertex_rotation_sums(parts, &w.rotations, n, &mut w.sums);
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
         w.targets.clear();
         for e in &self.pattern.edges {
             let part = &parts[e.part];
@@ -363,7 +409,7 @@ impl Solver {
                 (Some(&a), Some(&b)) => a - b,
                 _ => DVec2::ZERO,
             };
-            let r = local::edge_rotation(&w.sums, e.x, e.y, w.rotations[e.part]);
+            let r = local::edge_rotation(&w.vertex_parts, &w.rotations, e.x, e.y, e.part, cos_cone);
             w.targets.push(r.rotate(d0));
         }
     }
@@ -375,7 +421,7 @@ impl Solver {
         for part in parts {
             self.work.rotations.push(local::part_rotation(part, f));
         }
-        self.edge_targets(parts, f.len());
+        self.edge_targets(parts);
         let mut elastic = 0.0;
         for (e, &t) in self.pattern.edges.iter().zip(&self.work.targets) {
             elastic += (t - (f[e.x] - f[e.y])).length_squared();
@@ -533,23 +579,27 @@ fn sync_instance_states(asm: &mut Assembly) {
 
 /// Elastic energy (Eq. 4, unit weights) of the assembly's current positions and active states,
 /// with each part's rotation fitted to the current pose.
-pub fn elastic_energy(asm: &Assembly) -> f64 {
+pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
     let parts = &asm.data.parts;
     let f = &asm.data.positions;
     let rotations: Vec<DVec2> = parts.iter().map(|p| local::part_rotation(p, f)).collect();
-    let mut sums = Vec::new();
-    local::vertex_rotation_sums(parts, &rotations, f.len(), &mut sums);
+    let vertex_parts = local::VertexParts::build(parts, f.len());
+    let cos_cone = cone_cosine(config.rotation_cone_degrees);
     let mut energy = 0.0;
-    for (part, &own) in parts.iter().zip(&rotations) {
+    for (pi, part) in parts.iter().enumerate() {
         let Some(rest) = part.states.get(part.active) else { continue };
         for e in &part.edges {
             let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
             let d0 = rest.positions[e[0]] - rest.positions[e[1]];
-            let r = local::edge_rotation(&sums, x, y, own);
+            let r = local::edge_rotation(&vertex_parts, &rotations, x, y, pi, cos_cone);
             energy += (r.rotate(d0) - (f[x] - f[y])).length_squared();
         }
     }
     energy
+}
+
+fn cone_cosine(degrees: f64) -> f64 {
+    if degrees >= 180.0 { -1.0 } else { degrees.max(0.0).to_radians().cos() }
 }
 
 /// Largest `|length / rest length - 1|` over the edges of every part's active state (edges

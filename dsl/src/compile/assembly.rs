@@ -33,7 +33,10 @@ struct DockInfo {
 
 enum Named {
     Single(usize),
-    Chain { first: usize, count: usize },
+    Chain {
+        first: usize,
+        count: usize,
+    },
     /// Declared but broken (already reported): references to it are not reported again.
     Broken,
 }
@@ -58,7 +61,10 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                     names.insert(d.name.name.clone(), (Named::Broken, d.name.span));
                     continue;
                 };
-                names.insert(d.name.name.clone(), (Named::Single(insts.len()), d.name.span));
+                names.insert(
+                    d.name.name.clone(),
+                    (Named::Single(insts.len()), d.name.span),
+                );
                 insts.push(Inst {
                     name: d.name.name.clone(),
                     piece,
@@ -77,7 +83,9 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 let piece = c.resolve_piece(&d.piece);
                 let count = c.whole(&d.count, "the chain length", 1);
                 let at = d.at.as_ref().map(|p| c.point(p));
-                let (Some(piece), Some(count)) = (piece, count) else { continue };
+                let (Some(piece), Some(count)) = (piece, count) else {
+                    continue;
+                };
                 if count > (MAX_INSTANCES - insts.len().min(MAX_INSTANCES)) as u64 {
                     if !too_many {
                         c.error(
@@ -95,15 +103,27 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                         let t = c.resolve_site(piece, t);
                         match (f, t) {
                             (Some(f), Some(t)) => {
-                                let (sf, st) = (c.pieces[piece].sites[f].clone(), c.pieces[piece].sites[t].clone());
-                                let (fs, ts) = (d.along.as_ref().map_or(d.span, |a| a.0.span), d.along.as_ref().map_or(d.span, |a| a.1.span));
-                                if c.sites_fit(&st, &sf, ts, fs) { Some((f, t)) } else { None }
+                                let (sf, st) = (
+                                    c.pieces[piece].sites[f].clone(),
+                                    c.pieces[piece].sites[t].clone(),
+                                );
+                                let (fs, ts) = (
+                                    d.along.as_ref().map_or(d.span, |a| a.0.span),
+                                    d.along.as_ref().map_or(d.span, |a| a.1.span),
+                                );
+                                if c.sites_fit(&st, &sf, ts, fs) {
+                                    Some((f, t))
+                                } else {
+                                    None
+                                }
                             }
                             _ => None,
                         }
                     }
                     None => match piece_rule[piece] {
                         Some(r) => Some((c.stretch_rules[r].from, c.stretch_rules[r].to)),
+                        // The piece's stretch rule had errors, already reported.
+                        None if c.stretch_named.get(piece).copied().unwrap_or(false) => None,
                         None => {
                             let pname = c.pieces[piece].name.clone();
                             c.error(
@@ -121,19 +141,36 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                         name: format!("{}[{k}]", d.name.name),
                         piece,
                         at: if k == 0 { at } else { None },
-                        rotate: if k == 0 { d.rotate.map_or(0.0, |r| r.value) } else { 0.0 },
-                        rotate_span: if k == 0 { d.rotate.map(|r| r.span) } else { None },
+                        rotate: if k == 0 {
+                            d.rotate.map_or(0.0, |r| r.value)
+                        } else {
+                            0.0
+                        },
+                        rotate_span: if k == 0 {
+                            d.rotate.map(|r| r.span)
+                        } else {
+                            None
+                        },
                         span: d.name.span,
                     });
                     if k > 0 {
                         docks.push(DockInfo {
-                            a: InstanceSite { instance: first + k - 1, site: to },
-                            b: InstanceSite { instance: first + k, site: from },
+                            a: InstanceSite {
+                                instance: first + k - 1,
+                                site: to,
+                            },
+                            b: InstanceSite {
+                                instance: first + k,
+                                site: from,
+                            },
                             span: d.span,
                         });
                     }
                 }
-                names.insert(d.name.name.clone(), (Named::Chain { first, count }, d.name.span));
+                names.insert(
+                    d.name.name.clone(),
+                    (Named::Chain { first, count }, d.name.span),
+                );
             }
             ModelStmt::Dock(_) => {}
         }
@@ -146,14 +183,25 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
     }
     for stmt in stmts {
         let ModelStmt::Dock(d) = stmt else { continue };
+        let failed_before = c.dock_failed;
         let a = resolve_instance_site(c, &names, &insts, &d.a);
         let b = resolve_instance_site(c, &names, &insts, &d.b);
-        let (Some(a), Some(b)) = (a, b) else { continue };
+        let (Some(a), Some(b)) = (a, b) else {
+            c.dock_failed = true;
+            continue;
+        };
+        // Any failure below leaves the dock out; unplaced instances are then its consequence.
+        c.dock_failed = true;
         if a == b {
             c.error(
-                Diagnostic::error(codes::SELF_DOCK, "a site cannot dock with itself", d.b.span, "same site as the other side")
-                    .with_secondary(d.a.span, "this site")
-                    .with_hint("dock two different sites"),
+                Diagnostic::error(
+                    codes::SELF_DOCK,
+                    "a site cannot dock with itself",
+                    d.b.span,
+                    "same site as the other side",
+                )
+                .with_secondary(d.a.span, "this site")
+                .with_hint("dock two different sites"),
             );
             continue;
         }
@@ -176,6 +224,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
         if !c.sites_fit(&sa, &sb, d.a.span, d.b.span) {
             continue;
         }
+        c.dock_failed = failed_before;
         docked.insert(a, d.span);
         docked.insert(b, d.span);
         docks.push(DockInfo { a, b, span: d.span });
@@ -194,7 +243,13 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
             .into_iter()
             .zip(vertices)
             .enumerate()
-            .map(|(i, (inst, vertices))| Instance { id: i as u64, name: inst.name, piece: inst.piece, vertices, state: 0 })
+            .map(|(i, (inst, vertices))| Instance {
+                id: i as u64,
+                name: inst.name,
+                piece: inst.piece,
+                vertices,
+                state: 0,
+            })
             .collect(),
         docks: docks.iter().map(|d| Dock { a: d.a, b: d.b }).collect(),
         chains,
@@ -231,25 +286,48 @@ fn resolve_instance_site(
         (Some((Named::Single(i), _)), None) => *i,
         (Some((Named::Single(_), _)), Some(ix)) => {
             c.error(
-                Diagnostic::error(codes::BAD_ELEMENT, format!("`{}` is a single instance, not a chain", p.instance.name), ix.span, "no elements to index")
-                    .with_hint(format!("write `{}.{}`", p.instance.name, p.site.name)),
+                Diagnostic::error(
+                    codes::BAD_ELEMENT,
+                    format!("`{}` is a single instance, not a chain", p.instance.name),
+                    ix.span,
+                    "no elements to index",
+                )
+                .with_hint(format!("write `{}.{}`", p.instance.name, p.site.name)),
             );
             return None;
         }
         (Some((Named::Chain { count, .. }, _)), None) => {
             c.error(
-                Diagnostic::error(codes::BAD_ELEMENT, format!("`{}` is a chain of {count}; name one element", p.instance.name), p.instance.span, "a chain, not an instance")
-                    .with_hint(format!("write `{0}[0].{1}` or `{0}[last].{1}`", p.instance.name, p.site.name)),
+                Diagnostic::error(
+                    codes::BAD_ELEMENT,
+                    format!(
+                        "`{}` is a chain of {count}; name one element",
+                        p.instance.name
+                    ),
+                    p.instance.span,
+                    "a chain, not an instance",
+                )
+                .with_hint(format!(
+                    "write `{0}[0].{1}` or `{0}[last].{1}`",
+                    p.instance.name, p.site.name
+                )),
             );
             return None;
         }
         (Some((Named::Chain { first, count }, _)), Some(ix)) => match ix.index {
             ElementIndexKind::Last => first + count - 1,
-            ElementIndexKind::At(k) if (k as usize as u64) == k && (k as usize) < *count => first + k as usize,
+            ElementIndexKind::At(k) if (k as usize as u64) == k && (k as usize) < *count => {
+                first + k as usize
+            }
             ElementIndexKind::At(k) => {
                 c.error(
-                    Diagnostic::error(codes::BAD_ELEMENT, format!("chain `{}` has no element {k}", p.instance.name), ix.span, format!("elements are 0 to {}", count - 1))
-                        .with_hint(format!("use an index from 0 to {} or `last`", count - 1)),
+                    Diagnostic::error(
+                        codes::BAD_ELEMENT,
+                        format!("chain `{}` has no element {k}", p.instance.name),
+                        ix.span,
+                        format!("elements are 0 to {}", count - 1),
+                    )
+                    .with_hint(format!("use an index from 0 to {} or `last`", count - 1)),
                 );
                 return None;
             }
@@ -260,7 +338,12 @@ fn resolve_instance_site(
 }
 
 /// Rigid motion `(angle, translation)` of every instance.
-fn place(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], model_span: Span) -> Vec<(f64, DVec2)> {
+fn place(
+    c: &mut Compiler,
+    insts: &[Inst],
+    docks: &[DockInfo],
+    model_span: Span,
+) -> Vec<(f64, DVec2)> {
     let n = insts.len();
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (k, d) in docks.iter().enumerate() {
@@ -276,12 +359,18 @@ fn place(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], model_span: Span)
         }
     }
     let mut ignored_rotate = 0;
-    let mut bfs = |c: &mut Compiler, motion: &mut Vec<Option<(f64, DVec2)>>, queue: &mut VecDeque<usize>| {
+    let mut bfs = |c: &mut Compiler,
+                   motion: &mut Vec<Option<(f64, DVec2)>>,
+                   queue: &mut VecDeque<usize>| {
         while let Some(i) = queue.pop_front() {
             let (angle_a, shift_a) = motion[i].unwrap_or((0.0, DVec2::ZERO));
             for &k in &adj[i] {
                 let d = &docks[k];
-                let (mine, other) = if d.a.instance == i { (d.a, d.b) } else { (d.b, d.a) };
+                let (mine, other) = if d.a.instance == i {
+                    (d.a, d.b)
+                } else {
+                    (d.b, d.a)
+                };
                 if motion[other.instance].is_some() {
                     continue;
                 }
@@ -290,7 +379,12 @@ fn place(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], model_span: Span)
                 let centre = rotate(site_centre(sa, &pa.states[0].positions), angle_a) + shift_a;
                 let out = rotate(sa.out, angle_a);
                 let pb = &c.pieces[insts[other.instance].piece];
-                motion[other.instance] = Some(dock_motion(centre, out, &pb.sites[other.site], &pb.states[0].positions));
+                motion[other.instance] = Some(dock_motion(
+                    centre,
+                    out,
+                    &pb.sites[other.site],
+                    &pb.states[0].positions,
+                ));
                 if let Some(span) = insts[other.instance].rotate_span {
                     if ignored_rotate < MAX_REPEATS {
                         c.diags.push(
@@ -317,7 +411,7 @@ fn place(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], model_span: Span)
         if motion[i].is_some() {
             continue;
         }
-        if reported < MAX_REPEATS {
+        if reported < MAX_REPEATS && !c.dock_failed {
             c.error(
                 Diagnostic::error(codes::UNPLACED, format!("cannot place instance `{}`", insts[i].name), insts[i].span, "no `at` and not docked to a placed instance")
                     .with_secondary(model_span, "only the first instance goes to the origin by default")
@@ -330,7 +424,10 @@ fn place(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], model_span: Span)
         queue.push_back(i);
         bfs(c, &mut motion, &mut queue);
     }
-    motion.into_iter().map(|m| m.unwrap_or((0.0, DVec2::ZERO))).collect()
+    motion
+        .into_iter()
+        .map(|m| m.unwrap_or((0.0, DVec2::ZERO)))
+        .collect()
 }
 
 fn find(parent: &mut [usize], mut x: usize) -> usize {
@@ -343,7 +440,12 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
 
 /// Global vertices: docked site vertices (i with n-1-i) are one vertex, placed where the first
 /// instance (in declaration order) puts it.
-fn share_vertices(c: &Compiler, insts: &[Inst], docks: &[DockInfo], motions: &[(f64, DVec2)]) -> (Vec<DVec2>, Vec<Vec<usize>>) {
+fn share_vertices(
+    c: &Compiler,
+    insts: &[Inst],
+    docks: &[DockInfo],
+    motions: &[(f64, DVec2)],
+) -> (Vec<DVec2>, Vec<Vec<usize>>) {
     let mut offset = Vec::with_capacity(insts.len() + 1);
     let mut total = 0;
     for inst in insts {
@@ -357,7 +459,10 @@ fn share_vertices(c: &Compiler, insts: &[Inst], docks: &[DockInfo], motions: &[(
         let n = sa.vertices.len().min(sb.vertices.len());
         for i in 0..n {
             let x = find(&mut parent, offset[d.a.instance] + sa.vertices[i]);
-            let y = find(&mut parent, offset[d.b.instance] + sb.vertices[sb.vertices.len() - 1 - i]);
+            let y = find(
+                &mut parent,
+                offset[d.b.instance] + sb.vertices[sb.vertices.len() - 1 - i],
+            );
             if x != y {
                 // The earlier one stays the root, so positions come from the first instance.
                 let (lo, hi) = (x.min(y), x.max(y));
@@ -385,7 +490,12 @@ fn share_vertices(c: &Compiler, insts: &[Inst], docks: &[DockInfo], motions: &[(
     (positions, vertices)
 }
 
-fn check_coincidence(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], motions: &[(f64, DVec2)]) {
+fn check_coincidence(
+    c: &mut Compiler,
+    insts: &[Inst],
+    docks: &[DockInfo],
+    motions: &[(f64, DVec2)],
+) {
     let mut reported = 0;
     for d in docks {
         let (ia, ib) = (&insts[d.a.instance], &insts[d.b.instance]);
@@ -395,10 +505,12 @@ fn check_coincidence(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], motio
         if n != sb.vertices.len() {
             continue;
         }
-        let world = |p: &Piece, v: usize, m: (f64, DVec2)| rotate(p.states[0].positions[v], m.0) + m.1;
+        let world =
+            |p: &Piece, v: usize, m: (f64, DVec2)| rotate(p.states[0].positions[v], m.0) + m.1;
         for i in 0..n {
             let (va, vb) = (sa.vertices[i], sb.vertices[n - 1 - i]);
-            let gap = world(pa, va, motions[d.a.instance]).distance(world(pb, vb, motions[d.b.instance]));
+            let gap =
+                world(pa, va, motions[d.a.instance]).distance(world(pb, vb, motions[d.b.instance]));
             if gap > DOCK_TOLERANCE {
                 if reported < MAX_REPEATS {
                     let msg = format!(
@@ -423,13 +535,23 @@ fn check_coincidence(c: &mut Compiler, insts: &[Inst], docks: &[DockInfo], motio
 
 /// Maximal runs of instances of one stretch rule docked `to` -> `from`, in order; every such
 /// instance is in exactly one chain (a ring is cut open at its first instance).
-fn find_chains(c: &Compiler, insts: &[Inst], docks: &[DockInfo], piece_rule: &[Option<usize>]) -> Vec<Chain> {
+fn find_chains(
+    c: &Compiler,
+    insts: &[Inst],
+    docks: &[DockInfo],
+    piece_rule: &[Option<usize>],
+) -> Vec<Chain> {
     let n = insts.len();
     let mut next = vec![usize::MAX; n];
     let mut has_prev = vec![false; n];
     for d in docks {
-        let (ra, rb) = (piece_rule[insts[d.a.instance].piece], piece_rule[insts[d.b.instance].piece]);
-        let (Some(r), Some(r2)) = (ra, rb) else { continue };
+        let (ra, rb) = (
+            piece_rule[insts[d.a.instance].piece],
+            piece_rule[insts[d.b.instance].piece],
+        );
+        let (Some(r), Some(r2)) = (ra, rb) else {
+            continue;
+        };
         if r != r2 {
             continue;
         }
@@ -441,11 +563,11 @@ fn find_chains(c: &Compiler, insts: &[Inst], docks: &[DockInfo], piece_rule: &[O
         } else {
             None
         };
-        if let Some((x, y)) = link {
-            if x != y {
-                next[x] = y;
-                has_prev[y] = true;
-            }
+        if let Some((x, y)) = link
+            && x != y
+        {
+            next[x] = y;
+            has_prev[y] = true;
         }
     }
     let mut seen = vec![false; n];
@@ -462,17 +584,24 @@ fn find_chains(c: &Compiler, insts: &[Inst], docks: &[DockInfo], piece_rule: &[O
         run
     };
     for i in 0..n {
-        if let Some(r) = piece_rule[insts[i].piece] {
-            if !has_prev[i] && !seen[i] {
-                chains.push(Chain { rule: r, instances: walk(i, &mut seen) });
-            }
+        if let Some(r) = piece_rule[insts[i].piece]
+            && !has_prev[i]
+            && !seen[i]
+        {
+            chains.push(Chain {
+                rule: r,
+                instances: walk(i, &mut seen),
+            });
         }
     }
     for i in 0..n {
-        if let Some(r) = piece_rule[insts[i].piece] {
-            if !seen[i] {
-                chains.push(Chain { rule: r, instances: walk(i, &mut seen) });
-            }
+        if let Some(r) = piece_rule[insts[i].piece]
+            && !seen[i]
+        {
+            chains.push(Chain {
+                rule: r,
+                instances: walk(i, &mut seen),
+            });
         }
     }
     chains.sort_by_key(|ch| ch.instances[0]);

@@ -40,7 +40,10 @@ pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
     let mut diags = c.diags;
     diags.sort();
     match c.grammar {
-        Some(grammar) if !diags.has_errors() => Ok(Compiled { grammar, warnings: diags }),
+        Some(grammar) if !diags.has_errors() => Ok(Compiled {
+            grammar,
+            warnings: diags,
+        }),
         _ => Err(diags),
     }
 }
@@ -52,15 +55,23 @@ pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> 
         Ok(source) => compile(source, path),
         Err(e) => {
             let at = e.valid_up_to();
-            Err(Diagnostic::error(codes::NOT_UTF8, "file is not valid UTF-8 text", Span::new(at, at + 1), "invalid byte here")
-                .with_hint("save the file as UTF-8")
-                .into())
+            Err(Diagnostic::error(
+                codes::NOT_UTF8,
+                "file is not valid UTF-8 text",
+                Span::new(at, at + 1),
+                "invalid byte here",
+            )
+            .with_hint("save the file as UTF-8")
+            .into())
         }
     }
 }
 
 /// The closest candidate by edit distance, if it is close enough to be a likely typo.
-pub(crate) fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub(crate) fn closest<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     let limit = (name.chars().count() / 3).max(1) + usize::from(name.len() > 5);
     candidates
         .into_iter()
@@ -77,6 +88,8 @@ pub(crate) struct PieceSpans {
     pub name: Span,
     pub vertices: Vec<Span>,
     pub sites: Vec<Span>,
+    /// Where each of the piece's edges was written.
+    pub edges: Vec<Span>,
     /// False when the piece had errors: later passes skip geometric checks on it.
     pub sound: bool,
 }
@@ -96,6 +109,10 @@ pub(crate) struct Compiler {
     pub merge_spans: Vec<Span>,
     pub cut_rules: Vec<CutRule>,
     pub cut_spans: Vec<Span>,
+    /// Pieces named by a stretch rule (written, even if the rule had errors).
+    pub stretch_named: Vec<bool>,
+    /// Set when a `dock` statement had errors: unplaced instances are then not reported.
+    pub dock_failed: bool,
     pub grammar: Option<CompiledGrammar>,
 }
 
@@ -116,6 +133,8 @@ impl Compiler {
             merge_spans: Vec::new(),
             cut_rules: Vec::new(),
             cut_spans: Vec::new(),
+            stretch_named: Vec::new(),
+            dock_failed: false,
             grammar: None,
         }
     }
@@ -126,14 +145,25 @@ impl Compiler {
 
     pub fn duplicate(&mut self, what: &str, ident: &Ident, first: Span) {
         self.diags.push(
-            Diagnostic::error(codes::DUPLICATE, format!("{what} `{}` is defined twice", ident.name), ident.span, "defined again here")
-                .with_secondary(first, "first defined here")
-                .with_hint(format!("rename one of them or remove the second {what}")),
+            Diagnostic::error(
+                codes::DUPLICATE,
+                format!("{what} `{}` is defined twice", ident.name),
+                ident.span,
+                "defined again here",
+            )
+            .with_secondary(first, "first defined here")
+            .with_hint(format!("rename one of them or remove the second {what}")),
         );
     }
 
     /// Reports an unknown name, suggesting the closest known one.
-    pub fn unknown<'a>(&mut self, what: &str, ident: &Ident, known: impl IntoIterator<Item = &'a str>, context: Option<String>) {
+    pub fn unknown<'a>(
+        &mut self,
+        what: &str,
+        ident: &Ident,
+        known: impl IntoIterator<Item = &'a str>,
+        context: Option<String>,
+    ) {
         let known: Vec<&str> = known.into_iter().collect();
         let mut d = Diagnostic::error(
             codes::UNKNOWN,
@@ -156,13 +186,26 @@ impl Compiler {
     }
 
     /// A number that must lie in a range; reports and returns `None` otherwise.
-    pub fn in_range(&mut self, n: &Number, what: &str, ok: impl Fn(f64) -> bool, allowed: &str) -> Option<f64> {
+    pub fn in_range(
+        &mut self,
+        n: &Number,
+        what: &str,
+        ok: impl Fn(f64) -> bool,
+        allowed: &str,
+    ) -> Option<f64> {
         if ok(n.value) {
             Some(n.value)
         } else {
             self.diags.push(
-                Diagnostic::error(codes::OUT_OF_RANGE, format!("{what} is out of range"), n.span, format!("must be {allowed}"))
-                    .with_hint(format!("{what} must be {allowed}; see the table in docs/language.md")),
+                Diagnostic::error(
+                    codes::OUT_OF_RANGE,
+                    format!("{what} is out of range"),
+                    n.span,
+                    format!("must be {allowed}"),
+                )
+                .with_hint(format!(
+                    "{what} must be {allowed}; see the table in docs/language.md"
+                )),
             );
             None
         }
@@ -181,7 +224,10 @@ impl Compiler {
                     n.span,
                     format!("expected a whole number >= {min}"),
                 )
-                .with_hint(format!("write {what} as a whole number, like `{}`", min.max(2))),
+                .with_hint(format!(
+                    "write {what} as a whole number, like `{}`",
+                    min.max(2)
+                )),
             );
             None
         }
@@ -192,8 +238,15 @@ impl Compiler {
         for n in [&p.x, &p.y] {
             if n.value.abs() > MAX_COORDINATE {
                 self.diags.push(
-                    Diagnostic::error(codes::OUT_OF_RANGE, "coordinate is out of range", n.span, "too far from the origin")
-                        .with_hint(format!("coordinates are metres and must lie within +/-{MAX_COORDINATE:e}")),
+                    Diagnostic::error(
+                        codes::OUT_OF_RANGE,
+                        "coordinate is out of range",
+                        n.span,
+                        "too far from the origin",
+                    )
+                    .with_hint(format!(
+                        "coordinates are metres and must lie within +/-{MAX_COORDINATE:e}"
+                    )),
                 );
                 return DVec2::ZERO;
             }
@@ -238,7 +291,10 @@ impl Compiler {
             match item {
                 Item::Solver(s) => {
                     if let Some(first) = solver_seen {
-                        let id = Ident { name: "solver".into(), span: s.keyword };
+                        let id = Ident {
+                            name: "solver".into(),
+                            span: s.keyword,
+                        };
                         self.duplicate("block", &id, first);
                     } else {
                         solver_seen = Some(s.keyword);
@@ -247,7 +303,10 @@ impl Compiler {
                 }
                 Item::Model(m) => {
                     if let Some(first) = model {
-                        let id = Ident { name: "model".into(), span: m.keyword };
+                        let id = Ident {
+                            name: "model".into(),
+                            span: m.keyword,
+                        };
                         self.duplicate("block", &id, first.keyword);
                     } else {
                         model = Some(m);
@@ -256,8 +315,17 @@ impl Compiler {
                 _ => {}
             }
         }
-        let decls: Vec<&syntax::SiteTypeDecl> =
-            file.items.iter().filter_map(|i| if let Item::SiteType(s) = i { Some(s) } else { None }).collect();
+        let decls: Vec<&syntax::SiteTypeDecl> = file
+            .items
+            .iter()
+            .filter_map(|i| {
+                if let Item::SiteType(s) = i {
+                    Some(s)
+                } else {
+                    None
+                }
+            })
+            .collect();
         self.site_type_decls(&decls);
         for item in &file.items {
             if let Item::Piece(p) = item {
@@ -278,7 +346,14 @@ impl Compiler {
             stretch_rules: std::mem::take(&mut self.stretch_rules),
             merge_rules: std::mem::take(&mut self.merge_rules),
             cut_rules: std::mem::take(&mut self.cut_rules),
-            assembly: AssemblyData { positions: Vec::new(), instances: Vec::new(), docks: Vec::new(), chains: Vec::new(), parts: Vec::new(), next_id: 0 },
+            assembly: AssemblyData {
+                positions: Vec::new(),
+                instances: Vec::new(),
+                docks: Vec::new(),
+                chains: Vec::new(),
+                parts: Vec::new(),
+                next_id: 0,
+            },
         };
         if self.diags.has_errors() {
             return;
@@ -310,12 +385,22 @@ impl Compiler {
             let v = &e.value;
             match e.name.name.as_str() {
                 "hysteresis" => {
-                    if let Some(x) = self.in_range(v, "`hysteresis`", |x| (0.0..1.0).contains(&x), "at least 0 and below 1") {
+                    if let Some(x) = self.in_range(
+                        v,
+                        "`hysteresis`",
+                        |x| (0.0..1.0).contains(&x),
+                        "at least 0 and below 1",
+                    ) {
                         self.solver.hysteresis = x;
                     }
                 }
                 "norm" => {
-                    if let Some(x) = self.in_range(v, "`norm`", |x| x > 0.0 && x <= 2.0, "above 0 and at most 2") {
+                    if let Some(x) = self.in_range(
+                        v,
+                        "`norm`",
+                        |x| x > 0.0 && x <= 2.0,
+                        "above 0 and at most 2",
+                    ) {
                         self.solver.norm = x;
                     }
                 }
@@ -345,13 +430,18 @@ impl Compiler {
                 self.duplicate("site type", &d.name, self.site_type_spans[i]);
                 continue;
             }
-            self.site_types.push(SiteType { name: d.name.name.clone(), docks_with: Vec::new() });
+            self.site_types.push(SiteType {
+                name: d.name.name.clone(),
+                docks_with: Vec::new(),
+            });
             self.site_type_spans.push(d.name.span);
         }
         let n = self.site_types.len();
         let mut dock = vec![vec![false; n]; n];
         for d in decls {
-            let Some(me) = self.site_type_index(&d.name.name) else { continue };
+            let Some(me) = self.site_type_index(&d.name.name) else {
+                continue;
+            };
             if self.site_type_spans[me] != d.name.span {
                 continue; // a duplicate, already reported
             }
@@ -365,7 +455,8 @@ impl Compiler {
                         dock[o][me] = true;
                     }
                     None => {
-                        let names: Vec<String> = self.site_types.iter().map(|t| t.name.clone()).collect();
+                        let names: Vec<String> =
+                            self.site_types.iter().map(|t| t.name.clone()).collect();
                         self.unknown("site type", other, names.iter().map(String::as_str), None);
                     }
                 }
@@ -383,8 +474,18 @@ impl Compiler {
             return;
         }
         let errors_before = self.diags.error_count();
-        let mut piece = Piece { name: decl.name.name.clone(), vertices: Vec::new(), edges: Vec::new(), sites: Vec::new(), states: Vec::new(), axis: None };
-        let mut spans = PieceSpans { name: decl.name.span, ..Default::default() };
+        let mut piece = Piece {
+            name: decl.name.name.clone(),
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            sites: Vec::new(),
+            states: Vec::new(),
+            axis: None,
+        };
+        let mut spans = PieceSpans {
+            name: decl.name.span,
+            ..Default::default()
+        };
         let mut base = Vec::new();
         // Vertices first: statements may come in any order and refer to later vertices.
         for s in &decl.stmts {
@@ -400,8 +501,13 @@ impl Compiler {
         }
         if piece.vertices.is_empty() {
             self.error(
-                Diagnostic::error(codes::DEGENERATE, format!("piece `{}` has no vertices", decl.name.name), decl.name.span, "declared here")
-                    .with_hint("add vertices with `vertex NAME (x, y)`"),
+                Diagnostic::error(
+                    codes::DEGENERATE,
+                    format!("piece `{}` has no vertices", decl.name.name),
+                    decl.name.span,
+                    "declared here",
+                )
+                .with_hint("add vertices with `vertex NAME (x, y)`"),
             );
         }
         let mut edge_spans: Vec<Span> = Vec::new();
@@ -426,7 +532,10 @@ impl Compiler {
                 }
                 PieceStmt::Axis(a) => {
                     if let Some(first) = axis {
-                        let id = Ident { name: "axis".into(), span: a.span };
+                        let id = Ident {
+                            name: "axis".into(),
+                            span: a.span,
+                        };
                         self.duplicate("declaration", &id, first.span);
                     } else {
                         axis = Some(a);
@@ -437,20 +546,46 @@ impl Compiler {
             }
         }
         // Edges are stored as given (first-written orientation) and deduplicated.
-        self.check_state_geometry(&piece, "base", &base, &spans.vertices, decl.name.span, &edge_spans);
-        piece.states.push(RestState { name: "base".into(), positions: base.clone(), geometry: geometry.clone(), geometry_frame: 0 });
+        self.check_state_geometry(
+            &piece,
+            "base",
+            &base,
+            &spans.vertices,
+            decl.name.span,
+            &edge_spans,
+        );
+        piece.states.push(RestState {
+            name: "base".into(),
+            positions: base.clone(),
+            geometry: geometry.clone(),
+            geometry_frame: 0,
+        });
+        spans.edges = edge_spans;
         let mut state_spans: Vec<Span> = Vec::new();
         for s in &decl.stmts {
             if let PieceStmt::State(st) = s {
                 if st.name.name == "base" {
                     self.error(
-                        Diagnostic::error(codes::DUPLICATE, "state `base` is defined twice", st.name.span, "defined again here")
-                            .with_secondary(decl.name.span, "`base` is the state given by the piece's `vertex` positions")
-                            .with_hint("give the alternative state another name"),
+                        Diagnostic::error(
+                            codes::DUPLICATE,
+                            "state `base` is defined twice",
+                            st.name.span,
+                            "defined again here",
+                        )
+                        .with_secondary(
+                            decl.name.span,
+                            "`base` is the state given by the piece's `vertex` positions",
+                        )
+                        .with_hint("give the alternative state another name"),
                     );
                     continue;
                 }
-                if let Some(i) = piece.states.iter().skip(1).position(|x| x.name == st.name.name) {
+                if let Some(i) = piece
+                    .states
+                    .iter()
+                    .skip(1)
+                    .position(|x| x.name == st.name.name)
+                {
                     self.duplicate("state", &st.name, state_spans[i]);
                     continue;
                 }
@@ -463,10 +598,10 @@ impl Compiler {
         if let Some(a) = axis {
             let from = self.site_on(&piece, &a.from);
             let to = self.site_on(&piece, &a.to);
-            if let (Some(f), Some(t)) = (from, to) {
-                if self.opposite(&piece, f, t, a.span, "axis") {
-                    piece.axis = Some([f, t]);
-                }
+            if let (Some(f), Some(t)) = (from, to)
+                && self.opposite(&piece, f, t, a.span, "axis")
+            {
+                piece.axis = Some([f, t]);
             }
         }
         spans.sound = self.diags.error_count() == errors_before;
@@ -482,25 +617,48 @@ impl Compiler {
             Some(i) => Some(i),
             None => {
                 let names: Vec<&str> = piece.sites.iter().map(|s| s.name.as_str()).collect();
-                self.unknown("site", ident, names, Some(format!("on piece `{}`", piece.name)));
+                self.unknown(
+                    "site",
+                    ident,
+                    names,
+                    Some(format!("on piece `{}`", piece.name)),
+                );
                 None
             }
         }
     }
 
     /// Checks that sites `from` and `to` of a piece point roughly opposite ways.
-    pub fn opposite(&mut self, piece: &Piece, from: usize, to: usize, span: Span, what: &str) -> bool {
+    pub fn opposite(
+        &mut self,
+        piece: &Piece,
+        from: usize,
+        to: usize,
+        span: Span,
+        what: &str,
+    ) -> bool {
         let (f, t) = (&piece.sites[from], &piece.sites[to]);
         let ok = from != to && f.out.dot(t.out) < -0.5;
         if !ok {
             let mut d = Diagnostic::error(
                 codes::NOT_OPPOSITE,
-                format!("the {what} of piece `{}` needs two opposite sites", piece.name),
+                format!(
+                    "the {what} of piece `{}` needs two opposite sites",
+                    piece.name
+                ),
                 span,
                 if from == to {
                     format!("`{}` is used at both ends", f.name)
                 } else {
-                    format!("`{}` points ({}, {}) and `{}` points ({}, {})", f.name, fmt(f.out.x), fmt(f.out.y), t.name, fmt(t.out.x), fmt(t.out.y))
+                    format!(
+                        "`{}` points ({}, {}) and `{}` points ({}, {})",
+                        f.name,
+                        fmt(f.out.x),
+                        fmt(f.out.y),
+                        t.name,
+                        fmt(t.out.x),
+                        fmt(t.out.y)
+                    )
                 },
             );
             d = d.with_hint("the `out` directions of the two sites must point roughly opposite ways (their dot product below -0.5)");
@@ -514,31 +672,62 @@ impl Compiler {
             Some(i) => Some(i),
             None => {
                 let names: Vec<&str> = piece.vertices.iter().map(String::as_str).collect();
-                self.unknown("vertex", ident, names, Some(format!("in piece `{}`", piece.name)));
+                self.unknown(
+                    "vertex",
+                    ident,
+                    names,
+                    Some(format!("in piece `{}`", piece.name)),
+                );
                 None
             }
         }
     }
 
     /// Adds the edges of one `edges` statement, reporting unknown vertices, loops and repeats.
-    fn edges(&mut self, piece: &Piece, e: &syntax::EdgesDecl, edges: &mut Vec<[usize; 2]>, spans: &mut Vec<Span>) {
+    fn edges(
+        &mut self,
+        piece: &Piece,
+        e: &syntax::EdgesDecl,
+        edges: &mut Vec<[usize; 2]>,
+        spans: &mut Vec<Span>,
+    ) {
         for path in &e.paths {
-            let ids: Vec<Option<usize>> = path.iter().map(|v| self.vertex_index(piece, v)).collect();
+            let ids: Vec<Option<usize>> =
+                path.iter().map(|v| self.vertex_index(piece, v)).collect();
             for k in 0..path.len().saturating_sub(1) {
-                let (Some(a), Some(b)) = (ids[k], ids[k + 1]) else { continue };
+                let (Some(a), Some(b)) = (ids[k], ids[k + 1]) else {
+                    continue;
+                };
                 let span = path[k].span.to(path[k + 1].span);
                 if a == b {
                     self.error(
-                        Diagnostic::error(codes::ZERO_EDGE, format!("edge `{0}-{0}` joins a vertex to itself", path[k].name), span, "zero-length edge")
-                            .with_hint("remove the repeated vertex from the path"),
+                        Diagnostic::error(
+                            codes::ZERO_EDGE,
+                            format!("edge `{0}-{0}` joins a vertex to itself", path[k].name),
+                            span,
+                            "zero-length edge",
+                        )
+                        .with_hint("remove the repeated vertex from the path"),
                     );
                     continue;
                 }
-                if let Some(i) = edges.iter().position(|&[x, y]| (x, y) == (a, b) || (x, y) == (b, a)) {
+                if let Some(i) = edges
+                    .iter()
+                    .position(|&[x, y]| (x, y) == (a, b) || (x, y) == (b, a))
+                {
                     self.diags.push(
-                        Diagnostic::warning(codes::REPEATED_EDGE, format!("edge `{}-{}` is listed twice", path[k].name, path[k + 1].name), span, "repeated here")
-                            .with_secondary(spans[i], "first listed here")
-                            .with_hint("edges are undirected: `a-b` and `b-a` are the same edge"),
+                        Diagnostic::warning(
+                            codes::REPEATED_EDGE,
+                            format!(
+                                "edge `{}-{}` is listed twice",
+                                path[k].name,
+                                path[k + 1].name
+                            ),
+                            span,
+                            "repeated here",
+                        )
+                        .with_secondary(spans[i], "first listed here")
+                        .with_hint("edges are undirected: `a-b` and `b-a` are the same edge"),
                     );
                     continue;
                 }
@@ -553,7 +742,12 @@ impl Compiler {
             Some(t) => Some(t),
             None => {
                 let names: Vec<String> = self.site_types.iter().map(|t| t.name.clone()).collect();
-                self.unknown("site type", &s.site_type, names.iter().map(String::as_str), None);
+                self.unknown(
+                    "site type",
+                    &s.site_type,
+                    names.iter().map(String::as_str),
+                    None,
+                );
                 None
             }
         };
@@ -583,7 +777,12 @@ impl Compiler {
         if !ok {
             return None;
         }
-        Some(Site { name: s.name.name.clone(), site_type: site_type?, vertices, out: out / len })
+        Some(Site {
+            name: s.name.name.clone(),
+            site_type: site_type?,
+            vertices,
+            out: out / len,
+        })
     }
 
     fn geometry(&mut self, g: &syntax::GeometryDecl) -> Option<Proxy> {
@@ -608,7 +807,12 @@ impl Compiler {
             }
             syntax::ShapeDecl::Polyline { width, points } => {
                 let ok = self.enough_points(points.len(), 2, "polyline", g.keyword);
-                let w = self.in_range(width, "polyline `width`", |w| w > 0.0 && w <= MAX_COORDINATE, "above 0");
+                let w = self.in_range(
+                    width,
+                    "polyline `width`",
+                    |w| w > 0.0 && w <= MAX_COORDINATE,
+                    "above 0",
+                );
                 let points = points.iter().map(|p| self.point(p)).collect();
                 if !ok {
                     return None;
@@ -616,7 +820,11 @@ impl Compiler {
                 ProxyShape::Polyline { points, width: w? }
             }
         };
-        Some(Proxy { shape, fill, binding })
+        Some(Proxy {
+            shape,
+            fill,
+            binding,
+        })
     }
 
     fn enough_points(&mut self, n: usize, min: usize, what: &str, span: Span) -> bool {
@@ -624,14 +832,30 @@ impl Compiler {
             return true;
         }
         self.error(
-            Diagnostic::error(codes::DEGENERATE, format!("{what} has {n} point{}, needs at least {min}", if n == 1 { "" } else { "s" }), span, format!("too few points"))
-                .with_hint(format!("a {what} needs at least {min} points `(x, y)`")),
+            Diagnostic::error(
+                codes::DEGENERATE,
+                format!(
+                    "{what} has {n} point{}, needs at least {min}",
+                    if n == 1 { "" } else { "s" }
+                ),
+                span,
+                "too few points",
+            )
+            .with_hint(format!("a {what} needs at least {min} points `(x, y)`")),
         );
         false
     }
 
     /// Zero-length edges and coincident vertices of one rest state.
-    fn check_state_geometry(&mut self, piece: &Piece, state: &str, pos: &[DVec2], vspans: &[Span], fallback: Span, edge_spans: &[Span]) {
+    fn check_state_geometry(
+        &mut self,
+        piece: &Piece,
+        state: &str,
+        pos: &[DVec2],
+        vspans: &[Span],
+        fallback: Span,
+        edge_spans: &[Span],
+    ) {
         if pos.len() != piece.vertices.len() {
             return;
         }
@@ -640,17 +864,25 @@ impl Compiler {
             if pos[a].distance(pos[b]) < COINCIDENT_EPS {
                 reported[a] = true;
                 reported[b] = true;
-                let span = edge_spans.get(k).copied().unwrap_or(fallback);
-                self.error(
-                    Diagnostic::error(
-                        codes::ZERO_EDGE,
-                        format!("edge `{}-{}` has zero length in state `{state}`", piece.vertices[a], piece.vertices[b]),
-                        span,
-                        "both ends are at the same place",
-                    )
-                    .with_secondary(vspans.get(b).copied().unwrap_or(fallback), format!("`{}` is at ({}, {})", piece.vertices[b], fmt(pos[b].x), fmt(pos[b].y)))
-                    .with_hint("move one of the vertices, or merge them into one vertex"),
+                let mut d = Diagnostic::error(
+                    codes::ZERO_EDGE,
+                    format!(
+                        "edge `{}-{}` has zero length in state `{state}`",
+                        piece.vertices[a], piece.vertices[b]
+                    ),
+                    vspans.get(b).copied().unwrap_or(fallback),
+                    format!(
+                        "`{}` is at the same place as `{}`: ({}, {})",
+                        piece.vertices[b],
+                        piece.vertices[a],
+                        fmt(pos[b].x),
+                        fmt(pos[b].y)
+                    ),
                 );
+                if let Some(&e) = edge_spans.get(k) {
+                    d = d.with_secondary(e, "the edge is declared here");
+                }
+                self.error(d.with_hint("move one of the vertices, or merge them into one vertex"));
             }
         }
         // Sorting by x keeps this near-linear for big pieces.
@@ -668,11 +900,22 @@ impl Compiler {
                     self.error(
                         Diagnostic::error(
                             codes::COINCIDENT,
-                            format!("vertices `{}` and `{}` are at the same place in state `{state}`", piece.vertices[a], piece.vertices[b]),
+                            format!(
+                                "vertices `{}` and `{}` are at the same place in state `{state}`",
+                                piece.vertices[a], piece.vertices[b]
+                            ),
                             vspans.get(b).copied().unwrap_or(fallback),
-                            format!("`{}` is at ({}, {})", piece.vertices[b], fmt(pos[b].x), fmt(pos[b].y)),
+                            format!(
+                                "`{}` is at ({}, {})",
+                                piece.vertices[b],
+                                fmt(pos[b].x),
+                                fmt(pos[b].y)
+                            ),
                         )
-                        .with_secondary(vspans.get(a).copied().unwrap_or(fallback), format!("`{}` is here too", piece.vertices[a]))
+                        .with_secondary(
+                            vspans.get(a).copied().unwrap_or(fallback),
+                            format!("`{}` is here too", piece.vertices[a]),
+                        )
                         .with_hint("every vertex of a rest state needs its own position"),
                     );
                 }
@@ -680,7 +923,14 @@ impl Compiler {
         }
     }
 
-    fn state(&mut self, piece: &Piece, spans: &PieceSpans, st: &syntax::StateDecl, index: usize, base_geometry: &[Proxy]) -> RestState {
+    fn state(
+        &mut self,
+        piece: &Piece,
+        spans: &PieceSpans,
+        st: &syntax::StateDecl,
+        index: usize,
+        base_geometry: &[Proxy],
+    ) -> RestState {
         let n = piece.vertices.len();
         let mut pos: Vec<Option<DVec2>> = vec![None; n];
         let mut vspans: Vec<Span> = vec![st.name.span; n];
@@ -697,12 +947,17 @@ impl Compiler {
                 None => {
                     let mut d = Diagnostic::error(
                         codes::STATE_VERTICES,
-                        format!("state `{}` adds vertex `{}`, which piece `{}` does not have", st.name.name, p.name.name, piece.name),
+                        format!(
+                            "state `{}` adds vertex `{}`, which piece `{}` does not have",
+                            st.name.name, p.name.name, piece.name
+                        ),
                         p.name.span,
                         "not a vertex of the piece",
                     )
                     .with_secondary(spans.name, "piece declared here");
-                    if let Some(c) = closest(&p.name.name, piece.vertices.iter().map(String::as_str)) {
+                    if let Some(c) =
+                        closest(&p.name.name, piece.vertices.iter().map(String::as_str))
+                    {
                         d = d.with_hint(format!("did you mean `{c}`?"));
                     } else {
                         d = d.with_hint("an alternative state may not add vertices: it gives new positions to the piece's own vertices");
@@ -713,17 +968,29 @@ impl Compiler {
         }
         let missing: Vec<usize> = (0..n).filter(|&i| pos[i].is_none()).collect();
         if !missing.is_empty() {
-            let names: Vec<String> = missing.iter().map(|&i| format!("`{}`", piece.vertices[i])).collect();
+            let names: Vec<String> = missing
+                .iter()
+                .map(|&i| format!("`{}`", piece.vertices[i]))
+                .collect();
             let mut d = Diagnostic::error(
                 codes::STATE_VERTICES,
-                format!("state `{}` gives no position for vertex {}", st.name.name, names.join(", ")),
+                format!(
+                    "state `{}` gives no position for vertex {}",
+                    st.name.name,
+                    names.join(", ")
+                ),
                 st.name.span,
                 format!("missing {}", names.join(", ")),
             );
             if let Some(&i) = missing.first() {
-                d = d.with_secondary(spans.vertices.get(i).copied().unwrap_or(spans.name), format!("`{}` is declared here", piece.vertices[i]));
+                d = d.with_secondary(
+                    spans.vertices.get(i).copied().unwrap_or(spans.name),
+                    format!("`{}` is declared here", piece.vertices[i]),
+                );
             }
-            self.error(d.with_hint("an alternative state gives a position for every vertex of its piece"));
+            self.error(
+                d.with_hint("an alternative state gives a position for every vertex of its piece"),
+            );
         }
         // Restated edges must equal the piece's: the part's edge set is shared by all states.
         for e in &st.edges {
@@ -733,8 +1000,16 @@ impl Compiler {
             let key = |[a, b]: [usize; 2]| [a.min(b), a.max(b)];
             let mine: Vec<[usize; 2]> = piece.edges.iter().map(|&e| key(e)).collect();
             let theirs: Vec<[usize; 2]> = list.iter().map(|&e| key(e)).collect();
-            let extra: Vec<String> = theirs.iter().filter(|e| !mine.contains(e)).map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b])).collect();
-            let missing: Vec<String> = mine.iter().filter(|e| !theirs.contains(e)).map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b])).collect();
+            let extra: Vec<String> = theirs
+                .iter()
+                .filter(|e| !mine.contains(e))
+                .map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b]))
+                .collect();
+            let missing: Vec<String> = mine
+                .iter()
+                .filter(|e| !theirs.contains(e))
+                .map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b]))
+                .collect();
             if !extra.is_empty() || !missing.is_empty() {
                 let mut parts = Vec::new();
                 if !extra.is_empty() {
@@ -757,18 +1032,40 @@ impl Compiler {
         }
         let positions: Vec<DVec2> = pos.iter().map(|p| p.unwrap_or(DVec2::ZERO)).collect();
         if missing.is_empty() {
-            self.check_state_geometry(piece, &st.name.name, &positions, &vspans, st.name.span, &[]);
+            self.check_state_geometry(
+                piece,
+                &st.name.name,
+                &positions,
+                &vspans,
+                st.name.span,
+                &spans.edges,
+            );
         }
-        let own: Vec<Proxy> = st.geometry.iter().filter_map(|g| self.geometry(g)).collect();
-        let (geometry, geometry_frame) = if st.geometry.is_empty() { (base_geometry.to_vec(), 0) } else { (own, index) };
-        RestState { name: st.name.name.clone(), positions, geometry, geometry_frame }
+        let own: Vec<Proxy> = st
+            .geometry
+            .iter()
+            .filter_map(|g| self.geometry(g))
+            .collect();
+        let (geometry, geometry_frame) = if st.geometry.is_empty() {
+            (base_geometry.to_vec(), 0)
+        } else {
+            (own, index)
+        };
+        RestState {
+            name: st.name.name.clone(),
+            positions,
+            geometry,
+            geometry_frame,
+        }
     }
 
     /// Skinned geometry needs an axis (set by `axis` or by a stretch rule).
     fn check_skinned(&mut self, file: &syntax::File) {
         for item in &file.items {
             let Item::Piece(decl) = item else { continue };
-            let Some(&pi) = self.piece_index.get(&decl.name.name) else { continue };
+            let Some(&pi) = self.piece_index.get(&decl.name.name) else {
+                continue;
+            };
             if self.piece_spans[pi].name != decl.name.span || self.pieces[pi].axis.is_some() {
                 continue;
             }
@@ -807,13 +1104,26 @@ impl CompiledGrammar {
         let v = |p: &DVec2| p.is_finite();
         let proxies = |g: &[Proxy]| {
             g.iter().all(|p| match &p.shape {
-                ProxyShape::Polygon { outer, holes } => outer.iter().all(v) && holes.iter().flatten().all(v),
+                ProxyShape::Polygon { outer, holes } => {
+                    outer.iter().all(v) && holes.iter().flatten().all(v)
+                }
                 ProxyShape::Polyline { points, width } => points.iter().all(v) && width.is_finite(),
             })
         };
-        self.pieces.iter().all(|p| p.sites.iter().all(|s| v(&s.out)) && p.states.iter().all(|s| s.positions.iter().all(v) && proxies(&s.geometry)))
-            && self.stretch_rules.iter().all(|r| r.part.states.iter().all(|s| s.positions.iter().all(v)))
+        self.pieces.iter().all(|p| {
+            p.sites.iter().all(|s| v(&s.out))
+                && p.states
+                    .iter()
+                    .all(|s| s.positions.iter().all(v) && proxies(&s.geometry))
+        }) && self
+            .stretch_rules
+            .iter()
+            .all(|r| r.part.states.iter().all(|s| s.positions.iter().all(v)))
             && self.assembly.positions.iter().all(v)
-            && self.assembly.parts.iter().all(|p| p.states.iter().all(|s| s.positions.iter().all(v)))
+            && self
+                .assembly
+                .parts
+                .iter()
+                .all(|p| p.states.iter().all(|s| s.positions.iter().all(v)))
     }
 }

@@ -13,13 +13,25 @@ pub const STRETCH_STATES: [(&str, f64); 3] = [("one", 0.5), ("two", 1.0), ("thre
 
 /// Rotation by `angle` radians.
 pub(crate) fn rotate(v: DVec2, angle: f64) -> DVec2 {
-    DVec2::from_angle(angle).rotate(v)
+    // Snap cos/sin near 0 or +-1 so quarter turns are exact: a wall turned by 180 degrees
+    // should not carry 1e-16 noise into every position.
+    let snap = |x: f64| {
+        let r = x.round();
+        if (x - r).abs() < 1e-12 { r } else { x }
+    };
+    let (sin, cos) = angle.sin_cos();
+    DVec2::new(snap(cos), snap(sin)).rotate(v)
 }
 
 /// The rigid motion `(angle, translation)` that docks site `sb` of a piece with base positions
 /// `pos_b` onto a site whose global centre and out direction are `centre_a`, `out_a`: `sb`'s
 /// out turns opposite `out_a` and the centres meet.
-pub(crate) fn dock_motion(centre_a: DVec2, out_a: DVec2, sb: &Site, pos_b: &[DVec2]) -> (f64, DVec2) {
+pub(crate) fn dock_motion(
+    centre_a: DVec2,
+    out_a: DVec2,
+    sb: &Site,
+    pos_b: &[DVec2],
+) -> (f64, DVec2) {
     let angle = (-out_a).to_angle() - sb.out.to_angle();
     let centre_b = site_centre(sb, pos_b);
     (angle, centre_a - rotate(centre_b, angle))
@@ -35,6 +47,7 @@ impl Compiler {
     pub(super) fn rules(&mut self, file: &syntax::File) {
         // Which stretch rule (by its span) first claimed each piece.
         let mut claimed: Vec<Option<Span>> = vec![None; self.pieces.len()];
+        self.stretch_named = vec![false; self.pieces.len()];
         for item in &file.items {
             if let Item::Stretch(s) = item {
                 self.stretch(s, &mut claimed);
@@ -54,20 +67,32 @@ impl Compiler {
         for m in self.merge_rules.clone() {
             let Some(j) = m.junction else { continue };
             if !self.cut_rules.iter().any(|c| c.junction == j) {
-                self.cut_rules.push(CutRule { junction: j, into: m.target.piece, derived: true });
+                self.cut_rules.push(CutRule {
+                    junction: j,
+                    into: m.target.piece,
+                    derived: true,
+                });
             }
         }
     }
 
     fn stretch(&mut self, s: &syntax::StretchDecl, claimed: &mut [Option<Span>]) {
-        let Some(pi) = self.resolve_piece(&s.piece) else { return };
+        let Some(pi) = self.resolve_piece(&s.piece) else {
+            return;
+        };
+        self.stretch_named[pi] = true;
+        // `stretch PIECE from A to B`, without its `{ ... }` block: what messages point at.
+        let head = Span::new(s.span.start, s.to.span.end);
         let from = self.resolve_site(pi, &s.from);
         let to = self.resolve_site(pi, &s.to);
         let min = match s.min.as_slice() {
             [] => Some(2),
             [m, rest @ ..] => {
                 for r in rest {
-                    let id = syntax::Ident { name: "min".into(), span: r.span };
+                    let id = syntax::Ident {
+                        name: "min".into(),
+                        span: r.span,
+                    };
                     self.duplicate("setting", &id, m.span);
                 }
                 self.whole(m, "`min`", 2).map(|v| v as usize)
@@ -77,17 +102,28 @@ impl Compiler {
         let mut ok = true;
         if let Some((first, rest)) = s.variants.split_first() {
             for r in rest {
-                let id = syntax::Ident { name: "variants".into(), span: r.span };
+                let id = syntax::Ident {
+                    name: "variants".into(),
+                    span: r.span,
+                };
                 self.duplicate("setting", &id, first.span);
             }
             let mut sum = 0.0;
             for (k, e) in first.entries.iter().enumerate() {
-                if let Some(j) = first.entries[..k].iter().position(|x| x.piece.name == e.piece.name) {
+                if let Some(j) = first.entries[..k]
+                    .iter()
+                    .position(|x| x.piece.name == e.piece.name)
+                {
                     self.duplicate("variant", &e.piece, first.entries[j].piece.span);
                     ok = false;
                     continue;
                 }
-                let f = self.in_range(&e.frequency, "a variant frequency", |f| f > 0.0 && f <= 1.0, "above 0 and at most 1");
+                let f = self.in_range(
+                    &e.frequency,
+                    "a variant frequency",
+                    |f| f > 0.0 && f <= 1.0,
+                    "above 0 and at most 1",
+                );
                 sum += e.frequency.value;
                 let Some(vp) = self.resolve_piece(&e.piece) else {
                     ok = false;
@@ -97,7 +133,10 @@ impl Compiler {
                     ok = false;
                 }
                 match f {
-                    Some(frequency) => variants.push(Variant { piece: vp, frequency }),
+                    Some(frequency) => variants.push(Variant {
+                        piece: vp,
+                        frequency,
+                    }),
                     None => ok = false,
                 }
             }
@@ -109,24 +148,29 @@ impl Compiler {
                 ok = false;
             }
         } else {
-            variants.push(Variant { piece: pi, frequency: 1.0 });
+            variants.push(Variant {
+                piece: pi,
+                frequency: 1.0,
+            });
         }
         for v in &variants {
             if let Some(first) = claimed[v.piece] {
                 let name = self.pieces[v.piece].name.clone();
                 self.error(
-                    Diagnostic::error(codes::TWO_STRETCH, format!("piece `{name}` belongs to two stretch rules"), s.span, "second rule here")
+                    Diagnostic::error(codes::TWO_STRETCH, format!("piece `{name}` belongs to two stretch rules"), head, "second rule here")
                         .with_secondary(first, "first rule here")
                         .with_hint("a piece may be the piece or a variant of one stretch rule only, so chains are unambiguous"),
                 );
                 ok = false;
             } else {
-                claimed[v.piece] = Some(s.span);
+                claimed[v.piece] = Some(head);
             }
         }
-        let (Some(from), Some(to), Some(min)) = (from, to, min) else { return };
+        let (Some(from), Some(to), Some(min)) = (from, to, min) else {
+            return;
+        };
         let piece = self.pieces[pi].clone();
-        if !self.opposite(&piece, from, to, s.span, "stretch rule") {
+        if !self.opposite(&piece, from, to, head, "stretch rule") {
             return;
         }
         let (ff, tt) = (&piece.sites[from], &piece.sites[to]);
@@ -136,25 +180,45 @@ impl Compiler {
         if !ok || !self.piece_spans[pi].sound {
             return;
         }
-        let Some(part) = self.stretch_part(&piece, from, to, s) else { return };
+        let Some(part) = self.stretch_part(&piece, from, to, s) else {
+            return;
+        };
         for v in &variants {
             if self.pieces[v.piece].axis.is_none() {
                 self.pieces[v.piece].axis = Some([from, to]);
             }
         }
-        self.stretch_rules.push(StretchRule { piece: pi, variants, from, to, min, part });
+        self.stretch_rules.push(StretchRule {
+            piece: pi,
+            variants,
+            from,
+            to,
+            min,
+            part,
+        });
         self.stretch_spans.push(s.span);
     }
 
     /// Site types compatible and vertex counts equal; reports otherwise.
     pub(super) fn sites_fit(&mut self, a: &Site, b: &Site, span_a: Span, span_b: Span) -> bool {
         let mut ok = true;
-        if !self.site_types[a.site_type].docks_with.contains(&b.site_type) {
-            let (ta, tb) = (self.site_types[a.site_type].name.clone(), self.site_types[b.site_type].name.clone());
+        if !self.site_types[a.site_type]
+            .docks_with
+            .contains(&b.site_type)
+        {
+            let (ta, tb) = (
+                self.site_types[a.site_type].name.clone(),
+                self.site_types[b.site_type].name.clone(),
+            );
             self.error(
-                Diagnostic::error(codes::INCOMPATIBLE, format!("site types `{ta}` and `{tb}` cannot dock"), span_b, format!("`{}` has type `{tb}`", b.name))
-                    .with_secondary(span_a, format!("`{}` has type `{ta}`", a.name))
-                    .with_hint(format!("declare `site type {ta} docks {tb}` to allow it")),
+                Diagnostic::error(
+                    codes::INCOMPATIBLE,
+                    format!("site types `{ta}` and `{tb}` cannot dock"),
+                    span_b,
+                    format!("`{}` has type `{tb}`", b.name),
+                )
+                .with_secondary(span_a, format!("`{}` has type `{ta}`", a.name))
+                .with_hint(format!("declare `site type {ta} docks {tb}` to allow it")),
             );
             ok = false;
         }
@@ -188,14 +252,26 @@ impl Compiler {
         let ps: Vec<&str> = p.sites.iter().map(|s| s.name.as_str()).collect();
         let vs: Vec<&str> = v.sites.iter().map(|s| s.name.as_str()).collect();
         let problem = if p.vertices != v.vertices {
-            Some(format!("vertices [{}] differ from [{}]", v.vertices.join(", "), p.vertices.join(", ")))
+            Some(format!(
+                "vertices [{}] differ from [{}]",
+                v.vertices.join(", "),
+                p.vertices.join(", ")
+            ))
         } else if pe != ve {
             let name = |e: &[usize; 2]| format!("`{}-{}`", p.vertices[e[0]], p.vertices[e[1]]);
             let extra: Vec<String> = ve.iter().filter(|e| !pe.contains(e)).map(name).collect();
             let missing: Vec<String> = pe.iter().filter(|e| !ve.contains(e)).map(name).collect();
-            Some(format!("edges differ (extra: {}; missing: {})", or_none(&extra), or_none(&missing)))
+            Some(format!(
+                "edges differ (extra: {}; missing: {})",
+                or_none(&extra),
+                or_none(&missing)
+            ))
         } else if ps != vs {
-            Some(format!("sites [{}] differ from [{}]", vs.join(", "), ps.join(", ")))
+            Some(format!(
+                "sites [{}] differ from [{}]",
+                vs.join(", "),
+                ps.join(", ")
+            ))
         } else {
             None
         };
@@ -211,7 +287,13 @@ impl Compiler {
     }
 
     /// The two-element part: element 1 docked to element 0 through `to` -> `from`.
-    fn stretch_part(&mut self, piece: &Piece, from: usize, to: usize, s: &syntax::StretchDecl) -> Option<StretchPart> {
+    fn stretch_part(
+        &mut self,
+        piece: &Piece,
+        from: usize,
+        to: usize,
+        s: &syntax::StretchDecl,
+    ) -> Option<StretchPart> {
         let base = &piece.states[0].positions;
         let (sf, st) = (&piece.sites[from], &piece.sites[to]);
         let n = sf.vertices.len();
@@ -225,7 +307,7 @@ impl Compiler {
                     Diagnostic::error(
                         codes::NOT_COINCIDENT,
                         format!("piece `{}` does not dock with itself from `{}` to `{}`", piece.name, sf.name, st.name),
-                        s.span,
+                        Span::new(s.span.start, s.to.span.end),
                         format!("vertex `{}` of the next element misses `{}` by {} m", piece.vertices[b], piece.vertices[a], fmt(gap)),
                     )
                     .with_secondary(s.from.span, "the next element docks through this site")
@@ -235,31 +317,59 @@ impl Compiler {
             }
         }
         let nv = piece.vertices.len();
-        let mut vertices: Vec<ElementVertex> = (0..nv).map(|v| ElementVertex { element: 0, vertex: v }).collect();
+        let mut vertices: Vec<ElementVertex> = (0..nv)
+            .map(|v| ElementVertex {
+                element: 0,
+                vertex: v,
+            })
+            .collect();
         let mut map1 = vec![0usize; nv];
-        for v in 0..nv {
+        for (v, slot) in map1.iter_mut().enumerate() {
             if let Some(i) = sf.vertices.iter().position(|&x| x == v) {
-                map1[v] = st.vertices[n - 1 - i];
+                *slot = st.vertices[n - 1 - i];
             } else {
-                map1[v] = vertices.len();
-                vertices.push(ElementVertex { element: 1, vertex: v });
+                *slot = vertices.len();
+                vertices.push(ElementVertex {
+                    element: 1,
+                    vertex: v,
+                });
             }
         }
         let mut edges: Vec<[usize; 2]> = piece.edges.clone();
         for &[a, b] in &piece.edges {
             let e = [map1[a], map1[b]];
-            if !edges.iter().any(|&[x, y]| (x, y) == (e[0], e[1]) || (x, y) == (e[1], e[0])) {
+            if !edges
+                .iter()
+                .any(|&[x, y]| (x, y) == (e[0], e[1]) || (x, y) == (e[1], e[0]))
+            {
                 edges.push(e);
             }
         }
-        let two: Vec<DVec2> = vertices.iter().map(|ev| if ev.element == 0 { base[ev.vertex] } else { elem1[ev.vertex] }).collect();
+        let two: Vec<DVec2> = vertices
+            .iter()
+            .map(|ev| {
+                if ev.element == 0 {
+                    base[ev.vertex]
+                } else {
+                    elem1[ev.vertex]
+                }
+            })
+            .collect();
         let origin = site_centre(sf, base);
         let end = site_centre(st, &elem1);
         let axis = (end - origin).normalize_or_zero();
         if axis == DVec2::ZERO {
             self.error(
-                Diagnostic::error(codes::NOT_OPPOSITE, format!("piece `{}` has no length along its stretch axis", piece.name), s.span, "from and to sites are at the same place")
-                    .with_hint("the `from` and `to` sites must be at opposite ends of the piece"),
+                Diagnostic::error(
+                    codes::NOT_OPPOSITE,
+                    format!(
+                        "piece `{}` has no length along its stretch axis",
+                        piece.name
+                    ),
+                    Span::new(s.span.start, s.to.span.end),
+                    "from and to sites are at the same place",
+                )
+                .with_hint("the `from` and `to` sites must be at opposite ends of the piece"),
             );
             return None;
         }
@@ -277,7 +387,11 @@ impl Compiler {
                     .collect(),
             })
             .collect();
-        Some(StretchPart { vertices, edges, states })
+        Some(StretchPart {
+            vertices,
+            edges,
+            states,
+        })
     }
 
     fn site_ref(&mut self, p: &syntax::SitePath) -> Option<SiteRef> {
@@ -294,7 +408,9 @@ impl Compiler {
             Some(n) => self.in_range(n, "`within`", |d| d > 0.0, "above 0"),
             None => Some(self.solver.merge_distance),
         };
-        let (Some(mover), Some(target), Some(distance)) = (mover, target, distance) else { return };
+        let (Some(mover), Some(target), Some(distance)) = (mover, target, distance) else {
+            return;
+        };
         let ms = self.pieces[mover.piece].sites[mover.site].clone();
         let junction = match junction {
             None => {
@@ -311,7 +427,11 @@ impl Compiler {
                     return;
                 }
                 // J takes over the replaced instance's connections by site name.
-                let have: Vec<String> = self.pieces[j.piece].sites.iter().map(|s| s.name.clone()).collect();
+                let have: Vec<String> = self.pieces[j.piece]
+                    .sites
+                    .iter()
+                    .map(|s| s.name.clone())
+                    .collect();
                 let missing: Vec<String> = self.pieces[target.piece]
                     .sites
                     .iter()
@@ -320,7 +440,10 @@ impl Compiler {
                     .map(|n| format!("`{n}`"))
                     .collect();
                 if !missing.is_empty() {
-                    let (jn, tn) = (self.pieces[j.piece].name.clone(), self.pieces[target.piece].name.clone());
+                    let (jn, tn) = (
+                        self.pieces[j.piece].name.clone(),
+                        self.pieces[target.piece].name.clone(),
+                    );
                     self.error(
                         Diagnostic::error(codes::JUNCTION_SITES, format!("junction `{jn}` lacks site {} of `{tn}`", missing.join(", ")), jpath.piece.span, format!("lacks {}", missing.join(", ")))
                             .with_secondary(self.piece_spans[j.piece].name, format!("`{jn}` declared here"))
@@ -331,22 +454,36 @@ impl Compiler {
                 Some(j)
             }
         };
-        self.merge_rules.push(MergeRule { mover, target, junction, distance });
+        self.merge_rules.push(MergeRule {
+            mover,
+            target,
+            junction,
+            distance,
+        });
         self.merge_spans.push(m.span);
     }
 
     fn cut(&mut self, c: &syntax::CutDecl) {
         let junction = self.site_ref(&c.junction);
         let into = self.resolve_piece(&c.into);
-        let (Some(junction), Some(into)) = (junction, into) else { return };
+        let (Some(junction), Some(into)) = (junction, into) else {
+            return;
+        };
         if let Some(i) = self.cut_rules.iter().position(|x| x.junction == junction) {
-            let id = syntax::Ident { name: format!("{}.{}", c.junction.piece.name, c.junction.site.name), span: c.junction.span };
+            let id = syntax::Ident {
+                name: format!("{}.{}", c.junction.piece.name, c.junction.site.name),
+                span: c.junction.span,
+            };
             self.duplicate("cut rule for", &id, self.cut_spans[i]);
             return;
         }
         // The replacement takes over the junction's other connections by site name.
         let jp = &self.pieces[junction.piece];
-        let have: Vec<&str> = self.pieces[into].sites.iter().map(|s| s.name.as_str()).collect();
+        let have: Vec<&str> = self.pieces[into]
+            .sites
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect();
         let missing: Vec<String> = jp
             .sites
             .iter()
@@ -363,11 +500,19 @@ impl Compiler {
             );
             return;
         }
-        self.cut_rules.push(CutRule { junction, into, derived: false });
+        self.cut_rules.push(CutRule {
+            junction,
+            into,
+            derived: false,
+        });
         self.cut_spans.push(c.span);
     }
 }
 
 fn or_none(v: &[String]) -> String {
-    if v.is_empty() { "none".into() } else { v.join(", ") }
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
 }

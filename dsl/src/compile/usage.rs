@@ -6,42 +6,78 @@ use crate::syntax::{self, Item, ModelStmt};
 
 /// Which pieces the model names.
 pub(super) struct Usage {
+    /// False when a model statement names an unknown piece: the model is then incomplete and
+    /// usage warnings would mislead.
+    complete: bool,
     in_model: Vec<bool>,
+    /// Named by a rule (stretch piece or variant, merge junction, cut junction or target).
+    named: Vec<bool>,
 }
 
 impl Usage {
-    pub fn find(c: &Compiler, _file: &syntax::File, model: Option<&syntax::ModelBlock>) -> Self {
+    pub fn find(c: &Compiler, file: &syntax::File, model: Option<&syntax::ModelBlock>) -> Self {
         let mut in_model = vec![false; c.pieces.len()];
+        let mut complete = true;
+        // Names written in rules count as uses even when the rule had errors (already
+        // reported): warning that its pieces are unused would only add noise.
+        let mut named = vec![false; c.pieces.len()];
+        let mut name = |n: &str| {
+            if let Some(&i) = c.piece_index.get(n) {
+                named[i] = true;
+            }
+        };
+        for item in &file.items {
+            match item {
+                Item::Stretch(s) => {
+                    name(&s.piece.name);
+                    s.variants
+                        .iter()
+                        .flat_map(|v| &v.entries)
+                        .for_each(|e| name(&e.piece.name));
+                }
+                Item::Merge(m) => {
+                    if let Some(j) = &m.junction {
+                        name(&j.piece.name);
+                    }
+                }
+                Item::Cut(cut) => {
+                    name(&cut.junction.piece.name);
+                    name(&cut.into.name);
+                }
+                _ => {}
+            }
+        }
         for stmt in model.map_or(&[][..], |m| &m.stmts) {
             let name = match stmt {
                 ModelStmt::Instance(d) => &d.piece.name,
                 ModelStmt::Chain(d) => &d.piece.name,
                 ModelStmt::Dock(_) => continue,
             };
-            if let Some(&i) = c.piece_index.get(name) {
-                in_model[i] = true;
+            match c.piece_index.get(name) {
+                Some(&i) => in_model[i] = true,
+                None => complete = false,
             }
         }
-        Self { in_model }
+        Self {
+            complete,
+            in_model,
+            named,
+        }
     }
 
     pub fn report(&self, c: &mut Compiler, file: &syntax::File) {
-        let n = c.pieces.len();
+        if !self.complete {
+            return;
+        }
         // Pieces a rule may bring into the assembly.
-        let mut mentioned = self.in_model.clone();
-        for r in &c.stretch_rules {
-            for v in &r.variants {
-                mentioned[v.piece] = true;
-            }
-        }
-        for m in &c.merge_rules {
-            if let Some(j) = m.junction {
-                mentioned[j.piece] = true;
-            }
-        }
+        let mut mentioned: Vec<bool> = self
+            .in_model
+            .iter()
+            .zip(&self.named)
+            .map(|(a, b)| *a || *b)
+            .collect();
         for cut in &c.cut_rules {
             mentioned[cut.into] = true;
-            mentioned[cut.junction.piece] = true;
         }
         // Pieces that can actually appear: the model's, then whatever firing rules insert,
         // until nothing changes.
@@ -62,7 +98,8 @@ impl Usage {
                 }
             }
             for m in &c.merge_rules {
-                if let (Some(j), true) = (m.junction, reach[m.mover.piece] && reach[m.target.piece]) {
+                if let (Some(j), true) = (m.junction, reach[m.mover.piece] && reach[m.target.piece])
+                {
                     add(&mut reach, j.piece);
                 }
             }
@@ -75,8 +112,8 @@ impl Usage {
                 break;
             }
         }
-        for p in 0..n {
-            if !mentioned[p] {
+        for (p, used) in mentioned.iter().enumerate() {
+            if !used {
                 let name = c.pieces[p].name.clone();
                 c.diags.push(
                     Diagnostic::warning(codes::UNUSED_PIECE, format!("piece `{name}` is never used"), c.piece_spans[p].name, "declared here")
@@ -89,31 +126,52 @@ impl Usage {
         let mut cut = 0;
         for item in &file.items {
             match item {
-                Item::Stretch(s) if stretch < c.stretch_rules.len() && c.stretch_spans[stretch] == s.span => {
+                Item::Stretch(s)
+                    if stretch < c.stretch_rules.len() && c.stretch_spans[stretch] == s.span =>
+                {
                     let r = &c.stretch_rules[stretch];
                     stretch += 1;
                     if !reach[r.piece] && !r.variants.iter().any(|v| reach[v.piece]) {
                         let name = c.pieces[r.piece].name.clone();
                         c.diags.push(
-                            Diagnostic::warning(codes::DEAD_RULE, "this stretch rule can never fire", s.span, format!("no instance of `{name}` can ever be in the assembly"))
-                                .with_hint(format!("add `{name}` to the model, e.g. `{name}s = chain {name} x 2`")),
+                            Diagnostic::warning(
+                                codes::DEAD_RULE,
+                                "this stretch rule can never fire",
+                                crate::syntax::Span::new(s.span.start, s.to.span.end),
+                                format!("no instance of `{name}` can ever be in the assembly"),
+                            )
+                            .with_hint(format!(
+                                "add `{name}` to the model, e.g. `{name}s = chain {name} x 2`"
+                            )),
                         );
                     }
                 }
                 Item::Merge(s) if merge < c.merge_rules.len() && c.merge_spans[merge] == s.span => {
                     let r = c.merge_rules[merge].clone();
                     merge += 1;
-                    let missing: Vec<String> =
-                        [r.mover.piece, r.target.piece].iter().filter(|&&p| !reach[p]).map(|&p| format!("`{}`", c.pieces[p].name)).collect();
+                    let missing: Vec<String> = [r.mover.piece, r.target.piece]
+                        .iter()
+                        .filter(|&&p| !reach[p])
+                        .map(|&p| format!("`{}`", c.pieces[p].name))
+                        .collect();
                     if !missing.is_empty() {
                         c.diags.push(
-                            Diagnostic::warning(codes::DEAD_RULE, "this merge rule can never fire", s.span, format!("{} never appears in the assembly", missing.join(" and ")))
-                                .with_hint("a merge fires only when instances of both pieces exist"),
+                            Diagnostic::warning(
+                                codes::DEAD_RULE,
+                                "this merge rule can never fire",
+                                s.span,
+                                format!("{} never appears in the assembly", missing.join(" and ")),
+                            )
+                            .with_hint("a merge fires only when instances of both pieces exist"),
                         );
                     }
                 }
                 Item::Cut(s) => {
-                    let Some(k) = (cut..c.cut_rules.len()).find(|&k| !c.cut_rules[k].derived && c.cut_spans.get(k) == Some(&s.span)) else { continue };
+                    let Some(k) = (cut..c.cut_rules.len())
+                        .find(|&k| !c.cut_rules[k].derived && c.cut_spans.get(k) == Some(&s.span))
+                    else {
+                        continue;
+                    };
                     cut = k + 1;
                     let r = c.cut_rules[k].clone();
                     if !reach[r.junction.piece] {

@@ -1,7 +1,191 @@
-//! `clayc bench` (placeholder until the solver lands).
+//! `clayc bench`: times solver frames on synthetic assemblies. `--parts N` drags a corner of a
+//! city of about N parts (streets, junctions, a long wall); `--arap-grid K` runs classic ARAP
+//! iterations on a K x K triangulated grid (left column fixed, right column dragged).
+
+use std::sync::Arc;
+
+use clay::assembly::{Assembly, HandleKind};
+use clay::solver::{FrameReport, Solver, SolverConfig, SolverKind};
+use clay::synthetic;
+use glam::DVec2;
+use serde::Serialize;
+
 #[derive(clap::Args)]
-pub struct BenchArgs {}
-pub fn bench(_: BenchArgs) -> u8 {
-    eprintln!("clayc bench: not built yet");
-    2
+pub struct BenchArgs {
+    /// Approximate number of parts of the synthetic city.
+    #[arg(long, default_value_t = 10_000, conflicts_with = "arap_grid")]
+    pub parts: usize,
+    /// Run classic ARAP on a K x K grid instead of the city.
+    #[arg(long, value_name = "K")]
+    pub arap_grid: Option<usize>,
+    /// Linear solver of the global step.
+    #[arg(long, value_enum, default_value_t = SolverArg::Cholesky)]
+    pub solver: SolverArg,
+    /// Frames to time.
+    #[arg(long, default_value_t = 30)]
+    pub frames: usize,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SolverArg {
+    Cholesky,
+    Cg,
+}
+
+#[derive(Serialize)]
+struct Ms {
+    median: f64,
+    max: f64,
+}
+
+#[derive(Serialize)]
+struct BenchResult {
+    model: String,
+    parts: usize,
+    vertices: usize,
+    matrix_nonzeros: usize,
+    solver: &'static str,
+    frames: usize,
+    /// Mean IRLS (pass 1) and least-squares (pass 2) iterations per frame.
+    irls_iterations: f64,
+    l2_iterations: f64,
+    factorizations_per_frame: f64,
+    cg_iterations_per_frame: f64,
+    /// The first frame, which includes the symbolic analysis.
+    first_frame_ms: f64,
+    /// Frames after the first.
+    frame_ms: Ms,
+    /// ARAP only: time of one local + global iteration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    iteration_ms: Option<Ms>,
+    converged_frames: usize,
+}
+
+fn stats(values: &[f64]) -> Ms {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let median = if v.is_empty() { 0.0 } else { v[v.len() / 2] };
+    Ms { median, max: v.last().copied().unwrap_or(0.0) }
+}
+
+pub fn bench(args: BenchArgs) -> u8 {
+    if args.frames == 0 || args.frames > 100_000 {
+        eprintln!("error: --frames must be from 1 to 100000");
+        return 2;
+    }
+    let kind = match args.solver {
+        SolverArg::Cholesky => SolverKind::Cholesky,
+        SolverArg::Cg => SolverKind::Cg,
+    };
+    let mut config = SolverConfig { kind, ..SolverConfig::default() };
+    let (model, mut asm, drag) = match args.arap_grid {
+        Some(k) => {
+            if !(2..=2000).contains(&k) {
+                eprintln!("error: --arap-grid must be from 2 to 2000");
+                return 2;
+            }
+            // classic ARAP: least squares only, one local + global iteration per frame
+            config.irls_iterations = 0;
+            config.l2_iterations = 1;
+            config.tolerance = 0.0;
+            let mut asm = Assembly::new(Arc::new(synthetic::arap_grid(k)));
+            let left: Vec<usize> = (0..k).map(|j| j * k).collect();
+            let right: Vec<usize> = (0..k).map(|j| j * k + k - 1).collect();
+            asm.hold_vertices(left, HandleKind::Pin);
+            let h = asm.hold_vertices(right, HandleKind::Grab);
+            (format!("arap-grid {k}x{k}"), asm, h.map(|h| (h, DVec2::new(0.3, 0.5) * k as f64)))
+        }
+        None => {
+            if !(10..=10_000_000).contains(&args.parts) {
+                eprintln!("error: --parts must be from 10 to 10000000");
+                return 2;
+            }
+            let mut asm = Assembly::new(Arc::new(synthetic::city(args.parts)));
+            let (lo, hi) = grid_corners(&asm);
+            if let Some(p) = asm.part_nearest(lo) {
+                asm.hold_part(p, HandleKind::Pin);
+            }
+            let h = asm.part_nearest(hi).and_then(|p| asm.hold_part(p, HandleKind::Grab));
+            let size = (hi - lo).length();
+            (format!("city of ~{} parts", args.parts), asm, h.map(|h| (h, DVec2::new(0.3, 0.2) * size)))
+        }
+    };
+    let mut solver = Solver::new(config);
+    let mut reports: Vec<FrameReport> = Vec::with_capacity(args.frames);
+    for k in 1..=args.frames {
+        if let Some((h, offset)) = drag
+            && let Some(handle) = asm.handle_mut(h)
+        {
+            handle.translation = offset * (k as f64 / args.frames as f64);
+        }
+        match solver.frame(&mut asm) {
+            Ok(r) => reports.push(r),
+            Err(e) => {
+                eprintln!("error: frame {k}: {e}");
+                return 1;
+            }
+        }
+    }
+    let n = reports.len() as f64;
+    let later: Vec<f64> = reports.iter().skip(1).map(|r| r.ms).collect();
+    let later = if later.is_empty() { vec![reports[0].ms] } else { later };
+    let result = BenchResult {
+        model,
+        parts: asm.data.parts.len(),
+        vertices: asm.data.positions.len(),
+        matrix_nonzeros: solver.matrix_nonzeros(),
+        solver: match kind {
+            SolverKind::Cholesky => "cholesky",
+            SolverKind::Cg => "cg",
+        },
+        frames: reports.len(),
+        irls_iterations: reports.iter().map(|r| r.irls_iterations as f64).sum::<f64>() / n,
+        l2_iterations: reports.iter().map(|r| r.l2_iterations as f64).sum::<f64>() / n,
+        factorizations_per_frame: reports.iter().map(|r| r.factorizations as f64).sum::<f64>() / n,
+        cg_iterations_per_frame: reports.iter().map(|r| r.cg_iterations as f64).sum::<f64>() / n,
+        first_frame_ms: reports[0].ms,
+        iteration_ms: args.arap_grid.map(|_| {
+            let per: Vec<f64> = reports.iter().skip(1).map(|r| r.ms / (r.l2_iterations + r.irls_iterations).max(1) as f64).collect();
+            stats(&per)
+        }),
+        frame_ms: stats(&later),
+        converged_frames: reports.iter().filter(|r| r.converged).count(),
+    };
+    if args.json {
+        match serde_json::to_string_pretty(&result) {
+            Ok(s) => println!("{s}"),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return 2;
+            }
+        }
+    } else {
+        println!(
+            "{}: {} parts, {} vertices, solver {}, {} frames\niterations per frame: {:.2} IRLS + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}{}",
+            result.model,
+            result.parts,
+            result.vertices,
+            result.solver,
+            result.frames,
+            result.irls_iterations,
+            result.l2_iterations,
+            result.factorizations_per_frame,
+            result.cg_iterations_per_frame,
+            result.first_frame_ms,
+            result.frame_ms.median,
+            result.frame_ms.max,
+            result.iteration_ms.as_ref().map_or(String::new(), |m| format!("\niteration_ms median {:.2}, max {:.2}", m.median, m.max)),
+        );
+    }
+    0
+}
+
+/// South-west and north-east corners of the street grid (the parts above the wall).
+fn grid_corners(asm: &Assembly) -> (DVec2, DVec2) {
+    let above = asm.data.positions.iter().filter(|p| p.y >= 0.0);
+    let (lo, hi) = above.fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    if lo.x > hi.x { (DVec2::ZERO, DVec2::ZERO) } else { (lo, hi) }
 }

@@ -82,7 +82,11 @@ pub fn check(args: CheckArgs) -> u8 {
         }
         match args.format {
             Format::Human => print_human(&diags, &bytes, &path),
-            Format::Json => json.extend(clay_dsl::to_json(&diags, &String::from_utf8_lossy(&bytes), &path)),
+            Format::Json => json.extend(clay_dsl::to_json(
+                &diags,
+                &String::from_utf8_lossy(&bytes),
+                &path,
+            )),
         }
     }
     match args.format {
@@ -107,7 +111,11 @@ fn summary(errors: usize, warnings: usize) -> String {
     match (errors, warnings) {
         (0, w) => format!("check passed with {}", plural(w, "warning")),
         (e, 0) => format!("check failed: {}", plural(e, "error")),
-        (e, w) => format!("check failed: {}, {}", plural(e, "error"), plural(w, "warning")),
+        (e, w) => format!(
+            "check failed: {}, {}",
+            plural(e, "error"),
+            plural(w, "warning")
+        ),
     }
 }
 

@@ -3,8 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
+use std::sync::Arc;
+
+use clay::assembly::{Assembly, HandleKind};
 use clay::render::{Overlays, RenderOptions, render_png, render_svg, sheet_png, sheet_svg};
-use clay_dsl::compiled::CompiledGrammar;
+use clay::rules::Rules;
+use clay::script::Script;
+use clay::solver::SolverConfig;
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
 /// An overlay that `--overlay` can ask for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -117,6 +123,39 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
     }
 }
 
+/// Replays a sculpting script on the grammar's initial assembly (solver and rules, as
+/// `clayc run` does); gives the final assembly and the global vertices of its grab handles and
+/// of its pins.
+fn replay(
+    grammar: CompiledGrammar,
+    path: &Path,
+) -> Result<(AssemblyData, Vec<usize>, Vec<usize>), u8> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        eprintln!("error: cannot read {}: {e}", path.display());
+        IO_ERROR
+    })?;
+    let script = Script::parse(&text).map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        INPUT_ERROR
+    })?;
+    let config = SolverConfig::from_params(&grammar.solver);
+    let mut assembly = Assembly::new(Arc::new(grammar));
+    if let Err(e) = clay::script::replay(&mut assembly, &script, &config, &mut Rules::new()) {
+        eprintln!("error: {}: {e}", path.display());
+        return Err(INPUT_ERROR);
+    }
+    let vertices = |kind: HandleKind| -> Vec<usize> {
+        assembly
+            .handles()
+            .iter()
+            .filter(|h| h.kind == kind)
+            .flat_map(|h| h.vertices.iter().copied())
+            .collect()
+    };
+    let (handles, pins) = (vertices(HandleKind::Grab), vertices(HandleKind::Pin));
+    Ok((assembly.data, handles, pins))
+}
+
 fn wants_svg(output: &Path, flag: bool) -> bool {
     flag || output
         .extension()
@@ -138,15 +177,13 @@ pub fn render(args: RenderArgs) -> u8 {
         Ok(g) => g,
         Err(code) => return code,
     };
-    let assembly = grammar.assembly.clone();
-    let (handles, pins) = (Vec::new(), Vec::new());
-    if let Some(script) = &args.script {
-        eprintln!(
-            "error: --script {}: script replay is not available yet (the solver's replay API has not landed)",
-            script.display()
-        );
-        return IO_ERROR;
-    }
+    let (assembly, handles, pins) = match &args.script {
+        None => (grammar.assembly.clone(), Vec::new(), Vec::new()),
+        Some(script) => match replay(grammar.clone(), script) {
+            Ok(replayed) => replayed,
+            Err(code) => return code,
+        },
+    };
     let has = |k: OverlayKind| args.overlay.contains(&k);
     let overlays = Overlays {
         part_graph: has(OverlayKind::Graph),

@@ -1,0 +1,255 @@
+//! No input makes the compiler panic or hang: random mutations of valid grammars, truncations,
+//! binary junk, absurd numbers and nesting. Every error comes with spans inside the source.
+
+use clay_dsl::{Diagnostics, compile, compile_bytes, render};
+
+const EMBEDDED: &str = r#"
+solver { merge_distance = 0.3 hysteresis = 0.2 }
+site type joint
+site type plug docks joint
+piece brick {
+    vertex sw (0, 0)
+    vertex se (1, 0)
+    vertex ne (1, 0.5)
+    vertex nw (0, 0.5)
+    edges sw-se-ne-nw-sw, sw-ne
+    site west: joint [nw, sw] out (-1, 0)
+    site east: joint [se, ne] out (1, 0)
+    polygon skinned fill #b5651d { (0.03, 0.03) (0.97, 0.03) (0.97, 0.47) (0.03, 0.47) hole { (0.4, 0.2) (0.6, 0.2) (0.5, 0.3) } }
+    state squat { sw (0, 0) se (1, 0) ne (1, 0.4) nw (0, 0.4) polyline width 0.1 fill #00000080 { (0, 0) (1, 0.4) } }
+}
+piece tower {
+    vertex a (-1, -1) vertex b (1, -1) vertex c (1, 1) vertex d (-1, 1)
+    vertex p (-0.25, 1) vertex q (0.25, 1)
+    edges a-b-c-q-p-d-a, a-c
+    site north: plug [q, p] out (0, 1)
+    axis north -> north
+}
+stretch brick from west to east { min 2 variants { brick 1 } }
+merge brick.east onto brick.west within 0.4
+model {
+    wall = chain brick x 5 at (0, 0) rotate 30
+    t = tower
+    dock wall[0].west to t.north
+}
+"#;
+
+/// A tiny deterministic generator (xorshift64*), so failures reproduce.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+const TOKENS: &[&str] = &[
+    "(", ")", "{", "}", "[", "]", ",", ".", "-", "->", ":", "=", "#", "#fff", "0", "-1", "1e400",
+    "1e308", "9999999", "0.5", "brick", "piece", "site", "model", "stretch", "merge", "cut",
+    "chain", "x", "dock", "state", "edges", "vertex", "wall[0]", "last", "/*", "*/", "//", "\n",
+    " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate",
+];
+
+fn mutate(rng: &mut Rng, src: &str) -> String {
+    let mut s = src.to_string();
+    for _ in 0..1 + rng.below(3) {
+        let mut at = rng.below(s.len() + 1);
+        while !s.is_char_boundary(at) {
+            at -= 1;
+        }
+        match rng.below(6) {
+            0 => {
+                let mut end = (at + rng.below(20)).min(s.len());
+                while !s.is_char_boundary(end) {
+                    end += 1;
+                }
+                s.replace_range(at..end, "");
+            }
+            1 | 2 => s.insert_str(at, TOKENS[rng.below(TOKENS.len())]),
+            3 => s.truncate(at),
+            4 => {
+                // Duplicate a line elsewhere (duplicate names, docks, blocks).
+                let lines: Vec<&str> = s.lines().collect();
+                let line = lines[rng.below(lines.len())].to_string();
+                s.insert_str(at, &format!("\n{line}\n"));
+            }
+            _ => {
+                // Replace a digit run with something extreme.
+                if let Some(d) = s[at..].find(|c: char| c.is_ascii_digit()) {
+                    let start = at + d;
+                    let end = start
+                        + s[start..]
+                            .find(|c: char| !c.is_ascii_digit())
+                            .unwrap_or(s.len() - start);
+                    let repl =
+                        ["0", "-0", "1e400", "100000000", "3", "1e-300", "2.5"][rng.below(7)];
+                    s.replace_range(start..end, repl);
+                }
+            }
+        }
+    }
+    s
+}
+
+fn assert_spans_valid(diags: &Diagnostics, src: &str, what: &str) {
+    assert!(!diags.is_empty(), "{what}: Err without diagnostics");
+    assert!(diags.has_errors(), "{what}: Err without an error");
+    for d in diags {
+        for l in std::iter::once(&d.primary).chain(&d.secondary) {
+            assert!(
+                l.span.start <= l.span.end && l.span.end <= src.len(),
+                "{what}: {} span {:?} outside 0..{}",
+                d.code,
+                l.span,
+                src.len()
+            );
+        }
+        assert!(!d.message.is_empty());
+    }
+}
+
+fn check(src: &str, what: &str) {
+    match compile(src, "fuzz.clay") {
+        Ok(c) => {
+            for d in &c.warnings {
+                assert!(d.primary.span.end <= src.len(), "{what}");
+            }
+            assert!(
+                c.grammar.assembly.positions.iter().all(|p| p.is_finite()),
+                "{what}: non-finite output"
+            );
+        }
+        Err(d) => {
+            assert_spans_valid(&d, src, what);
+            let _ = render(&d, src, "fuzz.clay", false);
+        }
+    }
+}
+
+fn bases() -> Vec<(String, String)> {
+    let mut out = vec![("embedded".to_string(), EMBEDDED.to_string())];
+    if let Ok(entries) = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../grammars")) {
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "clay")
+                && let Ok(s) = std::fs::read_to_string(&p)
+            {
+                out.push((p.display().to_string(), s));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_embedded_grammar_is_valid() {
+    let c = compile(EMBEDDED, "e.clay").map_err(|d| render(&d, EMBEDDED, "e.clay", false));
+    // The tower's axis names one site twice, which is an error: make sure the fuzz base is
+    // interesting (errors and successes both get mutated), and that the message is the one
+    // expected.
+    let err = c.expect_err("axis north -> north is not two opposite sites");
+    assert!(err.contains("E040"), "{err}");
+    let fixed = EMBEDDED.replace("    axis north -> north\n", "");
+    compile(&fixed, "e.clay")
+        .map_err(|d| render(&d, &fixed, "e.clay", false))
+        .unwrap();
+}
+
+#[test]
+fn thousands_of_mutations_never_panic() {
+    let mut rng = Rng(0x5eed_c1a7);
+    let mut bases = bases();
+    bases.push((
+        "embedded-fixed".into(),
+        EMBEDDED.replace("    axis north -> north\n", ""),
+    ));
+    let per_base = 3000 / bases.len() + 1;
+    let (mut oks, mut errs) = (0, 0);
+    for (name, src) in &bases {
+        for k in 0..per_base {
+            let m = mutate(&mut rng, src);
+            let what = format!("{name} mutation {k}");
+            check(&m, &what);
+            if compile(&m, "f").is_ok() {
+                oks += 1;
+            } else {
+                errs += 1;
+            }
+        }
+    }
+    // Both outcomes occur, so the mutations exercise the compiler beyond the parser.
+    assert!(oks > 50 && errs > 50, "ok {oks}, err {errs}");
+}
+
+#[test]
+fn every_truncation_of_a_grammar_returns() {
+    for end in 0..=EMBEDDED.len() {
+        if EMBEDDED.is_char_boundary(end) {
+            check(&EMBEDDED[..end], &format!("prefix {end}"));
+        }
+    }
+}
+
+#[test]
+fn binary_and_non_utf8_input_is_reported() {
+    let mut rng = Rng(42);
+    for _ in 0..200 {
+        let bytes: Vec<u8> = (0..rng.below(300)).map(|_| rng.next() as u8).collect();
+        match compile_bytes(&bytes, "bin.clay") {
+            Ok(_) => {}
+            Err(d) => assert_spans_valid(&d, &String::from_utf8_lossy(&bytes), "binary"),
+        }
+    }
+    let d = compile_bytes(b"site type j\n\xff\xfe", "x.clay").unwrap_err();
+    assert_eq!(d.items[0].code, "E003");
+    assert_eq!(d.items[0].primary.span.start, 12);
+}
+
+#[test]
+fn deep_nesting_is_rejected_before_parsing() {
+    for src in [
+        "(".repeat(10_000),
+        "/*".repeat(10_000),
+        format!("model {{ a = b at {} }}", "[".repeat(100_000)),
+    ] {
+        let d = compile(&src, "deep.clay").unwrap_err();
+        assert_eq!(d.items[0].code, "E002");
+        assert_spans_valid(&d, &src, "deep");
+    }
+    // Nesting within the limit is an ordinary syntax error.
+    let d = compile(&"(".repeat(200), "x").unwrap_err();
+    assert_eq!(d.items[0].code, "E001");
+}
+
+#[test]
+fn absurd_numbers_are_diagnosed() {
+    let base = EMBEDDED.replace("    axis north -> north\n", "");
+    let d = compile(&base.replace("x 5", "x 100000000"), "x").unwrap_err();
+    assert!(d.iter().any(|d| d.code == "E014"));
+    let d = compile(&base.replace("(1, 0)", "(1e400, 0)"), "x").unwrap_err();
+    assert!(d.iter().any(|d| d.code == "E012"));
+    let d = compile(&base.replace("(1, 0)", "(1e300, 0)"), "x").unwrap_err();
+    assert!(d.iter().any(|d| d.code == "E013"));
+    let d = compile(
+        &base.replace("wall[0].west", "wall[99999999999999999999999].west"),
+        "x",
+    )
+    .unwrap_err();
+    assert!(d.iter().any(|d| d.code == "E015"));
+}
+
+#[test]
+fn a_million_instance_chain_compiles_in_reasonable_time() {
+    let base = EMBEDDED
+        .replace("    axis north -> north\n", "")
+        .replace("x 5", "x 200000");
+    let t = std::time::Instant::now();
+    let c = compile(&base, "big.clay").unwrap();
+    assert_eq!(c.grammar.assembly.instances.len(), 200_001);
+    assert!(t.elapsed().as_secs() < 30, "took {:?}", t.elapsed());
+}

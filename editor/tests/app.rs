@@ -1,0 +1,239 @@
+//! The real editor UI driven without a display through egui_kittest: pointer drags on the
+//! canvas sculpt the model, Ctrl+Z undoes the gesture, and a failed hot reload keeps the model
+//! and shows the diagnostics.
+
+use std::time::{Duration, Instant};
+
+use clay_dsl::compiled::PartKind;
+use clay_editor::EditorApp;
+use clay_editor::compile::CASTLE_SOURCE;
+use egui::{Modifiers, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
+    Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .with_max_steps(8)
+        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
+}
+
+/// Steps until the solver has settled (each step is one UI frame with its solver budget).
+fn settle(h: &mut Harness<'_, EditorApp>) {
+    for _ in 0..300 {
+        h.step();
+        if !h.state().sculpt.needs_work() {
+            return;
+        }
+    }
+    panic!("the model did not settle");
+}
+
+/// The first tower part (a piece part) of the castle.
+fn tower(app: &EditorApp) -> usize {
+    let s = &app.sculpt;
+    s.data()
+        .parts
+        .iter()
+        .position(|p| match p.kind {
+            PartKind::Piece { instance } => {
+                s.grammar().pieces[s.data().instances[instance].piece].name == "tower"
+            }
+            PartKind::Stretch { .. } => false,
+        })
+        .unwrap()
+}
+
+#[test]
+fn dragging_a_part_sculpts_and_ctrl_z_undoes_the_gesture() {
+    let mut h = harness(EditorApp::bundled());
+    settle(&mut h);
+    let before = h.state().sculpt.data().clone();
+    let part = tower(h.state());
+    let at = h.get_by_label(&format!("part {part}")).rect().center();
+
+    h.hover_at(at);
+    h.step();
+    assert_eq!(h.state().canvas.hovered, Some(part), "the tower is under the cursor");
+    h.drag_at(at);
+    h.step();
+    let to = at + Vec2::new(80.0, -40.0);
+    for k in 1..=4 {
+        h.hover_at(at + (to - at) * (k as f32 / 4.0));
+        h.step();
+    }
+    assert_eq!(h.state().sculpt.grabbed(), Some(part), "the tower is the handle");
+    h.step();
+    h.drop_at(to);
+    h.step();
+    settle(&mut h);
+    assert_eq!(h.state().sculpt.grabbed(), None);
+    let after = h.state().sculpt.data().clone();
+    let moved = h.state().canvas.to_screen(h.state().sculpt.assembly().part_centroid(part)) - at;
+    assert!(
+        (moved - (to - at)).length() < 10.0,
+        "the tower follows the pointer: moved {moved:?}"
+    );
+    assert!(after != before, "the model changed");
+    assert!(h.state().sculpt.dirty);
+
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert!(h.state().sculpt.data() == &before, "Ctrl+Z restores the model before the drag");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    // Frames after the redo let the solver polish the pose, so compare within 0.1 mm.
+    let redone = h.state().sculpt.data();
+    assert!(redone.instances == after.instances && redone.docks == after.docks);
+    let gap = redone
+        .positions
+        .iter()
+        .zip(&after.positions)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-4, "Ctrl+Shift+Z redoes the drag (gap {gap} m)");
+}
+
+#[test]
+fn p_pins_the_part_under_the_cursor() {
+    let mut h = harness(EditorApp::bundled());
+    settle(&mut h);
+    let part = tower(h.state());
+    let at = h.get_by_label(&format!("part {part}")).rect().center();
+    h.hover_at(at);
+    h.step();
+    h.key_press(egui::Key::P);
+    h.step();
+    assert!(h.state().sculpt.is_pinned(part));
+    h.key_press(egui::Key::P);
+    h.step();
+    assert!(!h.state().sculpt.is_pinned(part));
+}
+
+#[test]
+fn wheel_zooms_toward_the_cursor() {
+    let mut h = harness(EditorApp::bundled());
+    h.step();
+    let at = Pos2::new(300.0, 300.0);
+    h.hover_at(at);
+    h.step();
+    let world = h.state().canvas.to_world(at);
+    let scale = h.state().canvas.camera.scale;
+    h.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: Vec2::new(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        modifiers: Modifiers::NONE,
+        source: egui::MouseWheelSource::Wheel,
+    });
+    for _ in 0..6 {
+        h.step();
+    }
+    assert!(h.state().canvas.camera.scale > scale * 1.05, "zoomed in");
+    let again = h.state().canvas.to_world(at);
+    assert!((again - world).length() < 1e-3 * scale.recip() * 100.0, "{again} vs {world}");
+}
+
+#[test]
+fn a_failed_hot_reload_keeps_the_model_and_shows_diagnostics() {
+    let dir = std::env::temp_dir().join(format!("clay-editor-reload-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("castle.clay");
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    assert!(h.state().problems.is_empty());
+    let model = h.state().sculpt.data().clone();
+    assert!(!model.parts.is_empty());
+
+    // An editor saving by rename: write a broken grammar next to it and move it over.
+    let tmp = dir.join("castle.clay.new");
+    std::fs::write(&tmp, format!("{CASTLE_SOURCE}\npiece broken {{\n")).unwrap();
+    std::fs::rename(&tmp, &path).unwrap();
+
+    let start = Instant::now();
+    while h.state().problems.is_empty() && start.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(50));
+        h.step();
+    }
+    let app = h.state();
+    assert!(app.stale, "the broken file is reported");
+    assert!(!app.problems.is_empty());
+    assert!(app.sculpt.data() == &model, "the last good model stays live");
+    let first = app.problems[0].to_string();
+    assert!(first.contains("castle.clay:"), "{first}");
+    h.step();
+    h.get_by_label_contains("The file does not compile");
+    h.get_by_label(&first);
+
+    // Fix the file again: the model comes back and the errors go.
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+    let start = Instant::now();
+    while h.state().stale && start.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(50));
+        h.step();
+    }
+    assert!(!h.state().stale);
+    assert!(h.state().problems.is_empty());
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_first() {
+    let mut h = harness(EditorApp::bundled());
+    h.step();
+    // Nothing sculpted: a close request goes through.
+    request_close(&mut h);
+    assert!(!h.state().confirming());
+
+    h.state_mut().command(clay_editor::sculpt::Command::Reset);
+    h.step();
+    assert!(h.state().sculpt.dirty);
+    request_close(&mut h);
+    assert!(h.state().confirming(), "the unsaved sculpt is confirmed first");
+    let cancelled = h
+        .output()
+        .viewport_output
+        .values()
+        .any(|v| v.commands.contains(&egui::ViewportCommand::CancelClose));
+    assert!(cancelled, "the close is held back");
+    h.step();
+    h.get_by_label("Discard").click();
+    h.step();
+    assert!(!h.state().confirming());
+    let closing = h
+        .output()
+        .viewport_output
+        .values()
+        .any(|v| v.commands.contains(&egui::ViewportCommand::Close));
+    assert!(closing, "after Discard the window closes");
+}
+
+#[test]
+fn opening_another_file_with_unsaved_changes_asks_first() {
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().command(clay_editor::sculpt::Command::Reset);
+    h.step();
+    let kept = h.state().sculpt.data().clone();
+    h.state_mut()
+        .perform(clay_editor::app::Action::OpenGrammar("no/such/file.clay".into()));
+    assert!(h.state().confirming());
+    // A new modal is laid out invisibly on its first frame.
+    h.step();
+    h.step();
+    h.get_by_label("Cancel").click();
+    h.step();
+    assert!(!h.state().confirming());
+    assert!(h.state().sculpt.data() == &kept, "cancel keeps the sculpt");
+}
+
+fn request_close(h: &mut Harness<'_, EditorApp>) {
+    h.input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    h.step();
+}

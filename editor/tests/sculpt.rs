@@ -1,0 +1,318 @@
+//! The editor's state without a window: sculpt commands, undo/redo of whole gestures, sessions
+//! (round trip, malformed files) and atomic saves.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clay_dsl::compiled::PartKind;
+use clay_editor::EditorApp;
+use clay_editor::compile::{CASTLE_PATH, CASTLE_SOURCE, compile};
+use clay_editor::sculpt::{Command, Sculpt};
+use clay_editor::session::{self, Session, SessionError, Settings};
+use glam::DVec2;
+
+fn castle() -> Sculpt {
+    let c = compile(CASTLE_SOURCE, CASTLE_PATH).expect("the bundled castle compiles");
+    let mut s = Sculpt::new(c.grammar);
+    settle(&mut s);
+    s
+}
+
+fn settle(s: &mut Sculpt) {
+    for _ in 0..200 {
+        if !s.step(Duration::from_millis(50)) {
+            return;
+        }
+    }
+    panic!("the castle did not settle");
+}
+
+/// A piece part of the castle whose piece is a tower.
+fn tower(s: &Sculpt) -> usize {
+    let data = s.data();
+    data.parts
+        .iter()
+        .position(|p| match p.kind {
+            PartKind::Piece { instance } => {
+                s.grammar().pieces[data.instances[instance].piece].name == "tower"
+            }
+            PartKind::Stretch { .. } => false,
+        })
+        .expect("the castle has towers")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-editor-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn drag(s: &mut Sculpt, part: usize, by: DVec2) {
+    s.apply(Command::Grab { part });
+    s.apply(Command::MoveGrab {
+        translation: by,
+        angle: 0.0,
+    });
+    for _ in 0..40 {
+        s.step(Duration::from_millis(50));
+    }
+    s.apply(Command::Release);
+    settle(s);
+}
+
+#[test]
+fn a_drag_moves_the_part_and_undo_redo_restore_whole_gestures() {
+    let mut s = castle();
+    let before = s.data().clone();
+    let part = tower(&s);
+    let c0 = s.assembly().part_centroid(part);
+    drag(&mut s, part, DVec2::new(1.5, 0.5));
+    let after = s.data().clone();
+    let moved = s.assembly().part_centroid(part) - c0;
+    assert!(
+        (moved - DVec2::new(1.5, 0.5)).length() < 0.2,
+        "the grabbed tower follows the handle, moved {moved}"
+    );
+    assert!(s.dirty);
+
+    s.apply(Command::Undo);
+    assert!(s.data() == &before, "undo restores the model before the drag");
+    assert!(s.can_redo());
+    s.apply(Command::Redo);
+    assert!(s.data() == &after, "redo brings the drag back");
+}
+
+#[test]
+fn rotating_the_grabbed_part_turns_it() {
+    let mut s = castle();
+    let part = tower(&s);
+    let vertices = s.data().parts[part].vertices.clone();
+    let edge = |s: &Sculpt| s.data().positions[vertices[1]] - s.data().positions[vertices[0]];
+    let e0 = edge(&s);
+    s.apply(Command::Grab { part });
+    s.apply(Command::MoveGrab {
+        translation: DVec2::ZERO,
+        angle: 0.4,
+    });
+    for _ in 0..40 {
+        s.step(Duration::from_millis(50));
+    }
+    let turned = e0.angle_to(edge(&s));
+    assert!((turned - 0.4).abs() < 0.1, "turned by {turned}");
+}
+
+#[test]
+fn pins_hold_parts_and_are_undoable() {
+    let mut s = castle();
+    let part = tower(&s);
+    assert!(!s.is_pinned(part));
+    s.apply(Command::TogglePin { part });
+    assert!(s.is_pinned(part));
+    assert_eq!(s.pins().len(), 1);
+
+    // Drag a different tower: the pinned one stays where it is.
+    let other = (0..s.data().parts.len())
+        .filter(|&p| p != part && matches!(s.data().parts[p].kind, PartKind::Piece { .. }))
+        .max_by(|&a, &b| {
+            let pa = s.assembly().part_centroid(part);
+            s.assembly()
+                .part_centroid(a)
+                .distance(pa)
+                .total_cmp(&s.assembly().part_centroid(b).distance(pa))
+        })
+        .unwrap();
+    let pin = s.pins()[0].clone();
+    drag(&mut s, other, DVec2::new(2.0, 2.0));
+    // Rules may renumber parts and vertices; the pin follows its vertices.
+    let now = &s.pins()[0];
+    for (k, &v) in now.vertices.iter().enumerate() {
+        let drift = s.data().positions[v].distance(pin.at[k]);
+        assert!(drift < 0.02, "pinned vertex {v} drifted {drift} m");
+    }
+    s.apply(Command::Undo); // the drag
+    s.apply(Command::Undo); // the pin
+    assert!(!s.is_pinned(part));
+    assert!(s.pins().is_empty());
+}
+
+#[test]
+fn reset_returns_to_the_initial_model() {
+    let mut s = castle();
+    let initial = s.grammar().assembly.clone();
+    let part = tower(&s);
+    drag(&mut s, part, DVec2::new(-2.0, 1.0));
+    assert_ne!(s.data().positions, initial.positions);
+    s.apply(Command::Reset);
+    assert!(s.data() == &initial);
+    s.apply(Command::Undo);
+    assert_ne!(s.data().positions, initial.positions, "reset is undoable");
+}
+
+#[test]
+fn settings_apply_live_and_bad_values_are_refused() {
+    let mut s = castle();
+    let good = Settings {
+        hysteresis: 0.3,
+        norm: 1.0,
+        merge_distance: 0.8,
+    };
+    s.apply(Command::Settings(good));
+    assert_eq!(s.settings(), good);
+    s.apply(Command::Settings(Settings {
+        hysteresis: f64::NAN,
+        ..good
+    }));
+    assert_eq!(s.settings(), good);
+    let part = tower(&s);
+    assert_eq!(s.inspect(part).unwrap().hysteresis, 0.3);
+}
+
+#[test]
+fn the_inspector_explains_the_active_state() {
+    let s = castle();
+    let stretch = s
+        .data()
+        .parts
+        .iter()
+        .position(|p| matches!(p.kind, PartKind::Stretch { .. }))
+        .unwrap();
+    let r = s.inspect(stretch).unwrap();
+    assert_eq!(r.states.len(), 3, "one, two and three elements");
+    let d_active = r.states[r.active].1;
+    assert!((r.switch_below - (1.0 - r.hysteresis) * d_active).abs() < 1e-12);
+    // The model is at rest, so no other state is close enough to switch.
+    for (i, (_, d)) in r.states.iter().enumerate() {
+        if i != r.active {
+            assert!(*d >= r.switch_below);
+        }
+    }
+}
+
+#[test]
+fn cutting_a_connection_is_one_undoable_step() {
+    let mut s = castle();
+    let before = s.data().clone();
+    let centre = s.dock_centres()[0];
+    assert_eq!(s.cut_target(centre), Some(0));
+    s.apply(Command::Cut { point: centre });
+    assert!(s.log().iter().any(|e| e.message.starts_with("cut")));
+    assert_ne!(s.data(), &before, "the cut changed the assembly");
+    s.apply(Command::Undo);
+    assert!(s.data() == &before);
+    // Far from everything, a cut does nothing and leaves no undo step.
+    let undo_before = s.can_undo();
+    s.apply(Command::Cut {
+        point: DVec2::new(1e4, 1e4),
+    });
+    assert!(s.data() == &before);
+    assert_eq!(s.can_undo(), undo_before);
+}
+
+#[test]
+fn a_session_round_trips_through_a_file() {
+    let dir = scratch("roundtrip");
+    let mut app = EditorApp::bundled();
+    settle(&mut app.sculpt);
+    let part = tower(&app.sculpt);
+    app.sculpt.apply(Command::TogglePin { part });
+    let other = (0..app.sculpt.data().parts.len()).rev().find(|&p| p != part).unwrap();
+    drag(&mut app.sculpt, other, DVec2::new(0.0, -1.0));
+    let path = dir.join("s.json");
+    app.save_session(&path).unwrap();
+    assert!(!app.sculpt.dirty, "saving clears the unsaved flag");
+
+    let text = std::fs::read_to_string(&path).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(json["format"], "clay-session");
+    assert_eq!(json["version"], 1);
+    assert_eq!(json["grammar"], CASTLE_PATH);
+
+    let mut other_app = EditorApp::bundled();
+    other_app.open_session(&path).unwrap();
+    assert!(other_app.sculpt.data() == app.sculpt.data(), "the sculpt is restored exactly");
+    assert_eq!(other_app.sculpt.pins(), app.sculpt.pins());
+    assert!(other_app.sculpt.is_pinned(part));
+    assert!(session::read(&path).unwrap() == app.session());
+}
+
+#[test]
+fn malformed_sessions_are_clear_errors() {
+    let good = serde_json::to_value(Session::new(
+        CASTLE_PATH.into(),
+        compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar.assembly.clone(),
+        Vec::new(),
+        None,
+    ))
+    .unwrap();
+    let message = |text: &str| match session::parse(text) {
+        Err(SessionError::Malformed(m)) => m,
+        other => panic!("expected a malformed-session error, got {other:?}"),
+    };
+    assert!(message("not json at all").contains("invalid JSON"));
+    assert!(message("{\"format\": \"png\", \"version\": 1}").contains("\"format\" must be"));
+    let mut v2 = good.clone();
+    v2["version"] = 2.into();
+    assert!(message(&v2.to_string()).contains("version 2 is not supported"));
+    let mut no_assembly = good.clone();
+    no_assembly.as_object_mut().unwrap().remove("assembly");
+    assert!(message(&no_assembly.to_string()).contains("assembly"));
+    let mut bad_positions = good.clone();
+    bad_positions["assembly"]["positions"] = "oops".into();
+    assert!(message(&bad_positions.to_string()).contains("malformed session"));
+
+    // Well-formed JSON whose assembly does not fit the grammar: refused, the sculpt kept.
+    let dir = scratch("malformed");
+    let mut broken = good;
+    broken["assembly"]["instances"][0]["vertices"][0] = 999_999.into();
+    let path = dir.join("broken.json");
+    std::fs::write(&path, broken.to_string()).unwrap();
+    let mut app = EditorApp::bundled();
+    let kept = app.sculpt.data().clone();
+    let err = app.open_session(&path).unwrap_err();
+    assert!(err.contains("does not fit the grammar"), "{err}");
+    assert!(app.sculpt.data() == &kept);
+}
+
+#[test]
+fn a_failed_atomic_save_leaves_the_old_file_intact() {
+    let dir = scratch("atomic");
+    let path = dir.join("s.json");
+    std::fs::write(&path, "old contents").unwrap();
+    // Block the temporary file's place with a folder, so creating it fails the way an
+    // unwritable folder would (root ignores permissions, so chmod cannot simulate it).
+    let tmp = dir.join(format!(".s.json.{}.tmp", std::process::id()));
+    std::fs::create_dir(&tmp).unwrap();
+    let mut app = EditorApp::bundled();
+    let part = tower(&app.sculpt);
+    app.sculpt.apply(Command::TogglePin { part });
+    assert!(app.save_session(&path).is_err());
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "old contents");
+    assert!(app.sculpt.dirty, "a failed save keeps the unsaved flag");
+
+    std::fs::remove_dir(&tmp).unwrap();
+    app.save_session(&path).unwrap();
+    assert!(session::read(&path).is_ok());
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
+
+    // A folder that does not exist: an error, not a panic, and nothing created.
+    let missing = dir.join("no/such/folder/s.json");
+    assert!(app.save_session(&missing).is_err());
+    assert!(!dir.join("no").exists());
+}
+
+#[test]
+fn exports_write_a_png_and_the_assembly_json() {
+    let dir = scratch("export");
+    let app = EditorApp::bundled();
+    let png = dir.join("view.png");
+    app.export_png(&png).unwrap();
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let json = dir.join("asm.json");
+    app.export_json(&json).unwrap();
+    let back: clay_dsl::compiled::AssemblyData =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(&back == app.sculpt.data());
+}

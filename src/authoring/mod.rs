@@ -1,0 +1,120 @@
+//! Authoring (issue 7): turn a drawing into a readable `.clay` grammar. The steps are plain
+//! functions on plain data, so the CLI (`clayc author`) and the editor's authoring mode share
+//! them:
+//!
+//! 1. [`svg::drawing_from_svg`] (or a [`Drawing`] built in code): polylines in metres, y up;
+//! 2. [`graph::Graph::build`]: vertices snapped within a tolerance, edges, T-junctions split;
+//! 3. [`graph::Graph::cut`] at each cut point: the cut section's vertices are duplicated, one copy
+//!    per side, and the pair becomes a contact (two docking sites);
+//! 4. [`graph::Graph::regions`]: the regions between cuts (or, with no cut, every closed path)
+//!    and the [`graph::Contact`]s where regions touch;
+//! 5. [`pieces::find_pieces`]: regions equal up to a rigid motion become one piece with several
+//!    instances; contacts become typed docking sites;
+//! 6. [`pieces::Design::to_syntax`]: the grammar as a syntax tree, printed by
+//!    [`clay_dsl::format::print_file`].
+//!
+//! [`author`] runs them all.
+
+pub mod graph;
+pub mod pieces;
+pub mod svg;
+
+use glam::DVec2;
+
+pub use graph::{Contact, Graph, Region};
+pub use pieces::{Design, PieceDesign, StretchChoice};
+
+/// One stroke of a drawing, in metres with y up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polyline {
+    pub points: Vec<DVec2>,
+    /// The last point joins the first.
+    pub closed: bool,
+    /// Fill colour as drawn (`#rrggbb`), if any.
+    pub fill: Option<[u8; 3]>,
+    /// The drawing's name for it (an SVG `id`), used to name pieces.
+    pub name: Option<String>,
+}
+
+impl Polyline {
+    /// A closed polygon without colour or name.
+    pub fn polygon(points: Vec<DVec2>) -> Self {
+        Self { points, closed: true, fill: None, name: None }
+    }
+}
+
+/// A drawing: the input of authoring.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Drawing {
+    pub polylines: Vec<Polyline>,
+}
+
+/// Everything authoring needs besides the drawing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AuthorOptions {
+    /// Points closer than this (metres) are one vertex; a vertex this close to an edge splits it.
+    pub snap: f64,
+    /// Regions whose vertices match within this distance (metres) after a rigid motion are
+    /// instances of one piece.
+    pub congruence: f64,
+    /// Cut points (metres, y up).
+    pub cuts: Vec<DVec2>,
+    /// Make a piece stretchable.
+    pub stretch: Option<StretchChoice>,
+    /// A comment line for the top of the file (without `//`), e.g. where the drawing came from.
+    pub header: Option<String>,
+}
+
+impl Default for AuthorOptions {
+    fn default() -> Self {
+        Self { snap: 1e-3, congruence: 1e-3, cuts: Vec::new(), stretch: None, header: None }
+    }
+}
+
+/// Why a drawing could not become a grammar.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AuthorError(pub String);
+
+impl std::fmt::Display for AuthorError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for AuthorError {}
+
+/// The result of [`author`]: the design (pieces, instances, docks) and the grammar text.
+#[derive(Clone, Debug)]
+pub struct Authored {
+    pub design: Design,
+    pub text: String,
+}
+
+/// Runs every authoring step on a drawing.
+pub fn author(drawing: &Drawing, options: &AuthorOptions) -> Result<Authored, AuthorError> {
+    for (name, v) in [("snap tolerance", options.snap), ("congruence tolerance", options.congruence)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(AuthorError(format!("the {name} must be a positive number, found {v}")));
+        }
+    }
+    let mut graph = Graph::build(drawing, options.snap)?;
+    let cut_contacts = options.cuts.iter().map(|&p| graph.cut(p, options.snap)).collect::<Result<Vec<_>, _>>()?;
+    let (regions, contacts) = if cut_contacts.is_empty() {
+        graph.loop_regions(options.snap)?
+    } else {
+        graph.regions(&cut_contacts)
+    };
+    let mut design = pieces::find_pieces(&graph, &regions, &contacts, options.congruence)?;
+    if let Some(choice) = &options.stretch {
+        design.make_stretchable(choice)?;
+    }
+    let tree = design.to_syntax();
+    let mut text = String::new();
+    if let Some(h) = &options.header {
+        for line in h.lines() {
+            text += &format!("// {line}\n");
+        }
+    }
+    text += &clay_dsl::format::print_file(&tree);
+    Ok(Authored { design, text })
+}
