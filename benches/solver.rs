@@ -27,7 +27,10 @@ fn setup(parts: usize) -> (Assembly, u64) {
 
 fn frames(c: &mut Criterion) {
     let mut group = c.benchmark_group("frame");
-    group.sample_size(10).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3));
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
     for (parts, kind) in [
         (1_000, SolverKind::Cholesky),
         (1_000, SolverKind::Cg),
@@ -35,7 +38,10 @@ fn frames(c: &mut Criterion) {
         (100_000, SolverKind::Cholesky),
     ] {
         let (mut asm, h) = setup(parts);
-        let mut solver = Solver::new(SolverConfig { kind, ..SolverConfig::default() });
+        let mut solver = Solver::new(SolverConfig {
+            kind,
+            ..SolverConfig::default()
+        });
         solver.frame(&mut asm).unwrap(); // symbolic analysis happens here, outside the timing
         let mut k = 0u64;
         group.bench_function(format!("{kind:?}/{parts}"), |b| {

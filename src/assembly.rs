@@ -103,7 +103,14 @@ impl Assembly {
             data.parts = grammar.parts(&data);
         }
         let rotations = vec![DVec2::X; data.parts.len()];
-        Self { grammar, data, rotations, handles: Vec::new(), next_handle: 0, generation: 0 }
+        Self {
+            grammar,
+            data,
+            rotations,
+            handles: Vec::new(),
+            next_handle: 0,
+            generation: 0,
+        }
     }
 
     pub fn grammar(&self) -> &CompiledGrammar {
@@ -203,7 +210,11 @@ impl Assembly {
         if p.vertices.is_empty() {
             return DVec2::ZERO;
         }
-        p.vertices.iter().map(|&v| self.data.positions[v]).sum::<DVec2>() / p.vertices.len() as f64
+        p.vertices
+            .iter()
+            .map(|&v| self.data.positions[v])
+            .sum::<DVec2>()
+            / p.vertices.len() as f64
     }
 
     /// The part whose centroid is nearest `point` (ties: lowest index). `None` without parts.
@@ -222,14 +233,22 @@ impl Assembly {
         let d = dir.direction();
         let key = |i: usize| {
             let p = &self.data.parts[i];
-            let reach =
-                p.vertices.iter().map(|&v| self.data.positions[v].dot(d)).fold(f64::MIN, f64::max);
+            let reach = p
+                .vertices
+                .iter()
+                .map(|&v| self.data.positions[v].dot(d))
+                .fold(f64::MIN, f64::max);
             (reach, self.part_centroid(i).dot(d))
         };
         (0..self.data.parts.len())
             .filter(|&i| !self.data.parts[i].vertices.is_empty())
             .map(|i| (i, key(i)))
-            .max_by(|a, b| a.1.0.total_cmp(&b.1.0).then(a.1.1.total_cmp(&b.1.1)).then(b.0.cmp(&a.0)))
+            .max_by(|a, b| {
+                a.1.0
+                    .total_cmp(&b.1.0)
+                    .then(a.1.1.total_cmp(&b.1.1))
+                    .then(b.0.cmp(&a.0))
+            })
             .map(|(i, _)| i)
     }
 
@@ -247,7 +266,10 @@ impl Assembly {
         }
         for (ii, inst) in d.instances.iter().enumerate() {
             let Some(piece) = g.pieces.get(inst.piece) else {
-                errors.push(format!("instance {ii}: piece {} does not exist", inst.piece));
+                errors.push(format!(
+                    "instance {ii}: piece {} does not exist",
+                    inst.piece
+                ));
                 continue;
             };
             if inst.vertices.len() != piece.vertices.len() {
@@ -265,7 +287,10 @@ impl Assembly {
                 errors.push(format!("instance {ii}: state {} out of range", inst.state));
             }
             if inst.id >= d.next_id {
-                errors.push(format!("instance {ii}: id {} not below next_id {}", inst.id, d.next_id));
+                errors.push(format!(
+                    "instance {ii}: id {} not below next_id {}",
+                    inst.id, d.next_id
+                ));
             }
         }
         for (di, dock) in d.docks.iter().enumerate() {
@@ -282,7 +307,10 @@ impl Assembly {
         }
         for (ci, chain) in d.chains.iter().enumerate() {
             if chain.rule >= g.stretch_rules.len() {
-                errors.push(format!("chain {ci}: stretch rule {} does not exist", chain.rule));
+                errors.push(format!(
+                    "chain {ci}: stretch rule {} does not exist",
+                    chain.rule
+                ));
             }
             if chain.instances.iter().any(|&i| i >= d.instances.len()) {
                 errors.push(format!("chain {ci}: instance index out of range"));
@@ -293,14 +321,21 @@ impl Assembly {
             if part.vertices.iter().any(|&v| v >= n) {
                 errors.push(format!("part {pi}: vertex index out of range"));
             }
-            if part.edges.iter().any(|e| e[0] >= m || e[1] >= m || e[0] == e[1]) {
+            if part
+                .edges
+                .iter()
+                .any(|e| e[0] >= m || e[1] >= m || e[0] == e[1])
+            {
                 errors.push(format!("part {pi}: edge index out of range or a loop"));
             }
             if part.states.is_empty() {
                 errors.push(format!("part {pi}: no rest state"));
             }
             if part.active >= part.states.len().max(1) {
-                errors.push(format!("part {pi}: active state {} out of range", part.active));
+                errors.push(format!(
+                    "part {pi}: active state {} out of range",
+                    part.active
+                ));
             }
             for s in &part.states {
                 if s.positions.len() != m {
@@ -311,7 +346,10 @@ impl Assembly {
                     ));
                 }
                 if s.positions.iter().any(|p| !p.is_finite()) {
-                    errors.push(format!("part {pi}: state `{}` has a non-finite position", s.name));
+                    errors.push(format!(
+                        "part {pi}: state `{}` has a non-finite position",
+                        s.name
+                    ));
                 }
             }
             match part.kind {
@@ -319,9 +357,14 @@ impl Assembly {
                     errors.push(format!("part {pi}: instance {instance} does not exist"));
                 }
                 PartKind::Stretch { chain, first }
-                    if d.chains.get(chain).is_none_or(|c| first + 1 >= c.instances.len()) =>
+                    if d.chains
+                        .get(chain)
+                        .is_none_or(|c| first + 1 >= c.instances.len()) =>
                 {
-                    errors.push(format!("part {pi}: chain {chain} has no elements {first}, {}", first + 1));
+                    errors.push(format!(
+                        "part {pi}: chain {chain} has no elements {first}, {}",
+                        first + 1
+                    ));
                 }
                 _ => {}
             }
@@ -338,6 +381,10 @@ impl Assembly {
                 errors.push(format!("handle {}: vertices out of range", h.id));
             }
         }
-        if errors.is_empty() { Ok(()) } else { Err(errors) }
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            Err(errors)
+        }
     }
 }

@@ -6,3 +6,4 @@ pub mod render;
 pub mod synthetic;
 pub mod script;
 pub mod summary;
+pub mod authoring;

@@ -87,26 +87,40 @@ fn number(v: &Value, what: &str) -> Result<f64, String> {
 fn point(v: &Value, what: &str) -> Result<DVec2, String> {
     match v.as_array().map(Vec::as_slice) {
         Some([x, y]) => Ok(DVec2::new(number(x, what)?, number(y, what)?)),
-        _ => Err(format!("{what} must be an array of two numbers [x, y], found {v}")),
+        _ => Err(format!(
+            "{what} must be an array of two numbers [x, y], found {v}"
+        )),
     }
 }
 
 fn frames(obj: &serde_json::Map<String, Value>, kind: &str) -> Result<u64, String> {
-    let v = obj.get("frames").ok_or_else(|| format!("{kind} needs \"frames\""))?;
+    let v = obj
+        .get("frames")
+        .ok_or_else(|| format!("{kind} needs \"frames\""))?;
     match v.as_u64() {
         Some(n) if n <= MAX_FRAMES => Ok(n),
-        _ => Err(format!("{kind}: \"frames\" must be an integer from 0 to {MAX_FRAMES}, found {v}")),
+        _ => Err(format!(
+            "{kind}: \"frames\" must be an integer from 0 to {MAX_FRAMES}, found {v}"
+        )),
     }
 }
 
 fn object<'a>(v: &'a Value, kind: &str) -> Result<&'a serde_json::Map<String, Value>, String> {
-    v.as_object().ok_or_else(|| format!("{kind} takes an object, found {v}"))
+    v.as_object()
+        .ok_or_else(|| format!("{kind} takes an object, found {v}"))
 }
 
-fn only_keys(obj: &serde_json::Map<String, Value>, kind: &str, allowed: &[&str]) -> Result<(), String> {
+fn only_keys(
+    obj: &serde_json::Map<String, Value>,
+    kind: &str,
+    allowed: &[&str],
+) -> Result<(), String> {
     for k in obj.keys() {
         if !allowed.contains(&k.as_str()) {
-            return Err(format!("{kind}: unknown field \"{k}\" (expected {})", allowed.join(", ")));
+            return Err(format!(
+                "{kind}: unknown field \"{k}\" (expected {})",
+                allowed.join(", ")
+            ));
         }
     }
     Ok(())
@@ -121,18 +135,28 @@ fn selector(v: &Value, kind: &str) -> Result<Selector, String> {
             Some("west") => Ok(Selector::Extreme(Compass::West)),
             Some("north") => Ok(Selector::Extreme(Compass::North)),
             Some("south") => Ok(Selector::Extreme(Compass::South)),
-            _ => Err(format!("{kind}: \"extreme\" must be \"east\", \"west\", \"north\" or \"south\", found {dir}")),
+            _ => Err(format!(
+                "{kind}: \"extreme\" must be \"east\", \"west\", \"north\" or \"south\", found {dir}"
+            )),
         },
-        _ => Err(format!("{kind} takes {{\"at\": [x, y]}} or {{\"extreme\": \"east\"|\"west\"|\"north\"|\"south\"}}")),
+        _ => Err(format!(
+            "{kind} takes {{\"at\": [x, y]}} or {{\"extreme\": \"east\"|\"west\"|\"north\"|\"south\"}}"
+        )),
     }
 }
 
 fn step(v: &Value) -> Result<Step, String> {
-    let obj = v.as_object().ok_or_else(|| format!("a step must be an object, found {v}"))?;
+    let obj = v
+        .as_object()
+        .ok_or_else(|| format!("a step must be an object, found {v}"))?;
     if obj.len() != 1 {
         return Err(format!(
             "a step must have exactly one key (grab, pin, drag, rotate, release, hold, cut), found {}",
-            if obj.is_empty() { "none".to_string() } else { obj.keys().cloned().collect::<Vec<_>>().join(", ") }
+            if obj.is_empty() {
+                "none".to_string()
+            } else {
+                obj.keys().cloned().collect::<Vec<_>>().join(", ")
+            }
         ));
     }
     let (kind, body) = obj.iter().next().ok_or("empty step")?;
@@ -147,13 +171,22 @@ fn step(v: &Value) -> Result<Step, String> {
                 (None, Some(to)) => Motion::To(point(to, "drag: \"to\"")?),
                 _ => return Err("drag needs exactly one of \"by\" or \"to\"".into()),
             };
-            Ok(Step::Drag { motion, frames: frames(o, "drag")? })
+            Ok(Step::Drag {
+                motion,
+                frames: frames(o, "drag")?,
+            })
         }
         "rotate" => {
             let o = object(body, "rotate")?;
             only_keys(o, "rotate", &["degrees", "frames"])?;
-            let degrees = number(o.get("degrees").ok_or("rotate needs \"degrees\"")?, "rotate: \"degrees\"")?;
-            Ok(Step::Rotate { degrees, frames: frames(o, "rotate")? })
+            let degrees = number(
+                o.get("degrees").ok_or("rotate needs \"degrees\"")?,
+                "rotate: \"degrees\"",
+            )?;
+            Ok(Step::Rotate {
+                degrees,
+                frames: frames(o, "rotate")?,
+            })
         }
         "release" => {
             let o = object(body, "release")?;
@@ -163,26 +196,41 @@ fn step(v: &Value) -> Result<Step, String> {
         "hold" => {
             let o = object(body, "hold")?;
             only_keys(o, "hold", &["frames"])?;
-            Ok(Step::Hold { frames: frames(o, "hold")? })
+            Ok(Step::Hold {
+                frames: frames(o, "hold")?,
+            })
         }
         "cut" => {
             let o = object(body, "cut")?;
             only_keys(o, "cut", &["at"])?;
-            Ok(Step::Cut { at: point(o.get("at").ok_or("cut needs \"at\"")?, "cut: \"at\"")? })
+            Ok(Step::Cut {
+                at: point(o.get("at").ok_or("cut needs \"at\"")?, "cut: \"at\"")?,
+            })
         }
-        other => Err(format!("unknown step \"{other}\" (expected grab, pin, drag, rotate, release, hold or cut)")),
+        other => Err(format!(
+            "unknown step \"{other}\" (expected grab, pin, drag, rotate, release, hold or cut)"
+        )),
     }
 }
 
 impl Script {
     /// Parses and validates a script; every error names the step index and what is wrong.
     pub fn parse(json: &str) -> Result<Self, ScriptError> {
-        let doc: Value = serde_json::from_str(json)
-            .map_err(|e| ScriptError { step: None, message: format!("the script is not valid JSON: {e}") })?;
-        let whole = |message: String| ScriptError { step: None, message };
-        let obj = doc.as_object().ok_or_else(|| whole("the script must be an object {\"steps\": [...]}".into()))?;
+        let doc: Value = serde_json::from_str(json).map_err(|e| ScriptError {
+            step: None,
+            message: format!("the script is not valid JSON: {e}"),
+        })?;
+        let whole = |message: String| ScriptError {
+            step: None,
+            message,
+        };
+        let obj = doc
+            .as_object()
+            .ok_or_else(|| whole("the script must be an object {\"steps\": [...]}".into()))?;
         if let Some(k) = obj.keys().find(|k| *k != "steps") {
-            return Err(whole(format!("unknown top-level field \"{k}\" (expected \"steps\")")));
+            return Err(whole(format!(
+                "unknown top-level field \"{k}\" (expected \"steps\")"
+            )));
         }
         let steps = obj
             .get("steps")
@@ -192,7 +240,12 @@ impl Script {
         let steps = steps
             .iter()
             .enumerate()
-            .map(|(i, v)| step(v).map_err(|message| ScriptError { step: Some(i), message }))
+            .map(|(i, v)| {
+                step(v).map_err(|message| ScriptError {
+                    step: Some(i),
+                    message,
+                })
+            })
             .collect::<Result<_, _>>()?;
         Ok(Self { steps })
     }
@@ -202,7 +255,9 @@ impl Script {
         self.steps
             .iter()
             .map(|s| match s {
-                Step::Drag { frames, .. } | Step::Rotate { frames, .. } | Step::Hold { frames } => *frames,
+                Step::Drag { frames, .. } | Step::Rotate { frames, .. } | Step::Hold { frames } => {
+                    *frames
+                }
                 _ => 0,
             })
             .sum()
@@ -220,7 +275,13 @@ pub enum RuleKind {
 }
 
 impl RuleKind {
-    pub const ALL: [RuleKind; 5] = [RuleKind::Replace, RuleKind::Stretch, RuleKind::Shrink, RuleKind::Merge, RuleKind::Cut];
+    pub const ALL: [RuleKind; 5] = [
+        RuleKind::Replace,
+        RuleKind::Stretch,
+        RuleKind::Shrink,
+        RuleKind::Merge,
+        RuleKind::Cut,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -312,11 +373,18 @@ impl Replay {
     }
 
     /// Runs one solver frame, then the rules; counts piece-part state switches as `replace`.
-    pub fn frame(&mut self, asm: &mut Assembly, hook: &mut dyn FrameHook) -> Result<FrameReport, SolverError> {
+    pub fn frame(
+        &mut self,
+        asm: &mut Assembly,
+        hook: &mut dyn FrameHook,
+    ) -> Result<FrameReport, SolverError> {
         let start = std::time::Instant::now();
         let report = self.solver.frame(asm)?;
         for s in &report.switches {
-            if matches!(asm.data.parts.get(s.part).map(|p| p.kind), Some(PartKind::Piece { .. })) {
+            if matches!(
+                asm.data.parts.get(s.part).map(|p| p.kind),
+                Some(PartKind::Piece { .. })
+            ) {
                 *self.rules_fired.entry(RuleKind::Replace).or_default() += 1;
             }
         }
@@ -348,7 +416,9 @@ impl Replay {
             self.current = None;
             return (0..frames).try_for_each(|_| self.frame(asm, hook).map(drop));
         };
-        let Some(h) = asm.handle(id) else { return Ok(()) };
+        let Some(h) = asm.handle(id) else {
+            return Ok(());
+        };
         let (t0, a0) = (h.translation, h.angle);
         if frames == 0 {
             if let Some(h) = asm.handle_mut(id) {
@@ -370,7 +440,13 @@ impl Replay {
     }
 
     /// Runs one step (step index `index` is only used in notes).
-    pub fn step(&mut self, asm: &mut Assembly, index: usize, step: &Step, hook: &mut dyn FrameHook) -> Result<(), SolverError> {
+    pub fn step(
+        &mut self,
+        asm: &mut Assembly,
+        index: usize,
+        step: &Step,
+        hook: &mut dyn FrameHook,
+    ) -> Result<(), SolverError> {
         match *step {
             Step::Grab(sel) | Step::Pin(sel) => {
                 let Some(part) = self.select(asm, sel) else {
@@ -432,7 +508,13 @@ impl Replay {
 
     /// The summary of the session so far.
     pub fn summary(&self, asm: &Assembly) -> Summary {
-        summarize(asm, &self.frame_ms, &self.rules_fired, self.last_report.as_ref(), &self.solver.config)
+        summarize(
+            asm,
+            &self.frame_ms,
+            &self.rules_fired,
+            self.last_report.as_ref(),
+            &self.solver.config,
+        )
     }
 }
 
@@ -445,7 +527,10 @@ pub fn replay(
 ) -> Result<(Summary, Replay), ReplayError> {
     let mut session = Replay::new(*config);
     for (i, s) in script.steps.iter().enumerate() {
-        session.step(asm, i, s, hook).map_err(|error| ReplayError { step: Some(i), error })?;
+        session.step(asm, i, s, hook).map_err(|error| ReplayError {
+            step: Some(i),
+            error,
+        })?;
     }
     Ok((session.summary(asm), session))
 }

@@ -49,7 +49,11 @@ fn median(values: &[f64]) -> f64 {
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
     let m = v.len() / 2;
-    if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) }
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
 }
 
 /// Connected components of the part graph.
@@ -98,10 +102,19 @@ pub fn summarize(
     let mut pieces = BTreeMap::new();
     let mut states: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
     for inst in &asm.data.instances {
-        let Some(piece) = g.pieces.get(inst.piece) else { continue };
+        let Some(piece) = g.pieces.get(inst.piece) else {
+            continue;
+        };
         *pieces.entry(piece.name.clone()).or_insert(0) += 1;
-        let state = piece.states.get(inst.state).map_or("?", |s| s.name.as_str());
-        *states.entry(piece.name.clone()).or_default().entry(state.to_string()).or_insert(0) += 1;
+        let state = piece
+            .states
+            .get(inst.state)
+            .map_or("?", |s| s.name.as_str());
+        *states
+            .entry(piece.name.clone())
+            .or_default()
+            .entry(state.to_string())
+            .or_insert(0) += 1;
     }
     let finite = asm.data.positions.iter().all(|p| p.is_finite());
     let bbox = match bbox(&asm.data.positions) {
@@ -120,13 +133,21 @@ pub fn summarize(
         states,
         rules_fired: RuleKind::ALL
             .iter()
-            .map(|&k| (k.name().to_string(), rules_fired.get(&k).copied().unwrap_or(0)))
+            .map(|&k| {
+                (
+                    k.name().to_string(),
+                    rules_fired.get(&k).copied().unwrap_or(0),
+                )
+            })
             .collect(),
         components: components(asm),
         bbox,
         max_edge_strain: max_edge_strain(asm),
         energy,
-        frame_ms: FrameMs { median: median(frame_ms), max: frame_ms.iter().copied().fold(0.0, f64::max) },
+        frame_ms: FrameMs {
+            median: median(frame_ms),
+            max: frame_ms.iter().copied().fold(0.0, f64::max),
+        },
         finite,
     }
 }
@@ -134,7 +155,12 @@ pub fn summarize(
 impl Summary {
     /// A few lines for people.
     pub fn human(&self) -> String {
-        let list = |m: &BTreeMap<String, usize>| m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ");
+        let list = |m: &BTreeMap<String, usize>| {
+            m.iter()
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         let states = self
             .states
             .iter()
@@ -158,7 +184,11 @@ impl Summary {
             self.energy,
             self.frame_ms.median,
             self.frame_ms.max,
-            if self.finite { "" } else { "\nWARNING: some coordinates are not finite" }
+            if self.finite {
+                ""
+            } else {
+                "\nWARNING: some coordinates are not finite"
+            }
         )
     }
 }

@@ -4,15 +4,20 @@
 //! [`CompiledGrammar`] whose `assembly` is the model.
 
 use clay_dsl::compiled::{
-    AssemblyData, Binding, Chain, CompiledGrammar, Dock, ElementVertex, Instance, InstanceSite, Part,
-    PartKind, PartState, Piece, Proxy, ProxyShape, RestState, Rgba, Site, SiteType, SolverParams,
-    StretchPart, StretchRule, Variant, FORMAT_VERSION,
+    AssemblyData, Binding, Chain, CompiledGrammar, Dock, ElementVertex, FORMAT_VERSION, Instance,
+    InstanceSite, Part, PartKind, PartState, Piece, Proxy, ProxyShape, RestState, Rgba, Site,
+    SiteType, SolverParams, StretchPart, StretchRule, Variant,
 };
 use glam::DVec2;
 
 /// Brick / street-segment corners in piece order `sw, se, ne, nw`.
 fn quad(length: f64, width: f64) -> Vec<DVec2> {
-    vec![DVec2::ZERO, DVec2::new(length, 0.0), DVec2::new(length, width), DVec2::new(0.0, width)]
+    vec![
+        DVec2::ZERO,
+        DVec2::new(length, 0.0),
+        DVec2::new(length, width),
+        DVec2::new(0.0, width),
+    ]
 }
 
 /// Quad edges: the outline and both diagonals (braced so a quad keeps its shape).
@@ -22,7 +27,10 @@ fn state(name: &str, positions: Vec<DVec2>, colour: [u8; 4], binding: Binding) -
     RestState {
         name: name.into(),
         geometry: vec![Proxy {
-            shape: ProxyShape::Polygon { outer: positions.clone(), holes: vec![] },
+            shape: ProxyShape::Polygon {
+                outer: positions.clone(),
+                holes: vec![],
+            },
             fill: Rgba(colour),
             binding,
         }],
@@ -38,8 +46,18 @@ fn linear_piece(name: &str, site_type: usize, states: Vec<RestState>) -> Piece {
         vertices: ["sw", "se", "ne", "nw"].map(String::from).to_vec(),
         edges: QUAD_EDGES.to_vec(),
         sites: vec![
-            Site { name: "west".into(), site_type, vertices: vec![3, 0], out: -DVec2::X },
-            Site { name: "east".into(), site_type, vertices: vec![1, 2], out: DVec2::X },
+            Site {
+                name: "west".into(),
+                site_type,
+                vertices: vec![3, 0],
+                out: -DVec2::X,
+            },
+            Site {
+                name: "east".into(),
+                site_type,
+                vertices: vec![1, 2],
+                out: DVec2::X,
+            },
         ],
         states,
         axis: Some([0, 1]),
@@ -71,18 +89,39 @@ fn empty_grammar(source: &str) -> CompiledGrammar {
 fn brick_stretch_rule(piece: usize, length: f64, width: f64) -> StretchRule {
     // element 0: all four corners; element 1: its se, ne (its sw, nw are element 0's se, ne).
     let vertices = vec![
-        ElementVertex { element: 0, vertex: 0 },
-        ElementVertex { element: 0, vertex: 1 },
-        ElementVertex { element: 0, vertex: 2 },
-        ElementVertex { element: 0, vertex: 3 },
-        ElementVertex { element: 1, vertex: 1 },
-        ElementVertex { element: 1, vertex: 2 },
+        ElementVertex {
+            element: 0,
+            vertex: 0,
+        },
+        ElementVertex {
+            element: 0,
+            vertex: 1,
+        },
+        ElementVertex {
+            element: 0,
+            vertex: 2,
+        },
+        ElementVertex {
+            element: 0,
+            vertex: 3,
+        },
+        ElementVertex {
+            element: 1,
+            vertex: 1,
+        },
+        ElementVertex {
+            element: 1,
+            vertex: 2,
+        },
     ];
     let second = [1, 4, 5, 2];
     let mut edges: Vec<[usize; 2]> = QUAD_EDGES.to_vec();
     for e in QUAD_EDGES {
         let mapped = [second[e[0]], second[e[1]]];
-        if !edges.iter().any(|f| *f == mapped || *f == [mapped[1], mapped[0]]) {
+        if !edges
+            .iter()
+            .any(|f| *f == mapped || *f == [mapped[1], mapped[0]])
+        {
             edges.push(mapped);
         }
     }
@@ -94,10 +133,17 @@ fn brick_stretch_rule(piece: usize, length: f64, width: f64) -> StretchRule {
         DVec2::new(2.0 * length, 0.0),
         DVec2::new(2.0 * length, width),
     ];
-    let scaled = |s: f64| two.iter().map(|p| DVec2::new(p.x * s, p.y)).collect::<Vec<_>>();
+    let scaled = |s: f64| {
+        two.iter()
+            .map(|p| DVec2::new(p.x * s, p.y))
+            .collect::<Vec<_>>()
+    };
     StretchRule {
         piece,
-        variants: vec![Variant { piece, frequency: 1.0 }],
+        variants: vec![Variant {
+            piece,
+            frequency: 1.0,
+        }],
         from: 0,
         to: 1,
         min: 2,
@@ -105,24 +151,48 @@ fn brick_stretch_rule(piece: usize, length: f64, width: f64) -> StretchRule {
             vertices,
             edges,
             states: vec![
-                PartState { name: "one".into(), positions: scaled(0.5) },
-                PartState { name: "two".into(), positions: scaled(1.0) },
-                PartState { name: "three".into(), positions: scaled(1.5) },
+                PartState {
+                    name: "one".into(),
+                    positions: scaled(0.5),
+                },
+                PartState {
+                    name: "two".into(),
+                    positions: scaled(1.0),
+                },
+                PartState {
+                    name: "three".into(),
+                    positions: scaled(1.5),
+                },
             ],
         },
     }
 }
 
 /// Appends a chain of `count` bricks starting at `origin` along x: returns instance indices.
-fn add_brick_chain(data: &mut AssemblyData, piece: usize, origin: DVec2, count: usize, length: f64, width: f64, prefix: &str) -> Vec<usize> {
+fn add_brick_chain(
+    data: &mut AssemblyData,
+    piece: usize,
+    origin: DVec2,
+    count: usize,
+    length: f64,
+    width: f64,
+    prefix: &str,
+) -> Vec<usize> {
     let base = data.positions.len();
     for k in 0..=count {
-        data.positions.push(origin + DVec2::new(k as f64 * length, 0.0));
-        data.positions.push(origin + DVec2::new(k as f64 * length, width));
+        data.positions
+            .push(origin + DVec2::new(k as f64 * length, 0.0));
+        data.positions
+            .push(origin + DVec2::new(k as f64 * length, width));
     }
     let mut ids = Vec::with_capacity(count);
     for k in 0..count {
-        let (sw, nw, se, ne) = (base + 2 * k, base + 2 * k + 1, base + 2 * k + 2, base + 2 * k + 3);
+        let (sw, nw, se, ne) = (
+            base + 2 * k,
+            base + 2 * k + 1,
+            base + 2 * k + 2,
+            base + 2 * k + 3,
+        );
         let index = data.instances.len();
         data.instances.push(Instance {
             id: data.next_id,
@@ -134,8 +204,14 @@ fn add_brick_chain(data: &mut AssemblyData, piece: usize, origin: DVec2, count: 
         data.next_id += 1;
         if k > 0 {
             data.docks.push(Dock {
-                a: InstanceSite { instance: index - 1, site: 1 },
-                b: InstanceSite { instance: index, site: 0 },
+                a: InstanceSite {
+                    instance: index - 1,
+                    site: 1,
+                },
+                b: InstanceSite {
+                    instance: index,
+                    site: 0,
+                },
             });
         }
         ids.push(index);
@@ -147,12 +223,27 @@ fn add_brick_chain(data: &mut AssemblyData, piece: usize, origin: DVec2, count: 
 /// two-element stretch parts with `one`/`two`/`three` rest states (no rules: pure elasticity).
 pub fn wall(bricks: usize) -> CompiledGrammar {
     let mut g = empty_grammar("synthetic:wall");
-    g.site_types.push(SiteType { name: "course".into(), docks_with: vec![0] });
-    g.pieces.push(linear_piece("brick", 0, vec![state("base", quad(1.0, 0.5), [170, 80, 60, 255], Binding::Skinned)]));
+    g.site_types.push(SiteType {
+        name: "course".into(),
+        docks_with: vec![0],
+    });
+    g.pieces.push(linear_piece(
+        "brick",
+        0,
+        vec![state(
+            "base",
+            quad(1.0, 0.5),
+            [170, 80, 60, 255],
+            Binding::Skinned,
+        )],
+    ));
     g.stretch_rules.push(brick_stretch_rule(0, 1.0, 0.5));
     let mut data = g.assembly.clone();
     let ids = add_brick_chain(&mut data, 0, DVec2::ZERO, bricks, 1.0, 0.5, "wall");
-    data.chains.push(Chain { rule: 0, instances: ids });
+    data.chains.push(Chain {
+        rule: 0,
+        instances: ids,
+    });
     data.parts = g.parts(&data);
     g.assembly = data;
     g
@@ -173,8 +264,18 @@ fn street_states(l: f64, w: f64) -> Vec<RestState> {
     let grey = [90, 90, 100, 255];
     vec![
         state("base", quad(l, w), grey, Binding::Skinned),
-        state("left", turn(std::f64::consts::FRAC_PI_4, DVec2::new(l * 0.5, w)), grey, Binding::Skinned),
-        state("right", turn(-std::f64::consts::FRAC_PI_4, DVec2::new(l * 0.5, 0.0)), grey, Binding::Skinned),
+        state(
+            "left",
+            turn(std::f64::consts::FRAC_PI_4, DVec2::new(l * 0.5, w)),
+            grey,
+            Binding::Skinned,
+        ),
+        state(
+            "right",
+            turn(-std::f64::consts::FRAC_PI_4, DVec2::new(l * 0.5, 0.0)),
+            grey,
+            Binding::Skinned,
+        ),
     ]
 }
 
@@ -182,8 +283,12 @@ fn street_states(l: f64, w: f64) -> Vec<RestState> {
 /// piece part per segment.
 pub fn street(segments: usize) -> CompiledGrammar {
     let mut g = empty_grammar("synthetic:street");
-    g.site_types.push(SiteType { name: "road".into(), docks_with: vec![0] });
-    g.pieces.push(linear_piece("road", 0, street_states(2.0, 1.0)));
+    g.site_types.push(SiteType {
+        name: "road".into(),
+        docks_with: vec![0],
+    });
+    g.pieces
+        .push(linear_piece("road", 0, street_states(2.0, 1.0)));
     let mut data = g.assembly.clone();
     add_brick_chain(&mut data, 0, DVec2::ZERO, segments, 2.0, 1.0, "road");
     data.parts = g.parts(&data);
@@ -200,27 +305,80 @@ pub fn city(parts: usize) -> CompiledGrammar {
     let wall_parts = (parts / 10).max(2);
     // junctions g^2 plus streets 2 g (g - 1) SEGMENTS  ~= 7 g^2 for SEGMENTS = 3
     let street_budget = parts.saturating_sub(wall_parts) as f64;
-    let g_side = ((street_budget / (1.0 + 2.0 * SEGMENTS as f64)).sqrt().round() as usize).max(2);
+    let g_side = ((street_budget / (1.0 + 2.0 * SEGMENTS as f64))
+        .sqrt()
+        .round() as usize)
+        .max(2);
     let mut g = empty_grammar("synthetic:city");
-    g.site_types.push(SiteType { name: "road".into(), docks_with: vec![0] });
-    g.site_types.push(SiteType { name: "course".into(), docks_with: vec![1] });
+    g.site_types.push(SiteType {
+        name: "road".into(),
+        docks_with: vec![0],
+    });
+    g.site_types.push(SiteType {
+        name: "course".into(),
+        docks_with: vec![1],
+    });
     g.pieces.push(linear_piece("road", 0, street_states(L, W)));
     let grey = [90, 90, 100, 255];
-    let square = vec![DVec2::ZERO, DVec2::new(W, 0.0), DVec2::new(W, W), DVec2::new(0.0, W), DVec2::splat(W / 2.0)];
+    let square = vec![
+        DVec2::ZERO,
+        DVec2::new(W, 0.0),
+        DVec2::new(W, W),
+        DVec2::new(0.0, W),
+        DVec2::splat(W / 2.0),
+    ];
     g.pieces.push(Piece {
         name: "junction".into(),
         vertices: ["sw", "se", "ne", "nw", "c"].map(String::from).to_vec(),
-        edges: vec![[0, 1], [1, 2], [2, 3], [3, 0], [4, 0], [4, 1], [4, 2], [4, 3]],
+        edges: vec![
+            [0, 1],
+            [1, 2],
+            [2, 3],
+            [3, 0],
+            [4, 0],
+            [4, 1],
+            [4, 2],
+            [4, 3],
+        ],
         sites: vec![
-            Site { name: "east".into(), site_type: 0, vertices: vec![1, 2], out: DVec2::X },
-            Site { name: "north".into(), site_type: 0, vertices: vec![2, 3], out: DVec2::Y },
-            Site { name: "west".into(), site_type: 0, vertices: vec![3, 0], out: -DVec2::X },
-            Site { name: "south".into(), site_type: 0, vertices: vec![0, 1], out: -DVec2::Y },
+            Site {
+                name: "east".into(),
+                site_type: 0,
+                vertices: vec![1, 2],
+                out: DVec2::X,
+            },
+            Site {
+                name: "north".into(),
+                site_type: 0,
+                vertices: vec![2, 3],
+                out: DVec2::Y,
+            },
+            Site {
+                name: "west".into(),
+                site_type: 0,
+                vertices: vec![3, 0],
+                out: -DVec2::X,
+            },
+            Site {
+                name: "south".into(),
+                site_type: 0,
+                vertices: vec![0, 1],
+                out: -DVec2::Y,
+            },
         ],
         states: vec![state("base", square.clone(), grey, Binding::Rigid)],
         axis: None,
     });
-    g.pieces.push(linear_piece("brick", 1, vec![state("base", quad(1.0, 0.5), [170, 80, 60, 255], Binding::Skinned)]));
+    g.pieces.push(linear_piece(
+        "brick",
+        1,
+        vec![state(
+            "base",
+            quad(1.0, 0.5),
+            [170, 80, 60, 255],
+            Binding::Skinned,
+        )],
+    ));
     g.stretch_rules.push(brick_stretch_rule(2, 1.0, 0.5));
 
     let mut data = g.assembly.clone();
@@ -247,7 +405,11 @@ pub fn city(parts: usize) -> CompiledGrammar {
     }
     // A street from junction site `(a, a_site)` to `(b, b_site)`: segment ends are the two
     // vertex pairs `start` (sw, nw) and `end` (se, ne) of the street's local frame.
-    let add_street = |data: &mut AssemblyData, start: [usize; 2], end: [usize; 2], docks: [InstanceSite; 2], name: String| {
+    let add_street = |data: &mut AssemblyData,
+                      start: [usize; 2],
+                      end: [usize; 2],
+                      docks: [InstanceSite; 2],
+                      name: String| {
         let (s0, s1) = (data.positions[start[0]], data.positions[start[1]]);
         let (e0, e1) = (data.positions[end[0]], data.positions[end[1]]);
         let mut prev = start;
@@ -271,14 +433,26 @@ pub fn city(parts: usize) -> CompiledGrammar {
                 state: 0,
             });
             data.next_id += 1;
-            let west = InstanceSite { instance: index, site: 0 };
-            let a = prev_instance.map_or(docks[0], |p| InstanceSite { instance: p, site: 1 });
+            let west = InstanceSite {
+                instance: index,
+                site: 0,
+            };
+            let a = prev_instance.map_or(docks[0], |p| InstanceSite {
+                instance: p,
+                site: 1,
+            });
             data.docks.push(Dock { a, b: west });
             prev_instance = Some(index);
             prev = next;
         }
         if let Some(p) = prev_instance {
-            data.docks.push(Dock { a: InstanceSite { instance: p, site: 1 }, b: docks[1] });
+            data.docks.push(Dock {
+                a: InstanceSite {
+                    instance: p,
+                    site: 1,
+                },
+                b: docks[1],
+            });
         }
     };
     for i in 0..g_side {
@@ -286,18 +460,59 @@ pub fn city(parts: usize) -> CompiledGrammar {
             let v = junction_vertices[i][j];
             if i + 1 < g_side {
                 let u = junction_vertices[i + 1][j];
-                let docks = [InstanceSite { instance: junction[i][j], site: 0 }, InstanceSite { instance: junction[i + 1][j], site: 2 }];
-                add_street(&mut data, [v[1], v[2]], [u[0], u[3]], docks, format!("h[{i},{j}]"));
+                let docks = [
+                    InstanceSite {
+                        instance: junction[i][j],
+                        site: 0,
+                    },
+                    InstanceSite {
+                        instance: junction[i + 1][j],
+                        site: 2,
+                    },
+                ];
+                add_street(
+                    &mut data,
+                    [v[1], v[2]],
+                    [u[0], u[3]],
+                    docks,
+                    format!("h[{i},{j}]"),
+                );
             }
             if j + 1 < g_side {
                 let u = junction_vertices[i][j + 1];
-                let docks = [InstanceSite { instance: junction[i][j], site: 1 }, InstanceSite { instance: junction[i][j + 1], site: 3 }];
-                add_street(&mut data, [v[2], v[3]], [u[1], u[0]], docks, format!("v[{i},{j}]"));
+                let docks = [
+                    InstanceSite {
+                        instance: junction[i][j],
+                        site: 1,
+                    },
+                    InstanceSite {
+                        instance: junction[i][j + 1],
+                        site: 3,
+                    },
+                ];
+                add_street(
+                    &mut data,
+                    [v[2], v[3]],
+                    [u[1], u[0]],
+                    docks,
+                    format!("v[{i},{j}]"),
+                );
             }
         }
     }
-    let ids = add_brick_chain(&mut data, 2, DVec2::new(0.0, -5.0), wall_parts + 1, 1.0, 0.5, "wall");
-    data.chains.push(Chain { rule: 0, instances: ids });
+    let ids = add_brick_chain(
+        &mut data,
+        2,
+        DVec2::new(0.0, -5.0),
+        wall_parts + 1,
+        1.0,
+        0.5,
+        "wall",
+    );
+    data.chains.push(Chain {
+        rule: 0,
+        instances: ids,
+    });
     data.parts = g.parts(&data);
     g.assembly = data;
     g
@@ -313,7 +528,12 @@ pub fn arap_grid(k: usize) -> CompiledGrammar {
         vertices: vec!["v".into()],
         edges: vec![],
         sites: vec![],
-        states: vec![state("base", vec![DVec2::ZERO], [200, 200, 200, 255], Binding::Rigid)],
+        states: vec![state(
+            "base",
+            vec![DVec2::ZERO],
+            [200, 200, 200, 255],
+            Binding::Rigid,
+        )],
         axis: None,
     });
     let mut data = g.assembly.clone();
@@ -321,7 +541,13 @@ pub fn arap_grid(k: usize) -> CompiledGrammar {
     for j in 0..k {
         for i in 0..k {
             data.positions.push(DVec2::new(i as f64, j as f64));
-            data.instances.push(Instance { id: data.next_id, name: format!("n[{i},{j}]"), piece: 0, vertices: vec![id(i, j)], state: 0 });
+            data.instances.push(Instance {
+                id: data.next_id,
+                name: format!("n[{i},{j}]"),
+                piece: 0,
+                vertices: vec![id(i, j)],
+                state: 0,
+            });
             data.next_id += 1;
         }
     }
@@ -342,7 +568,10 @@ pub fn arap_grid(k: usize) -> CompiledGrammar {
                 kind: PartKind::Piece { instance: id(i, j) },
                 vertices,
                 edges,
-                states: vec![PartState { name: "base".into(), positions }],
+                states: vec![PartState {
+                    name: "base".into(),
+                    positions,
+                }],
                 active: 0,
             });
         }

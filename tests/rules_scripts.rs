@@ -99,9 +99,10 @@ fn junction_script_merges_then_cuts_apart() {
 }
 
 #[test]
-fn streets_script_merges_the_dead_end_into_a_second_tee() {
+fn streets_script_merges_the_dead_end_into_a_second_tee_and_bends_a_road() {
     let o = replay("streets");
     assert_eq!(count(&o, "merge"), 1, "{:?}", o.fired);
     assert_eq!(o.pieces["tee"], 2);
     assert_eq!(o.components, 1);
+    assert!(count(&o, "replace") >= 1, "no road bent: {:?}", o.fired);
 }

@@ -236,3 +236,22 @@ fn centipede_stretched_to_three_times_keeps_the_variant_mix() {
         );
     }
 }
+
+#[test]
+fn the_generation_changes_only_when_a_rule_rewrites_the_structure() {
+    let mut s = Session::new(grammar("wall.clay"), None);
+    s.run(&format!(
+        r#"{{"steps": [{PIN_WEST_GRAB_EAST}, {{"hold": {{"frames": 10}}}}]}}"#
+    ));
+    assert_eq!(s.asm.generation(), 0, "holding still rewrote something");
+    s.run(r#"{"steps": [{"drag": {"by": [3, 0], "frames": 60}}, {"hold": {"frames": 10}}]}"#);
+    let structural = s
+        .rules
+        .log
+        .iter()
+        .filter(|e| e.kind != clay::rules::RuleKind::Replace)
+        .count();
+    assert!(structural >= 2, "{structural} rewrites for a 3 m drag");
+    assert_eq!(s.asm.generation(), structural as u64);
+    assert!(s.asm.validate().is_ok(), "{:?}", s.asm.validate());
+}

@@ -71,12 +71,24 @@ fn bend_session(frames: u64) -> (Assembly, clay::script::Replay) {
 fn a_street_bent_round_a_pinned_end_switches_segments_to_turns() {
     let (asm, session) = bend_session(40);
     let piece = &asm.grammar().pieces[asm.data.instances[0].piece];
-    let names: Vec<&str> = asm.data.instances.iter().map(|i| piece.states[i.state].name.as_str()).collect();
-    assert!(names.iter().all(|n| ["base", "left", "right"].contains(n)), "{names:?}");
+    let names: Vec<&str> = asm
+        .data
+        .instances
+        .iter()
+        .map(|i| piece.states[i.state].name.as_str())
+        .collect();
+    assert!(
+        names.iter().all(|n| ["base", "left", "right"].contains(n)),
+        "{names:?}"
+    );
     assert!(names.contains(&"left"), "no segment turned left: {names:?}");
     assert!(session.rules_fired[&clay::script::RuleKind::Replace] >= 1);
     // the turned street is not torn: every edge is within 35% of its rest length
-    assert!(clay::solver::max_edge_strain(&asm) < 0.35, "strain {}", clay::solver::max_edge_strain(&asm));
+    assert!(
+        clay::solver::max_edge_strain(&asm) < 0.35,
+        "strain {}",
+        clay::solver::max_edge_strain(&asm)
+    );
 }
 
 #[test]
@@ -101,7 +113,10 @@ fn holding_a_pose_on_a_state_boundary_switches_at_most_once() {
             switches[s.part] += 1;
         }
     }
-    assert!(switches.iter().all(|&c| c <= 1), "switches per part while holding: {switches:?}");
+    assert!(
+        switches.iter().all(|&c| c <= 1),
+        "switches per part while holding: {switches:?}"
+    );
 }
 
 /// Elongation of every brick's bottom edge beyond its base length, west to east.
@@ -109,7 +124,9 @@ fn brick_stretch(asm: &Assembly) -> Vec<f64> {
     asm.data
         .instances
         .iter()
-        .map(|i| (asm.data.positions[i.vertices[1]] - asm.data.positions[i.vertices[0]]).length() - 1.0)
+        .map(|i| {
+            (asm.data.positions[i.vertices[1]] - asm.data.positions[i.vertices[0]]).length() - 1.0
+        })
         .collect()
 }
 
@@ -141,7 +158,10 @@ fn sub_quadratic_norm_gathers_stretch_where_least_squares_spreads_it() {
     let sparse = top_tenth_share(&mut assembly(synthetic::wall(40)), 0.5);
     let even = top_tenth_share(&mut assembly(synthetic::wall(40)), 2.0);
     assert!(even < 0.2, "p = 2 share {even}");
-    assert!(sparse > 2.0 * even, "p = 0.5 share {sparse}, p = 2 share {even}");
+    assert!(
+        sparse > 2.0 * even,
+        "p = 0.5 share {sparse}, p = 2 share {even}"
+    );
 }
 
 #[test]
@@ -169,8 +189,15 @@ fn cg_and_cholesky_agree_within_the_cg_tolerance() {
             positions.push(asm.data.positions.clone());
         }
         let size = clay::solver::bbox_diagonal(&positions[0]);
-        let worst = positions[0].iter().zip(&positions[1]).map(|(a, b)| a.distance(*b)).fold(0.0, f64::max);
-        assert!(worst < 1e-6 * size, "{name}: CG and Cholesky differ by {worst} (model size {size})");
+        let worst = positions[0]
+            .iter()
+            .zip(&positions[1])
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-6 * size,
+            "{name}: CG and Cholesky differ by {worst} (model size {size})"
+        );
     }
 }
 
@@ -190,6 +217,9 @@ fn cg_reaches_its_relative_residual_every_solve() {
         let r = solver.frame(&mut asm).unwrap();
         assert!(r.cg_iterations > 0);
         let residual = r.linear_residual.unwrap();
-        assert!(residual <= 1.01e-6, "frame {k}: relative residual {residual}");
+        assert!(
+            residual <= 1.01e-6,
+            "frame {k}: relative residual {residual}"
+        );
     }
 }

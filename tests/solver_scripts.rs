@@ -17,13 +17,17 @@ fn grammar_path(name: &str) -> String {
 }
 
 fn temp_file(name: &str, contents: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("clay-solver-scripts-{}-{name}", std::process::id()));
+    let path =
+        std::env::temp_dir().join(format!("clay-solver-scripts-{}-{name}", std::process::id()));
     std::fs::write(&path, contents).unwrap();
     path
 }
 
 fn clayc(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_clayc")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(args)
+        .output()
+        .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -51,7 +55,12 @@ fn an_empty_script_reports_the_initial_assembly() {
     assert_eq!(v["finite"], true);
     assert!(v["energy"].as_f64().unwrap() < 1e-12);
     assert!(v["max_edge_strain"].as_f64().unwrap() < 1e-9);
-    let bbox: Vec<f64> = v["bbox"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let bbox: Vec<f64> = v["bbox"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
     assert!((bbox[2] - bbox[0] - 8.0).abs() < 1e-9, "{bbox:?}");
     for k in ["replace", "stretch", "shrink", "merge", "cut"] {
         assert_eq!(v["rules_fired"][k], 0);
@@ -97,23 +106,48 @@ fn grabbing_on_an_empty_model_does_nothing_and_stays_finite() {
         r#"{"steps": [{"grab": {"at": [0, 0]}}, {"pin": {"extreme": "west"}}, {"drag": {"by": [1, 0], "frames": 3}}, {"rotate": {"degrees": 30, "frames": 2}}]}"#,
     )
     .unwrap();
-    let (summary, session) = replay(&mut asm, &script, &SolverConfig::default(), &mut NoRules).unwrap();
+    let (summary, session) =
+        replay(&mut asm, &script, &SolverConfig::default(), &mut NoRules).unwrap();
     assert!(summary.finite);
     assert_eq!(summary.frames, 5);
     assert_eq!(summary.parts, 0);
     assert_eq!(summary.components, 0);
-    assert!(session.notes.iter().any(|n| n.starts_with("step 0")), "{:?}", session.notes);
+    assert!(
+        session.notes.iter().any(|n| n.starts_with("step 0")),
+        "{:?}",
+        session.notes
+    );
 }
 
 #[test]
 fn malformed_scripts_name_the_step_and_exit_1() {
     let cases = [
-        (r#"{"steps": [{"grab": {"extreme": "east"}}, {"drag": {"by": [1, 0]}}]}"#, "step 1", "frames"),
+        (
+            r#"{"steps": [{"grab": {"extreme": "east"}}, {"drag": {"by": [1, 0]}}]}"#,
+            "step 1",
+            "frames",
+        ),
         (r#"{"steps": [{"jump": {}}]}"#, "step 0", "unknown step"),
-        (r#"{"steps": [{"grab": {"extreme": "up"}}]}"#, "step 0", "extreme"),
-        (r#"{"steps": [{"hold": {"frames": -1}}]}"#, "step 0", "frames"),
-        (r#"{"steps": [{"grab": {"at": [1]}}]}"#, "step 0", "two numbers"),
-        (r#"{"steps": [{"drag": {"by": [1, 0], "to": [1, 1], "frames": 2}}]}"#, "step 0", "exactly one"),
+        (
+            r#"{"steps": [{"grab": {"extreme": "up"}}]}"#,
+            "step 0",
+            "extreme",
+        ),
+        (
+            r#"{"steps": [{"hold": {"frames": -1}}]}"#,
+            "step 0",
+            "frames",
+        ),
+        (
+            r#"{"steps": [{"grab": {"at": [1]}}]}"#,
+            "step 0",
+            "two numbers",
+        ),
+        (
+            r#"{"steps": [{"drag": {"by": [1, 0], "to": [1, 1], "frames": 2}}]}"#,
+            "step 0",
+            "exactly one",
+        ),
         (r#"{"steps": {}}"#, "steps", "array"),
         ("not json", "JSON", "JSON"),
     ];
@@ -123,7 +157,10 @@ fn malformed_scripts_name_the_step_and_exit_1() {
         let (code, out, err) = clayc(&["run", &g, "--script", s.to_str().unwrap(), "--json"]);
         assert_eq!(code, 1, "{script}: {err}");
         assert!(out.is_empty(), "{script}: printed {out}");
-        assert!(err.contains(needle) && err.contains(what), "{script}: {err}");
+        assert!(
+            err.contains(needle) && err.contains(what),
+            "{script}: {err}"
+        );
         assert!(!err.contains("panicked"), "{err}");
     }
 }
@@ -144,17 +181,31 @@ fn missing_files_exit_2_and_bad_grammars_exit_1_with_diagnostics() {
 #[test]
 fn settings_are_validated_and_applied() {
     let g = grammar_path("wall.clay");
-    for bad in ["norm=3", "hysteresis=1.5", "colour=red", "norm", "irls_iterations=2.5", "solver=lu"] {
+    for bad in [
+        "norm=3",
+        "hysteresis=1.5",
+        "colour=red",
+        "norm",
+        "irls_iterations=2.5",
+        "solver=lu",
+    ] {
         let (code, _, err) = clayc(&["run", &g, "--set", bad]);
         assert_eq!(code, 2, "--set {bad}: {err}");
         assert!(err.contains("--set"), "{err}");
     }
     let script = r#"{"steps": [{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}}, {"drag": {"by": [0.5, 1], "frames": 4}}]}"#;
-    let cg = run_json("wall.clay", script, &["--set", "solver=cg", "--set", "norm=2"]);
+    let cg = run_json(
+        "wall.clay",
+        script,
+        &["--set", "solver=cg", "--set", "norm=2"],
+    );
     let ch = run_json("wall.clay", script, &["--set", "norm=2"]);
     assert_eq!(cg["finite"], true);
     for k in 0..4 {
-        let (a, b) = (cg["bbox"][k].as_f64().unwrap(), ch["bbox"][k].as_f64().unwrap());
+        let (a, b) = (
+            cg["bbox"][k].as_f64().unwrap(),
+            ch["bbox"][k].as_f64().unwrap(),
+        );
         // CG stops at a relative residual of 1e-6, which the 1e6 handle rows dominate: the
         // positions agree to centimetres, not to round-off (tests/solver_behaviour.rs compares
         // the two tightly).

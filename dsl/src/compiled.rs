@@ -194,8 +194,16 @@ pub struct MergeRule {
     pub target: SiteRef,
     /// The junction that replaces the target's instance, or `None` for a direct weld.
     pub junction: Option<SiteRef>,
-    /// Weld distance in metres.
-    pub distance: f64,
+    /// The rule's own weld distance in metres (`within`); `None` follows the live
+    /// `merge_distance`, so `--set merge_distance` and the editor's slider reach it.
+    pub within: Option<f64>,
+}
+
+impl MergeRule {
+    /// The weld distance in metres under the given solver parameters.
+    pub fn distance(&self, params: &SolverParams) -> f64 {
+        self.within.unwrap_or(params.merge_distance)
+    }
 }
 
 /// A cut rule: cutting `junction.site` turns the junction back into `into`.

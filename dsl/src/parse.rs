@@ -283,10 +283,10 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
             if let Some(k) = crate::compile::closest(text, keywords) {
                 d = d.with_hint(format!("did you mean `{k}`?"));
             }
-            if span.start >= source.len() {
-                if let Some(open) = unclosed(source) {
-                    d = d.with_secondary(open, "this bracket is never closed");
-                }
+            if span.start >= source.len()
+                && let Some(open) = unclosed(source)
+            {
+                d = d.with_secondary(open, "this bracket is never closed");
             }
             d
         }

@@ -326,7 +326,13 @@ fn merges_into_junctions_derive_their_cut() {
     assert_eq!(g.merge_rules.len(), 1);
     let m = &g.merge_rules[0];
     assert_eq!(m.junction, Some(SiteRef { piece: 1, site: 2 }));
-    assert_eq!(m.distance, 0.25);
+    assert_eq!(m.within, Some(0.25));
+    // An explicit `within` wins over the live merge distance; without it the rule follows it.
+    let mut params = g.solver;
+    params.merge_distance = 2.0;
+    assert_eq!(m.distance(&params), 0.25);
+    let follows = clay_dsl::compiled::MergeRule { within: None, ..m.clone() };
+    assert_eq!(follows.distance(&params), 2.0);
     assert_eq!(
         g.cut_rules,
         vec![CutRule {

@@ -220,7 +220,10 @@ impl EditorApp {
             Ok(w) => self.watch = Some(w),
             Err(e) => {
                 self.watch = None;
-                self.message = Some(format!("hot reload is off: cannot watch {}: {e}", path.display()));
+                self.message = Some(format!(
+                    "hot reload is off: cannot watch {}: {e}",
+                    path.display()
+                ));
             }
         }
     }
@@ -254,7 +257,9 @@ impl EditorApp {
             Err(problems) => {
                 self.problems = problems;
                 self.stale = true;
-                self.message = Some(format!("{shown} does not compile; keeping the last good model"));
+                self.message = Some(format!(
+                    "{shown} does not compile; keeping the last good model"
+                ));
             }
         }
     }
@@ -411,16 +416,22 @@ impl EditorApp {
             .count();
         egui::CollapsingHeader::new(format!("Diagnostics ({})", self.problems.len()))
             .default_open(true)
-            .show(ui, |ui| panels::diagnostics(ui, &self.problems, self.stale && errors > 0));
+            .show(ui, |ui| {
+                panels::diagnostics(ui, &self.problems, self.stale && errors > 0)
+            });
         egui::CollapsingHeader::new("Inspector")
             .default_open(true)
-            .show(ui, |ui| panels::inspector(ui, &self.sculpt, self.canvas.hovered));
+            .show(ui, |ui| {
+                panels::inspector(ui, &self.sculpt, self.canvas.hovered)
+            });
         egui::CollapsingHeader::new("Solver")
             .default_open(true)
             .show(ui, |ui| panels::statistics(ui, &self.sculpt));
         egui::CollapsingHeader::new("Parameters")
             .default_open(true)
-            .show(ui, |ui| panels::parameters(ui, &self.sculpt, &mut self.commands));
+            .show(ui, |ui| {
+                panels::parameters(ui, &self.sculpt, &mut self.commands)
+            });
         egui::CollapsingHeader::new("Rule log")
             .default_open(true)
             .show(ui, |ui| panels::rule_log(ui, &self.sculpt));
@@ -465,7 +476,9 @@ impl EditorApp {
                     Action::Quit => "quitting",
                     _ => "opening another file",
                 };
-                ui.label(format!("The sculpt has unsaved changes. Discard them before {what}?"));
+                ui.label(format!(
+                    "The sculpt has unsaved changes. Discard them before {what}?"
+                ));
                 ui.horizontal(|ui| {
                     if ui.button("Discard").clicked() {
                         answer = Some(true);
@@ -534,10 +547,18 @@ impl EditorApp {
                 self.open_grammar(&p);
                 Ok(Some(format!("opened {}", p.display())))
             }
-            Action::OpenSession(p) => self.open_session(&p).map(|()| Some(format!("opened session {}", p.display()))),
-            Action::SaveSession(p) => self.save_session(&p).map(|()| Some(format!("saved {}", p.display()))),
-            Action::ExportPng(p) => self.export_png(&p).map(|()| Some(format!("exported {}", p.display()))),
-            Action::ExportJson(p) => self.export_json(&p).map(|()| Some(format!("exported {}", p.display()))),
+            Action::OpenSession(p) => self
+                .open_session(&p)
+                .map(|()| Some(format!("opened session {}", p.display()))),
+            Action::SaveSession(p) => self
+                .save_session(&p)
+                .map(|()| Some(format!("saved {}", p.display()))),
+            Action::ExportPng(p) => self
+                .export_png(&p)
+                .map(|()| Some(format!("exported {}", p.display()))),
+            Action::ExportJson(p) => self
+                .export_json(&p)
+                .map(|()| Some(format!("exported {}", p.display()))),
             Action::Quit => {
                 self.confirm = Some(Action::Quit);
                 Ok(None)

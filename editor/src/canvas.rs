@@ -25,9 +25,14 @@ const EDGES: Color32 = Color32::from_rgb(70, 70, 90);
 enum Drag {
     Pan,
     /// Moving the grabbed part: world point where the drag started.
-    Move { start: DVec2 },
+    Move {
+        start: DVec2,
+    },
     /// Turning the grabbed part about `centre`; `start` is the pointer's initial angle.
-    Rotate { centre: DVec2, start: f64 },
+    Rotate {
+        centre: DVec2,
+        start: f64,
+    },
 }
 
 /// View state of the canvas, kept between frames.
@@ -232,7 +237,7 @@ impl Canvas {
         let screen = |p: DVec2| pos(self.camera.to_screen(p, mid));
         painter.rect_filled(self.rect, 0.0, Color32::from_rgb(246, 243, 236));
         for m in &self.meshes {
-            painter.add(Shape::mesh(mesh_of(m, |p| screen(p), colour(m.fill))));
+            painter.add(Shape::mesh(mesh_of(m, screen, colour(m.fill))));
         }
         for m in &self.meshes {
             let stroke = Stroke::new(1.0, darker(colour(m.fill)));
@@ -265,8 +270,12 @@ impl Canvas {
         }
         if let Some(part) = self.hovered {
             let instances = instances_of(data, part);
-            for m in self.meshes.iter().filter(|m| instances.contains(&m.instance)) {
-                painter.add(Shape::mesh(mesh_of(m, |p| screen(p), HOVER)));
+            for m in self
+                .meshes
+                .iter()
+                .filter(|m| instances.contains(&m.instance))
+            {
+                painter.add(Shape::mesh(mesh_of(m, screen, HOVER)));
             }
             let colour = if sculpt.grabbed() == Some(part) {
                 GRABBED
@@ -321,7 +330,11 @@ impl Canvas {
                 continue;
             }
             let id = ui.scope_id().with(("part", part));
-            let r = ui.interact(Rect::from_center_size(at, Vec2::splat(4.0)), id, Sense::hover());
+            let r = ui.interact(
+                Rect::from_center_size(at, Vec2::splat(4.0)),
+                id,
+                Sense::hover(),
+            );
             r.widget_info(|| {
                 egui::WidgetInfo::labeled(egui::Role::GraphicsObject, true, format!("part {part}"))
             });
@@ -373,7 +386,12 @@ fn instances_of(data: &AssemblyData, part: usize) -> HashSet<usize> {
 /// The part under world point `w`: the part covering the top-most instance whose geometry
 /// contains `w` (of several, the one whose centre is nearest), else the part with an edge
 /// within `tolerance`.
-pub fn part_at(w: DVec2, meshes: &[WorldMesh], data: &AssemblyData, tolerance: f64) -> Option<usize> {
+pub fn part_at(
+    w: DVec2,
+    meshes: &[WorldMesh],
+    data: &AssemblyData,
+    tolerance: f64,
+) -> Option<usize> {
     let centre = |part: &clay_dsl::compiled::Part| {
         let pts: Vec<DVec2> = part
             .vertices

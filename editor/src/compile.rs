@@ -157,7 +157,10 @@ mod tests {
         assert!(!problems.is_empty());
         let p = &problems[0];
         assert_eq!(p.severity, Severity::Error);
-        assert!(p.line >= 4, "error should point at the broken piece, got {p}");
+        assert!(
+            p.line >= 4,
+            "error should point at the broken piece, got {p}"
+        );
         assert!(p.to_string().starts_with("bad.clay:"));
     }
 

@@ -132,9 +132,8 @@ pub fn rule_log(ui: &mut egui::Ui, sculpt: &Sculpt) {
         .max_height(220.0)
         .show(ui, |ui| {
             for e in sculpt.log().iter().rev() {
-                let at = e
-                    .at
-                    .map_or(String::new(), |p| format!(" at ({:.2}, {:.2})", p.x, p.y));
+                let at =
+                    e.at.map_or(String::new(), |p| format!(" at ({:.2}, {:.2})", p.x, p.y));
                 ui.label(format!("frame {}: {}{at}", e.frame, e.message));
             }
         });

@@ -19,16 +19,25 @@ use crate::session::{Pin, Settings};
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// Start a gesture: `part` becomes the handle.
-    Grab { part: usize },
+    Grab {
+        part: usize,
+    },
     /// Move the grabbed part: its target is its start pose moved by `translation` and turned by
     /// `angle` radians about its centre.
-    MoveGrab { translation: DVec2, angle: f64 },
+    MoveGrab {
+        translation: DVec2,
+        angle: f64,
+    },
     /// End the gesture.
     Release,
     /// Pin the part, or unpin it if pinned.
-    TogglePin { part: usize },
+    TogglePin {
+        part: usize,
+    },
     /// Cut the connection nearest `point` (world coordinates).
-    Cut { point: DVec2 },
+    Cut {
+        point: DVec2,
+    },
     Undo,
     Redo,
     /// Back to the grammar's initial model (undoable).
@@ -434,17 +443,17 @@ impl Sculpt {
                             (n(s.from).to_string(), n(s.to).to_string())
                         });
                         let (from, to) = names.clone().unwrap_or_default();
-                        self.note(
-                            format!("state switch: part {} {from} -> {to}", s.part),
-                            at,
-                        );
+                        self.note(format!("state switch: part {} {from} -> {to}", s.part), at);
                     }
                     // Stretch, shrink, merge and replacement after every frame (paper 5.1).
                     let events = self.rules.after_frame(&mut self.assembly, &report);
                     self.rules.log.clear();
                     let changed = !events.is_empty();
                     for e in events {
-                        self.note(format!("{:?}: {}", e.kind, e.detail).to_lowercase(), Some(e.at));
+                        self.note(
+                            format!("{:?}: {}", e.kind, e.detail).to_lowercase(),
+                            Some(e.at),
+                        );
                     }
                     if changed && self.grab.is_some() {
                         self.follow_grab();

@@ -65,7 +65,10 @@ impl Session {
 /// Why a session could not be read or written.
 #[derive(Debug)]
 pub enum SessionError {
-    Io { path: PathBuf, error: io::Error },
+    Io {
+        path: PathBuf,
+        error: io::Error,
+    },
     /// The text is not JSON, or not a session of a version this editor reads.
     Malformed(String),
 }
@@ -84,9 +87,8 @@ impl std::error::Error for SessionError {}
 /// Parses session text. Checks the format tag and version before the body so that a file of
 /// another kind or version says so rather than naming a missing field.
 pub fn parse(text: &str) -> Result<Session, SessionError> {
-    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
-        SessionError::Malformed(format!("not a session file: invalid JSON ({e})"))
-    })?;
+    let value: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| SessionError::Malformed(format!("not a session file: invalid JSON ({e})")))?;
     let format = value.get("format").and_then(|f| f.as_str());
     if format != Some(SESSION_FORMAT) {
         return Err(SessionError::Malformed(format!(

@@ -24,10 +24,7 @@ pub struct FileWatch {
 impl FileWatch {
     /// Starts watching `path`. `wake` is called from the watcher's thread on every event so the
     /// UI can repaint and notice the change without polling.
-    pub fn new(
-        path: &Path,
-        wake: impl Fn() + Send + 'static,
-    ) -> Result<Self, notify::Error> {
+    pub fn new(path: &Path, wake: impl Fn() + Send + 'static) -> Result<Self, notify::Error> {
         let path = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
         let folder = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),

@@ -54,7 +54,11 @@ fn dragging_a_part_sculpts_and_ctrl_z_undoes_the_gesture() {
 
     h.hover_at(at);
     h.step();
-    assert_eq!(h.state().canvas.hovered, Some(part), "the tower is under the cursor");
+    assert_eq!(
+        h.state().canvas.hovered,
+        Some(part),
+        "the tower is under the cursor"
+    );
     h.drag_at(at);
     h.step();
     let to = at + Vec2::new(80.0, -40.0);
@@ -62,14 +66,22 @@ fn dragging_a_part_sculpts_and_ctrl_z_undoes_the_gesture() {
         h.hover_at(at + (to - at) * (k as f32 / 4.0));
         h.step();
     }
-    assert_eq!(h.state().sculpt.grabbed(), Some(part), "the tower is the handle");
+    assert_eq!(
+        h.state().sculpt.grabbed(),
+        Some(part),
+        "the tower is the handle"
+    );
     h.step();
     h.drop_at(to);
     h.step();
     settle(&mut h);
     assert_eq!(h.state().sculpt.grabbed(), None);
     let after = h.state().sculpt.data().clone();
-    let moved = h.state().canvas.to_screen(h.state().sculpt.assembly().part_centroid(part)) - at;
+    let moved = h
+        .state()
+        .canvas
+        .to_screen(h.state().sculpt.assembly().part_centroid(part))
+        - at;
     assert!(
         (moved - (to - at)).length() < 10.0,
         "the tower follows the pointer: moved {moved:?}"
@@ -79,7 +91,10 @@ fn dragging_a_part_sculpts_and_ctrl_z_undoes_the_gesture() {
 
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     h.step();
-    assert!(h.state().sculpt.data() == &before, "Ctrl+Z restores the model before the drag");
+    assert!(
+        h.state().sculpt.data() == &before,
+        "Ctrl+Z restores the model before the drag"
+    );
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
     h.step();
     // Frames after the redo let the solver polish the pose, so compare within 0.1 mm.
@@ -131,7 +146,10 @@ fn wheel_zooms_toward_the_cursor() {
     }
     assert!(h.state().canvas.camera.scale > scale * 1.05, "zoomed in");
     let again = h.state().canvas.to_world(at);
-    assert!((again - world).length() < 1e-3 * scale.recip() * 100.0, "{again} vs {world}");
+    assert!(
+        (again - world).length() < 1e-3 * scale.recip() * 100.0,
+        "{again} vs {world}"
+    );
 }
 
 #[test]
@@ -161,7 +179,10 @@ fn a_failed_hot_reload_keeps_the_model_and_shows_diagnostics() {
     let app = h.state();
     assert!(app.stale, "the broken file is reported");
     assert!(!app.problems.is_empty());
-    assert!(app.sculpt.data() == &model, "the last good model stays live");
+    assert!(
+        app.sculpt.data() == &model,
+        "the last good model stays live"
+    );
     let first = app.problems[0].to_string();
     assert!(first.contains("castle.clay:"), "{first}");
     h.step();
@@ -191,7 +212,10 @@ fn closing_with_unsaved_changes_asks_first() {
     h.step();
     assert!(h.state().sculpt.dirty);
     request_close(&mut h);
-    assert!(h.state().confirming(), "the unsaved sculpt is confirmed first");
+    assert!(
+        h.state().confirming(),
+        "the unsaved sculpt is confirmed first"
+    );
     let cancelled = h
         .output()
         .viewport_output
@@ -216,8 +240,9 @@ fn opening_another_file_with_unsaved_changes_asks_first() {
     h.state_mut().command(clay_editor::sculpt::Command::Reset);
     h.step();
     let kept = h.state().sculpt.data().clone();
-    h.state_mut()
-        .perform(clay_editor::app::Action::OpenGrammar("no/such/file.clay".into()));
+    h.state_mut().perform(clay_editor::app::Action::OpenGrammar(
+        "no/such/file.clay".into(),
+    ));
     assert!(h.state().confirming());
     // A new modal is laid out invisibly on its first frame.
     h.step();
@@ -236,4 +261,44 @@ fn request_close(h: &mut Harness<'_, EditorApp>) {
         .events
         .push(egui::ViewportEvent::Close);
     h.step();
+}
+
+#[test]
+fn right_drag_turns_the_grabbed_part() {
+    let mut h = harness(EditorApp::bundled());
+    settle(&mut h);
+    let part = tower(h.state());
+    let vertices = h.state().sculpt.data().parts[part].vertices.clone();
+    let edge = |h: &Harness<'_, EditorApp>| {
+        let p = &h.state().sculpt.data().positions;
+        p[vertices[1]] - p[vertices[0]]
+    };
+    let e0 = edge(&h);
+    let centre = h.get_by_label(&format!("part {part}")).rect().center();
+    let button = |pos: Pos2, pressed: bool| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Secondary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    };
+    // Press to the right of the centre and swing a quarter turn counter-clockwise (screen y
+    // points down, so "up" on screen is north).
+    let start = centre + Vec2::new(30.0, 0.0);
+    h.hover_at(start);
+    h.event(button(start, true));
+    h.step();
+    for k in 1..=6 {
+        let a = std::f32::consts::FRAC_PI_2 * k as f32 / 6.0;
+        h.hover_at(centre + Vec2::new(30.0 * a.cos(), -30.0 * a.sin()));
+        h.step();
+    }
+    // The solver follows the last move in the next frame.
+    h.step();
+    let turned = e0.angle_to(edge(&h));
+    h.event(button(centre + Vec2::new(0.0, -30.0), false));
+    h.step();
+    assert!(
+        (turned - std::f64::consts::FRAC_PI_2).abs() < 0.15,
+        "the tower turned by {turned} rad"
+    );
 }

@@ -77,7 +77,10 @@ fn a_drag_moves_the_part_and_undo_redo_restore_whole_gestures() {
     assert!(s.dirty);
 
     s.apply(Command::Undo);
-    assert!(s.data() == &before, "undo restores the model before the drag");
+    assert!(
+        s.data() == &before,
+        "undo restores the model before the drag"
+    );
     assert!(s.can_redo());
     s.apply(Command::Redo);
     assert!(s.data() == &after, "redo brings the drag back");
@@ -216,7 +219,10 @@ fn a_session_round_trips_through_a_file() {
     settle(&mut app.sculpt);
     let part = tower(&app.sculpt);
     app.sculpt.apply(Command::TogglePin { part });
-    let other = (0..app.sculpt.data().parts.len()).rev().find(|&p| p != part).unwrap();
+    let other = (0..app.sculpt.data().parts.len())
+        .rev()
+        .find(|&p| p != part)
+        .unwrap();
     drag(&mut app.sculpt, other, DVec2::new(0.0, -1.0));
     let path = dir.join("s.json");
     app.save_session(&path).unwrap();
@@ -230,7 +236,10 @@ fn a_session_round_trips_through_a_file() {
 
     let mut other_app = EditorApp::bundled();
     other_app.open_session(&path).unwrap();
-    assert!(other_app.sculpt.data() == app.sculpt.data(), "the sculpt is restored exactly");
+    assert!(
+        other_app.sculpt.data() == app.sculpt.data(),
+        "the sculpt is restored exactly"
+    );
     assert_eq!(other_app.sculpt.pins(), app.sculpt.pins());
     assert!(other_app.sculpt.is_pinned(part));
     assert!(session::read(&path).unwrap() == app.session());
@@ -240,7 +249,11 @@ fn a_session_round_trips_through_a_file() {
 fn malformed_sessions_are_clear_errors() {
     let good = serde_json::to_value(Session::new(
         CASTLE_PATH.into(),
-        compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar.assembly.clone(),
+        compile(CASTLE_SOURCE, CASTLE_PATH)
+            .unwrap()
+            .grammar
+            .assembly
+            .clone(),
         Vec::new(),
         None,
     ))
@@ -315,4 +328,35 @@ fn exports_write_a_png_and_the_assembly_json() {
     let back: clay_dsl::compiled::AssemblyData =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert!(&back == app.sculpt.data());
+}
+
+#[test]
+fn a_reload_with_the_same_model_keeps_the_sculpt() {
+    let mut s = castle();
+    let part = tower(&s);
+    s.apply(Command::TogglePin { part });
+    drag(&mut s, part, DVec2::new(0.0, 1.0));
+    let sculpted = s.data().positions.clone();
+    let saved_dirty = s.dirty;
+
+    // The same source recompiled (as after touching the file): the sculpt stays.
+    let again = compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar;
+    assert!(s.replace_grammar(again));
+    assert_eq!(s.data().positions, sculpted);
+    assert_eq!(s.pins().len(), 1);
+    assert_eq!(s.dirty, saved_dirty, "a reload alone is not unsaved work");
+
+    // A different model: rebuilt from the new grammar, and the reload is undoable.
+    let moved = CASTLE_SOURCE.replacen(
+        "    main_gate = gate",
+        "    lone = tower at (30, 30)\n    main_gate = gate",
+        1,
+    );
+    let g = compile(&moved, CASTLE_PATH)
+        .expect("a castle with an extra tower")
+        .grammar;
+    assert!(!s.replace_grammar(g.clone()));
+    assert!(s.data() == &g.assembly);
+    s.apply(Command::Undo);
+    assert_eq!(s.data().positions, sculpted);
 }

@@ -70,7 +70,11 @@ fn key(a: usize, b: usize) -> [usize; 2] {
 fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     let d = b - a;
     let len2 = d.length_squared();
-    let t = if len2 > 0.0 { ((p - a).dot(d) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if len2 > 0.0 {
+        ((p - a).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     ((a + d * t - p).length(), t)
 }
 
@@ -135,7 +139,11 @@ impl Graph {
         let mut seen = HashSet::new();
         for (k, (ids, closed)) in strokes.iter().enumerate() {
             let n = ids.len();
-            let segments = if *closed && n >= 3 { n } else { n.saturating_sub(1) };
+            let segments = if *closed && n >= 3 {
+                n
+            } else {
+                n.saturating_sub(1)
+            };
             for i in 0..segments {
                 let e = key(ids[i], ids[(i + 1) % n]);
                 if e[0] != e[1] && seen.insert(e) {
@@ -144,16 +152,26 @@ impl Graph {
                 }
             }
             if *closed && n >= 3 {
-                g.loops.push(Loop { vertices: ids.clone(), source: k });
+                g.loops.push(Loop {
+                    vertices: ids.clone(),
+                    source: k,
+                });
             }
         }
         if g.edges.is_empty() {
-            return Err(AuthorError("the drawing has no strokes (no path with two distinct points)".into()));
+            return Err(AuthorError(
+                "the drawing has no strokes (no path with two distinct points)".into(),
+            ));
         }
         Ok(g)
     }
 
-    fn snap_vertex(&mut self, grid: &mut HashMap<(i64, i64), Vec<usize>>, p: DVec2, snap: f64) -> usize {
+    fn snap_vertex(
+        &mut self,
+        grid: &mut HashMap<(i64, i64), Vec<usize>>,
+        p: DVec2,
+        snap: f64,
+    ) -> usize {
         let cell = ((p.x / snap).floor() as i64, (p.y / snap).floor() as i64);
         for dx in -1..=1 {
             for dy in -1..=1 {
@@ -182,7 +200,9 @@ impl Graph {
         }
         for l in &mut self.loops {
             let n = l.vertices.len();
-            if let Some(i) = (0..n).find(|&i| key(l.vertices[i], l.vertices[(i + 1) % n]) == key(a, b)) {
+            if let Some(i) =
+                (0..n).find(|&i| key(l.vertices[i], l.vertices[(i + 1) % n]) == key(a, b))
+            {
                 l.vertices.insert(i + 1, c);
             }
         }
@@ -213,7 +233,12 @@ impl Graph {
             .edges
             .iter()
             .enumerate()
-            .map(|(i, e)| (i, segment_distance(at, self.positions[e[0]], self.positions[e[1]]).0))
+            .map(|(i, e)| {
+                (
+                    i,
+                    segment_distance(at, self.positions[e[0]], self.positions[e[1]]).0,
+                )
+            })
             .min_by(|x, y| x.1.total_cmp(&y.1))
             .ok_or_else(|| AuthorError("there is no edge to cut".into()))?;
         let e = self.edges[nearest];
@@ -222,7 +247,10 @@ impl Graph {
         let q = pa + (pb - pa) * t;
         let along = (pb - pa).normalize_or_zero();
         if along == DVec2::ZERO {
-            return Err(AuthorError(format!("the edge nearest the cut at ({}, {}) has no length", at.x, at.y)));
+            return Err(AuthorError(format!(
+                "the edge nearest the cut at ({}, {}) has no length",
+                at.x, at.y
+            )));
         }
         let normal = along.perp();
         // The nearest other crossing of the cut line.
@@ -239,7 +267,10 @@ impl Graph {
             }
             let s = (a - q).perp_dot(d) / denom;
             let u = (a - q).perp_dot(normal) / denom;
-            if s.abs() > snap && (-1e-9..=1.0 + 1e-9).contains(&u) && far.is_none_or(|(best, _, _)| s.abs() < best.abs()) {
+            if s.abs() > snap
+                && (-1e-9..=1.0 + 1e-9).contains(&u)
+                && far.is_none_or(|(best, _, _)| s.abs() < best.abs())
+            {
                 far = Some((s, *f, q + normal * s));
             }
         }
@@ -267,7 +298,8 @@ impl Graph {
         }
         if section.len() == 2 && !self.edges.contains(&key(section[0], section[1])) {
             self.edges.push(key(section[0], section[1]));
-            self.edge_source.push(self.edge_source[nearest.min(self.edge_source.len() - 1)]);
+            self.edge_source
+                .push(self.edge_source[nearest.min(self.edge_source.len() - 1)]);
         }
         // Split every section vertex: edges leaving towards +along go to the new copy.
         let side = |p: DVec2| (p - q).dot(along);
@@ -281,9 +313,15 @@ impl Graph {
         for i in 0..self.edges.len() {
             let [a, b] = self.edges[i];
             match (in_section(a), in_section(b)) {
-                (Some(ia), Some(ib)) => added.push((key(copies[ia], copies[ib]), self.edge_source[i])),
-                (Some(ia), None) if side(self.positions[b]) > 0.0 => self.edges[i] = key(copies[ia], b),
-                (None, Some(ib)) if side(self.positions[a]) > 0.0 => self.edges[i] = key(a, copies[ib]),
+                (Some(ia), Some(ib)) => {
+                    added.push((key(copies[ia], copies[ib]), self.edge_source[i]))
+                }
+                (Some(ia), None) if side(self.positions[b]) > 0.0 => {
+                    self.edges[i] = key(copies[ia], b)
+                }
+                (None, Some(ib)) if side(self.positions[a]) > 0.0 => {
+                    self.edges[i] = key(a, copies[ib])
+                }
                 _ => {}
             }
         }
@@ -293,7 +331,11 @@ impl Graph {
         }
         // Loops describe the uncut drawing only.
         self.loops.clear();
-        Ok(CutSection { at, negative: section, positive: copies })
+        Ok(CutSection {
+            at,
+            negative: section,
+            positive: copies,
+        })
     }
 
     /// The regions after cutting: the connected pieces of the graph, with one contact per cut.
@@ -318,7 +360,12 @@ impl Graph {
         for (i, e) in self.edges.iter().enumerate() {
             let root = find(&mut parent, e[0]);
             let r = *by_root.entry(root).or_insert_with(|| {
-                regions.push(Region { vertices: Vec::new(), edges: Vec::new(), outline: None, source: None });
+                regions.push(Region {
+                    vertices: Vec::new(),
+                    edges: Vec::new(),
+                    outline: None,
+                    source: None,
+                });
                 sources.push(Vec::new());
                 regions.len() - 1
             });
@@ -347,7 +394,16 @@ impl Graph {
                     c.at.x, c.at.y
                 )));
             }
-            contacts.push(Contact { a, b, pairs: c.negative.iter().copied().zip(c.positive.iter().copied()).collect() });
+            contacts.push(Contact {
+                a,
+                b,
+                pairs: c
+                    .negative
+                    .iter()
+                    .copied()
+                    .zip(c.positive.iter().copied())
+                    .collect(),
+            });
         }
         Ok((regions, contacts))
     }
@@ -366,8 +422,18 @@ impl Graph {
             if signed_area(&self.positions, &outline) < 0.0 {
                 outline.reverse();
             }
-            let edges = self.edges.iter().filter(|e| set.contains(&e[0]) && set.contains(&e[1])).copied().collect();
-            regions.push(Region { vertices: outline.clone(), edges, outline: Some(outline), source: Some(l.source) });
+            let edges = self
+                .edges
+                .iter()
+                .filter(|e| set.contains(&e[0]) && set.contains(&e[1]))
+                .copied()
+                .collect();
+            regions.push(Region {
+                vertices: outline.clone(),
+                edges,
+                outline: Some(outline),
+                source: Some(l.source),
+            });
         }
         if regions.is_empty() {
             return Err(AuthorError(
@@ -399,11 +465,17 @@ impl Graph {
         }
         let mut contacts = Vec::new();
         for ((a, b), vs) in shared {
-            let lone_corner = vs.len() == 1 && !in_contact.contains(&(a, vs[0])) && !in_contact.contains(&(b, vs[0]));
+            let lone_corner = vs.len() == 1
+                && !in_contact.contains(&(a, vs[0]))
+                && !in_contact.contains(&(b, vs[0]));
             if vs.len() >= 2 || lone_corner {
                 let mut vs = vs;
                 vs.sort_unstable();
-                contacts.push(Contact { a, b, pairs: vs.iter().map(|&v| (v, v)).collect() });
+                contacts.push(Contact {
+                    a,
+                    b,
+                    pairs: vs.iter().map(|&v| (v, v)).collect(),
+                });
             }
         }
         Ok((regions, contacts))
@@ -427,7 +499,11 @@ impl Graph {
         let mut cur = adj[&vertices[0]][0];
         while cur != vertices[0] {
             cycle.push(cur);
-            let next = if adj[&cur][0] == prev { adj[&cur][1] } else { adj[&cur][0] };
+            let next = if adj[&cur][0] == prev {
+                adj[&cur][1]
+            } else {
+                adj[&cur][0]
+            };
             prev = cur;
             cur = next;
             if cycle.len() > vertices.len() {
@@ -447,7 +523,9 @@ impl Graph {
 /// Twice the signed area of a polygon of graph vertices (positive when counter-clockwise).
 pub fn signed_area(positions: &[DVec2], cycle: &[usize]) -> f64 {
     let n = cycle.len();
-    (0..n).map(|i| positions[cycle[i]].perp_dot(positions[cycle[(i + 1) % n]])).sum()
+    (0..n)
+        .map(|i| positions[cycle[i]].perp_dot(positions[cycle[(i + 1) % n]]))
+        .sum()
 }
 
 fn most_common(xs: &[usize]) -> Option<usize> {
@@ -455,5 +533,8 @@ fn most_common(xs: &[usize]) -> Option<usize> {
     for &x in xs {
         *counts.entry(x).or_default() += 1;
     }
-    counts.into_iter().max_by_key(|&(x, c)| (c, std::cmp::Reverse(x))).map(|(x, _)| x)
+    counts
+        .into_iter()
+        .max_by_key(|&(x, c)| (c, std::cmp::Reverse(x)))
+        .map(|(x, _)| x)
 }

@@ -39,7 +39,12 @@ pub struct Polyline {
 impl Polyline {
     /// A closed polygon without colour or name.
     pub fn polygon(points: Vec<DVec2>) -> Self {
-        Self { points, closed: true, fill: None, name: None }
+        Self {
+            points,
+            closed: true,
+            fill: None,
+            name: None,
+        }
     }
 }
 
@@ -67,7 +72,13 @@ pub struct AuthorOptions {
 
 impl Default for AuthorOptions {
     fn default() -> Self {
-        Self { snap: 1e-3, congruence: 1e-3, cuts: Vec::new(), stretch: None, header: None }
+        Self {
+            snap: 1e-3,
+            congruence: 1e-3,
+            cuts: Vec::new(),
+            stretch: None,
+            header: None,
+        }
     }
 }
 
@@ -92,17 +103,26 @@ pub struct Authored {
 
 /// Runs every authoring step on a drawing.
 pub fn author(drawing: &Drawing, options: &AuthorOptions) -> Result<Authored, AuthorError> {
-    for (name, v) in [("snap tolerance", options.snap), ("congruence tolerance", options.congruence)] {
+    for (name, v) in [
+        ("snap tolerance", options.snap),
+        ("congruence tolerance", options.congruence),
+    ] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(AuthorError(format!("the {name} must be a positive number, found {v}")));
+            return Err(AuthorError(format!(
+                "the {name} must be a positive number, found {v}"
+            )));
         }
     }
     let mut graph = Graph::build(drawing, options.snap)?;
-    let cut_contacts = options.cuts.iter().map(|&p| graph.cut(p, options.snap)).collect::<Result<Vec<_>, _>>()?;
+    let cut_contacts = options
+        .cuts
+        .iter()
+        .map(|&p| graph.cut(p, options.snap))
+        .collect::<Result<Vec<_>, _>>()?;
     let (regions, contacts) = if cut_contacts.is_empty() {
-        graph.loop_regions(options.snap)?
+        graph.loop_regions()?
     } else {
-        graph.regions(&cut_contacts)
+        graph.regions(&cut_contacts)?
     };
     let mut design = pieces::find_pieces(&graph, &regions, &contacts, options.congruence)?;
     if let Some(choice) = &options.stretch {

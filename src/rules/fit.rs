@@ -76,7 +76,7 @@ pub fn affine(from: &[DVec2], to: &[DVec2]) -> PointMap {
     }
     let det = pp.determinant();
     // Relative test: det is of order scale^2 for well-spread points.
-    if !(det.abs() > 1e-9 * scale * scale) {
+    if det.is_nan() || det.abs() <= 1e-9 * scale * scale {
         return rigid(from, to);
     }
     let linear = qp * pp.inverse();

@@ -61,7 +61,8 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
         {
             continue;
         }
-        let mut grid = SiteGrid::new(rule.distance);
+        let distance = rule.distance(&grammar.solver);
+        let mut grid = SiteGrid::new(distance);
         for (i, inst) in data.instances.iter().enumerate() {
             let s = InstanceSite {
                 instance: i,
@@ -87,7 +88,7 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
             };
             let accept =
                 |t: InstanceSite| t.instance != i && !neighbours.contains(&(i, t.instance));
-            if let Some((t, d)) = grid.nearest(c, rule.distance, accept)
+            if let Some((t, d)) = grid.nearest(c, distance, accept)
                 && best.is_none_or(|b| d < b.distance)
             {
                 best = Some(MergeMatch {

@@ -310,15 +310,15 @@ pub fn stretch(
         for &v in layout.to_site {
             a_vertices[v] = fresh(data, place.place(place.rest[0][v]));
         }
-        for v in 0..nv {
+        for (v, &g) in a_vertices.iter().enumerate() {
             if !layout.from_site.contains(&v) {
-                data.positions[a_vertices[v]] = place.place(place.rest[0][v]);
+                data.positions[g] = place.place(place.rest[0][v]);
             }
         }
         // N: from = A's new to, to = B's from (the old shared vertices), the rest fresh.
         let mut n_vertices = vec![usize::MAX; nv];
-        for v in 0..nv {
-            n_vertices[v] = if let Some(i) = layout.from_site.iter().position(|&x| x == v) {
+        for (v, slot) in n_vertices.iter_mut().enumerate() {
+            *slot = if let Some(i) = layout.from_site.iter().position(|&x| x == v) {
                 a_vertices[layout.to_site[n - 1 - i]]
             } else if let Some(i) = layout.to_site.iter().position(|&x| x == v) {
                 vb[layout.from_site[n - 1 - i]]
@@ -327,9 +327,9 @@ pub fn stretch(
             };
         }
         // B: same vertices; everything but its `to` site re-laid as element 2.
-        for v in 0..nv {
+        for (v, &g) in vb.iter().enumerate() {
             if !layout.to_site.contains(&v) {
-                data.positions[vb[v]] = place.place(place.rest[2][v]);
+                data.positions[g] = place.place(place.rest[2][v]);
             }
         }
         data.instances[ia].vertices = a_vertices;
@@ -452,15 +452,14 @@ pub fn shrink(
         {
             return Err("the element to remove is docked at a side site; not shrinking".into());
         }
-        let nv = va.len();
         let mut k_vertices = data.instances[keep].vertices.clone();
-        for v in 0..nv {
+        for (v, slot) in k_vertices.iter_mut().enumerate() {
             if let Some(i) = layout.from_site.iter().position(|&x| x == v) {
-                k_vertices[v] = va[layout.from_site[i]];
+                *slot = va[layout.from_site[i]];
             } else if let Some(i) = layout.to_site.iter().position(|&x| x == v) {
-                k_vertices[v] = vb[layout.to_site[i]];
+                *slot = vb[layout.to_site[i]];
             } else {
-                data.positions[k_vertices[v]] = place.place(place.rest[0][v]);
+                data.positions[*slot] = place.place(place.rest[0][v]);
             }
         }
         data.instances[keep].vertices = k_vertices;

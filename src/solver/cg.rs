@@ -21,20 +21,34 @@ pub struct CgOutcome {
     pub converged: bool,
 }
 
+/// When a solve stops: relative residual reached, or iteration cap.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CgStop {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    /// Per column, the norm the residual is measured against; `None` uses the right-hand
+    /// side's own norm.
+    pub reference: Option<[f64; 2]>,
+}
+
+fn col(n: usize, c: usize) -> std::ops::Range<usize> {
+    c * n..(c + 1) * n
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// Solves `A X = B` (two columns, column-major) starting from `x`, until every column's
-/// residual is below `tolerance` times its right-hand side's norm or `max_iterations` pass.
+/// residual is below `stop.tolerance` times its right-hand side's norm or
+/// `stop.max_iterations` pass.
 /// `precondition`, if given, replaces its argument (two columns) by `M^-1` times it.
 pub fn solve(
     pattern: &Pattern,
     values: &[f64],
     b: &[f64],
     x: &mut [f64],
-    tolerance: f64,
-    max_iterations: usize,
+    stop: CgStop,
     mut precondition: Option<&mut dyn FnMut(&mut [f64])>,
     work: &mut CgWork,
 ) -> CgOutcome {
@@ -44,22 +58,24 @@ pub fn solve(
         v.resize(2 * n, 0.0);
     }
     pattern.multiply(values, x, &mut work.ap, 2);
-    for i in 0..2 * n {
-        work.r[i] = b[i] - work.ap[i];
+    for ((r, bi), ax) in work.r.iter_mut().zip(b).zip(&work.ap) {
+        *r = bi - ax;
     }
-    let col = |v: &[f64], c: usize| -> std::ops::Range<usize> {
-        let _ = v;
-        c * n..(c + 1) * n
-    };
     let mut goal = [0.0; 2];
     let mut done = [false; 2];
-    for c in 0..2 {
-        let bn = dot(&b[col(b, c)], &b[col(b, c)]).sqrt();
-        goal[c] = tolerance * bn.max(1e-300);
-        done[c] = dot(&work.r[col(b, c)], &work.r[col(b, c)]).sqrt() <= goal[c];
+    for (c, (g, d)) in goal.iter_mut().zip(&mut done).enumerate() {
+        let bn = match stop.reference {
+            Some(r) => r[c],
+            None => dot(&b[col(n, c)], &b[col(n, c)]).sqrt(),
+        };
+        *g = stop.tolerance * bn.max(1e-300);
+        *d = dot(&work.r[col(n, c)], &work.r[col(n, c)]).sqrt() <= *g;
     }
     if done[0] && done[1] {
-        return CgOutcome { iterations: 0, converged: true };
+        return CgOutcome {
+            iterations: 0,
+            converged: true,
+        };
     }
     work.z.copy_from_slice(&work.r);
     if let Some(m) = precondition.as_mut() {
@@ -67,20 +83,20 @@ pub fn solve(
     }
     work.p.copy_from_slice(&work.z);
     let mut rz = [0.0; 2];
-    for c in 0..2 {
-        rz[c] = dot(&work.r[col(b, c)], &work.z[col(b, c)]);
+    for (c, v) in rz.iter_mut().enumerate() {
+        *v = dot(&work.r[col(n, c)], &work.z[col(n, c)]);
     }
     let mut iterations = 0;
-    while iterations < max_iterations && !(done[0] && done[1]) {
+    while iterations < stop.max_iterations && !(done[0] && done[1]) {
         iterations += 1;
         pattern.multiply(values, &work.p, &mut work.ap, 2);
         for c in 0..2 {
             if done[c] {
                 continue;
             }
-            let range = col(b, c);
+            let range = col(n, c);
             let pap = dot(&work.p[range.clone()], &work.ap[range.clone()]);
-            if !(pap > 0.0) || !pap.is_finite() {
+            if pap.is_nan() || pap <= 0.0 || !pap.is_finite() {
                 // breakdown: the direction carries no curvature; nothing more to gain.
                 done[c] = true;
                 continue;
@@ -105,7 +121,7 @@ pub fn solve(
             if done[c] {
                 continue;
             }
-            let range = col(b, c);
+            let range = col(n, c);
             let rz_new = dot(&work.r[range.clone()], &work.z[range.clone()]);
             let beta = if rz[c] != 0.0 { rz_new / rz[c] } else { 0.0 };
             rz[c] = rz_new;
@@ -116,6 +132,10 @@ pub fn solve(
     }
     // Recheck with the true residual's bookkeeping: breakdown columns count as converged only
     // if their residual really is small.
-    let converged = (0..2).all(|c| dot(&work.r[col(b, c)], &work.r[col(b, c)]).sqrt() <= goal[c] * 1.0001);
-    CgOutcome { iterations, converged }
+    let converged =
+        (0..2).all(|c| dot(&work.r[col(n, c)], &work.r[col(n, c)]).sqrt() <= goal[c] * 1.0001);
+    CgOutcome {
+        iterations,
+        converged,
+    }
 }

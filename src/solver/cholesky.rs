@@ -6,7 +6,8 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
@@ -42,7 +43,9 @@ impl NumericFactor {
 
 impl std::fmt::Debug for SymbolicFactor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SymbolicFactor").field("symbolic", &self.symbolic).finish_non_exhaustive()
+        f.debug_struct("SymbolicFactor")
+            .field("symbolic", &self.symbolic)
+            .finish_non_exhaustive()
     }
 }
 
@@ -65,7 +68,10 @@ impl SymbolicFactor {
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(2, Par::Seq),
         ]);
-        Ok(Self { symbolic, scratch: MemBuffer::new(req) })
+        Ok(Self {
+            symbolic,
+            scratch: MemBuffer::new(req),
+        })
     }
 
     /// Numerically factorises the matrix (same pattern as analysed) into `factor`.

@@ -67,10 +67,22 @@ impl Pattern {
                     // present by construction
                     col_ptr[lo] + col.binary_search(&hi).unwrap_or(0)
                 });
-                edges.push(EdgeSlot { part: pi, edge: ei, local: *e, x, y, slot });
+                edges.push(EdgeSlot {
+                    part: pi,
+                    edge: ei,
+                    local: *e,
+                    x,
+                    y,
+                    slot,
+                });
             }
         }
-        Self { n, col_ptr, row_idx, edges }
+        Self {
+            n,
+            col_ptr,
+            row_idx,
+            edges,
+        }
     }
 
     pub fn nnz(&self) -> usize {
@@ -103,9 +115,8 @@ impl Pattern {
             for j in 0..n {
                 let xj = xc[j];
                 let mut acc = 0.0;
-                for k in self.col_ptr[j]..self.col_ptr[j + 1] {
-                    let i = self.row_idx[k];
-                    let v = values[k];
+                let range = self.col_ptr[j]..self.col_ptr[j + 1];
+                for (&i, &v) in self.row_idx[range.clone()].iter().zip(&values[range]) {
                     oc[i] += v * xj;
                     if i != j {
                         acc += v * xc[i];
@@ -119,7 +130,13 @@ impl Pattern {
 
 /// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` into row x and its negation
 /// into row y, plus `extra` (handle and proximal terms), for the x column then the y column.
-pub fn fill_rhs(edges: &[EdgeSlot], weights: &[f64], targets: &[DVec2], extra: &[DVec2], rhs: &mut Vec<f64>) {
+pub fn fill_rhs(
+    edges: &[EdgeSlot],
+    weights: &[f64],
+    targets: &[DVec2],
+    extra: &[DVec2],
+    rhs: &mut Vec<f64>,
+) {
     let n = extra.len();
     rhs.clear();
     rhs.resize(2 * n, 0.0);
@@ -139,7 +156,13 @@ pub fn fill_rhs(edges: &[EdgeSlot], weights: &[f64], targets: &[DVec2], extra: &
 }
 
 /// Relative residual `|b - A x| / |b|` over both columns.
-pub fn relative_residual(pattern: &Pattern, values: &[f64], x: &[f64], b: &[f64], scratch: &mut Vec<f64>) -> f64 {
+pub fn relative_residual(
+    pattern: &Pattern,
+    values: &[f64],
+    x: &[f64],
+    b: &[f64],
+    scratch: &mut Vec<f64>,
+) -> f64 {
     scratch.resize(b.len(), 0.0);
     pattern.multiply(values, x, scratch, 2);
     let (mut num, mut den) = (0.0, 0.0);
@@ -147,5 +170,9 @@ pub fn relative_residual(pattern: &Pattern, values: &[f64], x: &[f64], b: &[f64]
         num += (bi - ax) * (bi - ax);
         den += bi * bi;
     }
-    if den > 0.0 { (num / den).sqrt() } else { num.sqrt() }
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        num.sqrt()
+    }
 }

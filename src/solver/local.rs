@@ -19,7 +19,10 @@ pub struct Alignment {
 pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignment {
     let m = vertices.len().min(rest.len());
     if m == 0 {
-        return Alignment { rotation: DVec2::X, distance: 0.0 };
+        return Alignment {
+            rotation: DVec2::X,
+            distance: 0.0,
+        };
     }
     let inv = 1.0 / m as f64;
     let rest_centre = rest[..m].iter().copied().sum::<DVec2>() * inv;
@@ -36,10 +39,21 @@ pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignme
         pp += p.length_squared();
         qq += q.length_squared();
     }
-    let len = dot.hypot(cross);
-    let rotation = if len > 1e-300 && len.is_finite() { DVec2::new(dot / len, cross / len) } else { DVec2::X };
+    let len = (dot * dot + cross * cross).sqrt();
+    let rotation = if len > 1e-300 && len.is_finite() {
+        DVec2::new(dot / len, cross / len)
+    } else {
+        DVec2::X
+    };
     let distance = (pp + qq - 2.0 * len).max(0.0);
-    Alignment { rotation, distance: if distance.is_finite() { distance } else { f64::MAX } }
+    Alignment {
+        rotation,
+        distance: if distance.is_finite() {
+            distance
+        } else {
+            f64::MAX
+        },
+    }
 }
 
 /// Picks the active state of `part` for the current positions: the nearest rest state, but
@@ -105,11 +119,43 @@ impl VertexParts {
                 fill[v] += 1;
             }
         }
-        Self { start: count, parts: list }
+        Self {
+            start: count,
+            parts: list,
+        }
     }
 
     pub fn of(&self, v: usize) -> &[usize] {
         &self.parts[self.start[v]..self.start[v + 1]]
+    }
+}
+
+/// Sum of the rotations of the parts containing `v` that lie within the cone `cos_cone` of
+/// `own`; [`edge_rotation`] is the normalised sum of this for both ends of an edge.
+pub fn vertex_rotation_sum(
+    vertex_parts: &VertexParts,
+    rotations: &[DVec2],
+    v: usize,
+    own: DVec2,
+    cos_cone: f64,
+) -> DVec2 {
+    let mut s = DVec2::ZERO;
+    for &j in vertex_parts.of(v) {
+        let r = rotations[j];
+        if r.dot(own) >= cos_cone {
+            s += r;
+        }
+    }
+    s
+}
+
+/// Normalises a sum of rotations, falling back to `own` when it (nearly) vanishes.
+pub fn normalised_or(s: DVec2, own: DVec2) -> DVec2 {
+    let len = s.length();
+    if len > 1e-9 && len.is_finite() {
+        s / len
+    } else {
+        own
     }
 }
 
@@ -133,15 +179,9 @@ pub fn edge_rotation(
     if cos_cone >= 1.0 {
         return own;
     }
-    let mut s = DVec2::ZERO;
-    for &j in vertex_parts.of(x).iter().chain(vertex_parts.of(y)) {
-        let r = rotations[j];
-        if r.dot(own) >= cos_cone {
-            s += r;
-        }
-    }
-    let len = s.length();
-    if len > 1e-9 && len.is_finite() { s / len } else { own }
+    let s = vertex_rotation_sum(vertex_parts, rotations, x, own, cos_cone)
+        + vertex_rotation_sum(vertex_parts, rotations, y, own, cos_cone);
+    normalised_or(s, own)
 }
 
 #[cfg(test)]
@@ -150,9 +190,16 @@ mod tests {
 
     #[test]
     fn align_recovers_a_rotation_and_zero_distance() {
-        let rest = [DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0), DVec2::new(0.0, 2.0)];
+        let rest = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(0.0, 2.0),
+        ];
         let rot = DVec2::from_angle(0.7);
-        let pos: Vec<DVec2> = rest.iter().map(|&p| rot.rotate(p) + DVec2::new(3.0, -1.0)).collect();
+        let pos: Vec<DVec2> = rest
+            .iter()
+            .map(|&p| rot.rotate(p) + DVec2::new(3.0, -1.0))
+            .collect();
         let a = align(&rest, &[0, 1, 2], &pos);
         assert!((a.rotation - rot).length() < 1e-12);
         assert!(a.distance < 1e-12);

@@ -55,7 +55,8 @@ pub struct SolverConfig {
     /// A pass stops early once no vertex moved more than this fraction of the model's size
     /// (and, in pass 1, no state switched).
     pub tolerance: f64,
-    /// Relative residual each CG solve reaches (`SolverKind::Cg`).
+    /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
+    /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
     pub cg_tolerance: f64,
     /// Cap on CG iterations per solve.
     pub cg_max_iterations: usize,
@@ -78,8 +79,8 @@ impl SolverConfig {
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
-            irls_iterations: 6,
-            l2_iterations: 3,
+            irls_iterations: 4,
+            l2_iterations: 2,
             handle_weight: 1e6,
             rotation_cone_degrees: 20.0,
             proximal_weight: 1e-8,
@@ -161,6 +162,7 @@ struct Work {
     solution: Vec<f64>,
     scratch: Vec<f64>,
     cg: cg::CgWork,
+    part_sums: Vec<DVec2>,
     warm: Vec<DVec2>,
     warm_held: Vec<DVec2>,
     f: Vec<DVec2>,
@@ -210,8 +212,11 @@ impl Solver {
         }
         for (i, p) in asm.data.parts.iter().enumerate() {
             let m = p.vertices.len();
-            if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m) {
-                return Err(SolverError(format!("part {i} refers to a vertex that does not exist")));
+            if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m)
+            {
+                return Err(SolverError(format!(
+                    "part {i} refers to a vertex that does not exist"
+                )));
             }
         }
         self.pattern = Pattern::build(n, &asm.data.parts);
@@ -249,7 +254,9 @@ impl Solver {
         warm.clear();
         warm.extend_from_slice(&asm.data.positions);
         if warm.iter().any(|p| !p.is_finite()) {
-            return Err(SolverError("the warm start has non-finite positions".into()));
+            return Err(SolverError(
+                "the warm start has non-finite positions".into(),
+            ));
         }
         let scale = bbox_diagonal(&warm).max(1e-9);
         let step_tolerance = cfg.tolerance * scale;
@@ -279,15 +286,24 @@ impl Solver {
             // with only the handles moved, the parts next to a handle look rotated and the
             // first solve would bend a model that should just follow rigidly.
             let pose = if it == 0 { &warm } else { &f };
-            self.local_step_switching(&mut asm.data.parts, pose, cfg.hysteresis, &mut report.switches);
+            self.local_step_switching(
+                &mut asm.data.parts,
+                pose,
+                cfg.hysteresis,
+                &mut report.switches,
+            );
             self.edge_targets(&asm.data.parts);
             let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
             let w = &mut self.work;
             w.weights.clear();
             for (e, &t) in self.pattern.edges.iter().zip(&w.targets) {
                 let r = (t - (f[e.x] - f[e.y])).length();
-                let weight = (r + eps).powf(p - 2.0);
-                w.weights.push(if weight.is_finite() { weight } else { eps.powf(p - 2.0) });
+                let weight = irls_weight(r + eps, p);
+                w.weights.push(if weight.is_finite() {
+                    weight
+                } else {
+                    eps.powf(p - 2.0)
+                });
             }
             let mean = mean_or_one(&w.weights);
             self.solve_global(&f, &mut next, mean, Pass::Irls, &mut report)?;
@@ -308,9 +324,19 @@ impl Solver {
         let handles = asm.handles();
         // Candidates: the pass-1 result, the warm start with the handles carried to their
         // targets (continues last frame's least-squares pose), and the plain warm start.
-        let mut terms = self.objective(&asm.data.parts, handles, &f);
-        let held_terms = self.objective(&asm.data.parts, handles, &warm_held);
+        // (evaluated last to first so that, in the usual case where the pass-1 result wins,
+        // its rotations are the ones left in the work buffers)
         let warm_terms = self.objective(&asm.data.parts, handles, &warm);
+        let held_terms = if report.irls_iterations > 0 {
+            self.objective(&asm.data.parts, handles, &warm_held)
+        } else {
+            // without pass 1, `f` is the handles-moved warm start
+            Terms {
+                elastic: f64::INFINITY,
+                handle: 0.0,
+            }
+        };
+        let mut terms = self.objective(&asm.data.parts, handles, &f);
         report.warm_objective = warm_terms.total();
         let mut chosen = 0;
         for (k, t) in [(1, held_terms), (2, warm_terms)] {
@@ -324,15 +350,20 @@ impl Solver {
         // objective() leaves the rotations the first solve uses in the work buffers: those of
         // the start, or for the handles-moved warm start those of the last displayed pose
         // (see pass 1).
-        let rotations_from = if chosen == 0 { &f } else { &warm };
-        self.objective(&asm.data.parts, handles, rotations_from);
+        if chosen != 0 || report.irls_iterations == 0 {
+            self.objective(&asm.data.parts, handles, &warm);
+        }
         let mut pass2_converged = cfg.l2_iterations == 0;
         for _ in 0..cfg.l2_iterations {
             report.l2_iterations += 1;
             // objective() left the rotations and edge targets of `f` in the work buffers.
             self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
             let new_terms = self.objective(&asm.data.parts, handles, &next);
-            if !(new_terms.total() <= terms.total()) {
+            let improved = new_terms
+                .total()
+                .partial_cmp(&terms.total())
+                .is_some_and(|o| o.is_le());
+            if !improved {
                 // restore rotations of the kept iterate
                 terms = self.objective(&asm.data.parts, handles, &f);
                 pass2_converged = true;
@@ -348,7 +379,9 @@ impl Solver {
         }
 
         if f.iter().any(|p| !p.is_finite()) {
-            return Err(SolverError("the solve produced non-finite positions".into()));
+            return Err(SolverError(
+                "the solve produced non-finite positions".into(),
+            ));
         }
         asm.data.positions.copy_from_slice(&f);
         let rot = asm.rotations_mut();
@@ -360,7 +393,12 @@ impl Solver {
         report.objective = terms.total();
         report.converged = pass1_converged && pass2_converged;
         report.ms = start.elapsed().as_secs_f64() * 1e3;
-        (self.work.warm, self.work.warm_held, self.work.f, self.work.next) = (warm, warm_held, f, next);
+        (
+            self.work.warm,
+            self.work.warm_held,
+            self.work.f,
+            self.work.next,
+        ) = (warm, warm_held, f, next);
         Ok(report)
     }
 
@@ -384,13 +422,23 @@ impl Solver {
     }
 
     /// Local step with state switching; fills `work.rotations`.
-    fn local_step_switching(&mut self, parts: &mut [Part], f: &[DVec2], hysteresis: f64, switches: &mut Vec<StateSwitch>) {
+    fn local_step_switching(
+        &mut self,
+        parts: &mut [Part],
+        f: &[DVec2],
+        hysteresis: f64,
+        switches: &mut Vec<StateSwitch>,
+    ) {
         let w = &mut self.work;
         w.rotations.clear();
         for (i, part) in parts.iter_mut().enumerate() {
             let (state, r) = local::choose_state(part, f, hysteresis);
             if state != part.active {
-                switches.push(StateSwitch { part: i, from: part.active, to: state });
+                switches.push(StateSwitch {
+                    part: i,
+                    from: part.active,
+                    to: state,
+                });
                 part.active = state;
             }
             w.rotations.push(r);
@@ -398,19 +446,47 @@ impl Solver {
     }
 
     /// `R_xy (x0 - y0)` for every part-edge from `work.rotations` and the active states.
+    /// Same result as [`local::edge_rotation`] per edge, but each part sums its vertices'
+    /// neighbour rotations once instead of once per edge end.
     fn edge_targets(&mut self, parts: &[Part]) {
         let w = &mut self.work;
         let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
         w.targets.clear();
-        for e in &self.pattern.edges {
-            let part = &parts[e.part];
-            let rest = part.states.get(part.active).map(|s| s.positions.as_slice()).unwrap_or(&[]);
-            let d0 = match (rest.get(e.local[0]), rest.get(e.local[1])) {
-                (Some(&a), Some(&b)) => a - b,
-                _ => DVec2::ZERO,
-            };
-            let r = local::edge_rotation(&w.vertex_parts, &w.rotations, e.x, e.y, e.part, cos_cone);
-            w.targets.push(r.rotate(d0));
+        let mut k = 0;
+        let edges = &self.pattern.edges;
+        for (pi, part) in parts.iter().enumerate() {
+            let own = w.rotations[pi];
+            w.part_sums.clear();
+            if cos_cone < 1.0 {
+                for &v in &part.vertices {
+                    w.part_sums.push(local::vertex_rotation_sum(
+                        &w.vertex_parts,
+                        &w.rotations,
+                        v,
+                        own,
+                        cos_cone,
+                    ));
+                }
+            }
+            let rest = part
+                .states
+                .get(part.active)
+                .map(|s| s.positions.as_slice())
+                .unwrap_or(&[]);
+            while k < edges.len() && edges[k].part == pi {
+                let e = &edges[k];
+                let d0 = match (rest.get(e.local[0]), rest.get(e.local[1])) {
+                    (Some(&a), Some(&b)) => a - b,
+                    _ => DVec2::ZERO,
+                };
+                let r = if cos_cone < 1.0 {
+                    local::normalised_or(w.part_sums[e.local[0]] + w.part_sums[e.local[1]], own)
+                } else {
+                    own
+                };
+                w.targets.push(r.rotate(d0));
+                k += 1;
+            }
         }
     }
 
@@ -437,7 +513,10 @@ impl Solver {
                 }
             }
         }
-        Terms { elastic, handle: self.config.handle_weight * handle }
+        Terms {
+            elastic,
+            handle: self.config.handle_weight * handle,
+        }
     }
 
     /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
@@ -456,9 +535,9 @@ impl Solver {
         let mu = cfg.proximal_weight * mean_weight;
         w.diagonal.clear();
         w.extra.clear();
-        for v in 0..n {
-            w.diagonal.push(lambda * w.handle_count[v] + mu);
-            w.extra.push(lambda * w.handle_sum[v] + mu * f[v]);
+        for ((&count, &sum), &p) in w.handle_count.iter().zip(&w.handle_sum).zip(f) {
+            w.diagonal.push(lambda * count + mu);
+            w.extra.push(lambda * sum + mu * p);
         }
         let weights: &[f64] = match pass {
             Pass::Irls => &w.weights,
@@ -468,25 +547,44 @@ impl Solver {
                 &w.ones
             }
         };
-        global::fill_rhs(&self.pattern.edges, weights, &w.targets, &w.extra, &mut w.rhs);
+        global::fill_rhs(
+            &self.pattern.edges,
+            weights,
+            &w.targets,
+            &w.extra,
+            &mut w.rhs,
+        );
         // The least-squares matrix depends only on the handles' vertices: reuse its values and
         // factor while they stay the same.
-        let l2_reusable = pass == Pass::LeastSquares && w.l2_diagonal == w.diagonal && !w.l2_values.is_empty();
+        let l2_reusable =
+            pass == Pass::LeastSquares && w.l2_diagonal == w.diagonal && !w.l2_values.is_empty();
         if !l2_reusable {
-            let target = if pass == Pass::LeastSquares { &mut w.l2_values } else { &mut w.values };
+            let target = if pass == Pass::LeastSquares {
+                &mut w.l2_values
+            } else {
+                &mut w.values
+            };
             self.pattern.fill_values(weights, &w.diagonal, target);
             if pass == Pass::LeastSquares {
                 w.l2_diagonal.clone_from(&w.diagonal);
                 self.l2_factor.invalidate();
             }
         }
-        let values = if pass == Pass::LeastSquares { &w.l2_values } else { &w.values };
+        let values = if pass == Pass::LeastSquares {
+            &w.l2_values
+        } else {
+            &w.values
+        };
         w.solution.clear();
         w.solution.extend(f.iter().map(|p| p.x));
         w.solution.extend(f.iter().map(|p| p.y));
         match (cfg.kind, self.symbolic.as_mut()) {
             (SolverKind::Cholesky, Some(symbolic)) => {
-                let factor = if pass == Pass::LeastSquares { &mut self.l2_factor } else { &mut self.irls_factor };
+                let factor = if pass == Pass::LeastSquares {
+                    &mut self.l2_factor
+                } else {
+                    &mut self.irls_factor
+                };
                 if pass == Pass::Irls || !factor.is_valid() {
                     symbolic
                         .factorize(factor, &self.pattern.col_ptr, &self.pattern.row_idx, values)
@@ -502,8 +600,11 @@ impl Solver {
                     values,
                     &w.rhs,
                     &mut w.solution,
-                    cfg.cg_tolerance,
-                    cfg.cg_max_iterations,
+                    cg::CgStop {
+                        tolerance: cfg.cg_tolerance,
+                        max_iterations: cfg.cg_max_iterations,
+                        reference: Some(elastic_norm(&w.rhs, &w.extra)),
+                    },
                     None,
                     &mut w.cg,
                 );
@@ -511,7 +612,13 @@ impl Solver {
             }
         }
         if cfg.measure_residual {
-            let r = global::relative_residual(&self.pattern, values, &w.solution, &w.rhs, &mut w.scratch);
+            let r = global::relative_residual(
+                &self.pattern,
+                values,
+                &w.solution,
+                &w.rhs,
+                &mut w.scratch,
+            );
             report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
         }
         for (v, p) in next.iter_mut().enumerate() {
@@ -539,6 +646,32 @@ impl Terms {
     }
 }
 
+/// Per column, the norm of the right-hand side's edge terms (without the handle and proximal
+/// terms in `extra`). CG measures its residual against this: the handle rows, a million times
+/// stiffer, would otherwise let a solve stop with the elastic rows far from balanced.
+fn elastic_norm(rhs: &[f64], extra: &[DVec2]) -> [f64; 2] {
+    let n = extra.len();
+    let (mut sx, mut sy) = (0.0, 0.0);
+    for (i, e) in extra.iter().enumerate() {
+        sx += (rhs[i] - e.x).powi(2);
+        sy += (rhs[n + i] - e.y).powi(2);
+    }
+    [sx.sqrt(), sy.sqrt()]
+}
+
+/// `a^(p - 2)`, with the common exponents spelled out (powf dominated the IRLS pass).
+fn irls_weight(a: f64, p: f64) -> f64 {
+    if p == 2.0 {
+        1.0
+    } else if p == 0.5 {
+        1.0 / (a * a.sqrt())
+    } else if p == 1.0 {
+        1.0 / a
+    } else {
+        a.powf(p - 2.0)
+    }
+}
+
 fn mean_or_one(values: &[f64]) -> f64 {
     if values.is_empty() {
         return 1.0;
@@ -548,7 +681,10 @@ fn mean_or_one(values: &[f64]) -> f64 {
 }
 
 fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f64::max)
 }
 
 /// Length of the diagonal of the positions' bounding box (0 for no or non-finite positions).
@@ -562,7 +698,11 @@ pub fn bbox_diagonal(positions: &[DVec2]) -> f64 {
 /// Bounding box `(min, max)` of the positions, `None` when there are none.
 pub fn bbox(positions: &[DVec2]) -> Option<(DVec2, DVec2)> {
     let first = *positions.first()?;
-    Some(positions.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+    Some(
+        positions
+            .iter()
+            .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+    )
 }
 
 /// Piece parts carry their active state to their instance (that is the replacement rule).
@@ -587,7 +727,9 @@ pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
     let cos_cone = cone_cosine(config.rotation_cone_degrees);
     let mut energy = 0.0;
     for (pi, part) in parts.iter().enumerate() {
-        let Some(rest) = part.states.get(part.active) else { continue };
+        let Some(rest) = part.states.get(part.active) else {
+            continue;
+        };
         for e in &part.edges {
             let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
             let d0 = rest.positions[e[0]] - rest.positions[e[1]];
@@ -599,7 +741,11 @@ pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
 }
 
 fn cone_cosine(degrees: f64) -> f64 {
-    if degrees >= 180.0 { -1.0 } else { degrees.max(0.0).to_radians().cos() }
+    if degrees >= 180.0 {
+        -1.0
+    } else {
+        degrees.max(0.0).to_radians().cos()
+    }
 }
 
 /// Largest `|length / rest length - 1|` over the edges of every part's active state (edges
@@ -614,7 +760,9 @@ pub fn edge_strains(asm: &Assembly) -> Vec<f64> {
     let f = &asm.data.positions;
     let mut out = Vec::new();
     for part in &asm.data.parts {
-        let Some(rest) = part.states.get(part.active) else { continue };
+        let Some(rest) = part.states.get(part.active) else {
+            continue;
+        };
         for e in &part.edges {
             let rest_len = (rest.positions[e[0]] - rest.positions[e[1]]).length();
             if rest_len > 1e-12 {

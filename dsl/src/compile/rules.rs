@@ -272,6 +272,28 @@ impl Compiler {
                 vs.join(", "),
                 ps.join(", ")
             ))
+        } else if let Some((a, b)) = p
+            .sites
+            .iter()
+            .zip(&v.sites)
+            .find(|(a, b)| a.vertices != b.vertices || a.site_type != b.site_type)
+        {
+            // Site indices and vertex lists are shared by every variant of the rule.
+            Some(if a.site_type != b.site_type {
+                format!(
+                    "site `{}` has type `{}`, not `{}`",
+                    b.name, self.site_types[b.site_type].name, self.site_types[a.site_type].name
+                )
+            } else {
+                let names = |s: &Site| {
+                    s.vertices
+                        .iter()
+                        .map(|&i| p.vertices[i].as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                format!("site `{}` lists [{}], not [{}]", b.name, names(b), names(a))
+            })
         } else {
             None
         };
@@ -281,7 +303,7 @@ impl Compiler {
         self.error(
             Diagnostic::error(codes::VARIANT_SHAPE, format!("variant `{vname}` does not have the shape of `{pname}`"), span, problem)
                 .with_secondary(def, format!("`{vname}` declared here"))
-                .with_hint(format!("variants share `{pname}`'s vertices (same names, same order), edges and site names; only their geometry may differ")),
+                .with_hint(format!("variants share `{pname}`'s vertices (same names, same order), edges and sites (names, types, vertices); only their proxy geometry may differ")),
         );
         false
     }
@@ -405,8 +427,8 @@ impl Compiler {
         let target = self.site_ref(&m.target);
         let junction = m.junction.as_ref().map(|j| (self.site_ref(j), j));
         let distance = match &m.within {
-            Some(n) => self.in_range(n, "`within`", |d| d > 0.0, "above 0"),
-            None => Some(self.solver.merge_distance),
+            Some(n) => self.in_range(n, "`within`", |d| d > 0.0, "above 0").map(Some),
+            None => Some(None),
         };
         let (Some(mover), Some(target), Some(distance)) = (mover, target, distance) else {
             return;
@@ -458,7 +480,7 @@ impl Compiler {
             mover,
             target,
             junction,
-            distance,
+            within: distance,
         });
         self.merge_spans.push(m.span);
     }

@@ -27,6 +27,12 @@ pub struct BenchArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Most IRLS (pass 1) iterations per frame (default: the solver's).
+    #[arg(long)]
+    pub irls_iterations: Option<usize>,
+    /// Most least-squares (pass 2) iterations per frame (default: the solver's).
+    #[arg(long)]
+    pub l2_iterations: Option<usize>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -68,7 +74,10 @@ fn stats(values: &[f64]) -> Ms {
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
     let median = if v.is_empty() { 0.0 } else { v[v.len() / 2] };
-    Ms { median, max: v.last().copied().unwrap_or(0.0) }
+    Ms {
+        median,
+        max: v.last().copied().unwrap_or(0.0),
+    }
 }
 
 pub fn bench(args: BenchArgs) -> u8 {
@@ -80,7 +89,16 @@ pub fn bench(args: BenchArgs) -> u8 {
         SolverArg::Cholesky => SolverKind::Cholesky,
         SolverArg::Cg => SolverKind::Cg,
     };
-    let mut config = SolverConfig { kind, ..SolverConfig::default() };
+    let mut config = SolverConfig {
+        kind,
+        ..SolverConfig::default()
+    };
+    if let Some(k) = args.irls_iterations {
+        config.irls_iterations = k.min(1000);
+    }
+    if let Some(k) = args.l2_iterations {
+        config.l2_iterations = k.min(1000);
+    }
     let (model, mut asm, drag) = match args.arap_grid {
         Some(k) => {
             if !(2..=2000).contains(&k) {
@@ -96,7 +114,11 @@ pub fn bench(args: BenchArgs) -> u8 {
             let right: Vec<usize> = (0..k).map(|j| j * k + k - 1).collect();
             asm.hold_vertices(left, HandleKind::Pin);
             let h = asm.hold_vertices(right, HandleKind::Grab);
-            (format!("arap-grid {k}x{k}"), asm, h.map(|h| (h, DVec2::new(0.3, 0.5) * k as f64)))
+            (
+                format!("arap-grid {k}x{k}"),
+                asm,
+                h.map(|h| (h, DVec2::new(0.3, 0.5) * k as f64)),
+            )
         }
         None => {
             if !(10..=10_000_000).contains(&args.parts) {
@@ -108,9 +130,15 @@ pub fn bench(args: BenchArgs) -> u8 {
             if let Some(p) = asm.part_nearest(lo) {
                 asm.hold_part(p, HandleKind::Pin);
             }
-            let h = asm.part_nearest(hi).and_then(|p| asm.hold_part(p, HandleKind::Grab));
+            let h = asm
+                .part_nearest(hi)
+                .and_then(|p| asm.hold_part(p, HandleKind::Grab));
             let size = (hi - lo).length();
-            (format!("city of ~{} parts", args.parts), asm, h.map(|h| (h, DVec2::new(0.3, 0.2) * size)))
+            (
+                format!("city of ~{} parts", args.parts),
+                asm,
+                h.map(|h| (h, DVec2::new(0.3, 0.2) * size)),
+            )
         }
     };
     let mut solver = Solver::new(config);
@@ -131,7 +159,11 @@ pub fn bench(args: BenchArgs) -> u8 {
     }
     let n = reports.len() as f64;
     let later: Vec<f64> = reports.iter().skip(1).map(|r| r.ms).collect();
-    let later = if later.is_empty() { vec![reports[0].ms] } else { later };
+    let later = if later.is_empty() {
+        vec![reports[0].ms]
+    } else {
+        later
+    };
     let result = BenchResult {
         model,
         parts: asm.data.parts.len(),
@@ -142,13 +174,21 @@ pub fn bench(args: BenchArgs) -> u8 {
             SolverKind::Cg => "cg",
         },
         frames: reports.len(),
-        irls_iterations: reports.iter().map(|r| r.irls_iterations as f64).sum::<f64>() / n,
+        irls_iterations: reports
+            .iter()
+            .map(|r| r.irls_iterations as f64)
+            .sum::<f64>()
+            / n,
         l2_iterations: reports.iter().map(|r| r.l2_iterations as f64).sum::<f64>() / n,
         factorizations_per_frame: reports.iter().map(|r| r.factorizations as f64).sum::<f64>() / n,
         cg_iterations_per_frame: reports.iter().map(|r| r.cg_iterations as f64).sum::<f64>() / n,
         first_frame_ms: reports[0].ms,
         iteration_ms: args.arap_grid.map(|_| {
-            let per: Vec<f64> = reports.iter().skip(1).map(|r| r.ms / (r.l2_iterations + r.irls_iterations).max(1) as f64).collect();
+            let per: Vec<f64> = reports
+                .iter()
+                .skip(1)
+                .map(|r| r.ms / (r.l2_iterations + r.irls_iterations).max(1) as f64)
+                .collect();
             stats(&per)
         }),
         frame_ms: stats(&later),
@@ -177,7 +217,13 @@ pub fn bench(args: BenchArgs) -> u8 {
             result.first_frame_ms,
             result.frame_ms.median,
             result.frame_ms.max,
-            result.iteration_ms.as_ref().map_or(String::new(), |m| format!("\niteration_ms median {:.2}, max {:.2}", m.median, m.max)),
+            result
+                .iteration_ms
+                .as_ref()
+                .map_or(String::new(), |m| format!(
+                    "\niteration_ms median {:.2}, max {:.2}",
+                    m.median, m.max
+                )),
         );
     }
     0
@@ -186,6 +232,13 @@ pub fn bench(args: BenchArgs) -> u8 {
 /// South-west and north-east corners of the street grid (the parts above the wall).
 fn grid_corners(asm: &Assembly) -> (DVec2, DVec2) {
     let above = asm.data.positions.iter().filter(|p| p.y >= 0.0);
-    let (lo, hi) = above.fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    if lo.x > hi.x { (DVec2::ZERO, DVec2::ZERO) } else { (lo, hi) }
+    let (lo, hi) = above.fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    if lo.x > hi.x {
+        (DVec2::ZERO, DVec2::ZERO)
+    } else {
+        (lo, hi)
+    }
 }

@@ -6,8 +6,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod author;
 mod bench;
 mod check;
+mod fmt;
 mod render;
 mod run;
 
@@ -32,6 +34,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Render every piece and rest state of a grammar side by side.
     Sheet(render::SheetArgs),
+    /// Print grammars in the canonical style (or --write / --check them).
+    Fmt(fmt::FmtArgs),
+    /// Turn an SVG drawing into a grammar.
+    Author(author::AuthorArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +56,8 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::bench(args),
         Command::Render(args) => render::render(args),
         Command::Sheet(args) => render::sheet(args),
+        Command::Fmt(args) => fmt::fmt(args),
+        Command::Author(args) => author::author_cmd(args),
     };
     ExitCode::from(code)
 }

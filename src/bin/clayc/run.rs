@@ -26,7 +26,11 @@ pub struct RunArgs {
 }
 
 /// Applies one `NAME=VALUE` override, checking the name and the range.
-pub fn apply_setting(config: &mut SolverConfig, merge_distance: &mut f64, setting: &str) -> Result<(), String> {
+pub fn apply_setting(
+    config: &mut SolverConfig,
+    merge_distance: &mut f64,
+    setting: &str,
+) -> Result<(), String> {
     let (name, value) = setting
         .split_once('=')
         .ok_or_else(|| format!("--set {setting}: expected NAME=VALUE"))?;
@@ -45,7 +49,11 @@ pub fn apply_setting(config: &mut SolverConfig, merge_distance: &mut f64, settin
         .filter(|x: &f64| x.is_finite())
         .ok_or_else(|| format!("--set {name}={value}: the value must be a finite number"))?;
     let check = |ok: bool, range: &str| {
-        if ok { Ok(()) } else { Err(format!("--set {name}={value}: must be {range}")) }
+        if ok {
+            Ok(())
+        } else {
+            Err(format!("--set {name}={value}: must be {range}"))
+        }
     };
     let count = |x: f64| x.fract() == 0.0 && (0.0..=1000.0).contains(&x);
     match name {
@@ -120,7 +128,10 @@ pub fn run(args: RunArgs) -> u8 {
         }
     };
     if !compiled.warnings.items.is_empty() {
-        eprint!("{}", clay_dsl::render(&compiled.warnings, &text, &path, false));
+        eprint!(
+            "{}",
+            clay_dsl::render(&compiled.warnings, &text, &path, false)
+        );
     }
     let mut grammar = compiled.grammar;
     let mut config = SolverConfig::from_params(&grammar.solver);
@@ -137,7 +148,10 @@ pub fn run(args: RunArgs) -> u8 {
     grammar.solver.merge_distance = merge_distance;
     let mut assembly = Assembly::new(Arc::new(grammar));
     if let Err(problems) = assembly.validate() {
-        eprintln!("error: the compiled assembly is inconsistent:\n  {}", problems.join("\n  "));
+        eprintln!(
+            "error: the compiled assembly is inconsistent:\n  {}",
+            problems.join("\n  ")
+        );
         return 1;
     }
     let mut rules = Rules::new();

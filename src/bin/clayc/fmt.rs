@@ -1,0 +1,108 @@
+//! `clayc fmt FILE...`: prints grammar files in the canonical style (clay_dsl::format), or with
+//! `--write` rewrites them in place (temp file, then rename), or with `--check` lists the files
+//! that would change. Exit codes: 0 fine, 1 a file would change or does not parse, 2 I/O.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct FmtArgs {
+    /// Grammar files to format (`-` reads standard input).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Rewrite the files in place instead of printing them.
+    #[arg(long, conflicts_with = "check")]
+    pub write: bool,
+    /// Print nothing but the names of files that are not formatted; exit 1 if there are any.
+    #[arg(long)]
+    pub check: bool,
+}
+
+fn read(path: &Path) -> std::io::Result<Vec<u8>> {
+    if path.as_os_str() == "-" {
+        let mut bytes = Vec::new();
+        std::io::stdin().read_to_end(&mut bytes)?;
+        Ok(bytes)
+    } else {
+        std::fs::read(path)
+    }
+}
+
+/// Writes `text` next to `path` and renames it over `path`, so a crash never leaves half a file.
+fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.clayfmt-{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()?;
+        if let Ok(meta) = std::fs::metadata(path) {
+            std::fs::set_permissions(&tmp, meta.permissions())?;
+        }
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+pub fn fmt(args: FmtArgs) -> u8 {
+    let mut worst = 0u8;
+    let mut out = std::io::stdout().lock();
+    for file in &args.files {
+        let path = file.display().to_string();
+        if args.write && file.as_os_str() == "-" {
+            eprintln!("error: --write needs files, not standard input");
+            worst = 2;
+            continue;
+        }
+        let bytes = match read(file) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("error: cannot read `{path}`: {e}");
+                worst = 2;
+                continue;
+            }
+        };
+        let source = String::from_utf8_lossy(&bytes);
+        let formatted = match std::str::from_utf8(&bytes) {
+            Ok(text) => clay_dsl::format::format(text),
+            // compile_bytes words the not-UTF-8 diagnostic; reuse it.
+            Err(_) => Err(clay_dsl::compile_bytes(&bytes, &path)
+                .err()
+                .unwrap_or_default()),
+        };
+        let formatted = match formatted {
+            Ok(f) => f,
+            Err(diags) => {
+                eprint!("{}", clay_dsl::render(&diags, &source, &path, false));
+                eprintln!("error: `{path}` was not formatted: it does not parse");
+                worst = worst.max(1);
+                continue;
+            }
+        };
+        let changed = formatted.as_bytes() != bytes.as_slice();
+        if args.check {
+            if changed {
+                let _ = writeln!(out, "{path}");
+                worst = worst.max(1);
+            }
+        } else if args.write {
+            if changed && let Err(e) = write_atomically(file, &formatted) {
+                eprintln!("error: cannot write `{path}`: {e}");
+                worst = 2;
+            }
+        } else if out.write_all(formatted.as_bytes()).is_err() {
+            return 2;
+        }
+    }
+    worst
+}
