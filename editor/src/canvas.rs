@@ -18,6 +18,8 @@ const HOVER: Color32 = Color32::from_rgba_premultiplied(120, 90, 0, 90);
 const GRABBED: Color32 = Color32::from_rgb(220, 30, 60);
 const PINNED: Color32 = Color32::from_rgb(30, 80, 220);
 const CUT: Color32 = Color32::from_rgb(230, 40, 160);
+/// Zoom (points per metre) below which proxy outlines are not drawn.
+const OUTLINE_MIN_SCALE: f64 = 20.0;
 const EDGES: Color32 = Color32::from_rgb(70, 70, 90);
 
 /// What a drag on the canvas is doing.
@@ -40,6 +42,8 @@ pub struct Canvas {
     pub camera: Camera,
     cache: TessellationCache,
     meshes: Vec<WorldMesh>,
+    /// The sculpt (grammar and revision) `meshes` were posed from.
+    posed: Option<(usize, u64)>,
     drag: Option<Drag>,
     /// Fit the view to the model at the next frame.
     fit_pending: bool,
@@ -57,6 +61,7 @@ impl Default for Canvas {
             camera: Camera::default(),
             cache: TessellationCache::new(),
             meshes: Vec::new(),
+            posed: None,
             drag: None,
             fit_pending: true,
             hovered: None,
@@ -83,6 +88,7 @@ impl Canvas {
     /// The grammar changed: cached tessellations are stale.
     pub fn grammar_changed(&mut self) {
         self.cache.clear();
+        self.posed = None;
     }
 
     /// Screen position of a world point in the last frame's canvas.
@@ -99,7 +105,14 @@ impl Canvas {
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
         self.rect = response.rect;
         let data = sculpt.data();
-        self.meshes = pose_assembly(sculpt.grammar(), data, &mut self.cache);
+        let key = (
+            std::sync::Arc::as_ptr(sculpt.grammar()) as usize,
+            sculpt.revision(),
+        );
+        if self.posed != Some(key) {
+            self.meshes = pose_assembly(sculpt.grammar(), data, &mut self.cache);
+            self.posed = Some(key);
+        }
         if self.fit_pending {
             self.fit(data);
             self.fit_pending = false;
@@ -236,15 +249,23 @@ impl Canvas {
         let mid = dv(self.rect.center());
         let screen = |p: DVec2| pos(self.camera.to_screen(p, mid));
         painter.rect_filled(self.rect, 0.0, Color32::from_rgb(246, 243, 236));
+        // One mesh for all fills: far cheaper for egui than a shape per proxy.
+        let mut fills = egui::Mesh::default();
         for m in &self.meshes {
-            painter.add(Shape::mesh(mesh_of(m, screen, colour(m.fill))));
+            append(&mut fills, m, screen, colour(m.fill));
         }
-        for m in &self.meshes {
-            let stroke = Stroke::new(1.0, darker(colour(m.fill)));
-            let pts: Vec<Pos2> = m.positions.iter().map(|&p| screen(world_of(p))).collect();
-            for &[a, b] in &m.outline {
-                if let (Some(&pa), Some(&pb)) = (pts.get(a as usize), pts.get(b as usize)) {
-                    painter.line_segment([pa, pb], stroke);
+        painter.add(Shape::mesh(fills));
+        // Outlines only where they are more than a smear (about 2 points per 10 cm).
+        if self.camera.scale >= OUTLINE_MIN_SCALE {
+            for m in &self.meshes {
+                let stroke = Stroke::new(1.0, darker(colour(m.fill)));
+                let pts: Vec<Pos2> = m.positions.iter().map(|&p| screen(world_of(p))).collect();
+                for &[a, b] in &m.outline {
+                    if let (Some(&pa), Some(&pb)) = (pts.get(a as usize), pts.get(b as usize))
+                        && (self.rect.contains(pa) || self.rect.contains(pb))
+                    {
+                        painter.line_segment([pa, pb], stroke);
+                    }
                 }
             }
         }
@@ -275,7 +296,9 @@ impl Canvas {
                 .iter()
                 .filter(|m| instances.contains(&m.instance))
             {
-                painter.add(Shape::mesh(mesh_of(m, screen, HOVER)));
+                let mut overlay = egui::Mesh::default();
+                append(&mut overlay, m, screen, HOVER);
+                painter.add(Shape::mesh(overlay));
             }
             let colour = if sculpt.grabbed() == Some(part) {
                 GRABBED
@@ -356,18 +379,18 @@ fn darker(c: Color32) -> Color32 {
     Color32::from_rgba_premultiplied(f(c.r()), f(c.g()), f(c.b()), c.a())
 }
 
-fn mesh_of(m: &WorldMesh, screen: impl Fn(DVec2) -> Pos2, fill: Color32) -> egui::Mesh {
-    let mut mesh = egui::Mesh::default();
+/// Appends a posed mesh, in screen space and one colour, to an egui mesh.
+fn append(mesh: &mut egui::Mesh, m: &WorldMesh, screen: impl Fn(DVec2) -> Pos2, fill: Color32) {
+    let base = mesh.vertices.len() as u32;
     for &p in &m.positions {
         mesh.colored_vertex(screen(world_of(p)), fill);
     }
     let n = m.positions.len() as u32;
     for &[a, b, c] in &m.triangles {
         if a < n && b < n && c < n {
-            mesh.add_triangle(a, b, c);
+            mesh.add_triangle(base + a, base + b, base + c);
         }
     }
-    mesh
 }
 
 /// The instances a part covers.

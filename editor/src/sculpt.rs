@@ -113,6 +113,8 @@ pub struct Sculpt {
     unsettled: bool,
     /// Solver frames run so far.
     frame: u64,
+    /// Bumped whenever `data` may have changed, so views re-pose only then.
+    revision: u64,
     last_report: Option<FrameReport>,
     /// Solver frames run in the last UI frame.
     pub frames_last_step: usize,
@@ -140,6 +142,7 @@ impl Sculpt {
             dirty: false,
             unsettled: true,
             frame: 0,
+            revision: 0,
             last_report: None,
             frames_last_step: 0,
             error: None,
@@ -198,6 +201,11 @@ impl Sculpt {
     /// Solver frames run so far.
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// Changes whenever the assembly data may have changed.
+    pub fn revision(&self) -> u64 {
+        self.revision
     }
 
     /// The last solver failure, if the model is stuck.
@@ -434,8 +442,23 @@ impl Sculpt {
                             .zip(&self.assembly.data.positions)
                             .all(|(a, b)| a.distance(*b) <= SETTLED_MOVE * scale);
                     self.frame += 1;
+                    self.revision += 1;
                     self.frames_last_step += 1;
-                    for s in &report.switches {
+                    // Piece parts' switches come back from the rules as replacement events;
+                    // stretch parts' switches are logged here.
+                    let stretch_switches: Vec<_> = report
+                        .switches
+                        .iter()
+                        .filter(|s| {
+                            self.assembly
+                                .data
+                                .parts
+                                .get(s.part)
+                                .is_some_and(|p| matches!(p.kind, PartKind::Stretch { .. }))
+                        })
+                        .copied()
+                        .collect();
+                    for s in &stretch_switches {
                         let at = (s.part < self.assembly.data.parts.len())
                             .then(|| self.assembly.part_centroid(s.part));
                         let names = &self.assembly.data.parts.get(s.part).map(|p| {
@@ -587,6 +610,7 @@ impl Sculpt {
     }
 
     fn restore(&mut self, s: Snapshot) {
+        self.revision += 1;
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
             if let Some(id) = self.assembly.hold_vertices(pin.vertices, HandleKind::Pin)
@@ -615,6 +639,7 @@ impl Sculpt {
         match self.rules.cut(&mut self.assembly, point) {
             Ok(e) => {
                 self.rules.log.clear();
+                self.revision += 1;
                 self.note(format!("cut: {}", e.detail), Some(e.at));
                 self.unsettled = true;
             }

@@ -21,6 +21,9 @@ pub struct CgOutcome {
     pub converged: bool,
 }
 
+/// Replaces its argument (two columns) by `M^-1` times it.
+pub type Preconditioner<'a> = dyn FnMut(&mut [f64]) + 'a;
+
 /// When a solve stops: relative residual reached, or iteration cap.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CgStop {
@@ -49,7 +52,7 @@ pub fn solve(
     b: &[f64],
     x: &mut [f64],
     stop: CgStop,
-    mut precondition: Option<&mut dyn FnMut(&mut [f64])>,
+    mut precondition: Option<&mut Preconditioner<'_>>,
     work: &mut CgWork,
 ) -> CgOutcome {
     let n = pattern.n;
