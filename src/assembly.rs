@@ -23,6 +23,18 @@ pub enum HandleKind {
     Pin,
 }
 
+/// The instance (piece element) a handle holds, by stable id, with the anchor of each of its
+/// vertices. Rules renumber and re-lay vertices (a stretch gives the first element fresh `to`
+/// vertices), so [`Assembly::topology_changed`] re-reads the handle's vertices from the
+/// instance instead of trusting the remapped vertex list.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldInstance {
+    /// `Instance::id` (stable across rewrites), not an index.
+    pub id: u64,
+    /// Anchor of the instance's `k`-th vertex (piece-vertex order).
+    pub anchor: Vec<DVec2>,
+}
+
 /// A handle (paper Eq. 3): a set of vertices with a target rigid placement. The target of
 /// vertex `k` is `centre + translation + rot(angle) * (anchor[k] - centre)`.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,6 +43,9 @@ pub struct Handle {
     pub kind: HandleKind,
     /// The part the handle was made from, if any (informative; parts are renumbered by rules).
     pub part: Option<usize>,
+    /// The instance the handle holds, when it was made by [`Assembly::hold_instance`]; its
+    /// vertices follow that instance across rewrites.
+    pub held: Option<HeldInstance>,
     /// Global vertex indices the handle holds.
     pub vertices: Vec<usize>,
     /// Positions of `vertices` when the handle was made.
@@ -127,14 +142,109 @@ impl Assembly {
     }
 
     /// Rules call this after rewriting `data` (parts, vertices, docks). Bumps the generation so
-    /// the solver rebuilds its pattern, resizes the rotations, and drops handles whose vertices
-    /// no longer exist (rules that renumber vertices should remap handles first, through
+    /// the solver rebuilds its pattern, resizes the rotations, re-reads the vertices of handles
+    /// that hold an instance (see [`HeldInstance`]), and drops handles whose vertices no longer
+    /// exist (rules that renumber vertices should remap handles first, through
     /// [`Assembly::handles_mut`]).
     pub fn topology_changed(&mut self) {
         self.generation += 1;
         self.rotations.resize(self.data.parts.len(), DVec2::X);
+        let mut handles = std::mem::take(&mut self.handles);
+        for h in &mut handles {
+            self.follow_instance(h);
+        }
+        self.handles = handles;
         let n = self.data.positions.len();
         self.handles.retain(|h| h.vertices.iter().all(|&v| v < n));
+    }
+
+    /// Points an instance handle at its instance's current vertices. When the instance is
+    /// gone (a shrink removed it, a merge replaced it), the handle moves to the instance that
+    /// now owns most of its surviving (already remapped) vertices, holding it as its rest shape
+    /// fitted rigidly to where it is now, so the targets move only by the instance's current
+    /// distortion. Without such an instance the handle keeps its surviving vertices and holds
+    /// no instance any more.
+    fn follow_instance(&self, h: &mut Handle) {
+        let Some(held) = h.held.take() else {
+            return;
+        };
+        let n = self.data.positions.len();
+        let instances = &self.data.instances;
+        if let Some(ii) = instances.iter().position(|i| i.id == held.id)
+            && instances[ii].vertices.len() == held.anchor.len()
+            && instances[ii].vertices.iter().all(|&v| v < n)
+        {
+            h.vertices = instances[ii].vertices.clone();
+            h.anchor = held.anchor.clone();
+            h.part = self.piece_part(ii);
+            h.held = Some(held);
+            return;
+        }
+        let owner = instances
+            .iter()
+            .enumerate()
+            .map(|(ii, inst)| {
+                let shared = inst
+                    .vertices
+                    .iter()
+                    .filter(|v| h.vertices.contains(v))
+                    .count();
+                (ii, shared)
+            })
+            .filter(|&(ii, shared)| shared > 0 && instances[ii].vertices.iter().all(|&v| v < n))
+            .max_by(|a, b| a.1.cmp(&b.1).then(b.0.cmp(&a.0)));
+        let Some((ii, _)) = owner else {
+            h.part = None;
+            return;
+        };
+        // Hold the new instance as a rigid copy of its rest shape, placed where it fits its
+        // current pose best: a rewritten instance may be laid out stretched at this moment,
+        // and anchoring it there would hold it stretched for good.
+        let inst = &instances[ii];
+        let current: Vec<DVec2> = inst
+            .vertices
+            .iter()
+            .map(|&v| self.data.positions[v])
+            .collect();
+        let placed = match self
+            .grammar
+            .pieces
+            .get(inst.piece)
+            .and_then(|p| p.states.get(inst.state))
+            .filter(|s| s.positions.len() == current.len())
+        {
+            Some(rest) => {
+                let map = crate::rules::fit::rigid(&rest.positions, &current);
+                let placed: Vec<DVec2> = rest.positions.iter().map(|&q| map.apply(q)).collect();
+                if placed.iter().all(|p| p.is_finite()) {
+                    placed
+                } else {
+                    current
+                }
+            }
+            None => current,
+        };
+        let unturn = DVec2::from_angle(-h.angle);
+        let anchor: Vec<DVec2> = placed
+            .iter()
+            .map(|&p| h.centre + unturn.rotate(p - h.centre - h.translation))
+            .collect();
+        h.vertices = inst.vertices.clone();
+        h.anchor = anchor.clone();
+        h.part = self.piece_part(ii);
+        h.held = Some(HeldInstance {
+            id: inst.id,
+            anchor,
+        });
+    }
+
+    /// The piece part over instance `instance`, if it has one (elements of stretch chains are
+    /// covered by two-element stretch parts instead).
+    pub fn piece_part(&self, instance: usize) -> Option<usize> {
+        self.data
+            .parts
+            .iter()
+            .position(|p| p.kind == PartKind::Piece { instance })
     }
 
     /// Per-part rotations (unit complex numbers) from the last solver frame.
@@ -188,12 +298,32 @@ impl Assembly {
             id,
             kind,
             part: None,
+            held: None,
             vertices,
             anchor,
             centre,
             translation: DVec2::ZERO,
             angle: 0.0,
         });
+        Some(id)
+    }
+
+    /// Makes a handle over one instance (piece element) at its current pose: the brick the
+    /// user grabbed, also when it is an element of a stretch chain, whose parts are two-element
+    /// windows. The handle follows the instance across rules' rewrites (see [`HeldInstance`]).
+    /// `None` if the instance does not exist or has no vertices.
+    pub fn hold_instance(&mut self, instance: usize, kind: HandleKind) -> Option<HandleId> {
+        let inst = self.data.instances.get(instance)?;
+        let (vertices, stable) = (inst.vertices.clone(), inst.id);
+        let id = self.hold_vertices(vertices, kind)?;
+        let part = self.piece_part(instance);
+        if let Some(h) = self.handle_mut(id) {
+            h.part = part;
+            h.held = Some(HeldInstance {
+                id: stable,
+                anchor: h.anchor.clone(),
+            });
+        }
         Some(id)
     }
 
@@ -243,6 +373,49 @@ impl Assembly {
         (0..self.data.parts.len())
             .filter(|&i| !self.data.parts[i].vertices.is_empty())
             .map(|i| (i, key(i)))
+            .max_by(|a, b| {
+                a.1.0
+                    .total_cmp(&b.1.0)
+                    .then(a.1.1.total_cmp(&b.1.1))
+                    .then(b.0.cmp(&a.0))
+            })
+            .map(|(i, _)| i)
+    }
+
+    /// Centroid of an instance's current vertex positions (`None`: no such instance or no
+    /// vertices).
+    pub fn instance_centroid(&self, instance: usize) -> Option<DVec2> {
+        let vs = &self.data.instances.get(instance)?.vertices;
+        if vs.is_empty() || vs.iter().any(|&v| v >= self.data.positions.len()) {
+            return None;
+        }
+        Some(vs.iter().map(|&v| self.data.positions[v]).sum::<DVec2>() / vs.len() as f64)
+    }
+
+    /// The instance (piece element) whose centroid is nearest `point` (ties: lowest index).
+    /// `None` without instances.
+    pub fn instance_nearest(&self, point: DVec2) -> Option<usize> {
+        (0..self.data.instances.len())
+            .filter_map(|i| Some((i, self.instance_centroid(i)?.distance_squared(point))))
+            .filter(|(_, d)| d.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// The instance with the vertex reaching furthest in `dir` (ties broken by the centroid,
+    /// then the lowest index). `None` without instances.
+    pub fn instance_extreme(&self, dir: Compass) -> Option<usize> {
+        let d = dir.direction();
+        (0..self.data.instances.len())
+            .filter_map(|i| {
+                let centre = self.instance_centroid(i)?;
+                let reach = self.data.instances[i]
+                    .vertices
+                    .iter()
+                    .map(|&v| self.data.positions[v].dot(d))
+                    .fold(f64::MIN, f64::max);
+                Some((i, (reach, centre.dot(d))))
+            })
             .max_by(|a, b| {
                 a.1.0
                     .total_cmp(&b.1.0)

@@ -15,12 +15,13 @@ use clay_dsl::compiled::PartKind;
 /// Largest frame count a single step may ask for (keeps a typo from running for hours).
 pub const MAX_FRAMES: u64 = 100_000;
 
-/// How a step picks a part.
+/// How a step picks what to hold: an instance (piece element), e.g. one brick of a wall, not
+/// the two-element stretch part around it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Selector {
-    /// The part whose centroid is nearest the point.
+    /// The instance whose centroid is nearest the point.
     At(DVec2),
-    /// The part reaching furthest in a compass direction.
+    /// The instance with the vertex reaching furthest in a compass direction.
     Extreme(Compass),
 }
 
@@ -36,9 +37,9 @@ pub enum Motion {
 /// One step of a script.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {
-    /// Make the selected part the current handle (releasing the previous grab; pins stay).
+    /// Make the selected instance the current handle (releasing the previous grab; pins stay).
     Grab(Selector),
-    /// Fix the selected part where it is.
+    /// Fix the selected instance where it is.
     Pin(Selector),
     /// Move the current handle linearly over `frames` frames (0: jump, no frame).
     Drag { motion: Motion, frames: u64 },
@@ -316,7 +317,8 @@ pub trait FrameHook {
     }
 }
 
-/// The hook used until rules exist: nothing fires, cuts are unavailable.
+/// A hook without rules (solver-only sessions and tests): nothing fires, cuts are unavailable.
+/// `clayc run` and the editor use `crate::rules::Rules`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoRules;
 
@@ -396,10 +398,11 @@ impl Replay {
         Ok(report)
     }
 
+    /// The instance a selector picks (see [`Selector`]).
     fn select(&self, asm: &Assembly, sel: Selector) -> Option<usize> {
         match sel {
-            Selector::At(p) => asm.part_nearest(p),
-            Selector::Extreme(dir) => asm.part_extreme(dir),
+            Selector::At(p) => asm.instance_nearest(p),
+            Selector::Extreme(dir) => asm.instance_extreme(dir),
         }
     }
 
@@ -449,22 +452,26 @@ impl Replay {
     ) -> Result<(), SolverError> {
         match *step {
             Step::Grab(sel) | Step::Pin(sel) => {
-                let Some(part) = self.select(asm, sel) else {
-                    self.notes.push(format!("step {index}: no part to select (the model is empty)"));
+                let Some(instance) = self.select(asm, sel) else {
+                    self.notes.push(format!(
+                        "step {index}: nothing to select (the model is empty)"
+                    ));
                     return Ok(());
                 };
                 if let Step::Grab(_) = step {
                     if let Some(old) = self.current.take() {
                         asm.release(old);
                     }
-                    self.current = asm.hold_part(part, HandleKind::Grab);
+                    self.current = asm.hold_instance(instance, HandleKind::Grab);
                 } else {
-                    asm.hold_part(part, HandleKind::Pin);
+                    asm.hold_instance(instance, HandleKind::Pin);
                 }
             }
             Step::Drag { motion, frames } => {
                 if self.current.is_none() {
-                    self.notes.push(format!("step {index}: drag without a grabbed part only holds"));
+                    self.notes.push(format!(
+                        "step {index}: drag without a grabbed part only holds"
+                    ));
                 }
                 let offset = match (motion, self.current.and_then(|id| asm.handle(id))) {
                     (Motion::By(d), _) => d,
@@ -475,7 +482,9 @@ impl Replay {
             }
             Step::Rotate { degrees, frames } => {
                 if self.current.is_none() {
-                    self.notes.push(format!("step {index}: rotate without a grabbed part only holds"));
+                    self.notes.push(format!(
+                        "step {index}: rotate without a grabbed part only holds"
+                    ));
                 }
                 self.move_handle(asm, hook, DVec2::ZERO, degrees.to_radians(), frames)?;
             }
@@ -483,7 +492,8 @@ impl Replay {
                 if let Some(id) = self.current.take() {
                     asm.release(id);
                 } else {
-                    self.notes.push(format!("step {index}: release without a grabbed part"));
+                    self.notes
+                        .push(format!("step {index}: release without a grabbed part"));
                 }
             }
             Step::Hold { frames } => {
@@ -498,7 +508,7 @@ impl Replay {
                     }
                 }
                 None => self.notes.push(format!(
-                    "step {index}: cut at [{}, {}] does nothing: cutting arrives with the rules (issue 4)",
+                    "step {index}: cut at [{}, {}] does nothing: this session runs without rules",
                     at.x, at.y
                 )),
             },

@@ -10,6 +10,9 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, SolverPa
 use egui::{Key, Modifiers};
 use glam::DVec2;
 
+use crate::author::{AuthorCommand, Authoring};
+use crate::author_canvas::{AuthorCanvas, Tool};
+use crate::author_panel::{self, AuthorForm};
 use crate::canvas::Canvas;
 use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Problem, Severity};
 use crate::panels;
@@ -31,6 +34,22 @@ pub enum Action {
     /// Ask for a path first.
     Ask(FileKind),
     Quit,
+    /// Authoring: make an SVG file (metres per SVG unit) the drawing.
+    ImportSvg(PathBuf, f64),
+    /// Authoring: write the grammar text to a file.
+    WriteGrammar(PathBuf),
+    /// Authoring: compile the grammar and sculpt it.
+    TryAuthored,
+    /// Show a message in the status bar.
+    Report(String),
+}
+
+/// What the editor is doing: sculpting a grammar's model, or authoring a grammar from a
+/// drawing. Switching keeps both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Sculpt,
+    Author,
 }
 
 /// What a path asked for in the file dialog is for.
@@ -92,6 +111,13 @@ pub struct EditorApp {
     waker: Option<egui::Context>,
     commands: Vec<Command>,
     actions: Vec<Action>,
+    pub mode: Mode,
+    pub author: Authoring,
+    pub author_canvas: AuthorCanvas,
+    pub author_form: AuthorForm,
+    author_commands: Vec<AuthorCommand>,
+    /// Tab was pressed (taken out of the input before egui moves keyboard focus with it).
+    mode_key: bool,
 }
 
 /// A grammar with nothing in it: the model shown when the first compile fails.
@@ -147,7 +173,21 @@ impl EditorApp {
             waker: None,
             commands: Vec::new(),
             actions: Vec::new(),
+            mode: Mode::Sculpt,
+            author: Authoring::default(),
+            author_canvas: AuthorCanvas::default(),
+            author_form: AuthorForm::default(),
+            author_commands: Vec::new(),
+            mode_key: false,
         }
+    }
+
+    /// Switches between sculpting and authoring; the work of both stays.
+    pub fn set_mode(&mut self, mode: Mode) {
+        if mode == Mode::Author && self.mode != Mode::Author {
+            self.author_canvas.request_fit();
+        }
+        self.mode = mode;
     }
 
     /// Lets the file watcher wake the UI when the grammar changes on disk.
@@ -164,9 +204,12 @@ impl EditorApp {
     }
 
     fn display_path(&self) -> String {
-        self.grammar_path
-            .as_ref()
-            .map_or(CASTLE_PATH.to_string(), |p| p.display().to_string())
+        match &self.grammar_path {
+            Some(p) => p.display().to_string(),
+            // The bundled castle, or an authored grammar not written to a file.
+            None if self.sculpt.grammar().source.is_empty() => CASTLE_PATH.to_string(),
+            None => self.sculpt.grammar().source.clone(),
+        }
     }
 
     /// Opens a grammar file: a new sculpt on it (even if it does not compile, so that hot
@@ -296,12 +339,26 @@ impl EditorApp {
         egui::Panel::right("panels")
             .default_size(340.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| self.side_panels(ui));
+                egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
+                    Mode::Sculpt => self.side_panels(ui),
+                    Mode::Author => author_panel::show(
+                        ui,
+                        &self.author,
+                        &mut self.author_canvas,
+                        &mut self.author_form,
+                        &mut self.author_commands,
+                        &mut self.actions,
+                    ),
+                });
             });
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
-            .show(ui, |ui| {
-                self.canvas.show(ui, &self.sculpt, &mut self.commands);
+            .show(ui, |ui| match self.mode {
+                Mode::Sculpt => self.canvas.show(ui, &self.sculpt, &mut self.commands),
+                Mode::Author => {
+                    self.author_canvas
+                        .show(ui, &self.author, &mut self.author_commands)
+                }
             });
         self.dialogs(ui.ctx());
         self.apply();
@@ -311,13 +368,30 @@ impl EditorApp {
         if ui.ctx().egui_wants_keyboard_input() {
             return;
         }
+        let mut toggle = std::mem::take(&mut self.mode_key);
         ui.input_mut(|i| {
+            let author = self.mode == Mode::Author;
             if i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
                 || i.consume_key(Modifiers::COMMAND, Key::Y)
             {
-                self.commands.push(Command::Redo);
+                if author {
+                    self.author_commands.push(AuthorCommand::Redo);
+                } else {
+                    self.commands.push(Command::Redo);
+                }
             } else if i.consume_key(Modifiers::COMMAND, Key::Z) {
-                self.commands.push(Command::Undo);
+                if author {
+                    self.author_commands.push(AuthorCommand::Undo);
+                } else {
+                    self.commands.push(Command::Undo);
+                }
+            }
+            toggle |= i.consume_key(Modifiers::NONE, Key::Tab);
+            if author && i.consume_key(Modifiers::NONE, Key::D) {
+                self.author_canvas.tool = Tool::Draw;
+            }
+            if author && i.consume_key(Modifiers::NONE, Key::C) {
+                self.author_canvas.tool = Tool::Cut;
             }
             if i.consume_key(Modifiers::COMMAND, Key::S) {
                 self.actions.push(match &self.session_path {
@@ -329,11 +403,26 @@ impl EditorApp {
                 self.actions.push(Action::Ask(FileKind::Grammar));
             }
         });
+        if toggle {
+            self.set_mode(match self.mode {
+                Mode::Sculpt => Mode::Author,
+                Mode::Author => Mode::Sculpt,
+            });
+        }
     }
 
     fn menu(&mut self, ui: &mut egui::Ui) {
         egui::Panel::top("menu").show(ui, |ui| {
             ui.horizontal_wrapped(|ui| {
+                let mut mode = self.mode;
+                ui.selectable_value(&mut mode, Mode::Sculpt, "Sculpt")
+                    .on_hover_text("Tab switches mode");
+                ui.selectable_value(&mut mode, Mode::Author, "Author")
+                    .on_hover_text("Tab switches mode");
+                if mode != self.mode {
+                    self.set_mode(mode);
+                }
+                ui.separator();
                 if ui.button("Open grammar…").clicked() {
                     self.actions.push(Action::Ask(FileKind::Grammar));
                 }
@@ -356,23 +445,41 @@ impl EditorApp {
                     self.actions.push(Action::Ask(FileKind::Json));
                 }
                 ui.separator();
+                let author = self.mode == Mode::Author;
+                let (can_undo, can_redo) = if author {
+                    (self.author.can_undo(), self.author.can_redo())
+                } else {
+                    (self.sculpt.can_undo(), self.sculpt.can_redo())
+                };
                 if ui
-                    .add_enabled(self.sculpt.can_undo(), egui::Button::new("Undo"))
+                    .add_enabled(can_undo, egui::Button::new("Undo"))
                     .clicked()
                 {
-                    self.commands.push(Command::Undo);
+                    if author {
+                        self.author_commands.push(AuthorCommand::Undo);
+                    } else {
+                        self.commands.push(Command::Undo);
+                    }
                 }
                 if ui
-                    .add_enabled(self.sculpt.can_redo(), egui::Button::new("Redo"))
+                    .add_enabled(can_redo, egui::Button::new("Redo"))
                     .clicked()
                 {
-                    self.commands.push(Command::Redo);
+                    if author {
+                        self.author_commands.push(AuthorCommand::Redo);
+                    } else {
+                        self.commands.push(Command::Redo);
+                    }
                 }
-                if ui.button("Reset").clicked() {
+                if !author && ui.button("Reset").clicked() {
                     self.commands.push(Command::Reset);
                 }
                 if ui.button("Fit (F)").clicked() {
-                    self.canvas.request_fit();
+                    if author {
+                        self.author_canvas.request_fit();
+                    } else {
+                        self.canvas.request_fit();
+                    }
                 }
             });
         });
@@ -510,6 +617,9 @@ impl EditorApp {
         for c in std::mem::take(&mut self.commands) {
             self.sculpt.apply(c);
         }
+        for c in std::mem::take(&mut self.author_commands) {
+            self.author.apply(c);
+        }
         for a in std::mem::take(&mut self.actions) {
             self.perform(a);
         }
@@ -520,9 +630,17 @@ impl EditorApp {
         self.commands.push(c);
     }
 
+    /// Queues an authoring command as if the UI had emitted it.
+    pub fn author_command(&mut self, c: AuthorCommand) {
+        self.author_commands.push(c);
+    }
+
     /// Performs a file action now (tests and the UI's queue).
     pub fn perform(&mut self, action: Action) {
-        let discards = matches!(action, Action::OpenGrammar(_) | Action::OpenSession(_));
+        let discards = matches!(
+            action,
+            Action::OpenGrammar(_) | Action::OpenSession(_) | Action::TryAuthored
+        );
         if discards && self.sculpt.dirty {
             self.confirm = Some(action);
             return;
@@ -563,6 +681,20 @@ impl EditorApp {
                 self.confirm = Some(Action::Quit);
                 Ok(None)
             }
+            Action::ImportSvg(p, scale) => self.author.import_svg(&p, scale).map(|()| {
+                self.author_canvas.request_fit();
+                Some(format!("imported {}", p.display()))
+            }),
+            Action::WriteGrammar(p) => self.author.write(&p).map(|()| {
+                let verdict = if self.author.compiles {
+                    "it compiles"
+                } else {
+                    "it does not compile yet"
+                };
+                Some(format!("wrote {}; {verdict}", p.display()))
+            }),
+            Action::TryAuthored => self.try_authored().map(Some),
+            Action::Report(m) => Ok(Some(m)),
         };
         match result {
             Ok(Some(m)) => self.message = Some(m),
@@ -588,8 +720,47 @@ impl EditorApp {
         )
     }
 
+    /// Compiles the authored grammar and sculpts it (switching to sculpt mode). The grammar
+    /// file is watched if the text was written to one; the authoring work stays.
+    pub fn try_authored(&mut self) -> Result<String, String> {
+        let text = match &self.author.result {
+            Ok(c) => c.text.clone(),
+            Err(e) => return Err(format!("nothing to try: {e}")),
+        };
+        let name = self.author.source_name();
+        let compiled = compile::compile(&text, &name).map_err(|problems| {
+            let first = problems.first().map_or(String::new(), |p| p.to_string());
+            format!("the authored grammar does not compile: {first}")
+        })?;
+        let written = self
+            .author
+            .written
+            .as_ref()
+            .filter(|(_, t)| *t == text)
+            .map(|(p, _)| p.clone());
+        self.problems = compiled.warnings;
+        self.stale = false;
+        self.sculpt = Sculpt::new(compiled.grammar);
+        self.grammar_path = written.clone();
+        self.session_path = None;
+        self.canvas.grammar_changed();
+        self.canvas.request_fit();
+        match written {
+            Some(p) => self.start_watch(&p),
+            None => self.watch = None,
+        }
+        self.mode = Mode::Sculpt;
+        Ok(format!("sculpting {name}"))
+    }
+
     /// Saves the sculpt atomically.
     pub fn save_session(&mut self, path: &Path) -> Result<(), String> {
+        if self.grammar_path.is_none() && self.sculpt.grammar().source != CASTLE_PATH {
+            return Err(
+                "write the authored grammar to a file first (Author mode, Write grammar): a session names its grammar file"
+                    .into(),
+            );
+        }
         session::write(path, &self.session()).map_err(|e| e.to_string())?;
         self.session_path = Some(path.to_path_buf());
         self.sculpt.dirty = false;
@@ -673,5 +844,26 @@ impl eframe::App for EditorApp {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         EditorApp::ui(self, ui);
+    }
+
+    /// Takes Tab (the mode switch) out of the input before egui sees it: egui would move the
+    /// keyboard focus to a button, and a later Enter (finish a stroke) would press it. Tab in
+    /// a text field is left alone.
+    fn raw_input_hook(&mut self, ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        raw_input.events.retain(|e| match e {
+            egui::Event::Key {
+                key: Key::Tab,
+                pressed,
+                modifiers,
+                ..
+            } if modifiers.is_none() => {
+                self.mode_key |= *pressed;
+                false
+            }
+            _ => true,
+        });
     }
 }

@@ -1,6 +1,9 @@
 //! The Clay editor: sculpt a grammar's model live with the mouse. The state (sculpt, sessions,
 //! camera) is separate from the drawing so it is tested without a window.
 pub mod app;
+pub mod author;
+pub mod author_canvas;
+pub mod author_panel;
 pub mod camera;
 pub mod canvas;
 pub mod compile;

@@ -9,7 +9,7 @@ pub mod cholesky;
 pub mod global;
 pub mod local;
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clay_dsl::compiled::{Part, PartKind, SolverParams};
 use glam::DVec2;
@@ -55,11 +55,27 @@ pub struct SolverConfig {
     /// A pass stops early once no vertex moved more than this fraction of the model's size
     /// (and, in pass 1, no state switched).
     pub tolerance: f64,
+    /// Pass 1 continues from the previous frame's pass-1 result (handle vertices moved to
+    /// their targets) instead of restarting from the displayed least-squares pose, as long as
+    /// the generation is the same and the positions are the ones the solver last displayed.
+    /// IRLS then converges across frames: from the evenly spread least-squares pose the weights
+    /// are all equal and a slow drag would never gather the stretch (paper Fig. 8).
+    pub carry_pass1: bool,
     /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
     /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
     pub cg_tolerance: f64,
     /// Cap on CG iterations per solve.
     pub cg_max_iterations: usize,
+    /// Cholesky path, pass 1: most iterations of CG preconditioned by the last IRLS factor
+    /// before the reweighted system is factorised afresh (0: factorise every IRLS iteration).
+    /// The factor is kept across iterations and frames; only the weights change in between.
+    pub pcg_max_iterations: usize,
+    /// Relative residual (against the right-hand side's edge terms, as `cg_tolerance`) the
+    /// preconditioned pass-1 solves reach. Pass 2 is always solved directly.
+    pub pcg_tolerance: f64,
+    /// A frame counts as converged ([`FrameReport::converged`]) when no state switched and the
+    /// displayed positions moved less than this fraction of the model's size.
+    pub settle_tolerance: f64,
     /// Compute the relative residual of every linear solve into the report (one extra matrix
     /// product per solve).
     pub measure_residual: bool,
@@ -79,14 +95,18 @@ impl SolverConfig {
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
-            irls_iterations: 4,
-            l2_iterations: 2,
+            irls_iterations: 1,
+            l2_iterations: 1,
             handle_weight: 1e6,
             rotation_cone_degrees: 20.0,
             proximal_weight: 1e-8,
             tolerance: 1e-6,
             cg_tolerance: 1e-6,
             cg_max_iterations: 20_000,
+            pcg_max_iterations: 0,
+            carry_pass1: false,
+            pcg_tolerance: 1e-6,
+            settle_tolerance: 1e-6,
             measure_residual: false,
         }
     }
@@ -118,15 +138,41 @@ pub struct FrameReport {
     pub switches: Vec<StateSwitch>,
     /// Wall time of the frame in milliseconds.
     pub ms: f64,
-    /// Both passes stopped on the tolerance rather than the iteration cap.
+    /// The frame left the model at rest: the frame was complete, no rest state switched, and
+    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`] times the
+    /// model's size (or both passes stopped on their step tolerance). Running another frame
+    /// with the same handles would change nothing visible, so a caller can stop solving.
     pub converged: bool,
+    /// The frame ran the iterations its passes asked for; `false` when
+    /// [`Solver::frame_budgeted`] cut it short to meet its time budget (the displayed
+    /// positions are still a least-squares pose; the next call continues from them).
+    pub complete: bool,
+    /// Largest distance a displayed vertex moved this frame.
+    pub moved: f64,
     /// Numeric Cholesky factorisations done this frame.
     pub factorizations: usize,
-    /// CG iterations summed over all solves this frame.
+    /// CG iterations summed over all solves this frame (unpreconditioned, `SolverKind::Cg`).
     pub cg_iterations: usize,
+    /// Iterations of CG preconditioned by a kept Cholesky factor (pass 1 of the Cholesky path).
+    pub pcg_iterations: usize,
+    /// Where the frame's time went.
+    pub phases: PhaseTimes,
     /// Largest relative residual `|b - A x| / |b|` of the frame's linear solves, when
     /// [`SolverConfig::measure_residual`] is set.
     pub linear_residual: Option<f64>,
+}
+
+/// Wall time of a frame by phase, in milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct PhaseTimes {
+    /// Local steps: rest-state choice, rotations, edge targets, objective evaluations.
+    pub local: f64,
+    /// IRLS weights, right-hand side and matrix values.
+    pub assembly: f64,
+    /// Numeric Cholesky factorisations.
+    pub factorization: f64,
+    /// Triangular solves and (preconditioned) CG.
+    pub solve: f64,
 }
 
 /// Why a frame could not be solved (left the positions unchanged).
@@ -164,7 +210,19 @@ struct Work {
     cg: cg::CgWork,
     part_sums: Vec<DVec2>,
     warm: Vec<DVec2>,
+    /// Rotations and edge targets of the warm start with the final states (filled by the
+    /// first local step of pass 1 when no later one switches, else by pass 2), so pass 2 does
+    /// not recompute them.
+    warm_rotations: Vec<DVec2>,
+    warm_targets: Vec<DVec2>,
+    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged.
+    kept_rotations: Vec<DVec2>,
+    kept_targets: Vec<DVec2>,
     warm_held: Vec<DVec2>,
+    /// The last frame's pass-1 result, the positions it displayed, and their generation.
+    pass1: Vec<DVec2>,
+    shown: Vec<DVec2>,
+    pass1_generation: Option<u64>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
 }
@@ -237,10 +295,38 @@ impl Solver {
 
     /// Runs one frame on `asm`: moves its positions, active states and rotations.
     pub fn frame(&mut self, asm: &mut Assembly) -> Result<FrameReport, SolverError> {
+        self.frame_within(asm, None)
+    }
+
+    /// Runs one frame that stops early once `budget` is (about to be) spent, for an editor
+    /// that must draw at a fixed rate. It always runs at least one IRLS iteration (so state
+    /// decisions progress) and ends with at least one least-squares solve, so the displayed
+    /// positions are a proper least-squares pose of the current states even when cut short.
+    /// An iteration is started only if the previous one of its pass fits in the time left.
+    /// When cut short, the report has `complete == false` and `converged == false`; call again
+    /// next frame: the positions and active states carry the work over (the solver keeps no
+    /// other half-done state). A budget of `Duration::MAX` behaves like [`Solver::frame`].
+    pub fn frame_budgeted(
+        &mut self,
+        asm: &mut Assembly,
+        budget: Duration,
+    ) -> Result<FrameReport, SolverError> {
+        let deadline = Instant::now().checked_add(budget);
+        self.frame_within(asm, deadline)
+    }
+
+    fn frame_within(
+        &mut self,
+        asm: &mut Assembly,
+        deadline: Option<Instant>,
+    ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
+        // Would another iteration that lasts as long as the last one overrun the deadline?
+        let out_of_time = |last: Duration| deadline.is_some_and(|d| Instant::now() + last > d);
         self.prepare(asm)?;
         let mut report = FrameReport::default();
         let n = asm.data.positions.len();
+        report.complete = true;
         if n == 0 || asm.data.parts.is_empty() {
             report.converged = true;
             report.ms = start.elapsed().as_secs_f64() * 1e3;
@@ -271,21 +357,49 @@ impl Solver {
                 *p = self.work.handle_sum[v] / count;
             }
         }
+        let mut pass1_pose = std::mem::take(&mut self.work.pass1);
+        let carried = cfg.carry_pass1
+            && pass1_pose.len() == n
+            && self.work.pass1_generation == Some(asm.generation())
+            && self.work.shown == warm;
         let mut f = std::mem::take(&mut self.work.f);
-        f.clone_from(&warm_held);
+        if carried {
+            f.clone_from(&pass1_pose);
+            for (v, p) in f.iter_mut().enumerate() {
+                let count = self.work.handle_count[v];
+                if count > 0.0 {
+                    *p = self.work.handle_sum[v] / count;
+                }
+            }
+        } else {
+            f.clone_from(&warm_held);
+        }
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
         next.resize(n, DVec2::ZERO);
         let mut pass1_converged = false;
+        let mut warm_cached = false;
 
         // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
+        let mut last_iteration = Duration::ZERO;
         for it in 0..cfg.irls_iterations {
+            if it > 0 && out_of_time(last_iteration) {
+                report.complete = false;
+                break;
+            }
+            let iteration_start = Instant::now();
             report.irls_iterations += 1;
+            let t = Instant::now();
             let switched_before = report.switches.len();
-            // The first local step looks at the last displayed pose: judged on the warm start
-            // with only the handles moved, the parts next to a handle look rotated and the
-            // first solve would bend a model that should just follow rigidly.
-            let pose = if it == 0 { &warm } else { &f };
+            // The first local step looks at the pose before the handles moved (the last
+            // pass-1 result, or the last displayed pose): judged with only the handles moved,
+            // the parts next to a handle look rotated and the first solve would bend a model
+            // that should just follow rigidly.
+            let pose = match (it, carried) {
+                (0, true) => &pass1_pose,
+                (0, false) => &warm,
+                _ => &f,
+            };
             self.local_step_switching(
                 &mut asm.data.parts,
                 pose,
@@ -293,6 +407,15 @@ impl Solver {
                 &mut report.switches,
             );
             self.edge_targets(&asm.data.parts);
+            if it == 0 && !carried {
+                self.work.warm_rotations.clone_from(&self.work.rotations);
+                self.work.warm_targets.clone_from(&self.work.targets);
+                warm_cached = true;
+            } else if report.switches.len() > switched_before {
+                warm_cached = false;
+            }
+            report.phases.local += ms_since(t);
+            let t = Instant::now();
             let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
             let w = &mut self.work;
             w.weights.clear();
@@ -306,9 +429,11 @@ impl Solver {
                 });
             }
             let mean = mean_or_one(&w.weights);
+            report.phases.assembly += ms_since(t);
             self.solve_global(&f, &mut next, mean, Pass::Irls, &mut report)?;
             let delta = max_move(&f, &next);
             std::mem::swap(&mut f, &mut next);
+            last_iteration = iteration_start.elapsed();
             if delta <= step_tolerance && report.switches.len() == switched_before {
                 pass1_converged = true;
                 break;
@@ -318,46 +443,69 @@ impl Solver {
             pass1_converged = true;
         }
 
+        if cfg.irls_iterations > 0 {
+            pass1_pose.clone_from(&f);
+        }
+
         // Pass 2: least squares, states fixed. Start from whichever of the pass-1 result and
         // the warm start is better, and never accept an iterate that raises the objective, so
         // the frame cannot end worse than it started.
         let handles = asm.handles();
+        let t = Instant::now();
         // Candidates: the pass-1 result, the warm start with the handles carried to their
-        // targets (continues last frame's least-squares pose), and the plain warm start.
-        // (evaluated last to first so that, in the usual case where the pass-1 result wins,
-        // its rotations are the ones left in the work buffers)
-        let warm_terms = self.objective(&asm.data.parts, handles, &warm);
-        let held_terms = if report.irls_iterations > 0 {
-            self.objective(&asm.data.parts, handles, &warm_held)
-        } else {
-            // without pass 1, `f` is the handles-moved warm start
-            Terms {
-                elastic: f64::INFINITY,
-                handle: 0.0,
-            }
-        };
-        let mut terms = self.objective(&asm.data.parts, handles, &f);
+        // targets (continues last frame's least-squares pose), and the plain warm start. The
+        // handles-moved start is judged only when the pass-1 result does not beat the warm
+        // start (while dragging it nearly always does: one local step saved).
+        let parts = &asm.data.parts;
+        if !warm_cached {
+            self.objective(parts, handles, &warm);
+            self.work.warm_rotations.clone_from(&self.work.rotations);
+            self.work.warm_targets.clone_from(&self.work.targets);
+        }
+        let hw = cfg.handle_weight;
+        let warm_terms = terms(&self.pattern.edges, &self.work.warm_targets, handles, &warm, hw);
+        // objective() leaves f's rotations and edge targets in the work buffers
+        let mut terms = self.objective(parts, handles, &f);
         report.warm_objective = warm_terms.total();
         let mut chosen = 0;
-        for (k, t) in [(1, held_terms), (2, warm_terms)] {
-            if t.total() < terms.total() {
-                (chosen, terms) = (k, t);
+        let held_judged = report.irls_iterations > 0;
+        if held_judged {
+            let held_terms = self.objective(parts, handles, &warm_held);
+            if held_terms.total() < terms.total() {
+                (chosen, terms) = (1, held_terms);
             }
+        }
+        if warm_terms.total() < terms.total() {
+            (chosen, terms) = (2, warm_terms);
         }
         if chosen != 0 {
             f.copy_from_slice(if chosen == 1 { &warm_held } else { &warm });
         }
-        // objective() leaves the rotations the first solve uses in the work buffers: those of
-        // the start, or for the handles-moved warm start those of the last displayed pose
-        // (see pass 1).
+        // The first solve uses the rotations of its start, or for the handles-moved warm
+        // start those of the last displayed pose (see pass 1).
         if chosen != 0 || report.irls_iterations == 0 {
-            self.objective(&asm.data.parts, handles, &warm);
+            self.work.rotations.clone_from(&self.work.warm_rotations);
+            self.work.targets.clone_from(&self.work.warm_targets);
+        } else if held_judged {
+            // judging the handles-moved start overwrote f's rotations
+            self.objective(parts, handles, &f);
         }
+        report.phases.local += ms_since(t);
         let mut pass2_converged = cfg.l2_iterations == 0;
-        for _ in 0..cfg.l2_iterations {
+        let mut last_iteration = Duration::ZERO;
+        for it in 0..cfg.l2_iterations {
+            if it > 0 && out_of_time(last_iteration) {
+                report.complete = false;
+                break;
+            }
+            let iteration_start = Instant::now();
             report.l2_iterations += 1;
             // objective() left the rotations and edge targets of `f` in the work buffers.
             self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
+            let t = Instant::now();
+            // keep f's rotations aside instead of recomputing them if `next` is rejected
+            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
+            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
             let new_terms = self.objective(&asm.data.parts, handles, &next);
             let improved = new_terms
                 .total()
@@ -365,13 +513,17 @@ impl Solver {
                 .is_some_and(|o| o.is_le());
             if !improved {
                 // restore rotations of the kept iterate
-                terms = self.objective(&asm.data.parts, handles, &f);
+                std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
+                std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
+                report.phases.local += ms_since(t);
                 pass2_converged = true;
                 break;
             }
+            report.phases.local += ms_since(t);
             let delta = max_move(&f, &next);
             std::mem::swap(&mut f, &mut next);
             terms = new_terms;
+            last_iteration = iteration_start.elapsed();
             if delta <= step_tolerance {
                 pass2_converged = true;
                 break;
@@ -391,7 +543,13 @@ impl Solver {
         sync_instance_states(asm);
         report.energy = terms.elastic;
         report.objective = terms.total();
-        report.converged = pass1_converged && pass2_converged;
+        report.moved = max_move(&warm, &f);
+        let settled =
+            report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
+        report.converged = report.complete && (settled || (pass1_converged && pass2_converged));
+        self.work.shown.clone_from(&f);
+        self.work.pass1_generation = Some(asm.generation());
+        self.work.pass1 = pass1_pose;
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         (
             self.work.warm,
@@ -498,25 +656,13 @@ impl Solver {
             self.work.rotations.push(local::part_rotation(part, f));
         }
         self.edge_targets(parts);
-        let mut elastic = 0.0;
-        for (e, &t) in self.pattern.edges.iter().zip(&self.work.targets) {
-            elastic += (t - (f[e.x] - f[e.y])).length_squared();
-        }
-        let mut handle = 0.0;
-        for h in handles {
-            for (k, &v) in h.vertices.iter().enumerate() {
-                if let Some(&p) = f.get(v) {
-                    let t = h.target(k);
-                    if t.is_finite() {
-                        handle += (p - t).length_squared();
-                    }
-                }
-            }
-        }
-        Terms {
-            elastic,
-            handle: self.config.handle_weight * handle,
-        }
+        terms(
+            &self.pattern.edges,
+            &self.work.targets,
+            handles,
+            f,
+            self.config.handle_weight,
+        )
     }
 
     /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
@@ -530,6 +676,7 @@ impl Solver {
     ) -> Result<(), SolverError> {
         let cfg = self.config;
         let n = f.len();
+        let t = Instant::now();
         let w = &mut self.work;
         let lambda = cfg.handle_weight * mean_weight;
         let mu = cfg.proximal_weight * mean_weight;
@@ -578,6 +725,7 @@ impl Solver {
         w.solution.clear();
         w.solution.extend(f.iter().map(|p| p.x));
         w.solution.extend(f.iter().map(|p| p.y));
+        report.phases.assembly += ms_since(t);
         match (cfg.kind, self.symbolic.as_mut()) {
             (SolverKind::Cholesky, Some(symbolic)) => {
                 let factor = if pass == Pass::LeastSquares {
@@ -585,16 +733,56 @@ impl Solver {
                 } else {
                     &mut self.irls_factor
                 };
-                if pass == Pass::Irls || !factor.is_valid() {
-                    symbolic
-                        .factorize(factor, &self.pattern.col_ptr, &self.pattern.row_idx, values)
-                        .map_err(|e| SolverError(e.0))?;
-                    report.factorizations += 1;
+                // Pass 1: the kept factor of an earlier IRLS matrix (same pattern, other
+                // weights) preconditions CG on this one; only when that takes too long is the
+                // matrix factorised afresh.
+                let mut solved = false;
+                if pass == Pass::Irls && factor.is_valid() && cfg.pcg_max_iterations > 0 {
+                    let t = Instant::now();
+                    let outcome = {
+                        let factor = &*factor;
+                        let mut precondition =
+                            |z: &mut [f64]| symbolic.solve_in_place(factor, z, 2);
+                        cg::solve(
+                            &self.pattern,
+                            values,
+                            &w.rhs,
+                            &mut w.solution,
+                            cg::CgStop {
+                                tolerance: cfg.pcg_tolerance,
+                                max_iterations: cfg.pcg_max_iterations,
+                                reference: Some(elastic_norm(&w.rhs, &w.extra)),
+                            },
+                            Some(&mut precondition),
+                            &mut w.cg,
+                        )
+                    };
+                    report.pcg_iterations += outcome.iterations;
+                    report.phases.solve += ms_since(t);
+                    solved = outcome.converged;
                 }
-                w.solution.copy_from_slice(&w.rhs);
-                symbolic.solve_in_place(factor, &mut w.solution, 2);
+                if !solved {
+                    if pass == Pass::Irls || !factor.is_valid() {
+                        let t = Instant::now();
+                        symbolic
+                            .factorize(
+                                factor,
+                                &self.pattern.col_ptr,
+                                &self.pattern.row_idx,
+                                values,
+                            )
+                            .map_err(|e| SolverError(e.0))?;
+                        report.factorizations += 1;
+                        report.phases.factorization += ms_since(t);
+                    }
+                    let t = Instant::now();
+                    w.solution.copy_from_slice(&w.rhs);
+                    symbolic.solve_in_place(factor, &mut w.solution, 2);
+                    report.phases.solve += ms_since(t);
+                }
             }
             _ => {
+                let t = Instant::now();
                 let outcome = cg::solve(
                     &self.pattern,
                     values,
@@ -609,6 +797,7 @@ impl Solver {
                     &mut w.cg,
                 );
                 report.cg_iterations += outcome.iterations;
+                report.phases.solve += ms_since(t);
             }
         }
         if cfg.measure_residual {
@@ -646,6 +835,35 @@ impl Terms {
     }
 }
 
+/// Pass-2 objective terms at `f` for the given edge targets.
+fn terms(
+    edges: &[global::EdgeSlot],
+    targets: &[DVec2],
+    handles: &[Handle],
+    f: &[DVec2],
+    handle_weight: f64,
+) -> Terms {
+    let mut elastic = 0.0;
+    for (e, &t) in edges.iter().zip(targets) {
+        elastic += (t - (f[e.x] - f[e.y])).length_squared();
+    }
+    let mut handle = 0.0;
+    for h in handles {
+        for (k, &v) in h.vertices.iter().enumerate() {
+            if let Some(&p) = f.get(v) {
+                let t = h.target(k);
+                if t.is_finite() {
+                    handle += (p - t).length_squared();
+                }
+            }
+        }
+    }
+    Terms {
+        elastic,
+        handle: handle_weight * handle,
+    }
+}
+
 /// Per column, the norm of the right-hand side's edge terms (without the handle and proximal
 /// terms in `extra`). CG measures its residual against this: the handle rows, a million times
 /// stiffer, would otherwise let a solve stop with the elastic rows far from balanced.
@@ -670,6 +888,10 @@ fn irls_weight(a: f64, p: f64) -> f64 {
     } else {
         a.powf(p - 2.0)
     }
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
 }
 
 fn mean_or_one(values: &[f64]) -> f64 {

@@ -1,0 +1,450 @@
+//! Authoring mode's canvas: draws the drawing, the grid, the cut points and the design (regions
+//! filled by piece, instance outlines, docking sites coloured by site type), and turns clicks
+//! into [`AuthorCommand`]s: drawing strokes snapped to the grid or to drawn points in the draw
+//! tool, placing cut points on the drawing in the cut tool. It never changes the work itself.
+
+use clay::authoring::Polyline;
+use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
+use glam::DVec2;
+
+use crate::author::{AuthorCommand, Authoring, Computed};
+use crate::camera::Camera;
+
+/// Pointer distance (screen points) within which a point or edge counts as under it.
+const PICK_RADIUS: f64 = 10.0;
+/// Grid lines closer than this on screen (points) are not drawn.
+const GRID_MIN_SPACING: f64 = 8.0;
+const BACKGROUND: Color32 = Color32::from_rgb(246, 243, 236);
+const GRID: Color32 = Color32::from_rgb(226, 222, 212);
+const STROKES: Color32 = Color32::from_rgb(60, 60, 70);
+const PENDING: Color32 = Color32::from_rgb(30, 80, 220);
+const CUT: Color32 = Color32::from_rgb(230, 40, 160);
+const LABELS: Color32 = Color32::from_rgb(50, 40, 30);
+
+/// Piece fills, by piece index.
+const PIECE_COLOURS: [Color32; 8] = [
+    Color32::from_rgb(232, 176, 120),
+    Color32::from_rgb(150, 196, 230),
+    Color32::from_rgb(170, 214, 150),
+    Color32::from_rgb(226, 160, 200),
+    Color32::from_rgb(236, 214, 120),
+    Color32::from_rgb(180, 170, 230),
+    Color32::from_rgb(140, 210, 200),
+    Color32::from_rgb(220, 150, 140),
+];
+
+/// Site type colours, by site type index.
+const SITE_COLOURS: [Color32; 6] = [
+    Color32::from_rgb(200, 30, 30),
+    Color32::from_rgb(20, 120, 40),
+    Color32::from_rgb(30, 60, 200),
+    Color32::from_rgb(190, 110, 0),
+    Color32::from_rgb(130, 30, 160),
+    Color32::from_rgb(0, 130, 140),
+];
+
+/// The colour a piece is drawn in.
+pub fn piece_colour(piece: usize) -> Color32 {
+    PIECE_COLOURS[piece % PIECE_COLOURS.len()]
+}
+
+/// The colour a site type is drawn in.
+pub fn site_colour(site_type: usize) -> Color32 {
+    SITE_COLOURS[site_type % SITE_COLOURS.len()]
+}
+
+/// What a click on the canvas does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tool {
+    /// Click to add points (snapped), click the first point to close, double-click or Enter
+    /// to finish an open stroke, Esc to drop it.
+    Draw,
+    /// Click on the drawing to cut it there; right-click a cut to remove it.
+    Cut,
+}
+
+/// View state of the authoring canvas, kept between frames.
+pub struct AuthorCanvas {
+    pub camera: Camera,
+    pub tool: Tool,
+    /// Grid spacing (metres) that drawn points snap to.
+    pub grid: f64,
+    /// The stroke being drawn (not yet part of the work).
+    pub pending: Vec<DVec2>,
+    /// Where a click would put a point or a cut, in the last frame.
+    pub target: Option<DVec2>,
+    panning: bool,
+    fit_pending: bool,
+    /// The canvas rectangle of the last fit, while the user has not moved the view since:
+    /// panels settle their width a frame after a change, so the fit follows the canvas.
+    fitted: Option<Rect>,
+    pub rect: Rect,
+}
+
+impl Default for AuthorCanvas {
+    fn default() -> Self {
+        Self {
+            camera: Camera {
+                centre: DVec2::new(2.0, 1.0),
+                scale: 100.0,
+            },
+            tool: Tool::Draw,
+            grid: 0.1,
+            pending: Vec::new(),
+            target: None,
+            panning: false,
+            fit_pending: true,
+            fitted: None,
+            rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
+        }
+    }
+}
+
+fn dv(p: Pos2) -> DVec2 {
+    DVec2::new(p.x as f64, p.y as f64)
+}
+
+fn pos(p: DVec2) -> Pos2 {
+    Pos2::new(p.x as f32, p.y as f32)
+}
+
+fn nearest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> DVec2 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + ab * t
+}
+
+/// The segments of a stroke, closing segment included.
+fn segments(p: &Polyline) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
+    let n = p.points.len();
+    let count = if p.closed && n > 2 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
+    (0..count).map(move |i| (p.points[i], p.points[(i + 1) % n]))
+}
+
+impl AuthorCanvas {
+    /// Fit the view to the drawing at the next frame.
+    pub fn request_fit(&mut self) {
+        self.fit_pending = true;
+    }
+
+    pub fn to_screen(&self, p: DVec2) -> Pos2 {
+        pos(self.camera.to_screen(p, dv(self.rect.center())))
+    }
+
+    pub fn to_world(&self, p: Pos2) -> DVec2 {
+        self.camera.to_world(dv(p), dv(self.rect.center()))
+    }
+
+    fn fit(&mut self, author: &Authoring) {
+        let pts = author
+            .work()
+            .drawing
+            .polylines
+            .iter()
+            .flat_map(|p| p.points.iter().copied());
+        let (mut min, mut max) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in pts {
+            min = min.min(p);
+            max = max.max(p);
+        }
+        let size = DVec2::new(self.rect.width() as f64, self.rect.height() as f64);
+        self.camera.fit(min, max, size, 40.0);
+    }
+
+    /// Where a click in the draw tool puts a point: a drawn or pending point under the
+    /// pointer, else the nearest grid point.
+    fn draw_target(&self, author: &Authoring, w: DVec2) -> DVec2 {
+        let radius = PICK_RADIUS / self.camera.scale;
+        let near = author
+            .work()
+            .drawing
+            .polylines
+            .iter()
+            .flat_map(|p| p.points.iter().copied())
+            .chain(self.pending.iter().copied())
+            .filter(|p| p.distance(w) <= radius)
+            .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)));
+        near.unwrap_or_else(|| {
+            if self.grid.is_finite() && self.grid > 0.0 {
+                (w / self.grid).round() * self.grid
+            } else {
+                w
+            }
+        })
+    }
+
+    /// Where a click in the cut tool cuts: the nearest point on the drawing within reach.
+    fn cut_target(&self, author: &Authoring, w: DVec2) -> Option<DVec2> {
+        let radius = PICK_RADIUS / self.camera.scale;
+        author
+            .work()
+            .drawing
+            .polylines
+            .iter()
+            .flat_map(segments)
+            .map(|(a, b)| nearest_on_segment(w, a, b))
+            .filter(|p| p.distance(w) <= radius)
+            .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)))
+    }
+
+    fn finish(&mut self, closed: bool, commands: &mut Vec<AuthorCommand>) {
+        let points = std::mem::take(&mut self.pending);
+        let needed = if closed { 3 } else { 2 };
+        if points.len() >= needed {
+            commands.push(AuthorCommand::AddPolyline(Polyline {
+                points,
+                closed,
+                fill: None,
+                name: None,
+            }));
+        }
+    }
+
+    /// Draws the authoring state and collects the user's commands.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        author: &Authoring,
+        commands: &mut Vec<AuthorCommand>,
+    ) {
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+        self.rect = response.rect;
+        if self.fitted.is_some_and(|r| r != self.rect) {
+            self.fit_pending = true;
+        }
+        if self.fit_pending {
+            if !author.work().drawing.polylines.is_empty() {
+                self.fit(author);
+                self.fitted = Some(self.rect);
+                ui.ctx().request_repaint();
+            }
+            self.fit_pending = false;
+        }
+        let mid = dv(self.rect.center());
+        let pointer = ui
+            .input(|i| i.pointer.hover_pos())
+            .filter(|p| self.rect.contains(*p));
+        let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
+        if let Some(p) = pointer {
+            let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            let factor = zoom as f64 * (scroll as f64 * 0.0025).exp();
+            if (factor - 1.0).abs() > 1e-6 {
+                self.camera.zoom_at(factor, dv(p), mid);
+                self.fitted = None;
+            }
+        }
+        if keyboard_free && ui.input(|i| i.key_pressed(Key::F)) {
+            self.fit(author);
+        }
+        // Every drag pans: clicks, not drags, edit the drawing.
+        if response.drag_started() {
+            self.panning = true;
+            self.fitted = None;
+        }
+        if self.panning {
+            let d = response.drag_delta();
+            self.camera.pan(DVec2::new(d.x as f64, d.y as f64));
+            if response.drag_stopped() || !ui.input(|i| i.pointer.any_down()) {
+                self.panning = false;
+            }
+        }
+
+        let world = pointer.map(|p| self.camera.to_world(dv(p), mid));
+        self.target = world.and_then(|w| match self.tool {
+            Tool::Draw => Some(self.draw_target(author, w)),
+            Tool::Cut => self.cut_target(author, w),
+        });
+        let radius = PICK_RADIUS / self.camera.scale;
+        match self.tool {
+            Tool::Draw => {
+                if response.clicked_by(PointerButton::Primary)
+                    && let Some(t) = self.target
+                {
+                    let closes = self.pending.len() >= 3 && self.pending[0].distance(t) <= radius;
+                    if closes {
+                        self.finish(true, commands);
+                    } else if self.pending.last() != Some(&t) {
+                        self.pending.push(t);
+                    }
+                }
+                let enter = keyboard_free && ui.input(|i| i.key_pressed(Key::Enter));
+                if response.double_clicked() || enter {
+                    self.finish(false, commands);
+                }
+                if keyboard_free && ui.input(|i| i.key_pressed(Key::Escape)) {
+                    self.pending.clear();
+                }
+                if keyboard_free && ui.input(|i| i.key_pressed(Key::Backspace)) {
+                    self.pending.pop();
+                }
+            }
+            Tool::Cut => {
+                if response.clicked_by(PointerButton::Primary)
+                    && let Some(t) = self.target
+                {
+                    commands.push(AuthorCommand::Cut { point: t });
+                }
+                if response.clicked_by(PointerButton::Secondary)
+                    && let Some(w) = world
+                    && let Some((index, _)) = author
+                        .work()
+                        .cuts
+                        .iter()
+                        .enumerate()
+                        .map(|(i, c)| (i, c.distance(w)))
+                        .filter(|(_, d)| *d <= radius)
+                        .min_by(|a, b| a.1.total_cmp(&b.1))
+                {
+                    commands.push(AuthorCommand::RemoveCut { index });
+                }
+            }
+        }
+        self.paint(&painter, author);
+    }
+
+    fn paint(&self, painter: &egui::Painter, author: &Authoring) {
+        let screen = |p: DVec2| self.to_screen(p);
+        painter.rect_filled(self.rect, 0.0, BACKGROUND);
+        self.paint_grid(painter);
+        if let Ok(c) = &author.result {
+            self.paint_design(painter, c);
+        }
+        for p in &author.work().drawing.polylines {
+            for (a, b) in segments(p) {
+                painter.line_segment([screen(a), screen(b)], Stroke::new(1.0, STROKES));
+            }
+        }
+        for &c in &author.work().cuts {
+            let s = screen(c);
+            painter.circle_stroke(s, 7.0, Stroke::new(2.0, CUT));
+            let d = Vec2::splat(4.0);
+            painter.line_segment([s - d, s + d], Stroke::new(2.0, CUT));
+            painter.line_segment(
+                [s + Vec2::new(-4.0, 4.0), s + Vec2::new(4.0, -4.0)],
+                Stroke::new(2.0, CUT),
+            );
+        }
+        let stroke = Stroke::new(2.0, PENDING);
+        for w in self.pending.windows(2) {
+            painter.line_segment([screen(w[0]), screen(w[1])], stroke);
+        }
+        for &p in &self.pending {
+            painter.circle_filled(screen(p), 3.0, PENDING);
+        }
+        if let Some(t) = self.target {
+            match self.tool {
+                Tool::Draw => {
+                    if let Some(&last) = self.pending.last() {
+                        painter.line_segment(
+                            [screen(last), screen(t)],
+                            Stroke::new(1.0, PENDING.gamma_multiply(0.6)),
+                        );
+                    }
+                    painter.circle_stroke(screen(t), 5.0, Stroke::new(1.5, PENDING));
+                }
+                Tool::Cut => {
+                    painter.circle_stroke(screen(t), 6.0, Stroke::new(2.0, CUT));
+                }
+            }
+        }
+    }
+
+    fn paint_grid(&self, painter: &egui::Painter) {
+        let step = self.grid * self.camera.scale;
+        if !(step.is_finite() && step >= GRID_MIN_SPACING) {
+            return;
+        }
+        let lo = self.to_world(self.rect.left_bottom());
+        let hi = self.to_world(self.rect.right_top());
+        let stroke = Stroke::new(1.0, GRID);
+        let mut x = (lo.x / self.grid).floor() * self.grid;
+        while x <= hi.x {
+            let sx = self.to_screen(DVec2::new(x, 0.0)).x;
+            painter.vline(sx, self.rect.y_range(), stroke);
+            x += self.grid;
+        }
+        let mut y = (lo.y / self.grid).floor() * self.grid;
+        while y <= hi.y {
+            let sy = self.to_screen(DVec2::new(0.0, y)).y;
+            painter.hline(self.rect.x_range(), sy, stroke);
+            y += self.grid;
+        }
+    }
+
+    /// Regions filled by piece, instance outlines, sites in their type's colour (drawn just
+    /// inside their instance so that two docked sites both show), instance names.
+    fn paint_design(&self, painter: &egui::Painter, c: &Computed) {
+        let screen = |p: DVec2| self.to_screen(p);
+        let design = &c.design;
+        let at = |v: usize| c.graph.positions.get(v).copied();
+        for inst in &design.instances {
+            let Some(piece) = design.pieces.get(inst.piece) else {
+                continue;
+            };
+            let fill = piece_colour(inst.piece);
+            let edge = Stroke::new(1.5, fill.gamma_multiply(0.5).to_opaque());
+            let world_of = |k: usize| inst.vertices.get(k).and_then(|&v| at(v));
+            match &piece.outline {
+                Some(outline) => {
+                    let ring: Vec<DVec2> = outline.iter().filter_map(|&k| world_of(k)).collect();
+                    if let Some((vs, tris)) = clay::render::tessellate_polygon(&ring, &[]) {
+                        let mut mesh = egui::Mesh::default();
+                        for &v in &vs {
+                            mesh.colored_vertex(screen(v), fill);
+                        }
+                        for t in tris {
+                            mesh.add_triangle(t[0], t[1], t[2]);
+                        }
+                        painter.add(Shape::mesh(mesh));
+                    }
+                    let pts: Vec<Pos2> = ring.iter().map(|&p| screen(p)).collect();
+                    painter.add(Shape::closed_line(pts, edge));
+                }
+                None => {
+                    for &[a, b] in &piece.edges {
+                        if let (Some(pa), Some(pb)) = (world_of(a), world_of(b)) {
+                            painter.line_segment([screen(pa), screen(pb)], Stroke::new(4.0, fill));
+                        }
+                    }
+                }
+            }
+            let rot = DVec2::from_angle(inst.angle);
+            for site in &piece.sites {
+                let out = rot.rotate(site.out);
+                // Screen y points down.
+                let inward = -Vec2::new(out.x as f32, -out.y as f32) * 3.0;
+                let pts: Vec<Pos2> = site
+                    .vertices
+                    .iter()
+                    .filter_map(|&k| world_of(k))
+                    .map(|p| screen(p) + inward)
+                    .collect();
+                let colour = site_colour(site.site_type);
+                if pts.len() >= 2 {
+                    painter.add(Shape::line(pts, Stroke::new(3.0, colour)));
+                } else if let Some(&p) = pts.first() {
+                    painter.circle_filled(p, 3.5, colour);
+                }
+            }
+            let centre = inst.vertices.iter().filter_map(|&v| at(v)).sum::<DVec2>()
+                / inst.vertices.len().max(1) as f64;
+            if self.camera.scale > 30.0 {
+                painter.text(
+                    screen(centre),
+                    Align2::CENTER_CENTER,
+                    &inst.name,
+                    FontId::proportional(11.0),
+                    LABELS,
+                );
+            }
+        }
+    }
+}

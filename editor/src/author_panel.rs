@@ -1,0 +1,411 @@
+//! Authoring mode's side panel: the tool and grid, SVG import, the pieces with their instance
+//! counts and sites, site type names, the stretch declaration, and writing and trying the
+//! grammar with its diagnostics. It reads state and emits commands and actions only.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use clay::authoring::StretchChoice;
+use egui::{Color32, RichText};
+
+use crate::app::Action;
+use crate::author::{AuthorCommand, Authoring, MergeChoice, site_names};
+use crate::author_canvas::{AuthorCanvas, Tool, piece_colour, site_colour};
+use crate::panels;
+
+/// Text the user is typing in the panel, kept between frames.
+pub struct AuthorForm {
+    pub svg_path: String,
+    pub scale: String,
+    pub write_path: String,
+    pub tolerance: String,
+    /// Site type name being edited, by generated name.
+    names: BTreeMap<String, String>,
+    /// Stretch sites being picked, by piece.
+    picks: BTreeMap<usize, (usize, usize)>,
+    /// Merge rule being put together: mover, target, junction (indices into the design's
+    /// `piece.site` list; `None` junction: dock directly).
+    merge: (usize, usize, Option<usize>),
+}
+
+impl Default for AuthorForm {
+    fn default() -> Self {
+        Self {
+            svg_path: "tests/fixtures/authoring/wall.svg".into(),
+            scale: "0.01".into(),
+            write_path: "authored.clay".into(),
+            tolerance: "0.001".into(),
+            names: BTreeMap::new(),
+            picks: BTreeMap::new(),
+            merge: (0, 1, None),
+        }
+    }
+}
+
+fn swatch(ui: &mut egui::Ui, colour: Color32) {
+    let (r, painter) = ui.allocate_painter(egui::Vec2::splat(12.0), egui::Sense::hover());
+    painter.rect_filled(r.rect, 2.0, colour);
+}
+
+/// The whole authoring panel.
+pub fn show(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    canvas: &mut AuthorCanvas,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+    actions: &mut Vec<Action>,
+) {
+    if let Some(m) = &author.message {
+        ui.label(RichText::new(m).color(Color32::from_rgb(200, 40, 40)));
+    }
+    egui::CollapsingHeader::new("Drawing")
+        .default_open(true)
+        .show(ui, |ui| {
+            drawing(ui, author, canvas, form, commands, actions)
+        });
+    let design = match &author.result {
+        Ok(c) => &c.design,
+        Err(e) => {
+            ui.label(e);
+            return;
+        }
+    };
+    egui::CollapsingHeader::new(format!("Pieces ({})", design.pieces.len()))
+        .default_open(true)
+        .show(ui, |ui| pieces(ui, author, form, commands));
+    egui::CollapsingHeader::new(format!("Site types ({})", design.site_types.len()))
+        .default_open(true)
+        .show(ui, |ui| site_types(ui, author, form, commands));
+    egui::CollapsingHeader::new(format!("Merge rules ({})", author.work().merges.len()))
+        .default_open(false)
+        .show(ui, |ui| merges(ui, author, form, commands));
+    if !design.notes.is_empty() {
+        egui::CollapsingHeader::new(format!("Notes ({})", design.notes.len()))
+            .default_open(true)
+            .show(ui, |ui| {
+                for n in &design.notes {
+                    ui.label(RichText::new(n).color(Color32::from_rgb(180, 120, 0)));
+                }
+            });
+    }
+    egui::CollapsingHeader::new("Grammar")
+        .default_open(true)
+        .show(ui, |ui| grammar(ui, author, form, actions));
+}
+
+fn drawing(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    canvas: &mut AuthorCanvas,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+    actions: &mut Vec<Action>,
+) {
+    ui.horizontal(|ui| {
+        ui.label("Tool:");
+        ui.selectable_value(&mut canvas.tool, Tool::Draw, "Draw (D)");
+        ui.selectable_value(&mut canvas.tool, Tool::Cut, "Cut (C)");
+    });
+    ui.horizontal(|ui| {
+        let l = ui.label("Grid (m):");
+        ui.add(
+            egui::DragValue::new(&mut canvas.grid)
+                .speed(0.01)
+                .range(0.001..=100.0),
+        )
+        .labelled_by(l.id);
+        let l = ui.label("Tolerance (m):");
+        let r = ui
+            .add(egui::TextEdit::singleline(&mut form.tolerance).desired_width(60.0))
+            .labelled_by(l.id);
+        if r.lost_focus() {
+            match form.tolerance.trim().parse::<f64>() {
+                Ok(t) if t != author.work().tolerance => {
+                    commands.push(AuthorCommand::SetTolerance(t))
+                }
+                Ok(_) => {}
+                Err(_) => form.tolerance = author.work().tolerance.to_string(),
+            }
+        }
+    });
+    let w = author.work();
+    ui.label(format!(
+        "{} strokes, {} cuts{}",
+        w.drawing.polylines.len(),
+        w.cuts.len(),
+        if canvas.pending.is_empty() {
+            String::new()
+        } else {
+            format!(", drawing ({} points)", canvas.pending.len())
+        }
+    ));
+    ui.horizontal(|ui| {
+        let l = ui.label("SVG:");
+        ui.add(egui::TextEdit::singleline(&mut form.svg_path).desired_width(170.0))
+            .labelled_by(l.id);
+    });
+    ui.horizontal(|ui| {
+        let l = ui.label("metres per unit:");
+        ui.add(egui::TextEdit::singleline(&mut form.scale).desired_width(60.0))
+            .labelled_by(l.id);
+        if ui.button("Import SVG").clicked() {
+            match form.scale.trim().parse::<f64>() {
+                Ok(scale) => actions.push(Action::ImportSvg(
+                    PathBuf::from(form.svg_path.trim()),
+                    scale,
+                )),
+                Err(_) => actions.push(Action::Report(format!(
+                    "the scale `{}` is not a number",
+                    form.scale.trim()
+                ))),
+            }
+        }
+    });
+    if ui.button("Clear drawing").clicked() {
+        commands.push(AuthorCommand::Clear);
+    }
+}
+
+fn pieces(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    let Some(design) = author.design() else {
+        return;
+    };
+    let mut counts = vec![0usize; design.pieces.len()];
+    for i in &design.instances {
+        if let Some(c) = counts.get_mut(i.piece) {
+            *c += 1;
+        }
+    }
+    for (pi, piece) in design.pieces.iter().enumerate() {
+        ui.horizontal(|ui| {
+            swatch(ui, piece_colour(pi));
+            ui.strong(&piece.name);
+            ui.label(format!(
+                "× {} instance{}",
+                counts[pi],
+                if counts[pi] == 1 { "" } else { "s" }
+            ));
+            if let Some([from, to]) = piece.stretch {
+                let name = |s: usize| piece.sites.get(s).map_or("?", |s| s.name.as_str());
+                ui.label(format!("stretch {} -> {}", name(from), name(to)));
+            }
+        });
+        ui.indent(("sites", pi), |ui| {
+            for s in &piece.sites {
+                ui.horizontal(|ui| {
+                    swatch(ui, site_colour(s.site_type));
+                    let t = design
+                        .site_types
+                        .get(s.site_type)
+                        .map_or("?", String::as_str);
+                    ui.label(format!("{}: {t}", s.name));
+                });
+            }
+            if piece.sites.len() >= 2 {
+                let pick = form
+                    .picks
+                    .entry(pi)
+                    .or_insert(piece.stretch.map_or((0, 1), |[a, b]| (a, b)));
+                ui.horizontal(|ui| {
+                    for (label, value) in [("from", &mut pick.0), ("to", &mut pick.1)] {
+                        let l = ui.label(label);
+                        egui::ComboBox::from_id_salt((label, pi))
+                            .width(80.0)
+                            .selected_text(piece.sites.get(*value).map_or("?", |s| &s.name))
+                            .show_ui(ui, |ui| {
+                                for (si, s) in piece.sites.iter().enumerate() {
+                                    ui.selectable_value(value, si, &s.name);
+                                }
+                            })
+                            .response
+                            .labelled_by(l.id);
+                    }
+                    if ui.button("Stretchable").clicked() {
+                        commands.push(AuthorCommand::SetStretch(Some(StretchChoice::Sites {
+                            piece: pi,
+                            from: pick.0,
+                            to: pick.1,
+                        })));
+                    }
+                });
+            }
+        });
+    }
+    ui.horizontal(|ui| {
+        if ui.button("Stretch: auto").clicked() {
+            commands.push(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+        }
+        if ui
+            .add_enabled(
+                author.work().stretch.is_some(),
+                egui::Button::new("No stretch"),
+            )
+            .clicked()
+        {
+            commands.push(AuthorCommand::SetStretch(None));
+        }
+    });
+}
+
+fn merges(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    for (i, m) in author.work().merges.iter().enumerate() {
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(m.to_string()).monospace());
+            if ui.small_button("remove").clicked() {
+                commands.push(AuthorCommand::RemoveMerge { index: i });
+            }
+        });
+    }
+    let Some(design) = author.design() else {
+        return;
+    };
+    let names = site_names(design);
+    if names.len() < 2 {
+        ui.label("A merge needs two docking sites.");
+        return;
+    }
+    let shown = |i: Option<usize>| {
+        i.and_then(|i| names.get(i))
+            .map_or("(dock directly)".to_string(), |s| s.to_string())
+    };
+    let (mover, target, junction) = &mut form.merge;
+    egui::Grid::new("merge pick").show(ui, |ui| {
+        for (label, value) in [("merge", &mut *mover), ("onto", &mut *target)] {
+            let l = ui.label(label);
+            egui::ComboBox::from_id_salt(label)
+                .selected_text(shown(Some(*value)))
+                .show_ui(ui, |ui| {
+                    for (i, n) in names.iter().enumerate() {
+                        ui.selectable_value(value, i, n.to_string());
+                    }
+                })
+                .response
+                .labelled_by(l.id);
+            ui.end_row();
+        }
+        let l = ui.label("into");
+        egui::ComboBox::from_id_salt("into")
+            .selected_text(shown(*junction))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(junction, None, shown(None));
+                for (i, n) in names.iter().enumerate() {
+                    ui.selectable_value(junction, Some(i), n.to_string());
+                }
+            })
+            .response
+            .labelled_by(l.id);
+        ui.end_row();
+    });
+    if ui.button("Add merge rule").clicked()
+        && let (Some(m), Some(t)) = (names.get(*mover), names.get(*target))
+    {
+        commands.push(AuthorCommand::AddMerge(MergeChoice {
+            mover: m.clone(),
+            target: t.clone(),
+            junction: junction.and_then(|j| names.get(j).cloned()),
+        }));
+    }
+}
+
+fn site_types(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    let Ok(c) = &author.result else {
+        return;
+    };
+    for (ti, generated) in c.generated_site_types.iter().enumerate() {
+        let shown = c.design.site_types.get(ti).cloned().unwrap_or_default();
+        ui.horizontal(|ui| {
+            swatch(ui, site_colour(ti));
+            let buffer = form
+                .names
+                .entry(generated.clone())
+                .or_insert_with(|| shown.clone());
+            let r = ui
+                .add(egui::TextEdit::singleline(buffer).desired_width(140.0))
+                .on_hover_text("site type name: edit, then Enter");
+            r.widget_info(|| {
+                egui::WidgetInfo::labeled(
+                    egui::Role::TextInput,
+                    true,
+                    format!("site type {generated}"),
+                )
+            });
+            if r.lost_focus() {
+                if *buffer != shown {
+                    commands.push(AuthorCommand::RenameSiteType {
+                        from: generated.clone(),
+                        to: buffer.clone(),
+                    });
+                }
+                // Show what the work holds; a refused rename reverts.
+                form.names.remove(generated);
+            } else if !r.has_focus() && *buffer != shown {
+                // Undo or redo changed the name under the field.
+                *buffer = shown.clone();
+            }
+        });
+    }
+}
+
+fn grammar(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    form: &mut AuthorForm,
+    actions: &mut Vec<Action>,
+) {
+    ui.horizontal(|ui| {
+        let l = ui.label("File:");
+        ui.add(egui::TextEdit::singleline(&mut form.write_path).desired_width(170.0))
+            .labelled_by(l.id);
+    });
+    ui.horizontal(|ui| {
+        if ui.button("Write grammar").clicked() && !form.write_path.trim().is_empty() {
+            actions.push(Action::WriteGrammar(PathBuf::from(form.write_path.trim())));
+        }
+        if ui
+            .add_enabled(author.compiles, egui::Button::new("Try it"))
+            .on_hover_text("compile and sculpt the grammar")
+            .clicked()
+        {
+            actions.push(Action::TryAuthored);
+        }
+    });
+    if let Some((p, t)) = &author.written {
+        let same = author.text() == Some(t.as_str());
+        ui.label(format!(
+            "written to {}{}",
+            p.display(),
+            if same { "" } else { " (changed since)" }
+        ));
+    }
+    if author.text().is_some() && !author.compiles {
+        ui.label(
+            RichText::new("The grammar does not compile.").color(Color32::from_rgb(200, 40, 40)),
+        );
+    }
+    panels::diagnostics(ui, &author.problems, false);
+    if let Some(text) = author.text() {
+        egui::CollapsingHeader::new("Text")
+            .default_open(false)
+            .show(ui, |ui| {
+                egui::ScrollArea::horizontal().show(ui, |ui| {
+                    ui.add(egui::Label::new(RichText::new(text).monospace()).extend());
+                });
+            });
+    }
+}

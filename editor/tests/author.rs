@@ -1,0 +1,420 @@
+//! Authoring mode without a window: the six-brick wall SVG becomes one piece with six
+//! instances, rules are declared through undoable commands, the grammar is written and
+//! compiles clean, and "Try it" sculpts it; plus the real UI driven headless by egui_kittest.
+
+use std::path::{Path, PathBuf};
+
+use clay::authoring::{Drawing, Polyline, StretchChoice};
+use clay_editor::EditorApp;
+use clay_editor::app::{Action, Mode};
+use clay_editor::author::{AuthorCommand, Authoring, Work};
+use clay_editor::author_canvas::Tool;
+use egui::{Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+
+fn wall_svg() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/authoring/wall.svg")
+}
+
+fn wall() -> Authoring {
+    let mut a = Authoring::default();
+    a.import_svg(&wall_svg(), 0.01).unwrap();
+    a
+}
+
+fn instances_of_each_piece(a: &Authoring) -> Vec<usize> {
+    let d = a.design().expect("a design");
+    (0..d.pieces.len())
+        .map(|p| d.instances.iter().filter(|i| i.piece == p).count())
+        .collect()
+}
+
+/// A temporary folder of this test process, removed at the end of the test.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let p = std::env::temp_dir().join(format!("clay-author-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&p).unwrap();
+        Self(p)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+#[test]
+fn the_wall_svg_is_one_piece_with_six_instances() {
+    let a = wall();
+    assert_eq!(instances_of_each_piece(&a), vec![6]);
+    let d = a.design().unwrap();
+    assert_eq!(d.pieces[0].name, "brick");
+    // Two docking sites per brick (west and east) of one site type; five docks between six.
+    assert_eq!(d.pieces[0].sites.len(), 2);
+    assert_eq!(d.site_types.len(), 1);
+    assert_eq!(d.docks.len(), 5);
+    assert!(a.compiles, "{:?}", a.problems);
+}
+
+#[test]
+fn marking_stretchable_is_undoable_and_the_text_compiles_clean() {
+    let mut a = wall();
+    let before = a.design().unwrap().clone();
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    let d = a.design().unwrap();
+    let [from, to] = d.pieces[0].stretch.expect("brick is stretchable");
+    assert_eq!(d.pieces[0].sites[from].name, "west");
+    assert_eq!(d.pieces[0].sites[to].name, "east");
+    let text = a.text().unwrap();
+    assert!(text.contains("stretch brick from west to east"), "{text}");
+    assert!(text.contains("chain brick x 6"), "{text}");
+    assert!(a.compiles && a.problems.is_empty(), "{:?}", a.problems);
+
+    a.apply(AuthorCommand::Undo);
+    assert_eq!(a.design().unwrap(), &before);
+    assert!(!a.text().unwrap().contains("stretch"));
+    a.apply(AuthorCommand::Redo);
+    assert!(a.design().unwrap().pieces[0].stretch.is_some());
+}
+
+#[test]
+fn a_stretch_between_sites_that_are_not_opposite_is_refused() {
+    // An L of two unit squares: the corner square has a west and a north site.
+    let sq = |x: f64, y: f64| {
+        Polyline::polygon(vec![
+            DVec2::new(x, y),
+            DVec2::new(x + 1.0, y),
+            DVec2::new(x + 1.0, y + 1.0),
+            DVec2::new(x, y + 1.0),
+        ])
+    };
+    let mut a = Authoring::new(Work {
+        drawing: Drawing {
+            polylines: vec![sq(0.0, 0.0), sq(1.0, 0.0), sq(1.0, 1.0)],
+        },
+        ..Work::default()
+    });
+    let d = a.design().unwrap().clone();
+    let (piece, p) = d
+        .pieces
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.sites.len() >= 2)
+        .expect("a piece with two sites");
+    let (from, to) = (0..p.sites.len())
+        .flat_map(|i| (0..p.sites.len()).map(move |j| (i, j)))
+        .find(|&(i, j)| i != j && p.sites[i].out.dot(p.sites[j].out).abs() < 0.5)
+        .expect("two perpendicular sites");
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Sites {
+        piece,
+        from,
+        to,
+    })));
+    assert!(a.message.as_deref().unwrap().contains("opposite"));
+    assert_eq!(
+        a.design().unwrap(),
+        &d,
+        "a refused declaration changes nothing"
+    );
+    assert!(!a.can_undo());
+}
+
+#[test]
+fn renaming_a_site_type_shows_in_the_text_and_undoes() {
+    let mut a = wall();
+    let generated = a.design().unwrap().site_types[0].clone();
+    a.apply(AuthorCommand::RenameSiteType {
+        from: generated.clone(),
+        to: "mortar_joint".into(),
+    });
+    assert_eq!(a.design().unwrap().site_types, vec!["mortar_joint"]);
+    assert!(a.text().unwrap().contains("mortar_joint"));
+    assert!(a.compiles, "{:?}", a.problems);
+    // The rename survives a recomputation (here: declaring the stretch).
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    assert_eq!(a.design().unwrap().site_types, vec!["mortar_joint"]);
+    a.apply(AuthorCommand::RenameSiteType {
+        from: generated.clone(),
+        to: "2bad".into(),
+    });
+    assert!(
+        a.message.is_some(),
+        "a name that is no identifier is refused"
+    );
+    assert_eq!(a.design().unwrap().site_types, vec!["mortar_joint"]);
+    a.apply(AuthorCommand::Undo);
+    a.apply(AuthorCommand::Undo);
+    assert_eq!(a.design().unwrap().site_types, vec![generated]);
+}
+
+/// A 4 m x 1 m strip drawn as one closed outline: with no cut it is one region.
+fn strip() -> Authoring {
+    let mut a = Authoring::default();
+    a.apply(AuthorCommand::AddPolyline(Polyline::polygon(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(4.0, 0.0),
+        DVec2::new(4.0, 1.0),
+        DVec2::new(0.0, 1.0),
+    ])));
+    a
+}
+
+#[test]
+fn cutting_splits_into_congruent_pieces_and_undo_restores_the_design() {
+    let mut a = strip();
+    assert_eq!(instances_of_each_piece(&a), vec![1]);
+    let uncut = a.design().unwrap().clone();
+    // Cuts at x = 1, 2, 3 across the strip: four equal 1 x 1 squares, one piece.
+    for x in [1.0, 2.0, 3.0] {
+        a.apply(AuthorCommand::Cut {
+            point: DVec2::new(x, 0.0),
+        });
+        assert!(a.message.is_none(), "{:?}", a.message);
+    }
+    assert_eq!(instances_of_each_piece(&a), vec![4]);
+    assert_eq!(a.design().unwrap().docks.len(), 3);
+    assert!(a.compiles, "{:?}", a.problems);
+    let three_cuts = a.design().unwrap().clone();
+    a.apply(AuthorCommand::Undo);
+    // Squares of 1 and a 2 x 1 end: two pieces.
+    assert_eq!(a.work().cuts.len(), 2);
+    assert_eq!(instances_of_each_piece(&a).iter().sum::<usize>(), 3);
+    a.apply(AuthorCommand::Undo);
+    a.apply(AuthorCommand::Undo);
+    assert_eq!(a.design().unwrap(), &uncut);
+    a.apply(AuthorCommand::Redo);
+    a.apply(AuthorCommand::Redo);
+    a.apply(AuthorCommand::Redo);
+    assert_eq!(a.design().unwrap(), &three_cuts);
+    a.apply(AuthorCommand::RemoveCut { index: 1 });
+    assert_eq!(a.work().cuts.len(), 2);
+}
+
+#[test]
+fn a_cut_the_library_refuses_keeps_the_design() {
+    let mut a = strip();
+    let before = a.design().unwrap().clone();
+    // A point that is not finite: the library refuses it.
+    a.apply(AuthorCommand::Cut {
+        point: DVec2::new(f64::NAN, 0.0),
+    });
+    assert!(a.message.is_some());
+    assert_eq!(a.design().unwrap(), &before);
+    assert!(a.work().cuts.is_empty());
+}
+
+#[test]
+fn write_try_and_switch_modes_keep_the_work() {
+    let dir = TempDir::new("try");
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.perform(Action::ImportSvg(wall_svg(), 0.01));
+    app.author_command(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    app.apply();
+    let out = dir.0.join("wall.clay");
+    app.perform(Action::WriteGrammar(out.clone()));
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(Some(written.as_str()), app.author.text());
+    let compiled = clay_editor::compile::compile(&written, "wall.clay").expect("compiles");
+    assert!(compiled.warnings.is_empty(), "{:?}", compiled.warnings);
+
+    let work = app.author.work().clone();
+    app.perform(Action::TryAuthored);
+    assert_eq!(app.mode, Mode::Sculpt);
+    assert!(!app.stale);
+    assert_eq!(app.grammar_path(), Some(out.as_path()));
+    let g = app.sculpt.grammar();
+    let data = app.sculpt.data();
+    assert_eq!(data.instances.len(), 6);
+    assert!(
+        data.instances
+            .iter()
+            .all(|i| g.pieces[i.piece].name == "brick")
+    );
+    assert_eq!(
+        data.chains.len(),
+        1,
+        "the six bricks are one stretchable chain"
+    );
+
+    app.set_mode(Mode::Author);
+    assert_eq!(app.author.work(), &work);
+    assert_eq!(instances_of_each_piece(&app.author), vec![6]);
+    assert!(app.author.can_undo());
+}
+
+#[test]
+fn trying_an_unwritten_grammar_sculpts_it_and_session_save_asks_to_write_first() {
+    let dir = TempDir::new("unwritten");
+    let mut app = EditorApp::bundled();
+    app.perform(Action::ImportSvg(wall_svg(), 0.01));
+    app.perform(Action::TryAuthored);
+    assert_eq!(app.mode, Mode::Sculpt);
+    assert_eq!(app.sculpt.data().instances.len(), 6);
+    assert_eq!(app.grammar_path(), None);
+    let err = app.save_session(&dir.0.join("s.json")).unwrap_err();
+    assert!(err.contains("write the authored grammar"), "{err}");
+}
+
+fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
+    Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .with_max_steps(8)
+        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
+}
+
+#[test]
+fn the_ui_imports_declares_and_tries_with_clicks() {
+    let mut h = harness(EditorApp::bundled());
+    h.run();
+    h.key_press(egui::Key::Tab);
+    h.run();
+    assert_eq!(h.state().mode, Mode::Author);
+    h.state_mut().author_form.svg_path = wall_svg().display().to_string();
+    h.get_by_label("Import SVG").click();
+    h.run();
+    assert_eq!(instances_of_each_piece(&h.state().author), vec![6]);
+    assert!(h.query_by_label("× 6 instances").is_some());
+    h.get_by_label("Stretch: auto").click();
+    h.run();
+    assert!(
+        h.state().author.design().unwrap().pieces[0]
+            .stretch
+            .is_some()
+    );
+    h.get_by_label("Try it").click();
+    h.run();
+    assert_eq!(h.state().mode, Mode::Sculpt);
+    assert_eq!(h.state().sculpt.data().instances.len(), 6);
+}
+
+#[test]
+fn clicking_grid_points_draws_a_closed_polygon() {
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().set_mode(Mode::Author);
+    h.run();
+    assert_eq!(h.state().author_canvas.tool, Tool::Draw);
+    let corners = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(1.0, 0.0),
+        DVec2::new(1.0, 0.5),
+        DVec2::new(0.0, 0.5),
+        DVec2::new(0.0, 0.0),
+    ];
+    for c in corners {
+        // A little off the grid point: the click snaps to it.
+        let at = h
+            .state()
+            .author_canvas
+            .to_screen(c + DVec2::new(0.02, -0.01));
+        click(&mut h, at);
+    }
+    let a = &h.state().author;
+    assert_eq!(a.work().drawing.polylines.len(), 1);
+    let p = &a.work().drawing.polylines[0];
+    assert!(p.closed);
+    assert_eq!(p.points, corners[..4].to_vec());
+    assert_eq!(instances_of_each_piece(a), vec![1]);
+    assert!(h.state().author_canvas.pending.is_empty());
+}
+
+fn click(h: &mut Harness<'_, EditorApp>, at: Pos2) {
+    let button = |pressed: bool| egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    h.hover_at(at);
+    h.event(button(true));
+    h.step();
+    h.event(button(false));
+    h.step();
+    // Apart in time, so two clicks are not a double-click.
+    h.step();
+}
+
+#[test]
+fn the_cut_tool_cuts_where_the_drawing_is_clicked_and_ctrl_z_undoes_it() {
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.author = strip();
+    app.author_canvas.tool = Tool::Cut;
+    let mut h = harness(app);
+    h.run();
+    // Near the bottom edge at x = 2 (within the pick radius, not on it): the cut goes on the
+    // edge, across the strip, leaving two 2 x 1 halves.
+    let at = h.state().author_canvas.to_screen(DVec2::new(2.0, -0.02));
+    click(&mut h, at);
+    let a = &h.state().author;
+    assert_eq!(a.work().cuts.len(), 1);
+    assert!((a.work().cuts[0] - DVec2::new(2.0, 0.0)).length() < 1e-9);
+    assert_eq!(instances_of_each_piece(a), vec![2]);
+    // A click on empty canvas far from the drawing cuts nothing.
+    let away = h.state().author_canvas.to_screen(DVec2::new(2.0, 0.5));
+    click(&mut h, away);
+    assert_eq!(h.state().author.work().cuts.len(), 1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.run();
+    assert!(h.state().author.work().cuts.is_empty());
+    assert_eq!(instances_of_each_piece(&h.state().author), vec![1]);
+}
+
+#[test]
+fn tab_switches_modes_without_moving_the_keyboard_focus() {
+    let mut app = EditorApp::bundled();
+    let ctx = egui::Context::default();
+    let mut raw = egui::RawInput::default();
+    raw.events.push(egui::Event::Key {
+        key: egui::Key::Tab,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    eframe::App::raw_input_hook(&mut app, &ctx, &mut raw);
+    assert!(raw.events.is_empty(), "egui never sees the Tab");
+    let mut out = ctx.run_ui(raw, |ui| app.frame(ui));
+    // No renderer here to take the font atlas.
+    out.textures_delta.clear();
+    assert_eq!(app.mode, Mode::Author);
+    assert_eq!(ctx.memory(|m| m.focused()), None);
+}
+
+#[test]
+fn a_merge_rule_is_written_compiles_and_undoes() {
+    use clay_editor::author::{MergeChoice, SiteName};
+    let site = |piece: &str, site: &str| SiteName {
+        piece: piece.into(),
+        site: site.into(),
+    };
+    let mut a = wall();
+    a.apply(AuthorCommand::AddMerge(MergeChoice {
+        mover: site("brick", "east"),
+        target: site("brick", "west"),
+        junction: None,
+    }));
+    assert!(a.message.is_none(), "{:?}", a.message);
+    let text = a.text().unwrap();
+    assert!(text.contains("merge brick.east onto brick.west"), "{text}");
+    let compiled = clay_editor::compile::compile(text, "wall.clay").expect("compiles");
+    assert_eq!(compiled.grammar.merge_rules.len(), 1);
+    assert!(a.compiles && a.problems.is_empty(), "{:?}", a.problems);
+
+    a.apply(AuthorCommand::AddMerge(MergeChoice {
+        mover: site("brick", "north"),
+        target: site("brick", "west"),
+        junction: None,
+    }));
+    assert!(a.message.as_deref().unwrap().contains("brick.north"));
+    assert_eq!(a.work().merges.len(), 1);
+
+    a.apply(AuthorCommand::Undo);
+    assert!(a.work().merges.is_empty());
+    assert!(!a.text().unwrap().contains("merge"));
+}
