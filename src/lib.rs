@@ -1,5 +1,6 @@
 //! Clay: live assemblies, the mutable elastic solver, rules and rendering.
 pub mod assembly;
+pub mod fit;
 pub mod solver;
 pub mod rules;
 pub mod render;

@@ -10,6 +10,32 @@ use super::pose::{WorldMesh, site_out};
 use super::text;
 
 /// A pixel-space drawing surface (x right, y down).
+/// Whether a pixel-space point is finite (NaN or infinity never reaches a picture).
+pub(crate) fn finite(p: &[f32; 2]) -> bool {
+    p[0].is_finite() && p[1].is_finite()
+}
+
+/// The triangles a canvas fills: those whose corners exist and are finite, all turned to one
+/// winding, so that under the nonzero rule their union is filled once, with no anti-aliasing
+/// seams along shared edges.
+pub(crate) fn wound_triangles<'a>(
+    points: &'a [[f32; 2]],
+    triangles: &'a [[u32; 3]],
+) -> impl Iterator<Item = [[f32; 2]; 3]> + 'a {
+    triangles.iter().filter_map(move |t| {
+        let mut c = [[0.0f32; 2]; 3];
+        for (k, &i) in t.iter().enumerate() {
+            c[k] = *points.get(i as usize).filter(|p| finite(p))?;
+        }
+        let area =
+            (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]);
+        if area < 0.0 {
+            c.swap(1, 2);
+        }
+        Some(c)
+    })
+}
+
 pub trait Canvas {
     /// Fills the union of the triangles (each one's winding is normalised, so overlaps do not
     /// cancel or double-blend).

@@ -7,57 +7,7 @@ use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Rgba};
 use glam::DVec2;
 
 use super::tessellate::{Mesh, TessellationCache, shown_geometry};
-
-/// A rotation and translation: `p -> rotation * (p - from_centre) + to_centre`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RigidMotion {
-    /// The rotation as a unit complex number `(cos, sin)`.
-    pub rotation: DVec2,
-    pub from_centre: DVec2,
-    pub to_centre: DVec2,
-}
-
-impl RigidMotion {
-    pub const IDENTITY: Self = Self {
-        rotation: DVec2::X,
-        from_centre: DVec2::ZERO,
-        to_centre: DVec2::ZERO,
-    };
-
-    pub fn apply(&self, p: DVec2) -> DVec2 {
-        self.rotation.rotate(p - self.from_centre) + self.to_centre
-    }
-
-    /// Rotates a direction (no translation).
-    pub fn apply_direction(&self, d: DVec2) -> DVec2 {
-        self.rotation.rotate(d)
-    }
-}
-
-/// The best rigid motion taking `from` onto `to` in the least-squares sense (2D Procrustes:
-/// centre both, angle = atan2(sum of cross products, sum of dot products)), the same closed form
-/// as the solver's shape distance. `None` when the slices differ in length, are empty, or hold
-/// non-finite points. A single point, or points that give no rotation, give a pure translation.
-pub fn rigid_motion(from: &[DVec2], to: &[DVec2]) -> Option<RigidMotion> {
-    if from.len() != to.len() || from.is_empty() || !from.iter().chain(to).all(|p| p.is_finite()) {
-        return None;
-    }
-    let n = from.len() as f64;
-    let from_centre = from.iter().sum::<DVec2>() / n;
-    let to_centre = to.iter().sum::<DVec2>() / n;
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (a, b) in from.iter().zip(to) {
-        let (a, b) = (*a - from_centre, *b - to_centre);
-        dot += a.dot(b);
-        cross += a.perp_dot(b);
-    }
-    let rotation = DVec2::new(dot, cross).try_normalize().unwrap_or(DVec2::X);
-    Some(RigidMotion {
-        rotation,
-        from_centre,
-        to_centre,
-    })
-}
+pub use crate::fit::{RigidMotion, rigid_motion};
 
 /// The frame of one axis site: its vertex centroid and its tangent (first to last site vertex),
 /// at rest and now. Mapping through it keeps the tangential coordinate scaled by the site's

@@ -6,7 +6,7 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform,
 };
 
-use super::draw::{Canvas, RenderOptions, View, bounds, draw_assembly};
+use super::draw::{Canvas, RenderOptions, View, bounds, draw_assembly, finite, wound_triangles};
 use super::pose::pose_assembly;
 use super::tessellate::TessellationCache;
 use super::text::{self, PathSink};
@@ -65,28 +65,10 @@ fn paint(c: Rgba) -> Paint<'static> {
     p
 }
 
-fn finite(p: &[f32; 2]) -> bool {
-    p[0].is_finite() && p[1].is_finite()
-}
-
 impl Canvas for PixmapCanvas {
     fn fill_triangles(&mut self, points: &[[f32; 2]], triangles: &[[u32; 3]], colour: Rgba) {
         let mut pb = PathBuilder::new();
-        for t in triangles {
-            let Some(mut c) = t
-                .iter()
-                .map(|&i| points.get(i as usize).filter(|p| finite(p)))
-                .collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            // One winding for all triangles: under the nonzero rule the union is filled once,
-            // with no anti-aliasing seams along shared edges.
-            let area = (c[1][0] - c[0][0]) * (c[2][1] - c[0][1])
-                - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]);
-            if area < 0.0 {
-                c.swap(1, 2);
-            }
+        for c in wound_triangles(points, triangles) {
             pb.move_to(c[0][0], c[0][1]);
             pb.line_to(c[1][0], c[1][1]);
             pb.line_to(c[2][0], c[2][1]);

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, Rgba};
 
-use super::draw::{Canvas, RenderOptions, draw_assembly, hex};
+use super::draw::{Canvas, RenderOptions, draw_assembly, finite, hex, wound_triangles};
 use super::pose::pose_assembly;
 use super::raster::view_for;
 use super::tessellate::TessellationCache;
@@ -49,10 +49,6 @@ fn num(v: f32) -> String {
     if s == "-0" { "0".into() } else { s.into() }
 }
 
-fn finite(p: &[f32; 2]) -> bool {
-    p[0].is_finite() && p[1].is_finite()
-}
-
 fn fill_attrs(c: Rgba) -> String {
     let (h, a) = hex(c);
     if a < 1.0 {
@@ -65,19 +61,7 @@ fn fill_attrs(c: Rgba) -> String {
 impl Canvas for SvgCanvas {
     fn fill_triangles(&mut self, points: &[[f32; 2]], triangles: &[[u32; 3]], colour: Rgba) {
         let mut d = String::new();
-        for t in triangles {
-            let Some(mut c) = t
-                .iter()
-                .map(|&i| points.get(i as usize).filter(|p| finite(p)))
-                .collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            let area = (c[1][0] - c[0][0]) * (c[2][1] - c[0][1])
-                - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]);
-            if area < 0.0 {
-                c.swap(1, 2);
-            }
+        for c in wound_triangles(points, triangles) {
             let _ = write!(
                 d,
                 "M{} {}L{} {}L{} {}Z",

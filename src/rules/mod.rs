@@ -9,7 +9,7 @@
 //! free sites; a rewrite itself costs O(instances + docks + vertices) and happens rarely.
 
 pub mod cut;
-pub mod fit;
+pub use crate::fit;
 pub mod merge;
 pub mod proximity;
 pub mod replace;

@@ -17,11 +17,11 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
-use super::fit::{self, PointMap};
 use super::{
     PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, generated_name, rebuild_parts,
     remove_instances, transaction,
 };
+use crate::fit::{self, PointMap};
 
 /// Index of the `one`, `two` and `three` states in a stretch part.
 pub const ONE: usize = 0;

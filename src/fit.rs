@@ -1,6 +1,7 @@
-//! Fitting maps from rest coordinates to the current pose: the best rigid motion (placing a
-//! junction over the instance it replaces) and the best affine map (laying new chain elements
-//! into a deformed pose). Both are least-squares fits over corresponding point pairs.
+//! Least-squares maps between corresponding point sets: the best rigid motion (2D Procrustes:
+//! posing rigid proxy geometry, placing a junction over the instance it replaces, handles'
+//! rest placement) and the best affine map (laying new chain elements into a deformed pose).
+//! The one home of these fits, so the renderer, the rules and the assembly agree exactly.
 
 use glam::{DMat2, DVec2};
 
@@ -22,6 +23,57 @@ impl PointMap {
     }
 }
 
+/// A rotation and translation: `p -> rotation * (p - from_centre) + to_centre`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidMotion {
+    /// The rotation as a unit complex number `(cos, sin)`.
+    pub rotation: DVec2,
+    pub from_centre: DVec2,
+    pub to_centre: DVec2,
+}
+
+impl RigidMotion {
+    pub const IDENTITY: Self = Self {
+        rotation: DVec2::X,
+        from_centre: DVec2::ZERO,
+        to_centre: DVec2::ZERO,
+    };
+
+    pub fn apply(&self, p: DVec2) -> DVec2 {
+        self.rotation.rotate(p - self.from_centre) + self.to_centre
+    }
+
+    /// Rotates a direction (no translation).
+    pub fn apply_direction(&self, d: DVec2) -> DVec2 {
+        self.rotation.rotate(d)
+    }
+}
+
+/// The best rigid motion taking `from` onto `to` in the least-squares sense (2D Procrustes:
+/// centre both, angle = atan2(sum of cross products, sum of dot products)), the same closed form
+/// as the solver's shape distance. `None` when the slices differ in length, are empty, or hold
+/// non-finite points. A single point, or points that give no rotation, give a pure translation.
+pub fn rigid_motion(from: &[DVec2], to: &[DVec2]) -> Option<RigidMotion> {
+    if from.len() != to.len() || from.is_empty() || !from.iter().chain(to).all(|p| p.is_finite()) {
+        return None;
+    }
+    let n = from.len() as f64;
+    let from_centre = from.iter().sum::<DVec2>() / n;
+    let to_centre = to.iter().sum::<DVec2>() / n;
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for (a, b) in from.iter().zip(to) {
+        let (a, b) = (*a - from_centre, *b - to_centre);
+        dot += a.dot(b);
+        cross += a.perp_dot(b);
+    }
+    let rotation = DVec2::new(dot, cross).try_normalize().unwrap_or(DVec2::X);
+    Some(RigidMotion {
+        rotation,
+        from_centre,
+        to_centre,
+    })
+}
+
 fn centroids(from: &[DVec2], to: &[DVec2]) -> (DVec2, DVec2) {
     let n = from.len().min(to.len()).max(1) as f64;
     let a = from.iter().copied().sum::<DVec2>() / n;
@@ -29,30 +81,19 @@ fn centroids(from: &[DVec2], to: &[DVec2]) -> (DVec2, DVec2) {
     (a, b)
 }
 
-/// Best rotation + translation taking `from[i]` to `to[i]` (2D Procrustes). With fewer than
-/// two distinct points the rotation is the identity.
+/// Best rotation + translation taking `from[i]` to `to[i]` (2D Procrustes) as a [`PointMap`],
+/// over the common prefix of the two slices. With fewer than two distinct points, or non-finite
+/// input, the rotation is the identity.
 pub fn rigid(from: &[DVec2], to: &[DVec2]) -> PointMap {
     let m = from.len().min(to.len());
-    if m == 0 {
+    let Some(motion) = rigid_motion(&from[..m], &to[..m]) else {
         return PointMap::IDENTITY;
-    }
-    let (cf, ct) = centroids(&from[..m], &to[..m]);
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (p, q) in from[..m].iter().zip(&to[..m]) {
-        let (p, q) = (*p - cf, *q - ct);
-        dot += p.dot(q);
-        cross += p.perp_dot(q);
-    }
-    let len = dot.hypot(cross);
-    let (c, s) = if len > 1e-12 && len.is_finite() {
-        (dot / len, cross / len)
-    } else {
-        (1.0, 0.0)
     };
+    let (c, s) = (motion.rotation.x, motion.rotation.y);
     let linear = DMat2::from_cols(DVec2::new(c, s), DVec2::new(-s, c));
     PointMap {
         linear,
-        offset: ct - linear * cf,
+        offset: motion.to_centre - linear * motion.from_centre,
     }
 }
 
