@@ -246,6 +246,12 @@ fn parts_of(grammar: &CompiledGrammar, assembly: &AssemblyData) -> Vec<clay_dsl:
 
 /// World-space bounding box of the meshes and the assembly's vertices.
 pub fn bounds(meshes: &[WorldMesh], assembly: &AssemblyData) -> (DVec2, DVec2) {
+    points_bounds(meshes, &assembly.positions)
+}
+
+/// World-space bounding box of the meshes' drawn corners and the given points, skipping
+/// non-finite ones (an empty input gives an inverted box: min +inf, max -inf).
+pub fn points_bounds(meshes: &[WorldMesh], positions: &[DVec2]) -> (DVec2, DVec2) {
     let mut min = DVec2::splat(f64::INFINITY);
     let mut max = DVec2::splat(f64::NEG_INFINITY);
     let points = meshes
@@ -257,7 +263,7 @@ pub fn bounds(meshes: &[WorldMesh], assembly: &AssemblyData) -> (DVec2, DVec2) {
                 .map(|&i| m.positions[i as usize])
         })
         .map(|[x, y]| DVec2::new(x as f64, y as f64))
-        .chain(assembly.positions.iter().copied());
+        .chain(positions.iter().copied());
     for p in points.filter(|p| p.is_finite()) {
         min = min.min(p);
         max = max.max(p);

@@ -5,8 +5,10 @@ use clay_dsl::compiled::{CompiledGrammar, Rgba};
 use glam::DVec2;
 use tiny_skia::Pixmap;
 
-use super::draw::{BACKGROUND, Canvas, View, draw_meshes, draw_site, label, site_type_colour};
-use super::pose::{WorldMesh, pose_piece, site_out};
+use super::draw::{
+    BACKGROUND, Canvas, View, draw_meshes, draw_site, label, points_bounds, site_type_colour,
+};
+use super::pose::{pose_piece, site_out};
 use super::raster::{MAX_SIDE, PixmapCanvas, RenderError};
 use super::svg::SvgCanvas;
 use super::tessellate::TessellationCache;
@@ -90,7 +92,7 @@ pub fn draw_sheet(canvas: &mut dyn Canvas, grammar: &CompiledGrammar) {
 
             let current = &state.positions;
             let meshes = pose_piece(grammar, pi, si, current, &mut cache);
-            let (min, max) = cell_bounds(&meshes, current);
+            let (min, max) = points_bounds(&meshes, current);
             let view = View::fit(
                 min,
                 max,
@@ -134,28 +136,6 @@ pub fn draw_sheet(canvas: &mut dyn Canvas, grammar: &CompiledGrammar) {
             }
         }
     }
-}
-
-fn cell_bounds(meshes: &[WorldMesh], positions: &[DVec2]) -> (DVec2, DVec2) {
-    let mut min = DVec2::splat(f64::INFINITY);
-    let mut max = DVec2::splat(f64::NEG_INFINITY);
-    let mesh_points = meshes
-        .iter()
-        .flat_map(|m| {
-            m.triangles
-                .iter()
-                .flatten()
-                .map(|&i| m.positions[i as usize])
-        })
-        .map(|[x, y]| DVec2::new(x as f64, y as f64));
-    for p in mesh_points
-        .chain(positions.iter().copied())
-        .filter(|p| p.is_finite())
-    {
-        min = min.min(p);
-        max = max.max(p);
-    }
-    (min, max)
 }
 
 /// The sheet as a pixmap.
