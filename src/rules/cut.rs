@@ -11,8 +11,8 @@ use glam::DVec2;
 
 use super::merge::take_over;
 use super::{
-    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, derive_chains, rebuild_parts,
-    remove_instances, site_centre, transaction,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, remove_instances,
+    site_centre, transaction,
 };
 
 /// How far (metres) from the nearest docked site's centre a cut may point; at least this,
@@ -120,20 +120,14 @@ pub fn cut_dock(
             }
         };
         derive_chains(grammar, data);
-        let mut vertex_map = compact_vertices(data);
-        vertex_map.truncate(before.vertices);
-        let part_map = rebuild_parts(grammar, data, &before, &touched);
-        Ok(Rewrite {
-            event: RuleEvent {
-                kind: RuleKind::Cut,
-                frame: 0,
-                at,
-                instances: ids,
-                detail,
-            },
-            vertex_map,
-            part_map,
-        })
+        let event = RuleEvent {
+            kind: RuleKind::Cut,
+            frame: 0,
+            at,
+            instances: ids,
+            detail,
+        };
+        Ok(finish(grammar, data, &before, &touched, event))
     })
 }
 

@@ -11,8 +11,8 @@ use glam::DVec2;
 
 use super::proximity::SiteGrid;
 use super::{
-    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, derive_chains, fit,
-    generated_name, rebuild_parts, remove_instances, site_centre, transaction,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, fit, generated_name,
+    remove_instances, site_centre, transaction,
 };
 
 /// A merge the rules found: `mover` came within `distance` of `target`.
@@ -279,19 +279,13 @@ pub fn apply(
             }
         };
         derive_chains(grammar, data);
-        let mut vertex_map = compact_vertices(data);
-        vertex_map.truncate(before.vertices);
-        let part_map = rebuild_parts(grammar, data, &before, &touched);
-        Ok(Rewrite {
-            event: RuleEvent {
-                kind: RuleKind::Merge,
-                frame: 0,
-                at,
-                instances: ids,
-                detail,
-            },
-            vertex_map,
-            part_map,
-        })
+        let event = RuleEvent {
+            kind: RuleKind::Merge,
+            frame: 0,
+            at,
+            instances: ids,
+            detail,
+        };
+        Ok(finish(grammar, data, &before, &touched, event))
     })
 }

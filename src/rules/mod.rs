@@ -142,6 +142,26 @@ pub(crate) fn rebuild_parts(
     part_map
 }
 
+/// Ends a rewrite: drops the vertices no instance uses any more, rebuilds the parts (keeping the
+/// active state of parts over untouched instances) and packages the event with the old -> new
+/// index maps. Every rule's rewrite leaves through here.
+pub(crate) fn finish(
+    grammar: &CompiledGrammar,
+    data: &mut AssemblyData,
+    before: &PartsBefore,
+    touched: &HashSet<u64>,
+    event: RuleEvent,
+) -> Rewrite {
+    let mut vertex_map = compact_vertices(data);
+    vertex_map.truncate(before.vertices);
+    let part_map = rebuild_parts(grammar, data, before, touched);
+    Rewrite {
+        event,
+        vertex_map,
+        part_map,
+    }
+}
+
 /// Removes the instances at the given indices, renumbering docks (docks touching a removed
 /// instance are dropped) and chains (removed elements are dropped; empty chains vanish).
 pub(crate) fn remove_instances(data: &mut AssemblyData, removed: &HashSet<usize>) {

@@ -18,8 +18,8 @@ use clay_dsl::compiled::{
 use glam::DVec2;
 
 use super::{
-    PartsBefore, Rewrite, RuleEvent, RuleKind, compact_vertices, generated_name, rebuild_parts,
-    remove_instances, transaction,
+    PartsBefore, Rewrite, RuleEvent, RuleKind, finish, generated_name, remove_instances,
+    transaction,
 };
 use crate::fit::{self, PointMap};
 
@@ -364,28 +364,22 @@ pub fn stretch(
         data.docks[di] = Dock { a: n_to, b: b_from };
         data.docks.push(Dock { a: a_to, b: n_from });
         data.chains[chain].instances.insert(first + 1, ni);
-        let mut vertex_map = compact_vertices(data);
-        vertex_map.truncate(before.vertices);
         let (ida, idb) = (data.instances[ia].id, data.instances[ib].id);
         let touched: HashSet<u64> = [ida, idb, id].into();
-        let part_map = rebuild_parts(grammar, data, &before, &touched);
         let count = data.chains[chain].instances.len();
         let mid = &data.instances[ni].vertices;
         let at = mid.iter().map(|&v| data.positions[v]).sum::<DVec2>() / mid.len().max(1) as f64;
-        Ok(Rewrite {
-            event: RuleEvent {
-                kind: RuleKind::Stretch,
-                frame: 0,
-                at,
-                instances: vec![ida, idb, id],
-                detail: format!(
-                    "chain {chain} at element {first}: 2 -> 3 elements, inserted {name} ({}); {count} elements",
-                    grammar.pieces[piece].name
-                ),
-            },
-            vertex_map,
-            part_map,
-        })
+        let event = RuleEvent {
+            kind: RuleKind::Stretch,
+            frame: 0,
+            at,
+            instances: vec![ida, idb, id],
+            detail: format!(
+                "chain {chain} at element {first}: 2 -> 3 elements, inserted {name} ({}); {count} elements",
+                grammar.pieces[piece].name
+            ),
+        };
+        Ok(finish(grammar, data, &before, &touched, event))
     })
 }
 
@@ -475,10 +469,7 @@ pub fn shrink(
         let (kid, gid) = (data.instances[keep].id, data.instances[gone].id);
         let gone_name = data.instances[gone].name.clone();
         remove_instances(data, &HashSet::from([gone]));
-        let mut vertex_map = compact_vertices(data);
-        vertex_map.truncate(before.vertices);
         let touched: HashSet<u64> = [kid, gid].into();
-        let part_map = rebuild_parts(grammar, data, &before, &touched);
         let ki = data
             .instances
             .iter()
@@ -487,18 +478,15 @@ pub fn shrink(
         let kv = &data.instances[ki].vertices;
         let at = kv.iter().map(|&v| data.positions[v]).sum::<DVec2>() / kv.len().max(1) as f64;
         let count = data.chains.get(chain).map_or(0, |c| c.instances.len());
-        Ok(Rewrite {
-            event: RuleEvent {
-                kind: RuleKind::Shrink,
-                frame: 0,
-                at,
-                instances: vec![kid, gid],
-                detail: format!(
-                    "chain {chain} at element {first}: 2 -> 1 elements, removed {gone_name}; {count} elements"
-                ),
-            },
-            vertex_map,
-            part_map,
-        })
+        let event = RuleEvent {
+            kind: RuleKind::Shrink,
+            frame: 0,
+            at,
+            instances: vec![kid, gid],
+            detail: format!(
+                "chain {chain} at element {first}: 2 -> 1 elements, removed {gone_name}; {count} elements"
+            ),
+        };
+        Ok(finish(grammar, data, &before, &touched, event))
     })
 }
