@@ -214,7 +214,7 @@ impl Assembly {
             .filter(|s| s.positions.len() == current.len())
         {
             Some(rest) => {
-                let map = crate::rules::fit::rigid(&rest.positions, &current);
+                let map = crate::fit::rigid(&rest.positions, &current);
                 let placed: Vec<DVec2> = rest.positions.iter().map(|&q| map.apply(q)).collect();
                 if placed.iter().all(|p| p.is_finite()) {
                     placed

@@ -166,7 +166,7 @@ impl Canvas {
             } else if (primary || secondary) && !cutting {
                 match part_at(w0, &self.meshes, data, tolerance) {
                     Some(part) => {
-                        commands.push(Command::Grab { part });
+                        commands.push(Command::Grab { part, at: w0 });
                         if secondary || modifiers.shift {
                             let centre = sculpt.assembly().part_centroid(part);
                             let d = w0 - centre;
@@ -230,8 +230,9 @@ impl Canvas {
         if keyboard_free
             && ui.input(|i| i.key_pressed(Key::P))
             && let Some(part) = self.hovered
+            && let Some(at) = world
         {
-            commands.push(Command::TogglePin { part });
+            commands.push(Command::TogglePin { part, at });
         }
 
         self.paint(&painter, sculpt);

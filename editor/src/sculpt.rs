@@ -18,9 +18,12 @@ use crate::session::{Pin, Settings};
 /// the frame.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
-    /// Start a gesture: `part` becomes the handle.
+    /// Start a gesture on `part`, pressed at world point `at`: the instance of the part nearest
+    /// `at` becomes the handle (in a stretch chain a part spans two elements; the user grabs the
+    /// brick under the cursor, not the pair, as `clayc run` does).
     Grab {
         part: usize,
+        at: DVec2,
     },
     /// Move the grabbed part: its target is its start pose moved by `translation` and turned by
     /// `angle` radians about its centre.
@@ -30,9 +33,10 @@ pub enum Command {
     },
     /// End the gesture.
     Release,
-    /// Pin the part, or unpin it if pinned.
+    /// Pin the instance of `part` nearest `at`, or unpin it if pinned.
     TogglePin {
         part: usize,
+        at: DVec2,
     },
     /// Cut the connection nearest `point` (world coordinates).
     Cut {
@@ -266,28 +270,58 @@ impl Sculpt {
         pins
     }
 
-    /// Whether `part` is held by a pin (its vertex set is a pin's).
+    /// Whether an instance of `part` is held by a pin.
     pub fn is_pinned(&self, part: usize) -> bool {
-        self.pin_of(part).is_some()
+        self.part_instances(part)
+            .into_iter()
+            .any(|i| self.pin_of(i).is_some())
             || self
                 .grab
                 .as_ref()
                 .is_some_and(|g| g.part == part && g.was_pinned)
     }
 
-    fn pin_of(&self, part: usize) -> Option<HandleId> {
-        let vertices = &self.assembly.data.parts.get(part)?.vertices;
+    /// The instances a part covers (one for a piece part, two for a stretch part).
+    fn part_instances(&self, part: usize) -> Vec<usize> {
+        let data = &self.assembly.data;
+        match data.parts.get(part).map(|p| p.kind) {
+            Some(PartKind::Piece { instance }) => vec![instance],
+            Some(PartKind::Stretch { chain, first }) => data
+                .chains
+                .get(chain)
+                .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
+                .unwrap_or_default(),
+            None => Vec::new(),
+        }
+    }
+
+    /// The instance of `part` whose centre is nearest `at`: what a handle on that part holds.
+    fn instance_at(&self, part: usize, at: DVec2) -> Option<usize> {
+        let asm = &self.assembly;
+        self.part_instances(part).into_iter().min_by(|&a, &b| {
+            let d = |i| {
+                asm.instance_centroid(i)
+                    .map_or(f64::INFINITY, |c| c.distance_squared(at))
+            };
+            d(a).total_cmp(&d(b))
+        })
+    }
+
+    /// The pin holding `instance`, found by the instance's stable id (its vertices change when
+    /// rules rewrite the chain around it).
+    fn pin_of(&self, instance: usize) -> Option<HandleId> {
+        let id = self.assembly.data.instances.get(instance)?.id;
         self.assembly
             .handles()
             .iter()
-            .find(|h| h.kind == HandleKind::Pin && &h.vertices == vertices)
+            .find(|h| h.kind == HandleKind::Pin && h.held.as_ref().is_some_and(|x| x.id == id))
             .map(|h| h.id)
     }
 
     /// Applies one command.
     pub fn apply(&mut self, command: Command) {
         match command {
-            Command::Grab { part } => self.grab(part),
+            Command::Grab { part, at } => self.grab(part, at),
             Command::MoveGrab { translation, angle } => {
                 if !(translation.is_finite() && angle.is_finite()) {
                     return;
@@ -302,20 +336,21 @@ impl Sculpt {
                 }
             }
             Command::Release => self.release(),
-            Command::TogglePin { part } => {
-                if part >= self.assembly.data.parts.len() {
+            Command::TogglePin { part, at } => {
+                let Some(instance) = self.instance_at(part, at) else {
                     return;
-                }
+                };
                 self.release();
                 self.checkpoint();
-                match self.pin_of(part) {
+                let name = self.assembly.data.instances[instance].name.clone();
+                match self.pin_of(instance) {
                     Some(id) => {
                         self.assembly.release(id);
-                        self.note(format!("unpinned part {part}"), None);
+                        self.note(format!("unpinned {name}"), None);
                     }
                     None => {
-                        self.assembly.hold_part(part, HandleKind::Pin);
-                        self.note(format!("pinned part {part}"), None);
+                        self.assembly.hold_instance(instance, HandleKind::Pin);
+                        self.note(format!("pinned {name}"), None);
                     }
                 }
                 self.unsettled = true;
@@ -556,17 +591,17 @@ impl Sculpt {
             .collect()
     }
 
-    fn grab(&mut self, part: usize) {
+    fn grab(&mut self, part: usize, at: DVec2) {
         self.release();
-        if part >= self.assembly.data.parts.len() {
+        let Some(instance) = self.instance_at(part, at) else {
             return;
-        }
+        };
         self.checkpoint();
-        let was_pinned = match self.pin_of(part) {
+        let was_pinned = match self.pin_of(instance) {
             Some(id) => self.assembly.release(id),
             None => false,
         };
-        if let Some(handle) = self.assembly.hold_part(part, HandleKind::Grab) {
+        if let Some(handle) = self.assembly.hold_instance(instance, HandleKind::Grab) {
             self.grab = Some(Grab {
                 handle,
                 part,
@@ -613,11 +648,26 @@ impl Sculpt {
         self.revision += 1;
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
-            if let Some(id) = self.assembly.hold_vertices(pin.vertices, HandleKind::Pin)
+            // A pin on exactly one instance's vertices holds that instance, so it keeps
+            // following it through rules; any other vertex set is held as it is.
+            let instance = self
+                .assembly
+                .data
+                .instances
+                .iter()
+                .position(|i| i.vertices == pin.vertices);
+            let held = match instance {
+                Some(i) => self.assembly.hold_instance(i, HandleKind::Pin),
+                None => self.assembly.hold_vertices(pin.vertices, HandleKind::Pin),
+            };
+            if let Some(id) = held
                 && let Some(h) = self.assembly.handle_mut(id)
                 && pin.at.len() == h.anchor.len()
             {
                 h.centre = pin.at.iter().copied().sum::<DVec2>() / pin.at.len().max(1) as f64;
+                if let Some(held) = &mut h.held {
+                    held.anchor.clone_from(&pin.at);
+                }
                 h.anchor = pin.at;
             }
         }

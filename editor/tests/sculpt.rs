@@ -49,7 +49,8 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn drag(s: &mut Sculpt, part: usize, by: DVec2) {
-    s.apply(Command::Grab { part });
+    let at = s.assembly().part_centroid(part);
+    s.apply(Command::Grab { part, at });
     s.apply(Command::MoveGrab {
         translation: by,
         angle: 0.0,
@@ -93,7 +94,8 @@ fn rotating_the_grabbed_part_turns_it() {
     let vertices = s.data().parts[part].vertices.clone();
     let edge = |s: &Sculpt| s.data().positions[vertices[1]] - s.data().positions[vertices[0]];
     let e0 = edge(&s);
-    s.apply(Command::Grab { part });
+    let at = s.assembly().part_centroid(part);
+    s.apply(Command::Grab { part, at });
     s.apply(Command::MoveGrab {
         translation: DVec2::ZERO,
         angle: 0.4,
@@ -110,7 +112,8 @@ fn pins_hold_parts_and_are_undoable() {
     let mut s = castle();
     let part = tower(&s);
     assert!(!s.is_pinned(part));
-    s.apply(Command::TogglePin { part });
+    let at = s.assembly().part_centroid(part);
+    s.apply(Command::TogglePin { part, at });
     assert!(s.is_pinned(part));
     assert_eq!(s.pins().len(), 1);
 
@@ -218,7 +221,8 @@ fn a_session_round_trips_through_a_file() {
     let mut app = EditorApp::bundled();
     settle(&mut app.sculpt);
     let part = tower(&app.sculpt);
-    app.sculpt.apply(Command::TogglePin { part });
+    let at = app.sculpt.assembly().part_centroid(part);
+    app.sculpt.apply(Command::TogglePin { part, at });
     let other = (0..app.sculpt.data().parts.len())
         .rev()
         .find(|&p| p != part)
@@ -298,7 +302,8 @@ fn a_failed_atomic_save_leaves_the_old_file_intact() {
     std::fs::create_dir(&tmp).unwrap();
     let mut app = EditorApp::bundled();
     let part = tower(&app.sculpt);
-    app.sculpt.apply(Command::TogglePin { part });
+    let at = app.sculpt.assembly().part_centroid(part);
+    app.sculpt.apply(Command::TogglePin { part, at });
     assert!(app.save_session(&path).is_err());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "old contents");
     assert!(app.sculpt.dirty, "a failed save keeps the unsaved flag");
@@ -334,7 +339,8 @@ fn exports_write_a_png_and_the_assembly_json() {
 fn a_reload_with_the_same_model_keeps_the_sculpt() {
     let mut s = castle();
     let part = tower(&s);
-    s.apply(Command::TogglePin { part });
+    let at = s.assembly().part_centroid(part);
+    s.apply(Command::TogglePin { part, at });
     drag(&mut s, part, DVec2::new(0.0, 1.0));
     let sculpted = s.data().positions.clone();
     let saved_dirty = s.dirty;
@@ -359,4 +365,42 @@ fn a_reload_with_the_same_model_keeps_the_sculpt() {
     assert!(s.data() == &g.assembly);
     s.apply(Command::Undo);
     assert_eq!(s.data().positions, sculpted);
+}
+
+#[test]
+fn a_handle_on_a_stretch_chain_holds_the_brick_under_the_cursor() {
+    let source = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../grammars/wall.clay"
+    ))
+    .unwrap();
+    let grammar = compile(&source, "grammars/wall.clay").unwrap().grammar;
+    let mut s = Sculpt::new(grammar);
+    // Part 0 spans bricks 0 and 1; press on brick 1.
+    let chain = s.data().chains[0].instances.clone();
+    let brick1 = s.assembly().instance_centroid(chain[1]).unwrap();
+    s.apply(Command::TogglePin {
+        part: 0,
+        at: brick1,
+    });
+    let pins = s.pins();
+    assert_eq!(pins.len(), 1);
+    let mut held = pins[0].vertices.clone();
+    let mut want = s.data().instances[chain[1]].vertices.clone();
+    held.sort_unstable();
+    want.sort_unstable();
+    assert_eq!(
+        held, want,
+        "the pin holds brick 1 alone, not the two-brick part"
+    );
+    assert!(
+        s.is_pinned(0) && s.is_pinned(1),
+        "both parts over brick 1 show it"
+    );
+    // The same press toggles it off again.
+    s.apply(Command::TogglePin {
+        part: 1,
+        at: brick1,
+    });
+    assert!(s.pins().is_empty());
 }
