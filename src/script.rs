@@ -8,6 +8,7 @@ use glam::DVec2;
 use serde_json::Value;
 
 use crate::assembly::{Assembly, Compass, HandleId, HandleKind};
+use crate::rules::{RuleEvent, RuleKind};
 use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
 use crate::summary::{Summary, summarize};
 use clay_dsl::compiled::PartKind;
@@ -263,44 +264,6 @@ impl Script {
             })
             .sum()
     }
-}
-
-/// The kinds of rule (paper 5.1), as counted in the summary.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum RuleKind {
-    Replace,
-    Stretch,
-    Shrink,
-    Merge,
-    Cut,
-}
-
-impl RuleKind {
-    pub const ALL: [RuleKind; 5] = [
-        RuleKind::Replace,
-        RuleKind::Stretch,
-        RuleKind::Shrink,
-        RuleKind::Merge,
-        RuleKind::Cut,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            RuleKind::Replace => "replace",
-            RuleKind::Stretch => "stretch",
-            RuleKind::Shrink => "shrink",
-            RuleKind::Merge => "merge",
-            RuleKind::Cut => "cut",
-        }
-    }
-}
-
-/// A rule that fired.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RuleEvent {
-    pub kind: RuleKind,
-    /// What happened, for logs (`"wall[3] split into 2"`).
-    pub detail: String,
 }
 
 /// Where rules plug into a session: called after every solver frame, and for cut requests.

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::assembly::Assembly;
-use crate::script::RuleKind;
+use crate::rules::RuleKind;
 use crate::solver::{FrameReport, SolverConfig, bbox, elastic_energy, max_edge_strain};
 
 /// Median and largest frame time in milliseconds (0 when no frame ran).

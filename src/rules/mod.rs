@@ -24,8 +24,8 @@ use serde::Serialize;
 use crate::assembly::Assembly;
 use crate::solver::FrameReport;
 
-/// What kind of rule fired.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+/// What kind of rule fired (paper 5.1), as logged and counted in the summary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RuleKind {
     Replace,
@@ -33,6 +33,27 @@ pub enum RuleKind {
     Shrink,
     Merge,
     Cut,
+}
+
+impl RuleKind {
+    pub const ALL: [RuleKind; 5] = [
+        RuleKind::Replace,
+        RuleKind::Stretch,
+        RuleKind::Shrink,
+        RuleKind::Merge,
+        RuleKind::Cut,
+    ];
+
+    /// The name used in summaries and logs (`"stretch"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            RuleKind::Replace => "replace",
+            RuleKind::Stretch => "stretch",
+            RuleKind::Shrink => "shrink",
+            RuleKind::Merge => "merge",
+            RuleKind::Cut => "cut",
+        }
+    }
 }
 
 /// One application of a rule.
@@ -440,45 +461,18 @@ impl Rules {
     }
 }
 
-impl From<RuleKind> for crate::script::RuleKind {
-    fn from(k: RuleKind) -> Self {
-        match k {
-            RuleKind::Replace => Self::Replace,
-            RuleKind::Stretch => Self::Stretch,
-            RuleKind::Shrink => Self::Shrink,
-            RuleKind::Merge => Self::Merge,
-            RuleKind::Cut => Self::Cut,
-        }
-    }
-}
-
-impl From<&RuleEvent> for crate::script::RuleEvent {
-    fn from(e: &RuleEvent) -> Self {
-        Self {
-            kind: e.kind.into(),
-            detail: e.detail.clone(),
-        }
-    }
-}
-
 /// The replay hook (`clayc run`, the editor). The replay counts `replace` itself from the
 /// solver's state switches, so replacement events are not passed on (no double counting).
 impl crate::script::FrameHook for Rules {
-    fn after_frame(
-        &mut self,
-        assembly: &mut Assembly,
-        report: &FrameReport,
-    ) -> Vec<crate::script::RuleEvent> {
-        Rules::after_frame(self, assembly, report)
-            .iter()
-            .filter(|e| e.kind != RuleKind::Replace)
-            .map(Into::into)
-            .collect()
+    fn after_frame(&mut self, assembly: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent> {
+        let mut events = Rules::after_frame(self, assembly, report);
+        events.retain(|e| e.kind != RuleKind::Replace);
+        events
     }
 
-    fn cut(&mut self, assembly: &mut Assembly, at: DVec2) -> Option<Vec<crate::script::RuleEvent>> {
+    fn cut(&mut self, assembly: &mut Assembly, at: DVec2) -> Option<Vec<RuleEvent>> {
         match Rules::cut(self, assembly, at) {
-            Ok(e) => Some(vec![(&e).into()]),
+            Ok(e) => Some(vec![e]),
             Err(message) => {
                 self.notes.push(message);
                 Some(Vec::new())
