@@ -57,6 +57,10 @@ fn valid_grammar_exits_0_and_builds_json() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr).trim(),
+        "check passed: 1 file, no errors or warnings"
+    );
     let out = clayc()
         .arg("build")
         .arg(&p)

@@ -97,18 +97,19 @@ pub fn check(args: CheckArgs) -> u8 {
                 return 2;
             }
         },
-        Format::Human => {
-            if errors > 0 || warnings > 0 {
-                eprintln!("{}", summary(errors, warnings));
-            }
-        }
+        // A clean check says so: silence would leave an author unsure anything was read.
+        Format::Human => eprintln!("{}", summary(args.files.len(), errors, warnings)),
     }
     worst
 }
 
-fn summary(errors: usize, warnings: usize) -> String {
+fn summary(files: usize, errors: usize, warnings: usize) -> String {
     let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
     match (errors, warnings) {
+        (0, 0) => format!(
+            "check passed: {}, no errors or warnings",
+            plural(files, "file")
+        ),
         (0, w) => format!("check passed with {}", plural(w, "warning")),
         (e, 0) => format!("check failed: {}", plural(e, "error")),
         (e, w) => format!(
@@ -132,7 +133,7 @@ pub fn build(args: BuildArgs) -> u8 {
         Ok(c) => c,
         Err(diags) => {
             print_human(&diags, &bytes, &path);
-            eprintln!("{}", summary(diags.error_count(), diags.warning_count()));
+            eprintln!("{}", summary(1, diags.error_count(), diags.warning_count()));
             return 1;
         }
     };
