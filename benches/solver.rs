@@ -63,17 +63,17 @@ fn frames(c: &mut Criterion) {
 /// Per-phase breakdown of the `clayc bench --parts N` drag (same model, handles and drag).
 fn phases(parts: usize) {
     let (mut asm, h) = setup(parts);
-    let (lo, hi) = asm
-        .data
-        .positions
-        .iter()
-        .filter(|p| p.y >= 0.0)
-        .fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
+    let (lo, hi) = asm.data.positions.iter().filter(|p| p.y >= 0.0).fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
     let offset = DVec2::new(0.3, 0.2) * (hi - lo).length();
     let mut config = SolverConfig::default();
-    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<usize>().ok());
+    let env = |name: &str| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse::<usize>().ok())
+    };
     if let Some(k) = env("CLAY_PCG") {
         config.pcg_max_iterations = k;
     }
@@ -118,7 +118,10 @@ fn phases(parts: usize) {
 criterion_group!(benches, frames);
 
 fn main() {
-    match std::env::var("CLAY_PHASES").ok().and_then(|v| v.parse().ok()) {
+    match std::env::var("CLAY_PHASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
         Some(parts) => phases(parts),
         None => {
             benches();

@@ -21,7 +21,11 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
     // Name the grammar as a reader of the docs would type it (`grammars/wall.clay`), not by this
     // machine's absolute path: the name is printed in the sheet's title.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let name = path.strip_prefix(root).unwrap_or(path).display().to_string();
+    let name = path
+        .strip_prefix(root)
+        .unwrap_or(path)
+        .display()
+        .to_string();
     clay_dsl::compile(source, &name)
         .map(|c| c.grammar)
         .map_err(|d| clay_dsl::render(&d, source, &name, false))

@@ -1,10 +1,10 @@
 //! Clay: live assemblies, the mutable elastic solver, rules and rendering.
 pub mod assembly;
-pub mod fit;
-pub mod solver;
-pub mod rules;
-pub mod render;
-pub mod synthetic;
-pub mod script;
-pub mod summary;
 pub mod authoring;
+pub mod fit;
+pub mod render;
+pub mod rules;
+pub mod script;
+pub mod solver;
+pub mod summary;
+pub mod synthetic;

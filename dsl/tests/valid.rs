@@ -331,7 +331,10 @@ fn merges_into_junctions_derive_their_cut() {
     let mut params = g.solver;
     params.merge_distance = 2.0;
     assert_eq!(m.distance(&params), 0.25);
-    let follows = clay_dsl::compiled::MergeRule { within: None, ..m.clone() };
+    let follows = clay_dsl::compiled::MergeRule {
+        within: None,
+        ..m.clone()
+    };
     assert_eq!(follows.distance(&params), 2.0);
     assert_eq!(
         g.cut_rules,

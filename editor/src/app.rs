@@ -393,6 +393,9 @@ impl EditorApp {
             if author && i.consume_key(Modifiers::NONE, Key::C) {
                 self.author_canvas.tool = Tool::Cut;
             }
+            if author && i.consume_key(Modifiers::NONE, Key::S) {
+                self.author_canvas.tool = Tool::Site;
+            }
             if i.consume_key(Modifiers::COMMAND, Key::S) {
                 self.actions.push(match &self.session_path {
                     Some(p) => Action::SaveSession(p.clone()),
@@ -493,6 +496,8 @@ impl EditorApp {
                 ui.separator();
                 let state = if let Some(e) = self.sculpt.error() {
                     format!("solver stopped: {e}")
+                } else if self.sculpt.last_report().is_some_and(|r| !r.complete) {
+                    "solving: frame over its time budget, continuing next frame".to_string()
                 } else if self.sculpt.needs_work() {
                     "solving: not converged yet, continuing next frame".to_string()
                 } else {

@@ -1,6 +1,7 @@
 //! Authoring mode's state: the drawing, its cut points and the author's rule declarations
-//! (site type names, the stretchable piece), the design recomputed from them through
-//! `clay::authoring`, and the grammar text with its diagnostics. Every change is an
+//! (site type names, site types, the stretchable piece and its variants, merge rules, posed
+//! rest states), the design recomputed from them through `clay::authoring` with the editor's
+//! additions to its syntax tree, and the grammar text with its diagnostics. Every change is an
 //! [`AuthorCommand`]; changes to the work are undoable as whole steps.
 
 use std::collections::BTreeMap;
@@ -29,6 +30,14 @@ pub struct Work {
     /// Merge rules, by piece and site names (the library's design has none: the editor adds
     /// them to the syntax tree before printing).
     pub merges: Vec<MergeChoice>,
+    /// Site types set per site: `piece.site` -> a type (a generated name, a shown name, or a
+    /// new one). Applied after the renames.
+    pub site_types: BTreeMap<SiteName, String>,
+    /// The stretch rule's `variants { ... }` (empty: none written).
+    pub variants: Vec<VariantChoice>,
+    /// Alternative rest states added by posing copies of pieces (the library's design has
+    /// none: the editor adds them to the syntax tree before printing).
+    pub states: Vec<StateChoice>,
     /// Points closer than this (metres) are one vertex; also the congruence tolerance.
     pub tolerance: f64,
 }
@@ -41,6 +50,9 @@ impl Default for Work {
             site_names: BTreeMap::new(),
             stretch: None,
             merges: Vec::new(),
+            site_types: BTreeMap::new(),
+            variants: Vec::new(),
+            states: Vec::new(),
             tolerance: 1e-3,
         }
     }
@@ -75,6 +87,22 @@ impl std::fmt::Display for MergeChoice {
         }
         Ok(())
     }
+}
+
+/// One entry of `variants { PIECE FREQ, ... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantChoice {
+    pub piece: String,
+    pub frequency: f64,
+}
+
+/// `state NAME { v0 (x, y) ... }` of a piece: one position per piece vertex, in the piece's
+/// coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateChoice {
+    pub piece: String,
+    pub name: String,
+    pub positions: Vec<DVec2>,
 }
 
 /// Every `piece.site` of a design.
@@ -116,6 +144,21 @@ pub enum AuthorCommand {
     /// Declare a merge rule (refused unless its sites exist).
     AddMerge(MergeChoice),
     RemoveMerge {
+        index: usize,
+    },
+    /// Give a site a type (an existing one or a new name). The sites docked with it, directly
+    /// or through other docks, get it too: the written types dock only with themselves.
+    SetSiteType {
+        site: SiteName,
+        site_type: String,
+    },
+    /// Set the stretch rule's variants (empty: none). Frequencies are normalised to sum to 1;
+    /// refused unless a stretch is declared and every variant has the stretch piece's shape.
+    SetVariants(Vec<VariantChoice>),
+    /// Add an alternative rest state to a piece (refused unless it has one finite position per
+    /// vertex, no two at one place, and a new name).
+    AddState(StateChoice),
+    RemoveState {
         index: usize,
     },
     SetTolerance(f64),
@@ -196,13 +239,79 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
             .notes
             .push(format!("the stretch declaration no longer applies: {e}"));
     }
-    let generated_site_types = design.site_types.clone();
+    let mut generated_site_types = design.site_types.clone();
     for t in &mut design.site_types {
         if let Some(n) = work.site_names.get(t) {
             t.clone_from(n);
         }
     }
+    for (site, ty) in &work.site_types {
+        let Some((p, si)) = find_site(&design, site) else {
+            design.notes.push(format!(
+                "the type of {site} no longer applies: there is no such site"
+            ));
+            continue;
+        };
+        let t = generated_site_types
+            .iter()
+            .position(|g| g == ty)
+            .or_else(|| design.site_types.iter().position(|n| n == ty))
+            .unwrap_or_else(|| {
+                generated_site_types.push(ty.clone());
+                let shown = work.site_names.get(ty).unwrap_or(ty);
+                design.site_types.push(shown.clone());
+                design.site_types.len() - 1
+            });
+        design.pieces[p].sites[si].site_type = t;
+    }
+    if !work.site_types.is_empty() {
+        // A type that no site has any more is not written (its sites all took another).
+        let used: Vec<bool> = (0..design.site_types.len())
+            .map(|t| {
+                design
+                    .pieces
+                    .iter()
+                    .any(|p| p.sites.iter().any(|s| s.site_type == t))
+            })
+            .collect();
+        let mut renumber = Vec::with_capacity(used.len());
+        let mut next = 0;
+        for &u in &used {
+            renumber.push(next);
+            next += usize::from(u);
+        }
+        for p in &mut design.pieces {
+            for s in &mut p.sites {
+                s.site_type = renumber[s.site_type];
+            }
+        }
+        let mut keep = used.iter();
+        design.site_types.retain(|_| *keep.next().unwrap_or(&true));
+        let mut keep = used.iter();
+        generated_site_types.retain(|_| *keep.next().unwrap_or(&true));
+    }
+    for d in &design.docks {
+        if let (Some(a), Some(b)) = (piece_site(&design, d.a), piece_site(&design, d.b)) {
+            let ty = |(p, s): (usize, usize)| design.pieces[p].sites[s].site_type;
+            if ty(a) != ty(b) {
+                let name = |(p, s): (usize, usize)| {
+                    format!(
+                        "{}.{}",
+                        design.pieces[p].name, design.pieces[p].sites[s].name
+                    )
+                };
+                design.notes.push(format!(
+                    "{} and {} are docked but of different types",
+                    name(a),
+                    name(b)
+                ));
+            }
+        }
+    }
     let mut tree = design.to_syntax();
+    // States first: rewriting a variant renames the vertices its states name.
+    add_states(work, &mut design, &mut tree);
+    add_variants(work, &mut design, &mut tree);
     let names = site_names(&design);
     let at = tree
         .items
@@ -230,6 +339,371 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
         generated_site_types,
         text,
     })
+}
+
+/// Piece and site index of `piece.site`.
+pub fn find_site(design: &Design, s: &SiteName) -> Option<(usize, usize)> {
+    let p = design.pieces.iter().position(|p| p.name == s.piece)?;
+    let si = design.pieces[p]
+        .sites
+        .iter()
+        .position(|x| x.name == s.site)?;
+    Some((p, si))
+}
+
+/// Piece and site index of an instance site `(instance, site)`.
+fn piece_site(design: &Design, (instance, site): (usize, usize)) -> Option<(usize, usize)> {
+    let p = design.instances.get(instance)?.piece;
+    design.pieces.get(p)?.sites.get(site)?;
+    Some((p, site))
+}
+
+/// The piece sites docked with `start` directly or through other docks, `start` first: they
+/// must share one site type, since the written types dock only with themselves.
+pub fn docked_sites(design: &Design, start: (usize, usize)) -> Vec<(usize, usize)> {
+    let mut out = vec![start];
+    let mut k = 0;
+    while k < out.len() {
+        let current = out[k];
+        k += 1;
+        for d in &design.docks {
+            let (Some(a), Some(b)) = (piece_site(design, d.a), piece_site(design, d.b)) else {
+                continue;
+            };
+            for (x, y) in [(a, b), (b, a)] {
+                if x == current && !out.contains(&y) {
+                    out.push(y);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The edges two pieces must share to be variants: the outline's when both have one (the
+/// library adds its own diagonals to make an outline rigid, and the variant takes the
+/// stretch piece's), otherwise all of them.
+fn reference_edges(
+    a: &clay::authoring::PieceDesign,
+    b: &clay::authoring::PieceDesign,
+) -> (Vec<[usize; 2]>, Vec<[usize; 2]>) {
+    let edges = |x: &clay::authoring::PieceDesign| -> Vec<[usize; 2]> {
+        let mut e: Vec<[usize; 2]> = match (&a.outline, &b.outline, &x.outline) {
+            (Some(_), Some(_), Some(o)) => {
+                (0..o.len()).map(|k| [o[k], o[(k + 1) % o.len()]]).collect()
+            }
+            _ => x.edges.clone(),
+        };
+        for [i, j] in &mut e {
+            (*i, *j) = ((*i).min(*j), (*i).max(*j));
+        }
+        e.sort_unstable();
+        e.dedup();
+        e
+    };
+    (edges(a), edges(b))
+}
+
+/// How piece `v` can be written as a variant of piece `p` (E041: the same vertices in the same
+/// order, the same edges and sites): `map[i]` is `p`'s vertex for `v`'s vertex `i`. The library
+/// numbers each piece's vertices by its own geometry, so the editor matches them through the
+/// site names and the edges, and writes the variant with `p`'s graph and its own positions.
+pub fn variant_map(design: &Design, p: usize, v: usize) -> Result<Vec<usize>, String> {
+    let (a, b) = (&design.pieces[p], &design.pieces[v]);
+    let n = a.positions.len();
+    if n != b.positions.len() {
+        return Err(format!(
+            "`{}` has {} vertices, `{}` has {}",
+            b.name,
+            b.positions.len(),
+            a.name,
+            n
+        ));
+    }
+    let other_sites = || {
+        format!(
+            "`{}` has other sites (names, types or vertex counts) than `{}`",
+            b.name, a.name
+        )
+    };
+    if a.sites.len() != b.sites.len() {
+        return Err(other_sites());
+    }
+    let mut map: Vec<Option<usize>> = vec![None; n];
+    for sa in &a.sites {
+        let sb = b
+            .sites
+            .iter()
+            .find(|s| s.name == sa.name)
+            .ok_or_else(other_sites)?;
+        if sb.site_type != sa.site_type || sb.vertices.len() != sa.vertices.len() {
+            return Err(other_sites());
+        }
+        for (&i, &j) in sb.vertices.iter().zip(&sa.vertices) {
+            match map[i] {
+                Some(k) if k != j => return Err(other_sites()),
+                _ => map[i] = Some(j),
+            }
+        }
+    }
+    let (ea, eb) = reference_edges(a, b);
+    let other_edges = || format!("`{}` has other edges than `{}`", b.name, a.name);
+    if ea.len() != eb.len() {
+        return Err(other_edges());
+    }
+    // The vertices on no site: a small search for an assignment that maps the edges onto
+    // the edges (pieces have a handful of vertices).
+    fn extend(
+        map: &mut Vec<Option<usize>>,
+        ea: &[[usize; 2]],
+        eb: &[[usize; 2]],
+        budget: &mut u32,
+    ) -> bool {
+        let consistent = eb.iter().all(|&[i, j]| match (map[i], map[j]) {
+            (Some(x), Some(y)) => ea.contains(&[x.min(y), x.max(y)]),
+            _ => true,
+        });
+        if !consistent || *budget == 0 {
+            return false;
+        }
+        *budget -= 1;
+        let Some(free) = map.iter().position(Option::is_none) else {
+            return true;
+        };
+        for target in 0..map.len() {
+            if map.contains(&Some(target)) {
+                continue;
+            }
+            map[free] = Some(target);
+            if extend(map, ea, eb, budget) {
+                return true;
+            }
+            map[free] = None;
+        }
+        false
+    }
+    let mut budget = 100_000;
+    if !extend(&mut map, &ea, &eb, &mut budget) {
+        return Err(other_edges());
+    }
+    let map: Vec<usize> = map.into_iter().map(|m| m.unwrap_or(0)).collect();
+    let mut mapped: Vec<[usize; 2]> = eb
+        .iter()
+        .map(|&[i, j]| [map[i].min(map[j]), map[i].max(map[j])])
+        .collect();
+    mapped.sort_unstable();
+    if mapped != ea {
+        return Err(other_edges());
+    }
+    Ok(map)
+}
+
+/// Writes the variants into the stretch rule, each variant piece rewritten with the stretch
+/// piece's vertices, edges and sites at its own positions; or notes why they no longer apply.
+fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::File) {
+    use clay_dsl::syntax::{Ident, Item, Number, PieceStmt, Span, VariantEntry, VariantsDecl};
+    if work.variants.is_empty() {
+        return;
+    }
+    let Some(sp) = design.pieces.iter().position(|p| p.stretch.is_some()) else {
+        design
+            .notes
+            .push("the variants no longer apply: no piece is stretchable".into());
+        return;
+    };
+    let mut maps = Vec::new();
+    for v in &work.variants {
+        let found = match design.pieces.iter().position(|p| p.name == v.piece) {
+            None => Err(format!("there is no piece `{}`", v.piece)),
+            Some(vi) => variant_map(design, sp, vi).map(|m| (vi, m)),
+        };
+        match found {
+            Ok(m) => maps.push(m),
+            Err(problem) => {
+                design
+                    .notes
+                    .push(format!("the variants no longer apply: {problem}"));
+                return;
+            }
+        }
+    }
+    let piece_decl = |tree: &clay_dsl::syntax::File, name: &str| {
+        tree.items
+            .iter()
+            .position(|i| matches!(i, Item::Piece(p) if p.name.name == name))
+    };
+    let Some(at) = piece_decl(tree, &design.pieces[sp].name) else {
+        return;
+    };
+    let Item::Piece(stretch_decl) = tree.items[at].clone() else {
+        return;
+    };
+    for (vi, map) in &maps {
+        if *vi == sp {
+            continue;
+        }
+        let variant = &design.pieces[*vi];
+        let Some(at) = piece_decl(tree, &variant.name) else {
+            continue;
+        };
+        let Item::Piece(decl) = &mut tree.items[at] else {
+            continue;
+        };
+        // Vertex names as written, in the variant's order and in the stretch piece's.
+        let names = |stmts: &[PieceStmt]| -> Vec<Ident> {
+            stmts
+                .iter()
+                .filter_map(|s| match s {
+                    PieceStmt::Vertex(v) => Some(v.name.clone()),
+                    _ => None,
+                })
+                .collect()
+        };
+        let (own, shared) = (names(&decl.stmts), names(&stretch_decl.stmts));
+        let mut inverse = vec![0; map.len()];
+        for (i, &j) in map.iter().enumerate() {
+            inverse[j] = i;
+        }
+        let own_decl = decl.stmts.clone();
+        let position = |j: usize| {
+            own_decl.iter().find_map(|s| match s {
+                PieceStmt::Vertex(v) if own.get(inverse[j]) == Some(&v.name) => Some(v.pos),
+                _ => None,
+            })
+        };
+        let mut stmts = Vec::new();
+        for s in &stretch_decl.stmts {
+            match s {
+                PieceStmt::Vertex(v) => {
+                    let j = shared.iter().position(|n| n == &v.name).unwrap_or(0);
+                    let mut v = v.clone();
+                    if let Some(p) = position(j) {
+                        v.pos = p;
+                    }
+                    stmts.push(PieceStmt::Vertex(v));
+                }
+                PieceStmt::Edges(_) => stmts.push(s.clone()),
+                PieceStmt::Site(site) => {
+                    let mut site = site.clone();
+                    if let Some(PieceStmt::Site(o)) = own_decl
+                        .iter()
+                        .find(|o| matches!(o, PieceStmt::Site(o) if o.name == site.name))
+                    {
+                        site.out = o.out;
+                    }
+                    stmts.push(PieceStmt::Site(site));
+                }
+                _ => {}
+            }
+        }
+        for s in own_decl {
+            match s {
+                PieceStmt::Vertex(_) | PieceStmt::Edges(_) | PieceStmt::Site(_) => {}
+                PieceStmt::State(mut st) => {
+                    // The state's positions follow the vertices to their new names.
+                    for p in &mut st.positions {
+                        if let Some(i) = own.iter().position(|n| n.name == p.name.name)
+                            && let Some(n) = shared.get(map[i])
+                        {
+                            p.name = n.clone();
+                        }
+                    }
+                    stmts.push(PieceStmt::State(st));
+                }
+                other => stmts.push(other),
+            }
+        }
+        decl.stmts = stmts;
+    }
+    let entries = work
+        .variants
+        .iter()
+        .map(|v| VariantEntry {
+            piece: Ident {
+                name: v.piece.clone(),
+                span: Span::default(),
+            },
+            frequency: Number {
+                value: v.frequency,
+                span: Span::default(),
+            },
+            span: Span::default(),
+        })
+        .collect();
+    for item in &mut tree.items {
+        if let Item::Stretch(s) = item
+            && s.piece.name == design.pieces[sp].name
+        {
+            s.variants = vec![VariantsDecl {
+                entries,
+                span: Span::default(),
+            }];
+            return;
+        }
+    }
+}
+
+/// Writes the alternative rest states into their pieces, or notes why they no longer apply.
+fn add_states(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::File) {
+    use clay_dsl::syntax::{Ident, Item, Number, PieceStmt, Point, Span, StateDecl, VertexDecl};
+    let number = |value: f64| Number {
+        value: (value * 1e6).round() / 1e6,
+        span: Span::default(),
+    };
+    for st in &work.states {
+        let piece = tree.items.iter_mut().find_map(|i| match i {
+            Item::Piece(p) if p.name.name == st.piece => Some(p),
+            _ => None,
+        });
+        let Some(piece) = piece else {
+            design.notes.push(format!(
+                "state `{}` no longer applies: there is no piece `{}`",
+                st.name, st.piece
+            ));
+            continue;
+        };
+        let vertices: Vec<Ident> = piece
+            .stmts
+            .iter()
+            .filter_map(|s| match s {
+                PieceStmt::Vertex(v) => Some(v.name.clone()),
+                _ => None,
+            })
+            .collect();
+        if vertices.len() != st.positions.len() {
+            design.notes.push(format!(
+                "state `{}` no longer applies: `{}` now has {} vertices, the state {}",
+                st.name,
+                st.piece,
+                vertices.len(),
+                st.positions.len()
+            ));
+            continue;
+        }
+        let positions = vertices
+            .into_iter()
+            .zip(&st.positions)
+            .map(|(name, p)| VertexDecl {
+                name,
+                pos: Point {
+                    x: number(p.x),
+                    y: number(p.y),
+                    span: Span::default(),
+                },
+                span: Span::default(),
+            })
+            .collect();
+        piece.stmts.push(PieceStmt::State(StateDecl {
+            name: Ident {
+                name: st.name.clone(),
+                span: Span::default(),
+            },
+            positions,
+            edges: Vec::new(),
+            geometry: Vec::new(),
+            span: Span::default(),
+        }));
+    }
 }
 
 fn site_path(s: &SiteName) -> clay_dsl::syntax::SitePath {
@@ -451,6 +925,98 @@ impl Authoring {
                     self.change(w, "remove that merge rule");
                 }
             }
+            AuthorCommand::SetSiteType { site, site_type } => {
+                let site_type = site_type.trim().to_string();
+                if !valid_identifier(&site_type) {
+                    self.message = Some(format!(
+                        "`{site_type}` is not a name: use letters, digits and _, not starting with a digit"
+                    ));
+                    return;
+                }
+                let Some(design) = self.design() else {
+                    return;
+                };
+                let Some(start) = find_site(design, &site) else {
+                    self.message = Some(format!("there is no site {site}"));
+                    return;
+                };
+                let along: Vec<SiteName> = docked_sites(design, start)
+                    .into_iter()
+                    .map(|(p, s)| SiteName {
+                        piece: design.pieces[p].name.clone(),
+                        site: design.pieces[p].sites[s].name.clone(),
+                    })
+                    .collect();
+                for s in &along {
+                    w.site_types.insert(s.clone(), site_type.clone());
+                }
+                let changed = w != self.work;
+                self.change(w, "set that site type");
+                if changed && along.len() > 1 && self.message.is_none() {
+                    let others: Vec<String> = along[1..].iter().map(|s| s.to_string()).collect();
+                    self.message = Some(format!(
+                        "{} docks with {}: they get the type `{site_type}` too",
+                        along[0],
+                        others.join(", ")
+                    ));
+                }
+            }
+            AuthorCommand::SetVariants(mut variants) => {
+                if variants.is_empty() {
+                    w.variants.clear();
+                    self.change(w, "remove the variants");
+                    return;
+                }
+                let Some(design) = self.design() else {
+                    return;
+                };
+                let Some(sp) = design.pieces.iter().position(|p| p.stretch.is_some()) else {
+                    self.message =
+                        Some("variants need a stretchable piece: declare one first".into());
+                    return;
+                };
+                for (k, v) in variants.iter().enumerate() {
+                    if !(v.frequency.is_finite() && v.frequency > 0.0) {
+                        self.message = Some(format!(
+                            "the frequency of `{}` must be a positive number",
+                            v.piece
+                        ));
+                        return;
+                    }
+                    if variants[..k].iter().any(|x| x.piece == v.piece) {
+                        self.message = Some(format!("`{}` is listed twice", v.piece));
+                        return;
+                    }
+                    let problem = match design.pieces.iter().position(|p| p.name == v.piece) {
+                        None => Some(format!("there is no piece `{}`", v.piece)),
+                        Some(vi) => variant_map(design, sp, vi).err(),
+                    };
+                    if let Some(p) = problem {
+                        self.message = Some(format!("`{}` cannot be a variant: {p}", v.piece));
+                        return;
+                    }
+                }
+                let sum: f64 = variants.iter().map(|v| v.frequency).sum();
+                for v in &mut variants {
+                    v.frequency /= sum;
+                }
+                w.variants = variants;
+                self.change(w, "set the variants");
+            }
+            AuthorCommand::AddState(st) => {
+                if let Err(e) = self.check_state(&st) {
+                    self.message = Some(e);
+                    return;
+                }
+                w.states.push(st);
+                self.change(w, "add that rest state");
+            }
+            AuthorCommand::RemoveState { index } => {
+                if index < w.states.len() {
+                    w.states.remove(index);
+                    self.change(w, "remove that rest state");
+                }
+            }
             AuthorCommand::SetTolerance(t) => {
                 if !(t.is_finite() && t > 0.0) {
                     self.message = Some("the tolerance must be a positive number".into());
@@ -474,6 +1040,59 @@ impl Authoring {
                 self.recompute();
             }
         }
+    }
+
+    /// Why a posed state cannot be added to its piece.
+    fn check_state(&self, st: &StateChoice) -> Result<(), String> {
+        if !valid_identifier(&st.name) {
+            return Err(format!(
+                "`{}` is not a name: use letters, digits and _, not starting with a digit",
+                st.name
+            ));
+        }
+        if st.name == "base" {
+            return Err("`base` is the name of the drawn rest state: pick another".into());
+        }
+        let design = self.design().ok_or("there is no design yet")?;
+        let piece = design
+            .pieces
+            .iter()
+            .find(|p| p.name == st.piece)
+            .ok_or_else(|| format!("there is no piece `{}`", st.piece))?;
+        if st.positions.len() != piece.positions.len() {
+            return Err(format!(
+                "`{}` has {} vertices, the state gives {}",
+                st.piece,
+                piece.positions.len(),
+                st.positions.len()
+            ));
+        }
+        if st.positions == piece.positions {
+            return Err("the posed copy is the base state: move a vertex first".into());
+        }
+        if st.positions.iter().any(|p| !p.is_finite()) {
+            return Err("a vertex position is not a finite number".into());
+        }
+        for (i, a) in st.positions.iter().enumerate() {
+            if st.positions[..i]
+                .iter()
+                .any(|b| (*a - *b).length() < self.work.tolerance)
+            {
+                return Err(format!(
+                    "two vertices of the state are at ({}, {}): move one",
+                    a.x, a.y
+                ));
+            }
+        }
+        if self
+            .work
+            .states
+            .iter()
+            .any(|s| s.piece == st.piece && s.name == st.name)
+        {
+            return Err(format!("`{}` already has a state `{}`", st.piece, st.name));
+        }
+        Ok(())
     }
 
     /// Reads an SVG drawing (`scale` metres per SVG unit) and makes it the drawing.

@@ -1,13 +1,15 @@
 //! Authoring mode's canvas: draws the drawing, the grid, the cut points and the design (regions
 //! filled by piece, instance outlines, docking sites coloured by site type), and turns clicks
 //! into [`AuthorCommand`]s: drawing strokes snapped to the grid or to drawn points in the draw
-//! tool, placing cut points on the drawing in the cut tool. It never changes the work itself.
+//! tool, placing cut points on the drawing in the cut tool; it also picks sites (site tool)
+//! and lets the author drag the vertices of a posed copy of a piece (a rest state in the
+//! making). It never changes the work itself.
 
 use clay::authoring::Polyline;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
-use crate::author::{AuthorCommand, Authoring, Computed};
+use crate::author::{AuthorCommand, Authoring, Computed, SiteName};
 use crate::camera::Camera;
 
 /// Pointer distance (screen points) within which a point or edge counts as under it.
@@ -19,6 +21,7 @@ const GRID: Color32 = Color32::from_rgb(226, 222, 212);
 const STROKES: Color32 = Color32::from_rgb(60, 60, 70);
 const PENDING: Color32 = Color32::from_rgb(30, 80, 220);
 const CUT: Color32 = Color32::from_rgb(230, 40, 160);
+const POSE: Color32 = Color32::from_rgb(0, 150, 110);
 const LABELS: Color32 = Color32::from_rgb(50, 40, 30);
 
 /// Piece fills, by piece index.
@@ -61,6 +64,21 @@ pub enum Tool {
     Draw,
     /// Click on the drawing to cut it there; right-click a cut to remove it.
     Cut,
+    /// Click a docking site to pick it (the panel then sets its type).
+    Site,
+}
+
+/// A posed copy of a piece: a new rest state in the making. Shown over one instance of the
+/// piece; its vertices are dragged (snapped to the grid in the piece's coordinates).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pose {
+    pub piece: String,
+    /// The instance the copy is shown over.
+    pub instance: usize,
+    /// One position per piece vertex, in the piece's coordinates.
+    pub positions: Vec<DVec2>,
+    /// The vertex being dragged.
+    pub dragging: Option<usize>,
 }
 
 /// View state of the authoring canvas, kept between frames.
@@ -73,6 +91,10 @@ pub struct AuthorCanvas {
     pub pending: Vec<DVec2>,
     /// Where a click would put a point or a cut, in the last frame.
     pub target: Option<DVec2>,
+    /// The site picked with the site tool.
+    pub selected_site: Option<SiteName>,
+    /// The rest state being posed, if any.
+    pub pose: Option<Pose>,
     panning: bool,
     fit_pending: bool,
     /// The canvas rectangle of the last fit, while the user has not moved the view since:
@@ -92,6 +114,8 @@ impl Default for AuthorCanvas {
             grid: 0.1,
             pending: Vec::new(),
             target: None,
+            selected_site: None,
+            pose: None,
             panning: false,
             fit_pending: true,
             fitted: None,
@@ -195,6 +219,93 @@ impl AuthorCanvas {
             .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)))
     }
 
+    /// Starts posing a copy of piece `piece` over its first instance.
+    pub fn start_pose(&mut self, author: &Authoring, piece: usize) {
+        let Some(design) = author.design() else {
+            return;
+        };
+        let (Some(p), Some(instance)) = (
+            design.pieces.get(piece),
+            design.instances.iter().position(|i| i.piece == piece),
+        ) else {
+            return;
+        };
+        self.pose = Some(Pose {
+            piece: p.name.clone(),
+            instance,
+            positions: p.positions.clone(),
+            dragging: None,
+        });
+    }
+
+    /// Where vertex `k` of the posed copy is drawn (metres, y up).
+    pub fn pose_world(&self, author: &Authoring, k: usize) -> Option<DVec2> {
+        let pose = self.pose.as_ref()?;
+        let inst = author.design()?.instances.get(pose.instance)?;
+        let p = *pose.positions.get(k)?;
+        Some(DVec2::from_angle(inst.angle).rotate(p) + inst.at)
+    }
+
+    /// Moves vertex `k` of the posed copy under the world point `w`, snapped to the grid in
+    /// the piece's coordinates (so the written state has round numbers).
+    pub fn move_pose_vertex(&mut self, author: &Authoring, k: usize, w: DVec2) {
+        let Some(inst) = self
+            .pose
+            .as_ref()
+            .and_then(|p| author.design()?.instances.get(p.instance))
+        else {
+            return;
+        };
+        let local = DVec2::from_angle(-inst.angle).rotate(w - inst.at);
+        let snapped = if self.grid.is_finite() && self.grid > 0.0 {
+            (local / self.grid).round() * self.grid
+        } else {
+            local
+        };
+        if let Some(p) = self.pose.as_mut().and_then(|p| p.positions.get_mut(k))
+            && snapped.is_finite()
+        {
+            *p = snapped;
+        }
+    }
+
+    /// The site of an instance under the world point `w`: the nearest site centre in reach.
+    fn site_at(&self, author: &Authoring, w: DVec2) -> Option<SiteName> {
+        let c = author.result.as_ref().ok()?;
+        let radius = PICK_RADIUS / self.camera.scale;
+        let mut best: Option<(f64, SiteName)> = None;
+        for inst in &c.design.instances {
+            let Some(piece) = c.design.pieces.get(inst.piece) else {
+                continue;
+            };
+            for site in &piece.sites {
+                let pts: Vec<DVec2> = site
+                    .vertices
+                    .iter()
+                    .filter_map(|&k| inst.vertices.get(k).and_then(|&v| c.graph.positions.get(v)))
+                    .copied()
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                // Docked sites share their vertices: a point just inside tells them apart.
+                let out = DVec2::from_angle(inst.angle).rotate(site.out);
+                let centre = pts.iter().sum::<DVec2>() / pts.len() as f64 - out * radius * 0.5;
+                let d = centre.distance(w);
+                if d <= radius && best.as_ref().is_none_or(|(b, _)| d < *b) {
+                    best = Some((
+                        d,
+                        SiteName {
+                            piece: piece.name.clone(),
+                            site: site.name.clone(),
+                        },
+                    ));
+                }
+            }
+        }
+        best.map(|(_, s)| s)
+    }
+
     fn finish(&mut self, closed: bool, commands: &mut Vec<AuthorCommand>) {
         let points = std::mem::take(&mut self.pending);
         let needed = if closed { 3 } else { 2 };
@@ -244,10 +355,38 @@ impl AuthorCanvas {
         if keyboard_free && ui.input(|i| i.key_pressed(Key::F)) {
             self.fit(author);
         }
-        // Every drag pans: clicks, not drags, edit the drawing.
+        // A drag on a posed vertex moves it; every other drag pans: clicks, not drags, edit
+        // the drawing.
         if response.drag_started() {
-            self.panning = true;
-            self.fitted = None;
+            let press = ui.input(|i| i.pointer.press_origin()).or(pointer);
+            let grabbed = press.and_then(|p| {
+                let n = self.pose.as_ref()?.positions.len();
+                (0..n)
+                    .filter_map(|k| {
+                        Some((k, self.to_screen(self.pose_world(author, k)?).distance(p)))
+                    })
+                    .filter(|(_, d)| *d as f64 <= PICK_RADIUS)
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(k, _)| k)
+            });
+            match (grabbed, self.pose.as_mut()) {
+                (Some(k), Some(pose)) => pose.dragging = Some(k),
+                _ => {
+                    self.panning = true;
+                    self.fitted = None;
+                }
+            }
+        }
+        if let Some(k) = self.pose.as_ref().and_then(|p| p.dragging) {
+            if let Some(p) = pointer {
+                let w = self.to_world(p);
+                self.move_pose_vertex(author, k, w);
+            }
+            if (response.drag_stopped() || !ui.input(|i| i.pointer.any_down()))
+                && let Some(pose) = self.pose.as_mut()
+            {
+                pose.dragging = None;
+            }
         }
         if self.panning {
             let d = response.drag_delta();
@@ -261,6 +400,7 @@ impl AuthorCanvas {
         self.target = world.and_then(|w| match self.tool {
             Tool::Draw => Some(self.draw_target(author, w)),
             Tool::Cut => self.cut_target(author, w),
+            Tool::Site => None,
         });
         let radius = PICK_RADIUS / self.camera.scale;
         match self.tool {
@@ -304,6 +444,13 @@ impl AuthorCanvas {
                         .min_by(|a, b| a.1.total_cmp(&b.1))
                 {
                     commands.push(AuthorCommand::RemoveCut { index });
+                }
+            }
+            Tool::Site => {
+                if response.clicked_by(PointerButton::Primary)
+                    && let Some(w) = world
+                {
+                    self.selected_site = self.site_at(author, w);
                 }
             }
         }
@@ -353,6 +500,37 @@ impl AuthorCanvas {
                 Tool::Cut => {
                     painter.circle_stroke(screen(t), 6.0, Stroke::new(2.0, CUT));
                 }
+                Tool::Site => {}
+            }
+        }
+        self.paint_pose(painter, author);
+    }
+
+    /// The posed copy: its edges and its vertices as handles.
+    fn paint_pose(&self, painter: &egui::Painter, author: &Authoring) {
+        let (Some(pose), Some(design)) = (&self.pose, author.design()) else {
+            return;
+        };
+        let Some(piece) = design.pieces.iter().find(|p| p.name == pose.piece) else {
+            return;
+        };
+        let at = |k: usize| self.pose_world(author, k).map(|p| self.to_screen(p));
+        for &[a, b] in &piece.edges {
+            if let (Some(pa), Some(pb)) = (at(a), at(b)) {
+                painter.line_segment([pa, pb], Stroke::new(2.0, POSE));
+            }
+        }
+        if let Some(o) = &piece.outline {
+            for k in 0..o.len() {
+                if let (Some(pa), Some(pb)) = (at(o[k]), at(o[(k + 1) % o.len()])) {
+                    painter.line_segment([pa, pb], Stroke::new(2.0, POSE));
+                }
+            }
+        }
+        for k in 0..pose.positions.len() {
+            if let Some(p) = at(k) {
+                let r = if pose.dragging == Some(k) { 7.0 } else { 5.0 };
+                painter.circle_filled(p, r, POSE);
             }
         }
     }
@@ -428,6 +606,13 @@ impl AuthorCanvas {
                     .map(|p| screen(p) + inward)
                     .collect();
                 let colour = site_colour(site.site_type);
+                let picked = self
+                    .selected_site
+                    .as_ref()
+                    .is_some_and(|s| s.piece == piece.name && s.site == site.name);
+                if picked && pts.len() >= 2 {
+                    painter.add(Shape::line(pts.clone(), Stroke::new(7.0, LABELS)));
+                }
                 if pts.len() >= 2 {
                     painter.add(Shape::line(pts, Stroke::new(3.0, colour)));
                 } else if let Some(&p) = pts.first() {

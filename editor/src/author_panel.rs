@@ -1,6 +1,8 @@
 //! Authoring mode's side panel: the tool and grid, SVG import, the pieces with their instance
-//! counts and sites, site type names, the stretch declaration, and writing and trying the
-//! grammar with its diagnostics. It reads state and emits commands and actions only.
+//! counts and sites, site type names and the picked site's type, the stretch declaration and
+//! its variants, merge rules, posed rest states, and writing and trying the grammar with its
+//! diagnostics. It reads state and emits commands and actions only (besides the canvas's
+//! pose and picked site, which are view state).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -9,7 +11,9 @@ use clay::authoring::StretchChoice;
 use egui::{Color32, RichText};
 
 use crate::app::Action;
-use crate::author::{AuthorCommand, Authoring, MergeChoice, site_names};
+use crate::author::{
+    AuthorCommand, Authoring, MergeChoice, StateChoice, VariantChoice, find_site, site_names,
+};
 use crate::author_canvas::{AuthorCanvas, Tool, piece_colour, site_colour};
 use crate::panels;
 
@@ -26,6 +30,12 @@ pub struct AuthorForm {
     /// Merge rule being put together: mover, target, junction (indices into the design's
     /// `piece.site` list; `None` junction: dock directly).
     merge: (usize, usize, Option<usize>),
+    /// Type name typed for the picked site.
+    pub site_type: String,
+    /// Variant frequencies being typed, by piece name (absent: not a variant).
+    pub variants: BTreeMap<String, String>,
+    /// Name for the rest state being posed.
+    pub state_name: String,
 }
 
 impl Default for AuthorForm {
@@ -38,6 +48,9 @@ impl Default for AuthorForm {
             names: BTreeMap::new(),
             picks: BTreeMap::new(),
             merge: (0, 1, None),
+            site_type: String::new(),
+            variants: BTreeMap::new(),
+            state_name: "posed".into(),
         }
     }
 }
@@ -73,10 +86,21 @@ pub fn show(
     };
     egui::CollapsingHeader::new(format!("Pieces ({})", design.pieces.len()))
         .default_open(true)
-        .show(ui, |ui| pieces(ui, author, form, commands));
+        .show(ui, |ui| pieces(ui, author, canvas, form, commands));
     egui::CollapsingHeader::new(format!("Site types ({})", design.site_types.len()))
         .default_open(true)
-        .show(ui, |ui| site_types(ui, author, form, commands));
+        .show(ui, |ui| {
+            site_types(ui, author, form, commands);
+            site_type_of_site(ui, author, canvas, form, commands);
+        });
+    if design.pieces.iter().any(|p| p.stretch.is_some()) {
+        egui::CollapsingHeader::new(format!("Variants ({})", author.work().variants.len()))
+            .default_open(false)
+            .show(ui, |ui| variants(ui, author, form, commands));
+    }
+    egui::CollapsingHeader::new(format!("Rest states ({})", author.work().states.len()))
+        .default_open(canvas.pose.is_some())
+        .show(ui, |ui| rest_states(ui, author, canvas, form, commands));
     egui::CollapsingHeader::new(format!("Merge rules ({})", author.work().merges.len()))
         .default_open(false)
         .show(ui, |ui| merges(ui, author, form, commands));
@@ -106,6 +130,7 @@ fn drawing(
         ui.label("Tool:");
         ui.selectable_value(&mut canvas.tool, Tool::Draw, "Draw (D)");
         ui.selectable_value(&mut canvas.tool, Tool::Cut, "Cut (C)");
+        ui.selectable_value(&mut canvas.tool, Tool::Site, "Pick site");
     });
     ui.horizontal(|ui| {
         let l = ui.label("Grid (m):");
@@ -170,6 +195,7 @@ fn drawing(
 fn pieces(
     ui: &mut egui::Ui,
     author: &Authoring,
+    canvas: &mut AuthorCanvas,
     form: &mut AuthorForm,
     commands: &mut Vec<AuthorCommand>,
 ) {
@@ -204,7 +230,20 @@ fn pieces(
                         .site_types
                         .get(s.site_type)
                         .map_or("?", String::as_str);
-                    ui.label(format!("{}: {t}", s.name));
+                    let picked = canvas
+                        .selected_site
+                        .as_ref()
+                        .is_some_and(|x| x.piece == piece.name && x.site == s.name);
+                    if ui
+                        .selectable_label(picked, format!("{}: {t}", s.name))
+                        .on_hover_text("pick this site to set its type")
+                        .clicked()
+                    {
+                        canvas.selected_site = Some(crate::author::SiteName {
+                            piece: piece.name.clone(),
+                            site: s.name.clone(),
+                        });
+                    }
                 });
             }
             if piece.sites.len() >= 2 {
@@ -359,6 +398,207 @@ fn site_types(
                 *buffer = shown.clone();
             }
         });
+    }
+}
+
+/// The picked site's type: an existing type or a new name.
+fn site_type_of_site(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    canvas: &AuthorCanvas,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    let Some(design) = author.design() else {
+        return;
+    };
+    ui.separator();
+    let Some(site) = &canvas.selected_site else {
+        ui.label("Pick a site (in the list above, or with the Pick site tool) to set its type.");
+        return;
+    };
+    let Some((p, s)) = find_site(design, site) else {
+        ui.label(format!("{site} is gone"));
+        return;
+    };
+    let current = design.pieces[p].sites[s].site_type;
+    ui.horizontal(|ui| {
+        swatch(ui, site_colour(current));
+        let l = ui.strong(site.to_string());
+        egui::ComboBox::from_id_salt("site type of site")
+            .selected_text(design.site_types.get(current).map_or("?", String::as_str))
+            .show_ui(ui, |ui| {
+                for (ti, t) in design.site_types.iter().enumerate() {
+                    if ui.selectable_label(ti == current, t).clicked() && ti != current {
+                        commands.push(AuthorCommand::SetSiteType {
+                            site: site.clone(),
+                            site_type: t.clone(),
+                        });
+                    }
+                }
+            })
+            .response
+            .labelled_by(l.id);
+    });
+    ui.horizontal(|ui| {
+        let l = ui.label("new type:");
+        ui.add(egui::TextEdit::singleline(&mut form.site_type).desired_width(100.0))
+            .labelled_by(l.id);
+        if ui.button("Set type").clicked() && !form.site_type.trim().is_empty() {
+            commands.push(AuthorCommand::SetSiteType {
+                site: site.clone(),
+                site_type: form.site_type.trim().to_string(),
+            });
+        }
+    });
+}
+
+/// The stretch rule's variants: pieces with the stretch piece's graph, with frequencies.
+fn variants(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    let Some(design) = author.design() else {
+        return;
+    };
+    let Some(sp) = design.pieces.iter().position(|p| p.stretch.is_some()) else {
+        return;
+    };
+    for v in &author.work().variants {
+        ui.label(RichText::new(format!("{} {:.4}", v.piece, v.frequency)).monospace());
+    }
+    ui.label("Pieces with the same vertices, edges and sites; frequencies are normalised:");
+    for (pi, piece) in design.pieces.iter().enumerate() {
+        let fits = pi == sp || crate::author::variant_map(design, sp, pi).is_ok();
+        ui.horizontal(|ui| {
+            let mut on = form.variants.contains_key(&piece.name);
+            let r = ui.add_enabled(
+                fits,
+                egui::Checkbox::new(&mut on, format!("variant {}", piece.name)),
+            );
+            if r.changed() {
+                if on {
+                    form.variants.insert(piece.name.clone(), "1".into());
+                } else {
+                    form.variants.remove(&piece.name);
+                }
+            }
+            if let Some(f) = form.variants.get_mut(&piece.name) {
+                ui.add(egui::TextEdit::singleline(f).desired_width(50.0))
+                    .on_hover_text("target frequency");
+            }
+            if !fits {
+                ui.label("(other shape)");
+            }
+        });
+    }
+    ui.horizontal(|ui| {
+        if ui.button("Set variants").clicked() {
+            let mut list = Vec::new();
+            for (piece, f) in &form.variants {
+                match f.trim().parse::<f64>() {
+                    Ok(frequency) => list.push(VariantChoice {
+                        piece: piece.clone(),
+                        frequency,
+                    }),
+                    Err(_) => {
+                        // A frequency that is no number: the command refuses it with a message.
+                        list.push(VariantChoice {
+                            piece: piece.clone(),
+                            frequency: f64::NAN,
+                        })
+                    }
+                }
+            }
+            // The stretch piece first, as it is the rule's piece.
+            list.sort_by_key(|v| v.piece != design.pieces[sp].name);
+            commands.push(AuthorCommand::SetVariants(list));
+        }
+        if ui
+            .add_enabled(
+                !author.work().variants.is_empty(),
+                egui::Button::new("No variants"),
+            )
+            .clicked()
+        {
+            commands.push(AuthorCommand::SetVariants(Vec::new()));
+        }
+    });
+}
+
+/// Alternative rest states: pose a copy of a piece on the canvas, then keep it.
+fn rest_states(
+    ui: &mut egui::Ui,
+    author: &Authoring,
+    canvas: &mut AuthorCanvas,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    if let Some(p) = &canvas.pose
+        && author
+            .work()
+            .states
+            .iter()
+            .any(|s| s.piece == p.piece && s.positions == p.positions)
+    {
+        canvas.pose = None;
+    }
+    for (i, st) in author.work().states.iter().enumerate() {
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(format!("{}: state {}", st.piece, st.name)).monospace());
+            if ui.small_button("remove").clicked() {
+                commands.push(AuthorCommand::RemoveState { index: i });
+            }
+        });
+    }
+    let Some(design) = author.design() else {
+        return;
+    };
+    match &canvas.pose {
+        None => {
+            ui.horizontal_wrapped(|ui| {
+                for (pi, p) in design.pieces.iter().enumerate() {
+                    if ui
+                        .button(format!("New rest state of {}", p.name))
+                        .on_hover_text("pose a copy: drag its vertices on the canvas")
+                        .clicked()
+                    {
+                        canvas.start_pose(author, pi);
+                    }
+                }
+            });
+        }
+        Some(pose) => {
+            ui.label(format!(
+                "Posing {}: drag its green vertices (they snap to the grid).",
+                pose.piece
+            ));
+            let mut keep = None;
+            let mut drop = false;
+            ui.horizontal(|ui| {
+                let l = ui.label("name:");
+                ui.add(egui::TextEdit::singleline(&mut form.state_name).desired_width(90.0))
+                    .labelled_by(l.id);
+                if ui.button("Keep state").clicked() {
+                    keep = Some(StateChoice {
+                        piece: pose.piece.clone(),
+                        name: form.state_name.trim().to_string(),
+                        positions: pose.positions.clone(),
+                    });
+                }
+                drop = ui.button("Drop pose").clicked();
+            });
+            if let Some(st) = keep {
+                // The pose stays until the state is in the work, so a refused one (the
+                // command's message says why) can be fixed.
+                commands.push(AuthorCommand::AddState(st));
+            }
+            if drop {
+                canvas.pose = None;
+            }
+        }
     }
 }
 

@@ -93,6 +93,8 @@ pub fn statistics(ui: &mut egui::Ui, sculpt: &Sculpt) {
             ui.label(format!("frame time: {:.2} ms", r.ms));
             ui.label(if r.converged {
                 "converged"
+            } else if !r.complete {
+                "stopped at the time budget; continues next frame"
             } else {
                 "not converged"
             });

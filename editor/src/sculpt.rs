@@ -98,7 +98,6 @@ pub struct PartReport {
 const LOG_LIMIT: usize = 500;
 /// Largest vertex move in a frame, relative to the model's size, for which the model counts
 /// as at rest.
-const SETTLED_MOVE: f64 = 1e-6;
 /// Most gestures kept for undo.
 const UNDO_LIMIT: usize = 200;
 
@@ -465,17 +464,12 @@ impl Sculpt {
         let start = Instant::now();
         self.frames_last_step = 0;
         while self.needs_work() {
-            let before = self.assembly.data.positions.clone();
-            match self.solver.frame(&mut self.assembly) {
+            // The frame gets what is left of the UI frame's budget: a frame the solver cannot
+            // finish in time stops early with a proper least-squares pose and continues on the
+            // next call, so a large model never blocks the window.
+            let left = budget.saturating_sub(start.elapsed());
+            match self.solver.frame_budgeted(&mut self.assembly, left) {
                 Ok(report) => {
-                    // The solver's own flag stays false when IRLS oscillates while pass 2
-                    // keeps the positions, so a frame that moved nothing also counts as settled.
-                    let scale = clay::solver::bbox_diagonal(&before).max(1e-9);
-                    let still = before.len() == self.assembly.data.positions.len()
-                        && before
-                            .iter()
-                            .zip(&self.assembly.data.positions)
-                            .all(|(a, b)| a.distance(*b) <= SETTLED_MOVE * scale);
                     self.frame += 1;
                     self.revision += 1;
                     self.frames_last_step += 1;
@@ -516,7 +510,9 @@ impl Sculpt {
                     if changed && self.grab.is_some() {
                         self.follow_grab();
                     }
-                    if (report.converged || (still && report.switches.is_empty())) && !changed {
+                    // `converged`: a complete frame with no state switch that moved no vertex
+                    // beyond the solver's settle tolerance, i.e. a fixed point.
+                    if report.converged && !changed {
                         self.unsettled = false;
                     }
                     self.last_report = Some(report);

@@ -418,3 +418,463 @@ fn a_merge_rule_is_written_compiles_and_undoes() {
     assert!(a.work().merges.is_empty());
     assert!(!a.text().unwrap().contains("merge"));
 }
+
+fn site(piece: &str, site: &str) -> clay_editor::author::SiteName {
+    clay_editor::author::SiteName {
+        piece: piece.into(),
+        site: site.into(),
+    }
+}
+
+#[test]
+fn setting_a_site_type_carries_it_to_docked_sites_compiles_and_undoes() {
+    let mut a = wall();
+    let old = a.design().unwrap().site_types.clone();
+    a.apply(AuthorCommand::SetSiteType {
+        site: site("brick", "east"),
+        site_type: "mortar".into(),
+    });
+    // East docks with west in the wall: both take the new type so the docks stay legal.
+    let m = a.message.clone().unwrap();
+    assert!(m.contains("brick.west"), "{m}");
+    let d = a.design().unwrap();
+    // The old type has no site left: it is not written.
+    assert_eq!(d.site_types, vec!["mortar"]);
+    assert!(d.pieces[0].sites.iter().all(|s| s.site_type == 0));
+    let text = a.text().unwrap();
+    assert!(text.contains("site type mortar"), "{text}");
+    assert!(!text.contains("joint"), "{text}");
+    assert!(text.contains("east: mortar"), "{text}");
+    assert!(text.contains("west: mortar"), "{text}");
+    let compiled = clay_editor::compile::compile(text, "wall.clay").expect("compiles");
+    let brick = &compiled.grammar.pieces[0];
+    let ty = &compiled.grammar.site_types;
+    assert!(brick.sites.iter().all(|s| ty[s.site_type].name == "mortar"));
+    assert!(a.compiles, "{:?}", a.problems);
+
+    // An existing type by its shown name; a bad name is refused.
+    a.apply(AuthorCommand::SetSiteType {
+        site: site("brick", "west"),
+        site_type: "9x".into(),
+    });
+    assert!(a.message.as_deref().unwrap().contains("not a name"));
+    a.apply(AuthorCommand::SetSiteType {
+        site: site("brick", "nowhere"),
+        site_type: "mortar".into(),
+    });
+    assert!(a.message.as_deref().unwrap().contains("no site"));
+    a.apply(AuthorCommand::Undo);
+    assert_eq!(a.design().unwrap().site_types, old);
+    assert!(!a.text().unwrap().contains("mortar"));
+}
+
+/// A 4.2 m x 1 m strip cut at x = 1, 2.2 and 3.2: three unit squares and, second, a 1.2 m
+/// long one with the same graph (the same vertices, edges and sites, other positions).
+fn squares_and_a_long_one() -> Authoring {
+    let mut a = Authoring::default();
+    a.apply(AuthorCommand::AddPolyline(Polyline::polygon(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(4.2, 0.0),
+        DVec2::new(4.2, 1.0),
+        DVec2::new(0.0, 1.0),
+    ])));
+    for x in [1.0, 2.2, 3.2] {
+        a.apply(AuthorCommand::Cut {
+            point: DVec2::new(x, 0.0),
+        });
+    }
+    a
+}
+
+#[test]
+fn a_congruent_graph_piece_becomes_a_stretch_variant_with_normalised_frequencies() {
+    use clay_editor::author::VariantChoice;
+    let mut a = squares_and_a_long_one();
+    assert_eq!(instances_of_each_piece(&a).len(), 2, "{:?}", a.design());
+    let d = a.design().unwrap().clone();
+    let square = d
+        .pieces
+        .iter()
+        .position(|p| {
+            p.positions.len() == 4 && {
+                let (lo, hi) = p
+                    .positions
+                    .iter()
+                    .fold((DVec2::MAX, DVec2::MIN), |(l, h), q| (l.min(*q), h.max(*q)));
+                ((hi - lo).x - 1.0).abs() < 1e-9
+            }
+        })
+        .unwrap();
+    let long = 1 - square;
+    let (sq, lg) = (d.pieces[square].name.clone(), d.pieces[long].name.clone());
+    let variants = |f: f64, g: f64| {
+        vec![
+            VariantChoice {
+                piece: sq.clone(),
+                frequency: f,
+            },
+            VariantChoice {
+                piece: lg.clone(),
+                frequency: g,
+            },
+        ]
+    };
+    // No stretch yet: refused.
+    a.apply(AuthorCommand::SetVariants(variants(3.0, 1.0)));
+    assert!(a.message.as_deref().unwrap().contains("stretchable"));
+    let east = d.pieces[square]
+        .sites
+        .iter()
+        .position(|s| s.name == "east")
+        .unwrap();
+    let west = d.pieces[square]
+        .sites
+        .iter()
+        .position(|s| s.name == "west")
+        .unwrap();
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Sites {
+        piece: square,
+        from: west,
+        to: east,
+    })));
+    assert!(a.message.is_none(), "{:?}", a.message);
+    // 3 : 1 is normalised to 0.75 : 0.25.
+    a.apply(AuthorCommand::SetVariants(variants(3.0, 1.0)));
+    assert!(
+        a.message.is_none(),
+        "{:?}\n{}",
+        a.message,
+        a.text().unwrap()
+    );
+    let text = a.text().unwrap();
+    assert!(text.contains("variants"), "{text}");
+    assert!(text.contains(&format!("{sq} 0.75")), "{text}");
+    assert!(text.contains(&format!("{lg} 0.25")), "{text}");
+    let compiled =
+        clay_editor::compile::compile(text, "v.clay").unwrap_or_else(|p| panic!("{p:?}\n{text}"));
+    let rule = &compiled.grammar.stretch_rules[0];
+    let freq: Vec<(String, f64)> = rule
+        .variants
+        .iter()
+        .map(|v| (compiled.grammar.pieces[v.piece].name.clone(), v.frequency))
+        .collect();
+    assert_eq!(freq, vec![(sq.clone(), 0.75), (lg.clone(), 0.25)]);
+    // The long piece is written with the square's vertex names and sites, at its own size.
+    let g = &compiled.grammar;
+    let (cs, cl) = (
+        &g.pieces[rule.variants[0].piece],
+        &g.pieces[rule.variants[1].piece],
+    );
+    assert_eq!(cs.vertices, cl.vertices);
+    let width = |p: &clay_dsl::compiled::Piece| {
+        let xs = p.states[0].positions.iter().map(|q| q.x);
+        xs.clone().fold(f64::MIN, f64::max) - xs.fold(f64::MAX, f64::min)
+    };
+    assert!((width(cs) - 1.0).abs() < 1e-9 && (width(cl) - 1.2).abs() < 1e-9);
+    assert!(a.compiles, "{:?}", a.problems);
+
+    a.apply(AuthorCommand::SetVariants(variants(1.0, -1.0)));
+    assert!(a.message.as_deref().unwrap().contains("positive"));
+    a.apply(AuthorCommand::Undo);
+    assert!(!a.text().unwrap().contains("variants"));
+}
+
+#[test]
+fn a_piece_of_another_shape_cannot_be_a_variant() {
+    use clay_editor::author::VariantChoice;
+    // Two unit squares and, at the end, a unit square with a fifth vertex on its top edge.
+    let mut a = Authoring::default();
+    a.apply(AuthorCommand::AddPolyline(Polyline::polygon(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(3.0, 0.0),
+        DVec2::new(3.0, 1.0),
+        DVec2::new(2.5, 1.0),
+        DVec2::new(0.0, 1.0),
+    ])));
+    for x in [1.0, 2.0] {
+        a.apply(AuthorCommand::Cut {
+            point: DVec2::new(x, 0.0),
+        });
+    }
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    let d = a.design().unwrap().clone();
+    assert_eq!(d.pieces.len(), 2, "{d:?}");
+    let sp = d.pieces.iter().position(|p| p.stretch.is_some());
+    let Some(sp) = sp else {
+        panic!("a stretchable piece: {:?}", d.notes)
+    };
+    let other = 1 - sp;
+    a.apply(AuthorCommand::SetVariants(vec![
+        VariantChoice {
+            piece: d.pieces[sp].name.clone(),
+            frequency: 0.5,
+        },
+        VariantChoice {
+            piece: d.pieces[other].name.clone(),
+            frequency: 0.5,
+        },
+    ]));
+    let m = a.message.clone().unwrap_or_default();
+    assert!(m.contains("cannot be a variant"), "{m}");
+    assert!(a.work().variants.is_empty());
+}
+
+#[test]
+fn a_posed_copy_becomes_a_second_rest_state_of_the_compiled_piece() {
+    use clay_editor::author::StateChoice;
+    let mut a = wall();
+    let brick = a.design().unwrap().pieces[0].clone();
+    // Shear the brick: the top vertices move 0.25 m east.
+    let top = brick.positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let posed: Vec<DVec2> = brick
+        .positions
+        .iter()
+        .map(|&p| {
+            if (p.y - top).abs() < 1e-9 {
+                p + DVec2::new(0.25, 0.0)
+            } else {
+                p
+            }
+        })
+        .collect();
+    assert_ne!(posed, brick.positions);
+    a.apply(AuthorCommand::AddState(StateChoice {
+        piece: "brick".into(),
+        name: "leaning".into(),
+        positions: posed.clone(),
+    }));
+    assert!(a.message.is_none(), "{:?}", a.message);
+    let text = a.text().unwrap();
+    assert!(text.contains("state leaning"), "{text}");
+    let compiled =
+        clay_editor::compile::compile(text, "s.clay").unwrap_or_else(|p| panic!("{p:?}\n{text}"));
+    let piece = &compiled.grammar.pieces[0];
+    assert_eq!(piece.states.len(), 2);
+    assert_eq!(piece.states[1].name, "leaning");
+    for (got, want) in piece.states[1].positions.iter().zip(&posed) {
+        assert!((*got - *want).length() < 1e-9, "{got} vs {want}");
+    }
+    assert!(a.compiles, "{:?}", a.problems);
+
+    // The same name again, `base`, or two vertices at one place: refused.
+    for (name, positions) in [
+        ("leaning", posed.clone()),
+        ("base", posed.clone()),
+        ("folded", vec![DVec2::ZERO; posed.len()]),
+        ("short", posed[1..].to_vec()),
+    ] {
+        a.apply(AuthorCommand::AddState(StateChoice {
+            piece: "brick".into(),
+            name: name.into(),
+            positions,
+        }));
+        assert!(a.message.is_some(), "{name} is refused");
+        assert_eq!(a.work().states.len(), 1);
+    }
+    a.apply(AuthorCommand::Undo);
+    assert!(!a.text().unwrap().contains("state"));
+}
+
+fn drag(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2) {
+    h.hover_at(from);
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    for k in 1..=5 {
+        h.hover_at(from + (to - from) * (k as f32 / 5.0));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    h.step();
+}
+
+#[test]
+fn the_ui_poses_a_copy_by_dragging_a_vertex_and_keeps_it_as_a_state() {
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.author = wall();
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label("Rest states (0)").click();
+    h.run();
+    h.get_by_label("New rest state of brick").click();
+    h.run();
+    let pose = h.state().author_canvas.pose.clone().expect("posing");
+    assert_eq!(pose.piece, "brick");
+    let base = pose.positions.clone();
+    // Drag vertex 0 by about one and a half grid steps (0.1 m) right: it snaps to a grid point.
+    let grid = h.state().author_canvas.grid;
+    let w0 = h
+        .state()
+        .author_canvas
+        .pose_world(&h.state().author, 0)
+        .unwrap();
+    let from = h.state().author_canvas.to_screen(w0);
+    let to = h
+        .state()
+        .author_canvas
+        .to_screen(w0 + DVec2::new(1.4 * grid, 0.0));
+    drag(&mut h, from, to);
+    let moved = h.state().author_canvas.pose.clone().unwrap().positions;
+    assert_eq!(moved[1..], base[1..]);
+    let snapped = (moved[0] / grid).round() * grid;
+    assert!((moved[0] - snapped).length() < 1e-9, "{}", moved[0]);
+    assert!(
+        (moved[0].x - base[0].x - grid).abs() < grid * 0.6,
+        "{} {}",
+        moved[0],
+        base[0]
+    );
+    h.state_mut().author_form.state_name = "pushed".into();
+    h.get_by_label("Keep state").click();
+    h.run();
+    let a = &h.state().author;
+    assert!(a.message.is_none(), "{:?}", a.message);
+    assert_eq!(a.work().states.len(), 1);
+    assert_eq!(a.work().states[0].positions, moved);
+    assert!(a.compiles, "{:?}", a.problems);
+    assert!(h.state().author_canvas.pose.is_none());
+}
+
+#[test]
+fn the_site_tool_picks_a_site_and_the_panel_sets_its_type() {
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.author = wall();
+    app.author_canvas.tool = Tool::Site;
+    let mut h = harness(app);
+    h.run();
+    // The first brick's free west site: the middle of its west edge, a little inside.
+    let (at, out) = {
+        let a = &h.state().author;
+        let d = a.design().unwrap();
+        let inst = &d.instances[0];
+        let piece = &d.pieces[inst.piece];
+        let west = piece.sites.iter().find(|s| s.name == "west").unwrap();
+        let world = |k: usize| DVec2::from_angle(inst.angle).rotate(piece.positions[k]) + inst.at;
+        let centre =
+            west.vertices.iter().map(|&k| world(k)).sum::<DVec2>() / west.vertices.len() as f64;
+        (centre, DVec2::from_angle(inst.angle).rotate(west.out))
+    };
+    let inside = at - out * 3.0 / h.state().author_canvas.camera.scale;
+    let p = h.state().author_canvas.to_screen(inside);
+    click(&mut h, p);
+    let picked = h.state().author_canvas.selected_site.clone();
+    assert_eq!(picked.map(|s| s.to_string()).as_deref(), Some("brick.west"));
+    h.state_mut().author_form.site_type = "mortar".into();
+    h.get_by_label("Set type").click();
+    h.run();
+    let a = &h.state().author;
+    let d = a.design().unwrap();
+    assert!(
+        d.pieces[0]
+            .sites
+            .iter()
+            .all(|s| d.site_types[s.site_type] == "mortar")
+    );
+    assert!(a.compiles, "{:?}", a.problems);
+}
+
+#[test]
+fn the_variants_panel_lists_fitting_pieces_and_sets_normalised_frequencies() {
+    let mut a = squares_and_a_long_one();
+    let d = a.design().unwrap().clone();
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    let sp = a
+        .design()
+        .unwrap()
+        .pieces
+        .iter()
+        .position(|p| p.stretch.is_some())
+        .expect("stretchable");
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.author = a;
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label("Variants (0)").click();
+    h.run();
+    for p in &d.pieces {
+        h.get_by_label(&format!("variant {}", p.name)).click();
+        h.run();
+    }
+    let long = d.pieces[1 - sp].name.clone();
+    h.state_mut()
+        .author_form
+        .variants
+        .insert(long.clone(), "0.5".into());
+    h.get_by_label("Set variants").click();
+    h.run();
+    let a = &h.state().author;
+    assert!(a.message.is_none(), "{:?}", a.message);
+    let v = &a.work().variants;
+    assert_eq!(v.len(), 2);
+    assert_eq!(v[0].piece, d.pieces[sp].name, "the rule's piece first");
+    assert!(
+        (v[0].frequency - 2.0 / 3.0).abs() < 1e-12 && (v[1].frequency - 1.0 / 3.0).abs() < 1e-12
+    );
+    assert!(a.compiles, "{:?}", a.problems);
+}
+
+#[test]
+fn a_state_of_a_variant_follows_its_vertices_when_the_variant_is_renumbered() {
+    use clay_editor::author::{StateChoice, VariantChoice};
+    let mut a = squares_and_a_long_one();
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    let d = a.design().unwrap().clone();
+    let sp = d.pieces.iter().position(|p| p.stretch.is_some()).unwrap();
+    let long = &d.pieces[1 - sp];
+    // Lift the long piece's vertex 0 by 0.3 m.
+    let mut posed = long.positions.clone();
+    posed[0] += DVec2::new(0.0, 0.3);
+    a.apply(AuthorCommand::AddState(StateChoice {
+        piece: long.name.clone(),
+        name: "lifted".into(),
+        positions: posed.clone(),
+    }));
+    a.apply(AuthorCommand::SetVariants(vec![
+        VariantChoice {
+            piece: d.pieces[sp].name.clone(),
+            frequency: 0.5,
+        },
+        VariantChoice {
+            piece: long.name.clone(),
+            frequency: 0.5,
+        },
+    ]));
+    assert!(a.message.is_none(), "{:?}", a.message);
+    let text = a.text().unwrap();
+    let compiled =
+        clay_editor::compile::compile(text, "vs.clay").unwrap_or_else(|p| panic!("{p:?}\n{text}"));
+    let cl = compiled
+        .grammar
+        .pieces
+        .iter()
+        .find(|p| p.name == long.name)
+        .unwrap();
+    assert_eq!(cl.states.len(), 2);
+    // Each compiled vertex goes from its drawn position to its posed one, whatever its name.
+    for (b, s) in cl.states[0].positions.iter().zip(&cl.states[1].positions) {
+        let i = long
+            .positions
+            .iter()
+            .position(|p| (*p - *b).length() < 1e-9)
+            .expect("a drawn position");
+        assert!(
+            (posed[i] - *s).length() < 1e-9,
+            "{b} -> {s}, want {}",
+            posed[i]
+        );
+    }
+    assert!(a.compiles, "{:?}", a.problems);
+}

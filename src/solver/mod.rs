@@ -95,8 +95,8 @@ impl SolverConfig {
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
-            irls_iterations: 1,
-            l2_iterations: 1,
+            irls_iterations: 4,
+            l2_iterations: 2,
             handle_weight: 1e6,
             rotation_cone_degrees: 20.0,
             proximal_weight: 1e-8,
@@ -463,7 +463,13 @@ impl Solver {
             self.work.warm_targets.clone_from(&self.work.targets);
         }
         let hw = cfg.handle_weight;
-        let warm_terms = terms(&self.pattern.edges, &self.work.warm_targets, handles, &warm, hw);
+        let warm_terms = terms(
+            &self.pattern.edges,
+            &self.work.warm_targets,
+            handles,
+            &warm,
+            hw,
+        );
         // objective() leaves f's rotations and edge targets in the work buffers
         let mut terms = self.objective(parts, handles, &f);
         report.warm_objective = warm_terms.total();
@@ -544,8 +550,7 @@ impl Solver {
         report.energy = terms.elastic;
         report.objective = terms.total();
         report.moved = max_move(&warm, &f);
-        let settled =
-            report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
+        let settled = report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
         report.converged = report.complete && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
         self.work.pass1_generation = Some(asm.generation());
@@ -765,12 +770,7 @@ impl Solver {
                     if pass == Pass::Irls || !factor.is_valid() {
                         let t = Instant::now();
                         symbolic
-                            .factorize(
-                                factor,
-                                &self.pattern.col_ptr,
-                                &self.pattern.row_idx,
-                                values,
-                            )
+                            .factorize(factor, &self.pattern.col_ptr, &self.pattern.row_idx, values)
                             .map_err(|e| SolverError(e.0))?;
                         report.factorizations += 1;
                         report.phases.factorization += ms_since(t);

@@ -427,7 +427,9 @@ impl Compiler {
         let target = self.site_ref(&m.target);
         let junction = m.junction.as_ref().map(|j| (self.site_ref(j), j));
         let distance = match &m.within {
-            Some(n) => self.in_range(n, "`within`", |d| d > 0.0, "above 0").map(Some),
+            Some(n) => self
+                .in_range(n, "`within`", |d| d > 0.0, "above 0")
+                .map(Some),
             None => Some(None),
         };
         let (Some(mover), Some(target), Some(distance)) = (mover, target, distance) else {

@@ -1,10 +1,13 @@
 //! `clayc bench`: times solver frames on synthetic assemblies. `--parts N` drags a corner of a
 //! city of about N parts (streets, junctions, a long wall); `--arap-grid K` runs classic ARAP
-//! iterations on a K x K triangulated grid (left column fixed, right column dragged).
+//! iterations on a K x K triangulated grid (left column fixed, right column dragged). The rules run
+//! after every frame, as in a live session, and are timed apart from the solver.
 
 use std::sync::Arc;
+use std::time::Instant;
 
 use clay::assembly::{Assembly, HandleKind};
+use clay::rules::Rules;
 use clay::solver::{FrameReport, Solver, SolverConfig, SolverKind};
 use clay::synthetic;
 use glam::DVec2;
@@ -64,6 +67,11 @@ struct BenchResult {
     first_frame_ms: f64,
     /// Frames after the first.
     frame_ms: Ms,
+    /// The rule checks after each frame (stretch/shrink candidates, the merge proximity
+    /// query, replacement), timed apart from the solver; includes any rewrite that fired.
+    rules_ms: Ms,
+    /// Rewrites that fired during the run.
+    rules_fired: usize,
     /// ARAP only: time of one local + global iteration.
     #[serde(skip_serializing_if = "Option::is_none")]
     iteration_ms: Option<Ms>,
@@ -142,6 +150,9 @@ pub fn bench(args: BenchArgs) -> u8 {
         }
     };
     let mut solver = Solver::new(config);
+    let mut rules = Rules::new();
+    let mut rules_ms = Vec::with_capacity(args.frames);
+    let mut rules_fired = 0;
     let mut reports: Vec<FrameReport> = Vec::with_capacity(args.frames);
     for k in 1..=args.frames {
         if let Some((h, offset)) = drag
@@ -150,7 +161,14 @@ pub fn bench(args: BenchArgs) -> u8 {
             handle.translation = offset * (k as f64 / args.frames as f64);
         }
         match solver.frame(&mut asm) {
-            Ok(r) => reports.push(r),
+            Ok(r) => {
+                // The rules run after every frame in a live session; their cost is part of the
+                // per-frame budget, so it is measured here too, apart from the solver's.
+                let start = Instant::now();
+                rules_fired += rules.after_frame(&mut asm, &r).len();
+                rules_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                reports.push(r);
+            }
             Err(e) => {
                 eprintln!("error: frame {k}: {e}");
                 return 1;
@@ -192,6 +210,8 @@ pub fn bench(args: BenchArgs) -> u8 {
             stats(&per)
         }),
         frame_ms: stats(&later),
+        rules_ms: stats(&rules_ms),
+        rules_fired,
         converged_frames: reports.iter().filter(|r| r.converged).count(),
     };
     if args.json {
@@ -204,7 +224,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         }
     } else {
         println!(
-            "{}: {} parts, {} vertices, solver {}, {} frames\niterations per frame: {:.2} IRLS + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}{}",
+            "{}: {} parts, {} vertices, solver {}, {} frames\niterations per frame: {:.2} IRLS + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
             result.model,
             result.parts,
             result.vertices,
@@ -217,6 +237,9 @@ pub fn bench(args: BenchArgs) -> u8 {
             result.first_frame_ms,
             result.frame_ms.median,
             result.frame_ms.max,
+            result.rules_ms.median,
+            result.rules_ms.max,
+            result.rules_fired,
             result
                 .iteration_ms
                 .as_ref()

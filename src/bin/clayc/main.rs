@@ -14,7 +14,11 @@ mod render;
 mod run;
 
 #[derive(Parser)]
-#[command(name = "clayc", version, about = "Check, build, run and render Clay grammars")]
+#[command(
+    name = "clayc",
+    version,
+    about = "Check, build, run and render Clay grammars"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
