@@ -74,14 +74,7 @@ fn empty_grammar(source: &str) -> CompiledGrammar {
         stretch_rules: vec![],
         merge_rules: vec![],
         cut_rules: vec![],
-        assembly: AssemblyData {
-            positions: vec![],
-            instances: vec![],
-            docks: vec![],
-            chains: vec![],
-            parts: vec![],
-            next_id: 0,
-        },
+        assembly: AssemblyData::default(),
     }
 }
 

@@ -224,7 +224,8 @@ pub struct SiteRef {
 
 /// An assembly: instances of pieces sharing vertices at docked sites, covered by parts.
 /// Both the compiler's initial assembly and the live one after rules have this form.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// `Default` is the empty assembly.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct AssemblyData {
     /// Global vertex positions in metres.
     pub positions: Vec<DVec2>,

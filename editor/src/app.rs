@@ -131,14 +131,7 @@ fn empty_grammar(path: &str) -> Arc<CompiledGrammar> {
         stretch_rules: Vec::new(),
         merge_rules: Vec::new(),
         cut_rules: Vec::new(),
-        assembly: AssemblyData {
-            positions: Vec::new(),
-            instances: Vec::new(),
-            docks: Vec::new(),
-            chains: Vec::new(),
-            parts: Vec::new(),
-            next_id: 0,
-        },
+        assembly: AssemblyData::default(),
     })
 }
 

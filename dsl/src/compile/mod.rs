@@ -346,14 +346,7 @@ impl Compiler {
             stretch_rules: std::mem::take(&mut self.stretch_rules),
             merge_rules: std::mem::take(&mut self.merge_rules),
             cut_rules: std::mem::take(&mut self.cut_rules),
-            assembly: AssemblyData {
-                positions: Vec::new(),
-                instances: Vec::new(),
-                docks: Vec::new(),
-                chains: Vec::new(),
-                parts: Vec::new(),
-                next_id: 0,
-            },
+            assembly: AssemblyData::default(),
         };
         if self.diags.has_errors() {
             return;
