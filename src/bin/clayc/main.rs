@@ -17,7 +17,7 @@ mod run;
 #[command(
     name = "clayc",
     version,
-    about = "Check, build, run and render Clay grammars"
+    about = "Check, build, run, render, format and author Clay grammars"
 )]
 struct Cli {
     #[command(subcommand)]
