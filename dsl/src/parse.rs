@@ -156,36 +156,77 @@ pub fn parse(source: &str) -> Result<File, Diagnostics> {
     }
 }
 
+/// One event of a scan of the source that knows comments (line comments skipped, block
+/// comments nested): a bracket opened or closed outside comments, or a block comment opened.
+enum Nesting {
+    Open(usize),
+    Close,
+    /// A block comment opened; `at` is its `*`, `depth` the comment nesting after it.
+    Comment {
+        at: usize,
+        depth: usize,
+    },
+}
+
+/// The bracket and comment events of `bytes`, in order: the one lexer that both the nesting
+/// guard and the unclosed-bracket hint use, so they agree on what a comment is.
+fn nesting_events(bytes: &[u8]) -> impl Iterator<Item = Nesting> + '_ {
+    let mut i = 0;
+    let mut comments = 0usize;
+    std::iter::from_fn(move || {
+        while i < bytes.len() {
+            let (b, next) = (bytes[i], bytes.get(i + 1).copied());
+            let at = i;
+            i += 1;
+            if comments > 0 {
+                if b == b'/' && next == Some(b'*') {
+                    comments += 1;
+                    i += 1;
+                    return Some(Nesting::Comment {
+                        at: at + 1,
+                        depth: comments,
+                    });
+                } else if b == b'*' && next == Some(b'/') {
+                    comments -= 1;
+                    i += 1;
+                }
+            } else if b == b'/' && next == Some(b'/') {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            } else if b == b'/' && next == Some(b'*') {
+                comments = 1;
+                i += 1;
+                return Some(Nesting::Comment {
+                    at: at + 1,
+                    depth: 1,
+                });
+            } else if matches!(b, b'(' | b'[' | b'{') {
+                return Some(Nesting::Open(at));
+            } else if matches!(b, b')' | b']' | b'}') {
+                return Some(Nesting::Close);
+            }
+        }
+        None
+    })
+}
+
 /// Rejects input nested deeper than [`MAX_NESTING`] (brackets of any kind and block comments)
 /// with one scan, before the recursive parser runs.
 fn check_nesting(source: &str) -> Option<Diagnostic> {
-    let bytes = source.as_bytes();
     let mut brackets = 0usize;
-    let mut comments = 0usize;
-    let mut i = 0;
-    while i < bytes.len() {
-        let b = bytes[i];
-        let next = bytes.get(i + 1).copied();
-        if comments > 0 {
-            if b == b'/' && next == Some(b'*') {
-                comments += 1;
-                i += 1;
-            } else if b == b'*' && next == Some(b'/') {
-                comments -= 1;
-                i += 1;
+    for event in nesting_events(source.as_bytes()) {
+        let (i, comments) = match event {
+            Nesting::Open(at) => {
+                brackets += 1;
+                (at, 0)
             }
-        } else if b == b'/' && next == Some(b'/') {
-            while i < bytes.len() && bytes[i] != b'\n' {
-                i += 1;
+            Nesting::Close => {
+                brackets = brackets.saturating_sub(1);
+                continue;
             }
-        } else if b == b'/' && next == Some(b'*') {
-            comments = 1;
-            i += 1;
-        } else if matches!(b, b'(' | b'[' | b'{') {
-            brackets += 1;
-        } else if matches!(b, b')' | b']' | b'}') {
-            brackets = brackets.saturating_sub(1);
-        }
+            Nesting::Comment { at, depth } => (at, depth),
+        };
         if brackets > MAX_NESTING || comments > MAX_NESTING {
             let what = if comments > MAX_NESTING {
                 "block comments"
@@ -202,7 +243,6 @@ fn check_nesting(source: &str) -> Option<Diagnostic> {
                 .with_hint("a clay file never needs more than three levels of brackets; look for an unclosed bracket or comment"),
             );
         }
-        i += 1;
     }
     None
 }
@@ -298,33 +338,15 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
 
 /// The innermost bracket left open at the end of the source (comments skipped).
 fn unclosed(source: &str) -> Option<Span> {
-    let bytes = source.as_bytes();
     let mut open: Vec<usize> = Vec::new();
-    let mut i = 0;
-    let mut comments = 0usize;
-    while i < bytes.len() {
-        let (b, next) = (bytes[i], bytes.get(i + 1).copied());
-        if comments > 0 {
-            if b == b'/' && next == Some(b'*') {
-                comments += 1;
-                i += 1;
-            } else if b == b'*' && next == Some(b'/') {
-                comments -= 1;
-                i += 1;
+    for event in nesting_events(source.as_bytes()) {
+        match event {
+            Nesting::Open(at) => open.push(at),
+            Nesting::Close => {
+                open.pop();
             }
-        } else if b == b'/' && next == Some(b'/') {
-            while i < bytes.len() && bytes[i] != b'\n' {
-                i += 1;
-            }
-        } else if b == b'/' && next == Some(b'*') {
-            comments = 1;
-            i += 1;
-        } else if matches!(b, b'(' | b'[' | b'{') {
-            open.push(i);
-        } else if matches!(b, b')' | b']' | b'}') {
-            open.pop();
+            Nesting::Comment { .. } => {}
         }
-        i += 1;
     }
     open.last().map(|&i| Span::new(i, i + 1))
 }
