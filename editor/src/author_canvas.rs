@@ -10,7 +10,7 @@ use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape
 use glam::DVec2;
 
 use crate::author::{AuthorCommand, Authoring, Computed, SiteName};
-use crate::camera::Camera;
+use crate::camera::{Camera, dv, pos};
 
 /// Pointer distance (screen points) within which a point or edge counts as under it.
 const PICK_RADIUS: f64 = 10.0;
@@ -122,14 +122,6 @@ impl Default for AuthorCanvas {
             rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
         }
     }
-}
-
-fn dv(p: Pos2) -> DVec2 {
-    DVec2::new(p.x as f64, p.y as f64)
-}
-
-fn pos(p: DVec2) -> Pos2 {
-    Pos2::new(p.x as f32, p.y as f32)
 }
 
 fn nearest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> DVec2 {

@@ -1,6 +1,7 @@
 //! The canvas camera: world metres (y north) to screen points (y down), with pan, zoom about a
 //! fixed screen point and fit-to-bounds.
 
+use egui::Pos2;
 use glam::DVec2;
 
 /// Nearest and furthest zoom, in screen points per metre.
@@ -68,6 +69,16 @@ impl Camera {
             .clamp(SCALE_RANGE.0, SCALE_RANGE.1);
         self.centre = (min + max) / 2.0;
     }
+}
+
+/// A screen point (egui, f32) as a `DVec2`, for the camera's f64 arithmetic.
+pub(crate) fn dv(p: Pos2) -> DVec2 {
+    DVec2::new(p.x as f64, p.y as f64)
+}
+
+/// A screen-space `DVec2` as an egui point.
+pub(crate) fn pos(p: DVec2) -> Pos2 {
+    Pos2::new(p.x as f32, p.y as f32)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use clay_dsl::compiled::{AssemblyData, PartKind};
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
-use crate::camera::Camera;
+use crate::camera::{Camera, dv, pos};
 use crate::sculpt::{Command, Sculpt};
 
 /// Pointer distance (screen points) within which an edge or connection counts as under it.
@@ -69,14 +69,6 @@ impl Default for Canvas {
             rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
         }
     }
-}
-
-fn dv(p: Pos2) -> DVec2 {
-    DVec2::new(p.x as f64, p.y as f64)
-}
-
-fn pos(p: DVec2) -> Pos2 {
-    Pos2::new(p.x as f32, p.y as f32)
 }
 
 impl Canvas {
