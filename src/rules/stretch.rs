@@ -13,7 +13,7 @@
 use std::collections::HashSet;
 
 use clay_dsl::compiled::{
-    AssemblyData, CompiledGrammar, Dock, Instance, InstanceSite, PartKind, StretchRule,
+    AssemblyData, Chain, CompiledGrammar, Dock, Instance, InstanceSite, PartKind, StretchRule,
 };
 use glam::DVec2;
 
@@ -265,15 +265,7 @@ pub fn stretch(
     transaction(grammar, data, |data| {
         let c = data.chains.get(chain).ok_or("no such chain")?;
         let rule = &grammar.stretch_rules[c.rule];
-        let (ia, ib) = match (c.instances.get(first), c.instances.get(first + 1)) {
-            (Some(&a), Some(&b)) => (a, b),
-            _ => {
-                return Err(format!(
-                    "chain {chain} has no elements {first}, {}",
-                    first + 1
-                ));
-            }
-        };
+        let (ia, ib) = element_pair(c, chain, first)?;
         let states =
             part_states(data, chain, first).ok_or("the stretch part has no three states")?;
         let layout = Layout::new(grammar, rule);
@@ -283,11 +275,7 @@ pub fn stretch(
         );
         let place = Placement::new(&layout, &states, THREE, 3, [&va, &vb], &data.positions)
             .ok_or("the stretch rule's part does not describe an axis")?;
-        let pieces: Vec<usize> = c
-            .instances
-            .iter()
-            .map(|&i| data.instances[i].piece)
-            .collect();
+        let pieces = chain_pieces(data, c);
         let piece = variants(rule)
             .into_iter()
             .map(|(p, _)| p)
@@ -383,6 +371,26 @@ pub fn stretch(
     })
 }
 
+/// Instance indices of elements `first` and `first + 1` of a chain: the stretch part that
+/// stretch and shrink rewrite.
+fn element_pair(c: &Chain, chain: usize, first: usize) -> Result<(usize, usize), String> {
+    match (c.instances.get(first), c.instances.get(first + 1)) {
+        (Some(&a), Some(&b)) => Ok((a, b)),
+        _ => Err(format!(
+            "chain {chain} has no elements {first}, {}",
+            first + 1
+        )),
+    }
+}
+
+/// The piece of every element of a chain, in order: the histogram the variants are matched to.
+fn chain_pieces(data: &AssemblyData, c: &Chain) -> Vec<usize> {
+    c.instances
+        .iter()
+        .map(|&i| data.instances[i].piece)
+        .collect()
+}
+
 /// Two elements -> one. The one kept (by the rule's frequencies; the first on ties) takes the
 /// outer sites of both; the other is removed with its unshared vertices.
 pub fn shrink(
@@ -401,15 +409,7 @@ pub fn shrink(
                 c.instances.len()
             ));
         }
-        let (ia, ib) = match (c.instances.get(first), c.instances.get(first + 1)) {
-            (Some(&a), Some(&b)) => (a, b),
-            _ => {
-                return Err(format!(
-                    "chain {chain} has no elements {first}, {}",
-                    first + 1
-                ));
-            }
-        };
+        let (ia, ib) = element_pair(c, chain, first)?;
         let states = part_states(data, chain, first).ok_or("the stretch part has no one state")?;
         let layout = Layout::new(grammar, rule);
         let (va, vb) = (
@@ -418,11 +418,7 @@ pub fn shrink(
         );
         let place = Placement::new(&layout, &states, ONE, 1, [&va, &vb], &data.positions)
             .ok_or("the stretch rule's part does not describe an axis")?;
-        let pieces: Vec<usize> = c
-            .instances
-            .iter()
-            .map(|&i| data.instances[i].piece)
-            .collect();
+        let pieces = chain_pieces(data, c);
         let (pa, pb) = (data.instances[ia].piece, data.instances[ib].piece);
         let keep_b = histogram_error(rule, &pieces, (pa, -1))
             < histogram_error(rule, &pieces, (pb, -1)) - 1e-12;
