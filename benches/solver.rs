@@ -80,6 +80,12 @@ fn phases(parts: usize) {
     if let Some(k) = env("CLAY_IRLS") {
         config.irls_iterations = k;
     }
+    if let Some(k) = env("CLAY_ADMM") {
+        config.admm_iterations = k;
+    }
+    if std::env::var("CLAY_PASS1").is_ok_and(|v| v == "irls") {
+        config.pass1 = clay::solver::Pass1::Irls;
+    }
     if let Some(k) = env("CLAY_L2") {
         config.l2_iterations = k;
     }
@@ -107,7 +113,7 @@ fn phases(parts: usize) {
         mean(&|r| r.phases.assembly),
         mean(&|r| r.phases.factorization),
         mean(&|r| r.phases.solve),
-        mean(&|r| r.irls_iterations as f64),
+        mean(&|r| r.pass1_iterations as f64),
         mean(&|r| r.l2_iterations as f64),
         mean(&|r| r.factorizations as f64),
         mean(&|r| r.pcg_iterations as f64),

@@ -86,8 +86,8 @@ pub fn statistics(ui: &mut egui::Ui, sculpt: &Sculpt) {
     match sculpt.last_report() {
         Some(r) => {
             ui.label(format!(
-                "iterations: {} IRLS + {} least squares",
-                r.irls_iterations, r.l2_iterations
+                "iterations: {} pass 1 + {} least squares",
+                r.pass1_iterations, r.l2_iterations
             ));
             ui.label(format!("energy: {:.6}", r.energy));
             ui.label(format!("frame time: {:.2} ms", r.ms));

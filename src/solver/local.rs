@@ -1,6 +1,8 @@
 //! The local step (paper 4.1-4.3): for each part and each of its rest states, the optimal 2D
 //! rotation onto the current pose and the shape distance, the choice of the active rest state
 //! with hysteresis, and the per-edge rotations `R_xy` averaged over the parts touching an edge.
+//! The free functions are the plain reference; [`RestCache`] gives the same results, bit for
+//! bit, from rest data flattened once per assembly generation (what the solver runs).
 
 use clay_dsl::compiled::Part;
 use glam::DVec2;
@@ -39,20 +41,37 @@ pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignme
         pp += p.length_squared();
         qq += q.length_squared();
     }
+    finish(dot, cross, pp, qq)
+}
+
+/// The alignment from the sums of dot and cross products of the centred rest (p) and pose (q)
+/// vectors and their squared norms; shared by [`align`] and [`RestCache`] so both give the
+/// same result bit for bit.
+fn finish(dot: f64, cross: f64, pp: f64, qq: f64) -> Alignment {
     let len = (dot * dot + cross * cross).sqrt();
-    let rotation = if len > 1e-300 && len.is_finite() {
-        DVec2::new(dot / len, cross / len)
+    Alignment {
+        rotation: rotation_of(dot, cross, len),
+        distance: distance_of(pp, qq, len),
+    }
+}
+
+#[inline]
+fn rotation_of(dot: f64, cross: f64, len: f64) -> DVec2 {
+    // divided before the test, as in `normalised_or`
+    let unit = DVec2::new(dot, cross) / len;
+    if len > 1e-300 && len.is_finite() {
+        unit
     } else {
         DVec2::X
-    };
+    }
+}
+
+fn distance_of(pp: f64, qq: f64, len: f64) -> f64 {
     let distance = (pp + qq - 2.0 * len).max(0.0);
-    Alignment {
-        rotation,
-        distance: if distance.is_finite() {
-            distance
-        } else {
-            f64::MAX
-        },
+    if distance.is_finite() {
+        distance
+    } else {
+        f64::MAX
     }
 }
 
@@ -150,10 +169,14 @@ pub fn vertex_rotation_sum(
 }
 
 /// Normalises a sum of rotations, falling back to `own` when it (nearly) vanishes.
+#[inline]
 pub fn normalised_or(s: DVec2, own: DVec2) -> DVec2 {
     let len = s.length();
+    // divided before the test (the quotient is dropped when unused): the compiler then
+    // divides both components in one instruction, and the division dominates the local step
+    let unit = s / len;
     if len > 1e-9 && len.is_finite() {
-        s / len
+        unit
     } else {
         own
     }
@@ -182,6 +205,422 @@ pub fn edge_rotation(
     let s = vertex_rotation_sum(vertex_parts, rotations, x, own, cos_cone)
         + vertex_rotation_sum(vertex_parts, rotations, y, own, cos_cone);
     normalised_or(s, own)
+}
+
+/// Where one part's data starts in the flat arrays of [`RestCache`]; part `i`'s data ends
+/// where part `i + 1`'s starts (there is one span more than parts).
+#[derive(Clone, Copy, Debug, Default)]
+struct Span {
+    /// Into `vertices` (one slot per vertex of the part).
+    vertex: u32,
+    /// Into `neighbours`.
+    neighbour: u32,
+    /// Into `edge_local` (the solver's edge order).
+    edge: u32,
+    /// Into the per-state arrays `pp` and `edge_rest_start`.
+    state: u32,
+    /// Into `rest`: the part's states' centred positions, state `j` at `rest + j * m`, or
+    /// [`SHORT`] when a state has fewer positions than the part has vertices ([`align`] then
+    /// centres the pose over a prefix of the vertices, so the part takes the reference path).
+    rest: u32,
+}
+
+const SHORT: u32 = u32::MAX;
+
+/// The rest data of every part, flattened once per assembly generation, so the local step
+/// reads contiguous arrays instead of chasing each part's and each state's own allocations,
+/// gathers and centres the pose once per part instead of once per rest state, and does not
+/// recompute the rest centres and norms (they only change with the generation).
+///
+/// Every result equals the reference functions' ([`choose_state`], [`part_rotation`],
+/// [`edge_rotation`]) bit for bit: the same numbers are summed in the same order, only
+/// computed less often. The active states are read from the parts at every call, since the
+/// local step switches them; everything else must not change without a generation bump.
+#[derive(Clone, Debug, Default)]
+pub struct RestCache {
+    spans: Vec<Span>,
+    vertices: Vec<u32>,
+    rest: Vec<DVec2>,
+    /// Per state: the squared norm of its centred positions.
+    pp: Vec<f64>,
+    /// Per state: where its rest edge vectors `x0 - y0` (one per edge of the part) start in
+    /// `rest_edges`.
+    edge_rest_start: Vec<u32>,
+    rest_edges: Vec<DVec2>,
+    edge_local: Vec<[u32; 2]>,
+    /// Per part-edge, the rest edge of its part's active state (zero when the part has no
+    /// such state), and per part the state it was copied from: the edge targets then read
+    /// one contiguous array instead of picking each part's block among all its states'.
+    active_rest_edges: Vec<DVec2>,
+    copied_state: Vec<usize>,
+    /// Per part-edge, its ends' global vertices (the solver's `EdgeSlot::x`, `y`, compact).
+    edge_ends: Vec<[u32; 2]>,
+    /// Per part, `[k, j]` for every part `j` containing the part's vertex `k`: vertex by
+    /// vertex, each vertex's parts in the order of [`VertexParts::of`] (so the sums run in
+    /// the reference's order), one flat list per part so its loop has one trip count.
+    neighbours: Vec<[u32; 2]>,
+    /// Scratch sized for the largest part: its centred pose, and its vertices' rotation sums.
+    pose: Vec<DVec2>,
+    sums: Vec<DVec2>,
+    /// Per part: the active state the last rotation step ([`RestCache::choose_state`] or
+    /// [`RestCache::part_rotation`]) left it in, and how many parts that step has noted
+    /// since the last [`RestCache::edge_targets`]: when all have, the edge targets need not
+    /// read the parts again.
+    active: Vec<usize>,
+    noted: usize,
+}
+
+impl RestCache {
+    /// Flattens `parts`; `None` when an index would not fit the compact `u32` arrays (the
+    /// solver then uses the reference functions).
+    pub fn build(parts: &[Part], vertex_parts: &VertexParts) -> Option<Self> {
+        let index = |i: usize| u32::try_from(i).ok().filter(|&i| i != SHORT);
+        let mut c = Self::default();
+        let mut most = 0;
+        for part in parts {
+            let m = part.vertices.len();
+            most = most.max(m);
+            let dense = m > 0 && part.states.iter().all(|s| s.positions.len() >= m);
+            c.spans.push(Span {
+                vertex: index(c.vertices.len())?,
+                neighbour: index(c.neighbours.len())?,
+                edge: index(c.edge_local.len())?,
+                state: index(c.pp.len())?,
+                rest: if dense { index(c.rest.len())? } else { SHORT },
+            });
+            for (k, &v) in part.vertices.iter().enumerate() {
+                c.vertices.push(index(v)?);
+                for &j in vertex_parts.of(v) {
+                    c.neighbours.push([index(k)?, index(j)?]);
+                }
+            }
+            for e in &part.edges {
+                c.edge_local.push([index(e[0])?, index(e[1])?]);
+                let end = |k: usize| part.vertices.get(k).copied().and_then(index);
+                c.edge_ends.push([end(e[0])?, end(e[1])?]);
+            }
+            for state in &part.states {
+                let rest = &state.positions;
+                let mut pp = 0.0;
+                if dense {
+                    // the same expressions, in the same order, as `align`
+                    let inv = 1.0 / m as f64;
+                    let centre = rest[..m].iter().copied().sum::<DVec2>() * inv;
+                    for &r in &rest[..m] {
+                        let p = r - centre;
+                        pp += p.length_squared();
+                        c.rest.push(p);
+                    }
+                }
+                c.pp.push(pp);
+                c.edge_rest_start.push(index(c.rest_edges.len())?);
+                for e in &part.edges {
+                    c.rest_edges.push(match (rest.get(e[0]), rest.get(e[1])) {
+                        (Some(&a), Some(&b)) => a - b,
+                        _ => DVec2::ZERO,
+                    });
+                }
+            }
+        }
+        c.spans.push(Span {
+            vertex: index(c.vertices.len())?,
+            neighbour: index(c.neighbours.len())?,
+            edge: index(c.edge_local.len())?,
+            state: index(c.pp.len())?,
+            rest: index(c.rest.len())?,
+        });
+        c.active = vec![0; parts.len()];
+        c.active_rest_edges = vec![DVec2::ZERO; c.edge_local.len()];
+        c.copied_state = vec![usize::MAX; parts.len()];
+        c.pose = vec![DVec2::ZERO; most];
+        c.sums = vec![DVec2::ZERO; most];
+        Some(c)
+    }
+
+    /// Number of parts the cache was built for.
+    pub fn parts(&self) -> usize {
+        self.spans.len().saturating_sub(1)
+    }
+
+    /// Number of part-edges the cache was built for.
+    pub fn edges(&self) -> usize {
+        self.edge_local.len()
+    }
+
+    /// The elastic energy `sum |t - (f_x - f_y)|^2` of `targets` (one per part-edge, in the
+    /// solver's order) at `positions`, summed in edge order as the solver's `terms`; `None`
+    /// when `targets` is not one per cached edge.
+    pub fn elastic(&self, targets: &[DVec2], positions: &[DVec2]) -> Option<f64> {
+        if targets.len() != self.edge_ends.len() {
+            return None;
+        }
+        let mut elastic = 0.0;
+        for (&[x, y], &t) in self.edge_ends.iter().zip(targets) {
+            elastic += (t - (positions[x as usize] - positions[y as usize])).length_squared();
+        }
+        Some(elastic)
+    }
+
+    /// Part `pi`'s span and the number of its states, when `part` still has the vertex and
+    /// state counts the cache was built with and dense rest data (else the reference path).
+    fn dense_span(&self, pi: usize, part: &Part) -> Option<(Span, usize)> {
+        let (s, next) = (*self.spans.get(pi)?, *self.spans.get(pi + 1)?);
+        let count = (next.state - s.state) as usize;
+        let fits = s.rest != SHORT
+            && (next.vertex - s.vertex) as usize == part.vertices.len()
+            && count == part.states.len();
+        fits.then_some((s, count))
+    }
+
+    /// Gathers and centres the pose of the part with span `s` into `self.pose[..m]`;
+    /// returns its squared norm. The same expressions, in the same order, as [`align`].
+    fn gather_pose(&mut self, s: Span, m: usize, positions: &[DVec2]) -> f64 {
+        let verts = &self.vertices[s.vertex as usize..][..m];
+        let inv = 1.0 / m as f64;
+        let centre = verts.iter().map(|&v| positions[v as usize]).sum::<DVec2>() * inv;
+        let mut qq = 0.0;
+        for (q, &v) in self.pose[..m].iter_mut().zip(verts) {
+            *q = positions[v as usize] - centre;
+            qq += q.length_squared();
+        }
+        qq
+    }
+
+    /// [`choose_state`] for part `pi` (which is `part`), from the cached rest data.
+    pub fn choose_state(
+        &mut self,
+        pi: usize,
+        part: &Part,
+        positions: &[DVec2],
+        hysteresis: f64,
+    ) -> (usize, DVec2) {
+        let (state, rotation) = self.choose_state_of(pi, part, positions, hysteresis);
+        // the caller makes `state` the part's active state
+        self.note(pi, state);
+        (state, rotation)
+    }
+
+    /// Records part `pi`'s active state; `noted` counts the parts noted in order from 0.
+    fn note(&mut self, pi: usize, active: usize) {
+        if pi == 0 {
+            self.noted = 0;
+        }
+        if let Some(a) = self.active.get_mut(pi) {
+            *a = active;
+        }
+        self.noted = if pi == self.noted { pi + 1 } else { usize::MAX };
+    }
+
+    fn choose_state_of(
+        &mut self,
+        pi: usize,
+        part: &Part,
+        positions: &[DVec2],
+        hysteresis: f64,
+    ) -> (usize, DVec2) {
+        let Some((s, count)) = self.dense_span(pi, part) else {
+            return choose_state(part, positions, hysteresis);
+        };
+        if count == 0 {
+            return choose_state(part, positions, hysteresis);
+        }
+        let m = part.vertices.len();
+        let active = part.active.min(count - 1);
+        let qq = self.gather_pose(s, m, positions);
+        let pose = &self.pose[..m];
+        let rest = &self.rest[s.rest as usize..][..count * m];
+        let pp = &self.pp[s.state as usize..][..count];
+        // One pass over the pose for all states (each state's sums still run in vertex
+        // order), then the reference's comparisons on the distances.
+        match count {
+            1 => decide::<1>(pose, rest, pp, qq, active, hysteresis),
+            2 => decide::<2>(pose, rest, pp, qq, active, hysteresis),
+            3 => decide::<3>(pose, rest, pp, qq, active, hysteresis),
+            4 => decide::<4>(pose, rest, pp, qq, active, hysteresis),
+            _ => {
+                let align_state = |j: usize| {
+                    let (dot, cross) = products(&rest[j * m..][..m], pose);
+                    finish(dot, cross, pp[j], qq)
+                };
+                let here = align_state(active);
+                let mut best = (active, here);
+                for j in (0..count).filter(|&j| j != active) {
+                    let a = align_state(j);
+                    if a.distance < best.1.distance {
+                        best = (j, a);
+                    }
+                }
+                if best.0 != active && best.1.distance < (1.0 - hysteresis) * here.distance {
+                    (best.0, best.1.rotation)
+                } else {
+                    (active, here.rotation)
+                }
+            }
+        }
+    }
+
+    /// [`part_rotation`] for part `pi` (which is `part`), from the cached rest data.
+    pub fn part_rotation(&mut self, pi: usize, part: &Part, positions: &[DVec2]) -> DVec2 {
+        self.note(pi, part.active);
+        let Some((s, count)) = self.dense_span(pi, part) else {
+            return part_rotation(part, positions);
+        };
+        if part.active >= count {
+            return part_rotation(part, positions);
+        }
+        let m = part.vertices.len();
+        let verts = &self.vertices[s.vertex as usize..][..m];
+        let rest = &self.rest[s.rest as usize + part.active * m..][..m];
+        // the same expressions, in the same order, as `align`, without storing the pose
+        let inv = 1.0 / m as f64;
+        let centre = verts.iter().map(|&v| positions[v as usize]).sum::<DVec2>() * inv;
+        let (mut dot, mut cross, mut qq) = (0.0, 0.0, 0.0);
+        for (p, &v) in rest.iter().zip(verts) {
+            let q = positions[v as usize] - centre;
+            dot += p.dot(q);
+            cross += p.perp_dot(q);
+            qq += q.length_squared();
+        }
+        finish(dot, cross, self.pp[s.state as usize + part.active], qq).rotation
+    }
+
+    /// `R_xy (x0 - y0)` for every part-edge, in the solver's edge order, into `targets`: the
+    /// same as [`edge_rotation`] per edge with the active state's rest edge, but each part
+    /// sums its vertices' neighbour rotations once instead of once per edge end.
+    ///
+    /// Reads the parts' active states from the last rotation step when it noted every part
+    /// (and the caller has not switched states since), else from `parts`.
+    pub fn edge_targets(
+        &mut self,
+        parts: &[Part],
+        rotations: &[DVec2],
+        cos_cone: f64,
+        targets: &mut Vec<DVec2>,
+    ) {
+        let count = parts.len().min(self.parts());
+        if self.noted != parts.len() || count != parts.len() {
+            for (a, part) in self.active.iter_mut().zip(parts) {
+                *a = part.active;
+            }
+        }
+        self.noted = 0;
+        // every target is written below: no clearing pass over them
+        targets.resize(self.spans[count].edge as usize, DVec2::ZERO);
+        for pi in 0..count {
+            let own = rotations[pi];
+            let active = self.active[pi];
+            let (s, next) = (self.spans[pi], self.spans[pi + 1]);
+            let (e0, e1) = (s.edge as usize, next.edge as usize);
+            let edges = &self.edge_local[e0..e1];
+            let out = &mut targets[e0..e1];
+            let rest = &mut self.active_rest_edges[e0..e1];
+            if self.copied_state[pi] != active {
+                // a part without its active state gets zero rest edges, as in the reference
+                if active < (next.state - s.state) as usize {
+                    let start = self.edge_rest_start[s.state as usize + active] as usize;
+                    rest.copy_from_slice(&self.rest_edges[start..][..edges.len()]);
+                } else {
+                    rest.fill(DVec2::ZERO);
+                }
+                self.copied_state[pi] = active;
+            }
+            let rest = &*rest;
+            if cos_cone >= 1.0 {
+                for (t, &d) in out.iter_mut().zip(rest) {
+                    *t = own.rotate(d);
+                }
+                continue;
+            }
+            let m = (next.vertex - s.vertex) as usize;
+            let neighbours = &self.neighbours[s.neighbour as usize..next.neighbour as usize];
+            // small parts sum on the stack: a fixed-size zeroing is a few stores, where the
+            // slice's would be a call to memset per part
+            let mut small = [DVec2::ZERO; 8];
+            let sums = if m <= small.len() {
+                &mut small[..m]
+            } else {
+                let sums = &mut self.sums[..m];
+                sums.fill(DVec2::ZERO);
+                sums
+            };
+            part_targets(sums, neighbours, rotations, own, cos_cone, edges, rest, out);
+        }
+    }
+}
+
+/// The edge targets of one part: `sums` (zeroed, one per vertex of the part) gathers the
+/// rotations of the parts around each vertex within the cone of `own`, then every edge gets
+/// the normalised sum of its ends' sums applied to its rest edge.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn part_targets(
+    sums: &mut [DVec2],
+    neighbours: &[[u32; 2]],
+    rotations: &[DVec2],
+    own: DVec2,
+    cos_cone: f64,
+    edges: &[[u32; 2]],
+    rest: &[DVec2],
+    out: &mut [DVec2],
+) {
+    // sums start at +0 and gain terms in the order of `vertex_rotation_sum`
+    for &[k, j] in neighbours {
+        let r = rotations[j as usize];
+        if r.dot(own) >= cos_cone {
+            sums[k as usize] += r;
+        }
+    }
+    for ((t, e), &d) in out.iter_mut().zip(edges).zip(rest) {
+        *t = normalised_or(sums[e[0] as usize] + sums[e[1] as usize], own).rotate(d);
+    }
+}
+
+/// Sums of dot and cross products of centred rest positions with the centred pose, in vertex
+/// order as in [`align`].
+fn products(rest: &[DVec2], pose: &[DVec2]) -> (f64, f64) {
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for (p, q) in rest.iter().zip(pose) {
+        dot += p.dot(*q);
+        cross += p.perp_dot(*q);
+    }
+    (dot, cross)
+}
+
+/// [`choose_state`]'s decision for a part with `N` dense states (`rest` holds state `j` at
+/// `j * m`): the states' sums run side by side over the pose, each in vertex order, and only
+/// the chosen state's rotation is computed.
+#[inline]
+fn decide<const N: usize>(
+    pose: &[DVec2],
+    rest: &[DVec2],
+    pp: &[f64],
+    qq: f64,
+    active: usize,
+    hysteresis: f64,
+) -> (usize, DVec2) {
+    let m = pose.len();
+    let (mut dot, mut cross) = ([0.0; N], [0.0; N]);
+    for (k, q) in pose.iter().enumerate() {
+        for j in 0..N {
+            let p = rest[j * m + k];
+            dot[j] += p.dot(*q);
+            cross[j] += p.perp_dot(*q);
+        }
+    }
+    let len: [f64; N] = std::array::from_fn(|j| (dot[j] * dot[j] + cross[j] * cross[j]).sqrt());
+    let distance: [f64; N] = std::array::from_fn(|j| distance_of(pp[j], qq, len[j]));
+    let mut best = active;
+    for j in (0..N).filter(|&j| j != active) {
+        if distance[j] < distance[best] {
+            best = j;
+        }
+    }
+    let chosen = if best != active && distance[best] < (1.0 - hysteresis) * distance[active] {
+        best
+    } else {
+        active
+    };
+    (chosen, rotation_of(dot[chosen], cross[chosen], len[chosen]))
 }
 
 #[cfg(test)]
@@ -246,5 +685,127 @@ mod tests {
         // with the cone wide open, opposite rotations may cancel: fall back to our own
         let opposite = [DVec2::X, -DVec2::X];
         assert_eq!(edge_rotation(&vp, &opposite, 1, 1, 0, -1.0), DVec2::X);
+    }
+
+    /// A part over `vertices` (indices into `n` positions) with `states` rest states; states
+    /// may be short (fewer positions than vertices) to exercise the reference fallback.
+    fn arbitrary_part(vertices: Vec<usize>, states: Vec<Vec<(f64, f64)>>, active: usize) -> Part {
+        let m = vertices.len();
+        let edges = (0..m)
+            .flat_map(|a| (a + 1..m).map(move |b| [a, b]))
+            .filter(|e| (e[0] * 7 + e[1]) % 3 != 0)
+            .collect();
+        Part {
+            kind: clay_dsl::compiled::PartKind::Piece { instance: 0 },
+            vertices,
+            edges,
+            states: states
+                .into_iter()
+                .map(|p| clay_dsl::compiled::PartState {
+                    name: String::new(),
+                    positions: p.into_iter().map(|(x, y)| DVec2::new(x, y)).collect(),
+                })
+                .collect(),
+            active,
+        }
+    }
+
+    fn same(a: DVec2, b: DVec2) -> bool {
+        a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
+    }
+
+    fn assembly() -> impl proptest::strategy::Strategy<Value = (Vec<Part>, Vec<DVec2>, f64, f64)> {
+        use proptest::prelude::*;
+        let n = 12usize;
+        let coordinate = -3.0..3.0f64;
+        let part = (
+            proptest::collection::vec(0..n, 0..11),
+            proptest::collection::vec(
+                proptest::collection::vec((coordinate.clone(), coordinate.clone()), 0..11),
+                0..6,
+            ),
+            0..7usize,
+            any::<bool>(),
+        )
+            .prop_map(|(vertices, mut states, active, full)| {
+                // mostly states with one position per vertex, as grammars make them
+                if full {
+                    for s in &mut states {
+                        s.resize(vertices.len(), (0.5, -0.25));
+                    }
+                }
+                arbitrary_part(vertices, states, active)
+            });
+        (
+            proptest::collection::vec(part, 1..8),
+            proptest::collection::vec((coordinate.clone(), coordinate), n),
+            0.0..0.5f64,
+            0.0..200.0f64,
+        )
+            .prop_map(|(parts, positions, hysteresis, cone)| {
+                let positions = positions
+                    .into_iter()
+                    .map(|(x, y)| DVec2::new(x, y))
+                    .collect();
+                (parts, positions, hysteresis, cone)
+            })
+    }
+
+    proptest::proptest! {
+        /// The cached local step chooses the same states and gives bit-identical rotations,
+        /// edge targets and energy as the straightforward `align`-based functions.
+        #[test]
+        fn rest_cache_matches_the_reference((parts, positions, hysteresis, cone) in assembly()) {
+            let vp = VertexParts::build(&parts, positions.len());
+            let mut cache = RestCache::build(&parts, &vp).unwrap();
+            let cos_cone = if cone >= 180.0 { -1.0 } else { cone.to_radians().cos() };
+            let mut parts = parts;
+            // the switching step, then the states-fixed step, as the solver runs them
+            let mut rotations = Vec::new();
+            for (pi, part) in parts.iter_mut().enumerate() {
+                let want = choose_state(part, &positions, hysteresis);
+                let got = cache.choose_state(pi, part, &positions, hysteresis);
+                proptest::prop_assert_eq!(want.0, got.0);
+                proptest::prop_assert!(same(want.1, got.1), "{:?} vs {:?}", want.1, got.1);
+                part.active = got.0;
+                rotations.push(got.1);
+            }
+            for round in 0..2 {
+                let mut targets = Vec::new();
+                cache.edge_targets(&parts, &rotations, cos_cone, &mut targets);
+                let mut want = Vec::new();
+                for (pi, part) in parts.iter().enumerate() {
+                    let rest = part.states.get(part.active).map(|s| s.positions.as_slice());
+                    for e in &part.edges {
+                        let d0 = match rest.map(|r| (r.get(e[0]), r.get(e[1]))) {
+                            Some((Some(&a), Some(&b))) => a - b,
+                            _ => DVec2::ZERO,
+                        };
+                        let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
+                        let r = edge_rotation(&vp, &rotations, x, y, pi, cos_cone);
+                        want.push(r.rotate(d0));
+                    }
+                }
+                proptest::prop_assert_eq!(want.len(), targets.len());
+                for (w, t) in want.iter().zip(&targets) {
+                    proptest::prop_assert!(same(*w, *t), "round {}: {:?} vs {:?}", round, w, t);
+                }
+                let mut elastic = 0.0;
+                for (part, t) in parts.iter().flat_map(|p| p.edges.iter().map(move |e| (p, e))).zip(&want) {
+                    let (x, y) = (part.0.vertices[part.1[0]], part.0.vertices[part.1[1]]);
+                    elastic += (*t - (positions[x] - positions[y])).length_squared();
+                }
+                let got = cache.elastic(&targets, &positions).unwrap();
+                proptest::prop_assert_eq!(elastic.to_bits(), got.to_bits());
+                // states fixed: rotations of the active states
+                rotations.clear();
+                for (pi, part) in parts.iter().enumerate() {
+                    let want = part_rotation(part, &positions);
+                    let got = cache.part_rotation(pi, part, &positions);
+                    proptest::prop_assert!(same(want, got), "{:?} vs {:?}", want, got);
+                    rotations.push(got);
+                }
+            }
+        }
     }
 }

@@ -4,6 +4,7 @@
 //! norm (IRLS) and decides the active rest states; pass 2 is plain least squares with the
 //! states fixed, and its positions are what the user sees.
 
+pub mod admm;
 pub mod cg;
 pub mod cholesky;
 pub mod global;
@@ -29,17 +30,64 @@ pub enum SolverKind {
     Cg,
 }
 
+/// How pass 1 minimises the sub-quadratic energy (both decide the active rest states).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Pass1 {
+    /// Iteratively reweighted least squares (the paper's 5.2), restarted from the displayed
+    /// pose every frame: a numeric factorisation per iteration.
+    Irls,
+    /// Variable splitting ([`admm`]): least-squares solves with the pass-2 factor, per-edge
+    /// gaps and duals carried from frame to frame. No factorisation while the assembly and
+    /// the held vertices stay the same.
+    #[default]
+    Admm,
+}
+
+impl Pass1 {
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass1::Irls => "irls",
+            Pass1::Admm => "admm",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "irls" => Some(Pass1::Irls),
+            "admm" => Some(Pass1::Admm),
+            _ => None,
+        }
+    }
+}
+
 /// Solver parameters. The first four mirror the grammar's [`SolverParams`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverConfig {
     pub kind: SolverKind,
+    /// The pass-1 method.
+    pub pass1: Pass1,
+    /// [`Pass1::Admm`]: residuals shorter than this fraction of the mean rest edge length
+    /// close (the edge stays rigid); longer ones open as gaps.
+    pub admm_threshold: f64,
+    /// [`Pass1::Admm`]: edges at a held vertex close below this fraction of the threshold,
+    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained edges the gaps
+    /// then open at the handles first (paper 5.2: the handles are the outliers); without it a
+    /// chain pulled evenly stays evenly stretched, a stationary point the splitting cannot
+    /// leave by itself. Slightly below 1 breaks such ties without overriding real differences
+    /// (0.5 makes the streets next to a handle turn first and tears a bent street).
+    pub admm_handle_factor: f64,
+    /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
+    /// the kept factor, a shrink and a dual update). The variables carry over between frames,
+    /// so fewer are needed than IRLS iterations.
+    pub admm_iterations: usize,
     /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
     pub hysteresis: f64,
     /// Exponent p of the IRLS pass (2 = least squares).
     pub norm: f64,
     /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
     pub irls_epsilon: f64,
-    /// Most IRLS (pass 1) iterations per frame; each is a local and a global step.
+    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local and a global step
+    /// with a fresh numeric factorisation.
     pub irls_iterations: usize,
     /// Most least-squares (pass 2) iterations per frame.
     pub l2_iterations: usize,
@@ -55,12 +103,6 @@ pub struct SolverConfig {
     /// A pass stops early once no vertex moved more than this fraction of the model's size
     /// (and, in pass 1, no state switched).
     pub tolerance: f64,
-    /// Pass 1 continues from the previous frame's pass-1 result (handle vertices moved to
-    /// their targets) instead of restarting from the displayed least-squares pose, as long as
-    /// the generation is the same and the positions are the ones the solver last displayed.
-    /// IRLS then converges across frames: from the evenly spread least-squares pose the weights
-    /// are all equal and a slow drag would never gather the stretch (paper Fig. 8).
-    pub carry_pass1: bool,
     /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
     /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
     pub cg_tolerance: f64,
@@ -92,6 +134,10 @@ impl SolverConfig {
     pub fn from_params(params: &SolverParams) -> Self {
         Self {
             kind: SolverKind::Cholesky,
+            pass1: Pass1::Admm,
+            admm_threshold: 0.05,
+            admm_handle_factor: 0.9,
+            admm_iterations: 2,
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
@@ -104,7 +150,6 @@ impl SolverConfig {
             cg_tolerance: 1e-6,
             cg_max_iterations: 20_000,
             pcg_max_iterations: 0,
-            carry_pass1: false,
             pcg_tolerance: 1e-6,
             settle_tolerance: 1e-6,
             measure_residual: false,
@@ -123,8 +168,8 @@ pub struct StateSwitch {
 /// What one frame did.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct FrameReport {
-    /// IRLS (pass 1) iterations run.
-    pub irls_iterations: usize,
+    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`]).
+    pub pass1_iterations: usize,
     /// Least-squares (pass 2) iterations run.
     pub l2_iterations: usize,
     /// Pass-2 elastic energy (Eq. 4 with the final states and rotations), handles excluded.
@@ -192,6 +237,9 @@ impl std::error::Error for SolverError {}
 struct Work {
     rotations: Vec<DVec2>,
     vertex_parts: local::VertexParts,
+    /// The parts' rest data flattened for the local step (rebuilt with the generation);
+    /// `None` when it could not be built, and the local step then reads the parts directly.
+    rest: Option<local::RestCache>,
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
     weights: Vec<f64>,
@@ -219,10 +267,8 @@ struct Work {
     kept_rotations: Vec<DVec2>,
     kept_targets: Vec<DVec2>,
     warm_held: Vec<DVec2>,
-    /// The last frame's pass-1 result, the positions it displayed, and their generation.
-    pass1: Vec<DVec2>,
+    /// The positions the last frame displayed (the splitting pass continues only from them).
     shown: Vec<DVec2>,
-    pass1_generation: Option<u64>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
 }
@@ -238,6 +284,10 @@ pub struct Solver {
     irls_factor: NumericFactor,
     l2_factor: NumericFactor,
     work: Work,
+    /// Pass-1 splitting variables ([`Pass1::Admm`]), carried between frames.
+    splitting: admm::Splitting,
+    /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
+    shifted: Vec<DVec2>,
 }
 
 impl Solver {
@@ -250,6 +300,8 @@ impl Solver {
             irls_factor: NumericFactor::default(),
             l2_factor: NumericFactor::default(),
             work: Work::default(),
+            splitting: admm::Splitting::default(),
+            shifted: Vec::new(),
         }
     }
 
@@ -264,7 +316,12 @@ impl Solver {
         let edge_count: usize = asm.data.parts.iter().map(|p| p.edges.len()).sum();
         let stale = self.generation != Some(asm.generation())
             || self.pattern.n != n
-            || self.pattern.edges.len() != edge_count;
+            || self.pattern.edges.len() != edge_count
+            || self
+                .work
+                .rest
+                .as_ref()
+                .is_some_and(|c| c.parts() != asm.data.parts.len());
         if !stale {
             return Ok(());
         }
@@ -279,6 +336,7 @@ impl Solver {
         }
         self.pattern = Pattern::build(n, &asm.data.parts);
         self.work.vertex_parts = local::VertexParts::build(&asm.data.parts, n);
+        self.work.rest = local::RestCache::build(&asm.data.parts, &self.work.vertex_parts);
         self.symbolic = match self.config.kind {
             SolverKind::Cholesky if n > 0 => Some(
                 SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
@@ -299,13 +357,14 @@ impl Solver {
     }
 
     /// Runs one frame that stops early once `budget` is (about to be) spent, for an editor
-    /// that must draw at a fixed rate. It always runs at least one IRLS iteration (so state
-    /// decisions progress) and ends with at least one least-squares solve, so the displayed
-    /// positions are a proper least-squares pose of the current states even when cut short.
-    /// An iteration is started only if the previous one of its pass fits in the time left.
-    /// When cut short, the report has `complete == false` and `converged == false`; call again
-    /// next frame: the positions and active states carry the work over (the solver keeps no
-    /// other half-done state). A budget of `Duration::MAX` behaves like [`Solver::frame`].
+    /// that must draw at a fixed rate. It always runs the pass-1 iterations that decide states
+    /// (two splitting iterations, or one IRLS iteration; fewer if the configuration asks for
+    /// fewer) and ends with at least one least-squares solve, so the displayed positions are a
+    /// proper least-squares pose of the current states even when cut short. A further
+    /// iteration is started only if the previous one of its pass fits in the time left. When
+    /// cut short, the report has `complete == false` and `converged == false`; call again next
+    /// frame: the positions, active states and splitting variables carry the work over. A
+    /// budget of `Duration::MAX` behaves like [`Solver::frame`].
     pub fn frame_budgeted(
         &mut self,
         asm: &mut Assembly,
@@ -357,49 +416,54 @@ impl Solver {
                 *p = self.work.handle_sum[v] / count;
             }
         }
-        let mut pass1_pose = std::mem::take(&mut self.work.pass1);
-        let carried = cfg.carry_pass1
-            && pass1_pose.len() == n
-            && self.work.pass1_generation == Some(asm.generation())
-            && self.work.shown == warm;
         let mut f = std::mem::take(&mut self.work.f);
-        if carried {
-            f.clone_from(&pass1_pose);
-            for (v, p) in f.iter_mut().enumerate() {
-                let count = self.work.handle_count[v];
-                if count > 0.0 {
-                    *p = self.work.handle_sum[v] / count;
-                }
-            }
-        } else {
-            f.clone_from(&warm_held);
-        }
+        f.clone_from(&warm_held);
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
         next.resize(n, DVec2::ZERO);
         let mut pass1_converged = false;
         let mut warm_cached = false;
 
+        // Pass 1 by splitting: least-squares solves with the pass-2 factor.
+        let pass1_iterations = match cfg.pass1 {
+            Pass1::Irls => cfg.irls_iterations,
+            Pass1::Admm => cfg.admm_iterations,
+        };
+        let mut irls_iterations = cfg.irls_iterations;
+        if cfg.pass1 == Pass1::Admm {
+            let carry = self.work.shown == warm;
+            pass1_converged = self.split_pass(
+                asm,
+                SplitStart {
+                    warm: &warm,
+                    carry,
+                    step_tolerance,
+                    deadline,
+                },
+                &mut f,
+                &mut next,
+                &mut report,
+                &mut warm_cached,
+            )?;
+            irls_iterations = 0;
+        }
+
         // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
         let mut last_iteration = Duration::ZERO;
-        for it in 0..cfg.irls_iterations {
+        for it in 0..irls_iterations {
             if it > 0 && out_of_time(last_iteration) {
                 report.complete = false;
                 break;
             }
             let iteration_start = Instant::now();
-            report.irls_iterations += 1;
+            report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            // The first local step looks at the pose before the handles moved (the last
-            // pass-1 result, or the last displayed pose): judged with only the handles moved,
+            // The first local step looks at the displayed pose, before the handles moved:
+            // judged with only the handles moved,
             // the parts next to a handle look rotated and the first solve would bend a model
             // that should just follow rigidly.
-            let pose = match (it, carried) {
-                (0, true) => &pass1_pose,
-                (0, false) => &warm,
-                _ => &f,
-            };
+            let pose = if it == 0 { &warm } else { &f };
             self.local_step_switching(
                 &mut asm.data.parts,
                 pose,
@@ -407,7 +471,7 @@ impl Solver {
                 &mut report.switches,
             );
             self.edge_targets(&asm.data.parts);
-            if it == 0 && !carried {
+            if it == 0 {
                 self.work.warm_rotations.clone_from(&self.work.rotations);
                 self.work.warm_targets.clone_from(&self.work.targets);
                 warm_cached = true;
@@ -439,12 +503,8 @@ impl Solver {
                 break;
             }
         }
-        if cfg.irls_iterations == 0 {
+        if pass1_iterations == 0 {
             pass1_converged = true;
-        }
-
-        if cfg.irls_iterations > 0 {
-            pass1_pose.clone_from(&f);
         }
 
         // Pass 2: least squares, states fixed. Start from whichever of the pass-1 result and
@@ -474,8 +534,11 @@ impl Solver {
         let mut terms = self.objective(parts, handles, &f);
         report.warm_objective = warm_terms.total();
         let mut chosen = 0;
-        let held_judged = report.irls_iterations > 0;
+        let held_judged = report.pass1_iterations > 0 && terms.total() >= warm_terms.total();
         if held_judged {
+            // keep f's rotations and edge targets aside while the held start is judged
+            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
+            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
             let held_terms = self.objective(parts, handles, &warm_held);
             if held_terms.total() < terms.total() {
                 (chosen, terms) = (1, held_terms);
@@ -489,12 +552,13 @@ impl Solver {
         }
         // The first solve uses the rotations of its start, or for the handles-moved warm
         // start those of the last displayed pose (see pass 1).
-        if chosen != 0 || report.irls_iterations == 0 {
+        if chosen != 0 || report.pass1_iterations == 0 {
             self.work.rotations.clone_from(&self.work.warm_rotations);
             self.work.targets.clone_from(&self.work.warm_targets);
         } else if held_judged {
-            // judging the handles-moved start overwrote f's rotations
-            self.objective(parts, handles, &f);
+            // judging the handles-moved start overwrote f's rotations: take back the kept ones
+            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
+            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
         }
         report.phases.local += ms_since(t);
         let mut pass2_converged = cfg.l2_iterations == 0;
@@ -553,8 +617,6 @@ impl Solver {
         let settled = report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
         report.converged = report.complete && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
-        self.work.pass1_generation = Some(asm.generation());
-        self.work.pass1 = pass1_pose;
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         (
             self.work.warm,
@@ -563,6 +625,140 @@ impl Solver {
             self.work.next,
         ) = (warm, warm_held, f, next);
         Ok(report)
+    }
+
+    /// Pass 1 by splitting ([`admm`]): up to `admm_iterations` iterations of local step,
+    /// least-squares solve with the edge targets shifted by `z - u` (pass 2's factor), shrink
+    /// and dual update. Continues the last frame's splitting variables and pass-1 pose when
+    /// the assembly is the same generation and shows what the solver last displayed; else
+    /// starts from the displayed pose with no gaps. Leaves the pass-1 pose in `f`; returns
+    /// whether it converged.
+    #[allow(clippy::too_many_arguments)]
+    fn split_pass(
+        &mut self,
+        asm: &mut Assembly,
+        start: SplitStart<'_>,
+        f: &mut Vec<DVec2>,
+        next: &mut Vec<DVec2>,
+        report: &mut FrameReport,
+        warm_cached: &mut bool,
+    ) -> Result<bool, SolverError> {
+        let cfg = self.config;
+        let warm = start.warm;
+        let n = warm.len();
+        let m = self.pattern.edges.len();
+        let mut split = std::mem::take(&mut self.splitting);
+        if !(start.carry && split.is_valid(asm.generation(), m, n)) {
+            split.reset(asm.generation(), m, warm);
+        }
+        // The pass-1 pose continues; the handles' vertices jump to their targets.
+        f.clone_from(&split.pose);
+        for (v, p) in f.iter_mut().enumerate() {
+            let count = self.work.handle_count[v];
+            if count > 0.0 {
+                *p = self.work.handle_sum[v] / count;
+            }
+        }
+        let p = cfg.norm;
+        let mut rho = 1.0;
+        let mut converged = false;
+        let mut last_iteration = Duration::ZERO;
+        let mut result = Ok(());
+        for it in 0..cfg.admm_iterations {
+            // Two iterations are the least that decides states: the first judges the
+            // displayed pose, the second the pass-1 pose, where the gaps are.
+            if it >= MIN_SPLIT_ITERATIONS
+                && start
+                    .deadline
+                    .is_some_and(|d| Instant::now() + last_iteration > d)
+            {
+                report.complete = false;
+                break;
+            }
+            let iteration_start = Instant::now();
+            report.pass1_iterations += 1;
+            let t = Instant::now();
+            let switched_before = report.switches.len();
+            // As in IRLS, the first local step judges the displayed pose (before the handles
+            // moved); it also gives pass 2 its warm-start rotations.
+            let on_shown = it == 0;
+            let pose: &[DVec2] = if on_shown { warm } else { f };
+            self.local_step_switching(
+                &mut asm.data.parts,
+                pose,
+                cfg.hysteresis,
+                &mut report.switches,
+            );
+            self.edge_targets(&asm.data.parts);
+            if on_shown {
+                self.work.warm_rotations.clone_from(&self.work.rotations);
+                self.work.warm_targets.clone_from(&self.work.targets);
+                *warm_cached = true;
+            } else if report.switches.len() > switched_before {
+                *warm_cached = false;
+            }
+            // A part that switched state has new rest edges: its gaps and duals start over.
+            let edges = &self.pattern.edges;
+            for s in &report.switches[switched_before..] {
+                // edges are listed part by part
+                let first = edges.partition_point(|e| e.part < s.part);
+                let count = edges[first..]
+                    .iter()
+                    .take_while(|e| e.part == s.part)
+                    .count();
+                split.z[first..first + count].fill(DVec2::ZERO);
+                split.u[first..first + count].fill(DVec2::ZERO);
+            }
+            if it == 0 {
+                let lengths: f64 = self.work.targets.iter().map(|t| t.length()).sum();
+                let mean = if m > 0 { lengths / m as f64 } else { 1.0 };
+                let threshold = cfg.admm_threshold * if mean > 0.0 { mean } else { 1.0 };
+                rho = admm::penalty(threshold, p);
+            }
+            self.shifted.clear();
+            self.shifted.extend(
+                self.work
+                    .targets
+                    .iter()
+                    .zip(split.z.iter().zip(&split.u))
+                    .map(|(&t, (&z, &u))| t + z - u),
+            );
+            report.phases.local += ms_since(t);
+            std::mem::swap(&mut self.work.targets, &mut self.shifted);
+            let solved = self.solve_global(f, next, 1.0, Pass::LeastSquares, report);
+            std::mem::swap(&mut self.work.targets, &mut self.shifted);
+            if let Err(e) = solved {
+                result = Err(e);
+                break;
+            }
+            let t = Instant::now();
+            let shrink = admm::Shrink::new(rho, p);
+            // weight c = factor^(2 - p) in the norm: the penalty seen by the shrink is rho / c
+            let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
+            let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
+            let held = &self.work.handle_count;
+            for (k, e) in self.pattern.edges.iter().enumerate() {
+                let v = (next[e.x] - next[e.y]) - self.work.targets[k] + split.u[k];
+                let z = if held[e.x] > 0.0 || held[e.y] > 0.0 {
+                    at_handle.apply(v)
+                } else {
+                    shrink.apply(v)
+                };
+                split.z[k] = z;
+                split.u[k] = v - z;
+            }
+            report.phases.local += ms_since(t);
+            let delta = max_move(f, next);
+            std::mem::swap(f, next);
+            last_iteration = iteration_start.elapsed();
+            if delta <= start.step_tolerance && report.switches.len() == switched_before {
+                converged = true;
+                break;
+            }
+        }
+        split.pose.clone_from(f);
+        self.splitting = split;
+        result.map(|()| converged)
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
@@ -595,7 +791,10 @@ impl Solver {
         let w = &mut self.work;
         w.rotations.clear();
         for (i, part) in parts.iter_mut().enumerate() {
-            let (state, r) = local::choose_state(part, f, hysteresis);
+            let (state, r) = match &mut w.rest {
+                Some(cache) => cache.choose_state(i, part, f, hysteresis),
+                None => local::choose_state(part, f, hysteresis),
+            };
             if state != part.active {
                 switches.push(StateSwitch {
                     part: i,
@@ -614,9 +813,16 @@ impl Solver {
     fn edge_targets(&mut self, parts: &[Part]) {
         let w = &mut self.work;
         let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let edges = &self.pattern.edges;
+        if let Some(cache) = &mut w.rest
+            && cache.parts() == parts.len()
+            && cache.edges() == edges.len()
+        {
+            cache.edge_targets(parts, &w.rotations, cos_cone, &mut w.targets);
+            return;
+        }
         w.targets.clear();
         let mut k = 0;
-        let edges = &self.pattern.edges;
         for (pi, part) in parts.iter().enumerate() {
             let own = w.rotations[pi];
             w.part_sums.clear();
@@ -656,18 +862,25 @@ impl Solver {
     /// Pass-2 objective at `f` with the states fixed; leaves `f`'s rotations and edge targets
     /// in the work buffers.
     fn objective(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
-        self.work.rotations.clear();
-        for part in parts {
-            self.work.rotations.push(local::part_rotation(part, f));
+        let w = &mut self.work;
+        w.rotations.clear();
+        for (i, part) in parts.iter().enumerate() {
+            w.rotations.push(match &mut w.rest {
+                Some(cache) => cache.part_rotation(i, part, f),
+                None => local::part_rotation(part, f),
+            });
         }
         self.edge_targets(parts);
-        terms(
-            &self.pattern.edges,
-            &self.work.targets,
-            handles,
-            f,
-            self.config.handle_weight,
-        )
+        let hw = self.config.handle_weight;
+        let w = &self.work;
+        // the compact edge ends of the rest cache instead of the wide edge slots
+        match w.rest.as_ref().and_then(|c| c.elastic(&w.targets, f)) {
+            Some(elastic) => Terms {
+                elastic,
+                ..terms(&[], &[], handles, f, hw)
+            },
+            None => terms(&self.pattern.edges, &w.targets, handles, f, hw),
+        }
     }
 
     /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
@@ -815,6 +1028,20 @@ impl Solver {
         }
         Ok(())
     }
+}
+
+/// Splitting iterations a budgeted frame always runs (when configured to run that many).
+const MIN_SPLIT_ITERATIONS: usize = 2;
+
+/// Where a splitting pass 1 starts from.
+struct SplitStart<'a> {
+    /// The displayed pose.
+    warm: &'a [DVec2],
+    /// Whether the displayed pose is the one this solver last produced (so the splitting
+    /// variables may continue).
+    carry: bool,
+    step_tolerance: f64,
+    deadline: Option<Instant>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

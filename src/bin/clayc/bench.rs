@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use clay::assembly::{Assembly, HandleKind};
 use clay::rules::Rules;
-use clay::solver::{FrameReport, Solver, SolverConfig, SolverKind};
+use clay::solver::{FrameReport, Pass1, Solver, SolverConfig, SolverKind};
 use clay::synthetic;
 use glam::DVec2;
 use serde::Serialize;
@@ -30,12 +30,24 @@ pub struct BenchArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-    /// Most IRLS (pass 1) iterations per frame (default: the solver's).
+    /// How pass 1 minimises the sub-quadratic energy.
+    #[arg(long, value_enum, default_value_t = Pass1Arg::Admm)]
+    pub pass1: Pass1Arg,
+    /// Most splitting (pass 1, `--pass1 admm`) iterations per frame (default: the solver's).
+    #[arg(long)]
+    pub admm_iterations: Option<usize>,
+    /// Most IRLS (pass 1, `--pass1 irls`) iterations per frame (default: the solver's).
     #[arg(long)]
     pub irls_iterations: Option<usize>,
     /// Most least-squares (pass 2) iterations per frame (default: the solver's).
     #[arg(long)]
     pub l2_iterations: Option<usize>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Pass1Arg {
+    Admm,
+    Irls,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -57,9 +69,10 @@ struct BenchResult {
     vertices: usize,
     matrix_nonzeros: usize,
     solver: &'static str,
+    pass1: &'static str,
     frames: usize,
-    /// Mean IRLS (pass 1) and least-squares (pass 2) iterations per frame.
-    irls_iterations: f64,
+    /// Mean pass-1 (splitting or IRLS) and least-squares (pass 2) iterations per frame.
+    pass1_iterations: f64,
     l2_iterations: f64,
     factorizations_per_frame: f64,
     cg_iterations_per_frame: f64,
@@ -99,8 +112,15 @@ pub fn bench(args: BenchArgs) -> u8 {
     };
     let mut config = SolverConfig {
         kind,
+        pass1: match args.pass1 {
+            Pass1Arg::Admm => Pass1::Admm,
+            Pass1Arg::Irls => Pass1::Irls,
+        },
         ..SolverConfig::default()
     };
+    if let Some(k) = args.admm_iterations {
+        config.admm_iterations = k.min(1000);
+    }
     if let Some(k) = args.irls_iterations {
         config.irls_iterations = k.min(1000);
     }
@@ -115,6 +135,7 @@ pub fn bench(args: BenchArgs) -> u8 {
             }
             // classic ARAP: least squares only, one local + global iteration per frame
             config.irls_iterations = 0;
+            config.admm_iterations = 0;
             config.l2_iterations = 1;
             config.tolerance = 0.0;
             let mut asm = Assembly::new(Arc::new(synthetic::arap_grid(k)));
@@ -191,10 +212,11 @@ pub fn bench(args: BenchArgs) -> u8 {
             SolverKind::Cholesky => "cholesky",
             SolverKind::Cg => "cg",
         },
+        pass1: config.pass1.name(),
         frames: reports.len(),
-        irls_iterations: reports
+        pass1_iterations: reports
             .iter()
-            .map(|r| r.irls_iterations as f64)
+            .map(|r| r.pass1_iterations as f64)
             .sum::<f64>()
             / n,
         l2_iterations: reports.iter().map(|r| r.l2_iterations as f64).sum::<f64>() / n,
@@ -205,7 +227,7 @@ pub fn bench(args: BenchArgs) -> u8 {
             let per: Vec<f64> = reports
                 .iter()
                 .skip(1)
-                .map(|r| r.ms / (r.l2_iterations + r.irls_iterations).max(1) as f64)
+                .map(|r| r.ms / (r.l2_iterations + r.pass1_iterations).max(1) as f64)
                 .collect();
             stats(&per)
         }),
@@ -224,13 +246,14 @@ pub fn bench(args: BenchArgs) -> u8 {
         }
     } else {
         println!(
-            "{}: {} parts, {} vertices, solver {}, {} frames\niterations per frame: {:.2} IRLS + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
+            "{}: {} parts, {} vertices, solver {}, pass 1 {}, {} frames\niterations per frame: {:.2} pass-1 + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
             result.model,
             result.parts,
             result.vertices,
             result.solver,
+            result.pass1,
             result.frames,
-            result.irls_iterations,
+            result.pass1_iterations,
             result.l2_iterations,
             result.factorizations_per_frame,
             result.cg_iterations_per_frame,

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use clay::assembly::Assembly;
 use clay::rules::Rules;
 use clay::script::{Script, replay};
-use clay::solver::{SolverConfig, SolverKind};
+use clay::solver::{Pass1, SolverConfig, SolverKind};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
@@ -20,7 +20,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub json: bool,
     /// Override a solver parameter: hysteresis, norm, irls_epsilon, merge_distance,
-    /// irls_iterations, l2_iterations, handle_weight, solver (cholesky|cg).
+    /// pass1 (admm|irls), admm_iterations, irls_iterations, l2_iterations, handle_weight,
+    /// solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
@@ -41,6 +42,11 @@ pub fn apply_setting(
             "cg" => SolverKind::Cg,
             _ => return Err(format!("--set solver={value}: expected cholesky or cg")),
         };
+        return Ok(());
+    }
+    if name == "pass1" {
+        config.pass1 = Pass1::parse(value)
+            .ok_or_else(|| format!("--set pass1={value}: expected admm or irls"))?;
         return Ok(());
     }
     let number: f64 = value
@@ -73,6 +79,10 @@ pub fn apply_setting(
             check(number >= 0.0, "at least 0")?;
             *merge_distance = number;
         }
+        "admm_iterations" => {
+            check(count(number), "an integer from 0 to 1000")?;
+            config.admm_iterations = number as usize;
+        }
         "irls_iterations" => {
             check(count(number), "an integer from 0 to 1000")?;
             config.irls_iterations = number as usize;
@@ -87,7 +97,7 @@ pub fn apply_setting(
         }
         _ => {
             return Err(format!(
-                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, irls_iterations, l2_iterations, handle_weight or solver)"
+                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, pass1, admm_iterations, irls_iterations, l2_iterations, handle_weight or solver)"
             ));
         }
     }

@@ -1,0 +1,257 @@
+//! Pass 1 by variable splitting (ADMM) instead of reweighting: the sub-quadratic energy
+//! `sum |r_e|^p` over the part-edges' residuals `r_e = f(x) - f(y) - R_xy (x0 - y0)` is split
+//! as `sum |z_e|^p` subject to `z_e = r_e`. Each iteration then solves the *least-squares*
+//! system with the targets moved by `z - u` (the matrix never changes, so pass 1 reuses pass
+//! 2's factor: no numeric factorisation per iteration), shrinks every edge's residual with the
+//! proximal map of `|.|^p` (residuals below a threshold snap back to zero: those edges stay
+//! rigid; larger ones become free gaps) and accumulates the scaled dual `u`. This is the
+//! splitting Bouaziz et al. use for sparse ICP; IRLS and it minimise the same energy, but here
+//! the edges' splitting state carries over from frame to frame, so the solver converges
+//! across frames instead of re-weighting from scratch.
+//!
+//! This module holds the per-edge state and the shrink operator; `Solver` drives it.
+
+use glam::DVec2;
+
+/// Per part-edge splitting variables, valid for one assembly generation.
+#[derive(Clone, Debug, Default)]
+pub struct Splitting {
+    /// The generation the variables belong to (`None`: not initialised).
+    pub generation: Option<u64>,
+    /// Gaps `z_e`: the part of each residual the sub-quadratic norm leaves open.
+    pub z: Vec<DVec2>,
+    /// Scaled duals `u_e`.
+    pub u: Vec<DVec2>,
+    /// The pass-1 pose the variables were last updated with.
+    pub pose: Vec<DVec2>,
+}
+
+impl Splitting {
+    /// Whether the variables can continue for `generation` with `edges` part-edges and `n`
+    /// vertices.
+    pub fn is_valid(&self, generation: u64, edges: usize, n: usize) -> bool {
+        self.generation == Some(generation)
+            && self.z.len() == edges
+            && self.u.len() == edges
+            && self.pose.len() == n
+    }
+
+    /// Starts afresh: no gaps, no duals.
+    pub fn reset(&mut self, generation: u64, edges: usize, pose: &[DVec2]) {
+        self.generation = Some(generation);
+        self.z.clear();
+        self.z.resize(edges, DVec2::ZERO);
+        self.u.clear();
+        self.u.resize(edges, DVec2::ZERO);
+        self.pose.clear();
+        self.pose.extend_from_slice(pose);
+    }
+}
+
+/// The penalty `rho` whose shrink threshold (the residual length below which a gap closes)
+/// is `threshold`, for the norm `p`. For `p < 1` the proximal map of `|z|^p / rho` is zero
+/// below `C_p rho^(-1 / (2 - p))`; for `p >= 1` we take `rho = threshold^(p - 2)`, which gives
+/// the soft threshold `threshold` at `p = 1`.
+pub fn penalty(threshold: f64, p: f64) -> f64 {
+    let threshold = threshold.max(1e-12);
+    let c = if p < 1.0 {
+        let a = (2.0 * (1.0 - p)).powf(1.0 / (2.0 - p));
+        a + p * a.powf(p - 1.0)
+    } else {
+        1.0
+    };
+    // rho = (c / threshold)^(2 - p); at p = 2 any rho works (the norm is the least-squares
+    // one), so keep 1 there.
+    if p >= 2.0 {
+        1.0
+    } else {
+        (c / threshold).powf(2.0 - p)
+    }
+}
+
+/// The proximal map of the sub-quadratic norm for one penalty: `argmin_z |z|^p + rho/2
+/// |z - v|^2` for a 2D residual `v` (isotropic, so `z` is `v` scaled by `s / |v|` with `s`
+/// the 1D solution). The threshold is computed once, not per edge.
+#[derive(Clone, Copy, Debug)]
+pub struct Shrink {
+    rho: f64,
+    p: f64,
+    /// Residuals no longer than this close to zero (`p < 1`; 0 otherwise).
+    threshold: f64,
+    /// Lower end of the bracket of the shrunk length (`p < 1`: where the 1D objective's
+    /// nonzero branch starts; 0 otherwise).
+    lower: f64,
+}
+
+impl Shrink {
+    pub fn new(rho: f64, p: f64) -> Self {
+        let (threshold, lower) = if p < 1.0 && rho > 0.0 {
+            let a = (2.0 * (1.0 - p) / rho).powf(1.0 / (2.0 - p));
+            (a + (p / rho) * a.powf(p - 1.0), a)
+        } else if p == 1.0 && rho > 0.0 {
+            (1.0 / rho, 0.0)
+        } else {
+            (0.0, 0.0)
+        };
+        Self {
+            rho,
+            p,
+            threshold,
+            lower,
+        }
+    }
+
+    /// Residuals no longer than this close to zero.
+    pub fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    /// `s^(p - 1)` and `s^(p - 2)`, with p = 0.5 spelled out (powf would dominate).
+    fn powers(&self, s: f64) -> (f64, f64) {
+        if self.p == 0.5 {
+            let r = 1.0 / s.sqrt();
+            (r, r / s)
+        } else {
+            let a = s.powf(self.p - 1.0);
+            (a, a / s)
+        }
+    }
+
+    pub fn apply(&self, v: DVec2) -> DVec2 {
+        let n2 = v.length_squared();
+        // NaN fails every comparison: a NaN residual or penalty closes the gap
+        let open = n2 > self.threshold * self.threshold && n2.is_finite() && self.rho > 0.0;
+        if !open {
+            return DVec2::ZERO;
+        }
+        let n = n2.sqrt();
+        let (rho, p) = (self.rho, self.p);
+        if p >= 2.0 {
+            // |z|^2: z = rho v / (rho + 2)
+            return v * (rho / (rho + 2.0));
+        }
+        if p == 1.0 {
+            return v * ((n - self.threshold) / n);
+        }
+        if p == 0.5 {
+            // s + c / sqrt(s) = n with c = 1 / (2 rho): with w = sqrt(s) the depressed cubic
+            // w^3 - n w + c = 0, which has three real roots above the threshold
+            // (27 c^2 < 4 n^3 there); the largest, by the trigonometric formula, is the one.
+            let c = 0.5 / rho;
+            let r = (n / 3.0).sqrt();
+            let cos3 = (-1.5 * c / n * (3.0 / n).sqrt()).clamp(-1.0, 1.0);
+            let w = 2.0 * r * (cos3.acos() / 3.0).cos();
+            let s = w * w;
+            if s.is_finite() {
+                return v * (s.clamp(0.0, n) / n);
+            }
+        }
+        // Stationarity for s > 0: phi(s) = s + (p / rho) s^(p - 1) - n = 0, with the root
+        // bracketed: for p < 1 between the stationary point of the 1D objective's second
+        // branch (`lower`) and n, for 1 < p < 2 between 0 and n. Newton, falling back to
+        // bisection whenever a step leaves the bracket.
+        let (mut lo, mut hi) = (self.lower, n);
+        let mut s = n;
+        for _ in 0..60 {
+            let (a, b) = self.powers(s);
+            let phi = s + (p / rho) * a - n;
+            if phi > 0.0 {
+                hi = s;
+            } else {
+                lo = s;
+            }
+            let dphi = 1.0 + (p * (p - 1.0) / rho) * b;
+            let newton = s - phi / dphi;
+            let next = if dphi > 0.0 && newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if (next - s).abs() <= 1e-12 * n || hi - lo <= 1e-12 * n {
+                s = next;
+                break;
+            }
+            s = next;
+        }
+        v * (s.clamp(0.0, n) / n)
+    }
+}
+
+/// [`Shrink::apply`] for one residual (tests and one-off use).
+pub fn shrink(v: DVec2, rho: f64, p: f64) -> DVec2 {
+    Shrink::new(rho, p).apply(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute-force 1D minimiser of `s^p + rho/2 (s - n)^2` over `[0, n]`.
+    fn brute(n: f64, rho: f64, p: f64) -> f64 {
+        let cost = |s: f64| s.powf(p) + 0.5 * rho * (s - n) * (s - n);
+        let mut best = (0.0, cost(0.0));
+        let steps = 200_000;
+        for k in 1..=steps {
+            let s = n * k as f64 / steps as f64;
+            let c = cost(s);
+            if c < best.1 {
+                best = (s, c);
+            }
+        }
+        best.0
+    }
+
+    #[test]
+    fn shrink_minimises_the_proximal_objective() {
+        for &p in &[0.5, 0.8, 1.0, 1.5, 2.0] {
+            for &rho in &[0.3, 2.0, 50.0] {
+                for &n in &[0.01, 0.3, 1.0, 2.5, 10.0] {
+                    let v = DVec2::new(0.6, -0.8) * n;
+                    let z = shrink(v, rho, p);
+                    let s = z.length();
+                    let expected = brute(n, rho, p);
+                    assert!(
+                        (s - expected).abs() <= 1e-4 * n.max(1.0),
+                        "p {p} rho {rho} n {n}: {s} vs {expected}"
+                    );
+                    // same direction as v (or zero)
+                    assert!(s == 0.0 || (z / s - v / n).length() < 1e-9);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_closed_form_for_p_one_half_is_a_stationary_point() {
+        for &rho in &[0.01, 1.0, 164.0, 1e4] {
+            let shrink = Shrink::new(rho, 0.5);
+            for k in 0..200 {
+                let n = shrink.threshold() * (1.0 + 1e-9 + 0.05 * k as f64);
+                let s = shrink.apply(DVec2::new(0.0, n)).length();
+                let phi = s + 0.5 / rho / s.sqrt() - n;
+                assert!(phi.abs() <= 1e-10 * n, "rho {rho} n {n}: s {s}, phi {phi}");
+                // the open branch beats closing the gap
+                assert!(s.sqrt() + 0.5 * rho * (s - n).powi(2) <= 0.5 * rho * n * n + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn penalty_puts_the_threshold_where_asked() {
+        for &p in &[0.3, 0.5, 0.9] {
+            for &t in &[0.01, 0.2, 3.0] {
+                let rho = penalty(t, p);
+                let v = DVec2::X * t;
+                assert_eq!(shrink(v * 0.99, rho, p), DVec2::ZERO, "p {p} t {t}");
+                assert!(shrink(v * 1.01, rho, p).length() > 0.0, "p {p} t {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_input_gives_zero_not_nan() {
+        assert_eq!(shrink(DVec2::ZERO, 1.0, 0.5), DVec2::ZERO);
+        assert_eq!(shrink(DVec2::NAN, 1.0, 0.5), DVec2::ZERO);
+        assert_eq!(shrink(DVec2::X, 0.0, 0.5), DVec2::ZERO);
+    }
+}
