@@ -4,7 +4,8 @@
 
 use std::collections::HashSet;
 
-use clay::render::{TessellationCache, WorldMesh, pose_assembly};
+use clay::render::pose::pose_assembly_into;
+use clay::render::{TessellationCache, WorldMesh};
 use clay_dsl::compiled::{AssemblyData, PartKind};
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
@@ -102,7 +103,8 @@ impl Canvas {
             sculpt.revision(),
         );
         if self.posed != Some(key) {
-            self.meshes = pose_assembly(sculpt.grammar(), data, &mut self.cache);
+            // In place: the meshes' buffers are reused on every solver frame of a drag.
+            pose_assembly_into(sculpt.grammar(), data, &mut self.cache, &mut self.meshes);
             self.posed = Some(key);
         }
         if self.fit_pending {

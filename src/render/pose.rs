@@ -3,6 +3,8 @@
 //! axis-site frames for linear pieces. The output is plain world-space triangles that tiny-skia,
 //! SVG and egui all draw the same way.
 
+use std::sync::Arc;
+
 use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Rgba};
 use glam::DVec2;
 
@@ -48,47 +50,7 @@ impl Skin {
         from_site: &[usize],
         to_site: &[usize],
     ) -> Option<Self> {
-        let centroid = |pos: &[DVec2], site: &[usize]| -> Option<DVec2> {
-            let mut sum = DVec2::ZERO;
-            for &v in site {
-                sum += *pos.get(v)?;
-            }
-            (!site.is_empty()).then(|| sum / site.len() as f64)
-        };
-        let (r0, r1) = (centroid(rest, from_site)?, centroid(rest, to_site)?);
-        let (c0, c1) = (centroid(current, from_site)?, centroid(current, to_site)?);
-        let rest_axis = (r1 - r0).try_normalize()?;
-        let axis = (c1 - c0).try_normalize()?;
-        let frame = |site: &[usize], rest_origin: DVec2, origin: DVec2| -> SiteFrame {
-            let (first, last) = (site[0], site[site.len() - 1]);
-            let rest_span = rest[last] - rest[first];
-            let span = current[last] - current[first];
-            match (rest_span.try_normalize(), span.try_normalize()) {
-                (Some(rest_tangent), Some(tangent)) => SiteFrame {
-                    rest_origin,
-                    rest_tangent,
-                    origin,
-                    tangent,
-                    stretch: span.length() / rest_span.length(),
-                },
-                // A one-vertex site has no tangent of its own: the axis turns it instead.
-                _ => SiteFrame {
-                    rest_origin,
-                    rest_tangent: rest_axis.perp(),
-                    origin,
-                    tangent: axis.perp(),
-                    stretch: 1.0,
-                },
-            }
-        };
-        let skin = Self {
-            from: frame(from_site, r0, c0),
-            to: frame(to_site, r1, c1),
-        };
-        let finite = |f: &SiteFrame| {
-            f.tangent.is_finite() && f.rest_tangent.is_finite() && f.stretch.is_finite()
-        };
-        (finite(&skin.from) && finite(&skin.to)).then_some(skin)
+        RestSkin::new(rest, from_site, to_site)?.pose(current)
     }
 
     /// The blend weight of a rest-frame point: 0 at the `from` site, 1 at the `to` site.
@@ -100,6 +62,94 @@ impl Skin {
     pub fn apply(&self, p: DVec2) -> DVec2 {
         let w = self.weight(p);
         self.from.apply(p) * (1.0 - w) + self.to.apply(p) * w
+    }
+}
+
+/// The centroid of a site's vertices; `None` when the site is empty or out of range.
+fn centroid(positions: &[DVec2], site: &[usize]) -> Option<DVec2> {
+    let mut sum = DVec2::ZERO;
+    for &v in site {
+        sum += *positions.get(v)?;
+    }
+    (!site.is_empty()).then(|| sum / site.len() as f64)
+}
+
+/// One axis site at rest: its vertices, centroid, unit tangent (first to last vertex; `None`
+/// for a one-vertex site) and width.
+#[derive(Clone, Copy, Debug)]
+struct RestSite<'g> {
+    vertices: &'g [usize],
+    origin: DVec2,
+    tangent: Option<DVec2>,
+    width: f64,
+}
+
+impl<'g> RestSite<'g> {
+    /// `vertices` must be in range of `rest` (their centroid was found).
+    fn new(rest: &[DVec2], vertices: &'g [usize], origin: DVec2) -> Self {
+        let span = rest[vertices[vertices.len() - 1]] - rest[vertices[0]];
+        Self {
+            vertices,
+            origin,
+            tangent: span.try_normalize(),
+            width: span.length(),
+        }
+    }
+
+    fn frame(&self, current: &[DVec2], origin: DVec2, rest_axis: DVec2, axis: DVec2) -> SiteFrame {
+        let span = current[self.vertices[self.vertices.len() - 1]] - current[self.vertices[0]];
+        match (self.tangent, span.try_normalize()) {
+            (Some(rest_tangent), Some(tangent)) => SiteFrame {
+                rest_origin: self.origin,
+                rest_tangent,
+                origin,
+                tangent,
+                stretch: span.length() / self.width,
+            },
+            // A one-vertex site has no tangent of its own: the axis turns it instead.
+            _ => SiteFrame {
+                rest_origin: self.origin,
+                rest_tangent: rest_axis.perp(),
+                origin,
+                tangent: axis.perp(),
+                stretch: 1.0,
+            },
+        }
+    }
+}
+
+/// The half of a [`Skin`] that depends only on the rest state, so posing many instances of a
+/// piece computes it once (it is half of the skin's square roots and divisions).
+#[derive(Clone, Copy, Debug)]
+struct RestSkin<'g> {
+    from: RestSite<'g>,
+    to: RestSite<'g>,
+    axis: DVec2,
+}
+
+impl<'g> RestSkin<'g> {
+    fn new(rest: &[DVec2], from_site: &'g [usize], to_site: &'g [usize]) -> Option<Self> {
+        let (r0, r1) = (centroid(rest, from_site)?, centroid(rest, to_site)?);
+        Some(Self {
+            axis: (r1 - r0).try_normalize()?,
+            from: RestSite::new(rest, from_site, r0),
+            to: RestSite::new(rest, to_site, r1),
+        })
+    }
+
+    /// The skin for the piece's vertices now at `current`.
+    fn pose(&self, current: &[DVec2]) -> Option<Skin> {
+        let c0 = centroid(current, self.from.vertices)?;
+        let c1 = centroid(current, self.to.vertices)?;
+        let axis = (c1 - c0).try_normalize()?;
+        let skin = Skin {
+            from: self.from.frame(current, c0, self.axis, axis),
+            to: self.to.frame(current, c1, self.axis, axis),
+        };
+        let finite = |f: &SiteFrame| {
+            f.tangent.is_finite() && f.rest_tangent.is_finite() && f.stretch.is_finite()
+        };
+        (finite(&skin.from) && finite(&skin.to)).then_some(skin)
     }
 }
 
@@ -125,24 +175,19 @@ pub fn pose_instance(
     instance: usize,
     cache: &mut TessellationCache,
 ) -> Vec<WorldMesh> {
+    let mut out = Vec::new();
     let Some(inst) = assembly.instances.get(instance) else {
-        return Vec::new();
+        return out;
     };
-    let Some(current) = inst
-        .vertices
-        .iter()
-        .map(|&v| assembly.positions.get(v).copied())
-        .collect::<Option<Vec<DVec2>>>()
-    else {
-        return Vec::new();
-    };
-    pose_piece(grammar, inst.piece, inst.state, &current, cache)
-        .into_iter()
-        .map(|mut m| {
-            m.instance = instance;
-            m
-        })
-        .collect()
+    let mut current = Vec::new();
+    if !gather(&assembly.positions, &inst.vertices, &mut current) {
+        return out;
+    }
+    if let Some(shown) = Shown::new(grammar, inst.piece, inst.state, cache) {
+        let used = shown.pose_into(&current, instance, &mut out, 0);
+        out.truncate(used);
+    }
+    out
 }
 
 /// Poses a piece in rest state `state` whose vertices are now at `current` (one per piece
@@ -154,33 +199,12 @@ pub fn pose_piece(
     current: &[DVec2],
     cache: &mut TessellationCache,
 ) -> Vec<WorldMesh> {
-    let Some((_, frame)) = shown_geometry(grammar, piece, state) else {
-        return Vec::new();
-    };
-    let p = &grammar.pieces[piece];
-    let rest = &p.states[frame].positions;
-    let rigid = rigid_motion(rest, current);
-    let skin = p.axis.and_then(|[a, b]| {
-        Skin::new(
-            rest,
-            current,
-            &p.sites.get(a)?.vertices,
-            &p.sites.get(b)?.vertices,
-        )
-    });
-    let meshes = cache.meshes(grammar, piece, state);
-    meshes
-        .iter()
-        .filter_map(|mesh| {
-            let map = |q: DVec2| match (mesh.binding, skin, rigid) {
-                (Binding::Skinned, Some(s), _) => Some(s.apply(q)),
-                // A skinned proxy without a usable axis falls back to the rigid motion.
-                (_, _, Some(r)) => Some(r.apply(q)),
-                _ => None,
-            };
-            world_mesh(mesh, map)
-        })
-        .collect()
+    let mut out = Vec::new();
+    if let Some(shown) = Shown::new(grammar, piece, state, cache) {
+        let used = shown.pose_into(current, 0, &mut out, 0);
+        out.truncate(used);
+    }
+    out
 }
 
 /// Poses every instance of the assembly, in instance order.
@@ -189,9 +213,201 @@ pub fn pose_assembly(
     assembly: &AssemblyData,
     cache: &mut TessellationCache,
 ) -> Vec<WorldMesh> {
-    (0..assembly.instances.len())
-        .flat_map(|i| pose_instance(grammar, assembly, i, cache))
-        .collect()
+    let mut out = Vec::with_capacity(assembly.instances.len());
+    pose_assembly_into(grammar, assembly, cache, &mut out);
+    out
+}
+
+/// [`pose_assembly`] into `out`, reusing its meshes' buffers: what the editor calls on every
+/// solver frame, where a fresh `Vec` of fresh meshes would cost most of the posing time in the
+/// allocator. Afterwards `out` holds exactly what [`pose_assembly`] returns.
+pub fn pose_assembly_into(
+    grammar: &CompiledGrammar,
+    assembly: &AssemblyData,
+    cache: &mut TessellationCache,
+    out: &mut Vec<WorldMesh>,
+) {
+    // What does not depend on current positions is found once per (piece, state) and call,
+    // not once per instance: slot `first_state[piece] + state`, filled on first use.
+    let mut first_state = Vec::with_capacity(grammar.pieces.len());
+    let mut states = 0;
+    for p in &grammar.pieces {
+        first_state.push(states);
+        states += p.states.len();
+    }
+    let mut shown: Vec<Option<Option<Shown>>> = vec![None; states];
+
+    let mut current = Vec::new();
+    let mut used = 0;
+    for (i, inst) in assembly.instances.iter().enumerate() {
+        let Some(piece) = grammar.pieces.get(inst.piece) else {
+            continue;
+        };
+        if inst.state >= piece.states.len()
+            || !gather(&assembly.positions, &inst.vertices, &mut current)
+        {
+            continue;
+        }
+        let slot = &mut shown[first_state[inst.piece] + inst.state];
+        let slot = slot.get_or_insert_with(|| Shown::new(grammar, inst.piece, inst.state, cache));
+        if let Some(s) = slot {
+            used = s.pose_into(&current, i, out, used);
+        }
+    }
+    out.truncate(used);
+}
+
+/// Copies the current positions of an instance's vertices into `current`; false when an index
+/// is out of range (the instance is then not drawn).
+fn gather(positions: &[DVec2], vertices: &[usize], current: &mut Vec<DVec2>) -> bool {
+    current.clear();
+    for &v in vertices {
+        match positions.get(v) {
+            Some(&p) => current.push(p),
+            None => return false,
+        }
+    }
+    true
+}
+
+/// What posing needs of a piece in a rest state that does not depend on where its vertices are
+/// now: the tessellated proxies, the rest positions they are authored against, and the rest
+/// half of the skin (only when a proxy is skinned).
+#[derive(Clone)]
+struct Shown<'g> {
+    meshes: Arc<[Mesh]>,
+    rest: &'g [DVec2],
+    skin: Option<RestSkin<'g>>,
+    all_skinned: bool,
+}
+
+impl<'g> Shown<'g> {
+    /// `None` when the piece or state does not exist.
+    fn new(
+        grammar: &'g CompiledGrammar,
+        piece: usize,
+        state: usize,
+        cache: &mut TessellationCache,
+    ) -> Option<Self> {
+        let (_, frame) = shown_geometry(grammar, piece, state)?;
+        let p = &grammar.pieces[piece];
+        let rest = &p.states[frame].positions;
+        let meshes = cache.meshes(grammar, piece, state);
+        let skinned = |m: &Mesh| m.binding == Binding::Skinned;
+        let skin = if meshes.iter().any(skinned) {
+            p.axis.and_then(|[a, b]| {
+                RestSkin::new(rest, &p.sites.get(a)?.vertices, &p.sites.get(b)?.vertices)
+            })
+        } else {
+            None
+        };
+        let all_skinned = meshes.iter().all(skinned);
+        Some(Self {
+            meshes,
+            rest,
+            skin,
+            all_skinned,
+        })
+    }
+
+    /// Writes the meshes posed for vertices at `current` into `out[used..]`, overwriting (and
+    /// reusing the buffers of) meshes already there; returns the new count of meshes in use.
+    /// Meshes left with no triangle are not kept.
+    fn pose_into(
+        &self,
+        current: &[DVec2],
+        instance: usize,
+        out: &mut Vec<WorldMesh>,
+        mut used: usize,
+    ) -> usize {
+        if self.meshes.is_empty() {
+            return used;
+        }
+        let skin = self.skin.as_ref().and_then(|s| s.pose(current));
+        // The rigid motion serves rigid proxies, and skinned ones when the skin is unusable.
+        let rigid = if skin.is_none() || !self.all_skinned {
+            rigid_motion(self.rest, current)
+        } else {
+            None
+        };
+        for mesh in self.meshes.iter() {
+            let kept = match (mesh.binding, &skin, &rigid) {
+                (Binding::Skinned, Some(s), _) => write_mesh(mesh, |q| s.apply(q), out, used),
+                // A skinned proxy without a usable axis falls back to the rigid motion.
+                (_, _, Some(r)) => write_mesh(mesh, |q| r.apply(q), out, used),
+                // No vertex can be placed, so no triangle survives.
+                _ => false,
+            };
+            if kept {
+                out[used].instance = instance;
+                used += 1;
+            }
+        }
+        used
+    }
+}
+
+/// Writes `mesh` mapped through `map` into `out[at]` (pushed when `out` is that short); false
+/// when no triangle has all three vertices finite, in which case `out[at]` is scratch.
+fn write_mesh(
+    mesh: &Mesh,
+    map: impl Fn(DVec2) -> DVec2,
+    out: &mut Vec<WorldMesh>,
+    at: usize,
+) -> bool {
+    if mesh.triangles.is_empty() {
+        return false;
+    }
+    if at == out.len() {
+        out.push(WorldMesh {
+            positions: Vec::with_capacity(mesh.vertices.len()),
+            triangles: Vec::with_capacity(mesh.triangles.len()),
+            outline: Vec::with_capacity(mesh.outline.len()),
+            fill: mesh.fill,
+            instance: 0,
+        });
+    }
+    let w = &mut out[at];
+    w.fill = mesh.fill;
+    w.positions.clear();
+    w.triangles.clear();
+    w.outline.clear();
+    let finite = |f: &[f32; 2]| f[0].is_finite() && f[1].is_finite();
+    let mut all_finite = true;
+    w.positions.extend(mesh.vertices.iter().map(|&q| {
+        let p = map(q);
+        let f = [p.x as f32, p.y as f32];
+        if finite(&f) {
+            f
+        } else {
+            all_finite = false;
+            // A finite placeholder; no kept triangle or edge refers to it.
+            [0.0, 0.0]
+        }
+    }));
+    if all_finite {
+        // The common case: every triangle and edge survives, so copy instead of filtering.
+        // Element-wise: these lists are a few entries long, too short for a `memmove` call to pay.
+        for &t in &mesh.triangles {
+            w.triangles.push(t);
+        }
+        for &e in &mesh.outline {
+            w.outline.push(e);
+        }
+        return true;
+    }
+    // A placeholder cannot be told from a real origin, so ask the map again (it is pure).
+    let ok = |i: u32| {
+        finite(&{
+            let p = map(mesh.vertices[i as usize]);
+            [p.x as f32, p.y as f32]
+        })
+    };
+    w.triangles
+        .extend(mesh.triangles.iter().filter(|t| t.iter().all(|&i| ok(i))));
+    w.outline
+        .extend(mesh.outline.iter().filter(|e| e.iter().all(|&i| ok(i))));
+    !w.triangles.is_empty()
 }
 
 /// The current outward direction of a site of an instance: the site's `out` (base-state
@@ -208,49 +424,291 @@ pub fn site_out(
     motion.apply_direction(out).try_normalize()
 }
 
-fn world_mesh(mesh: &Mesh, map: impl Fn(DVec2) -> Option<DVec2>) -> Option<WorldMesh> {
-    let mapped: Vec<Option<[f32; 2]>> = mesh
-        .vertices
-        .iter()
-        .map(|&q| {
-            let w = map(q)?;
-            let f = [w.x as f32, w.y as f32];
-            (f[0].is_finite() && f[1].is_finite()).then_some(f)
-        })
-        .collect();
-    let ok = |i: &u32| mapped[*i as usize].is_some();
-    let triangles: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .copied()
-        .filter(|t| t.iter().all(ok))
-        .collect();
-    if triangles.is_empty() {
-        return None;
-    }
-    let outline = mesh
-        .outline
-        .iter()
-        .copied()
-        .filter(|e| e.iter().all(ok))
-        .collect();
-    // Unmapped vertices keep a finite placeholder; no kept triangle or edge refers to them.
-    let positions = mapped
-        .into_iter()
-        .map(|p| p.unwrap_or([0.0, 0.0]))
-        .collect();
-    Some(WorldMesh {
-        positions,
-        triangles,
-        outline,
-        fill: mesh.fill,
-        instance: 0,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The straightforward posing the fast path replaced, kept as the reference it must match
+    /// exactly: per vertex an `Option`, per mesh a filtered triangle and edge list.
+    mod reference {
+        use super::super::*;
+
+        pub fn pose_assembly(
+            grammar: &CompiledGrammar,
+            assembly: &AssemblyData,
+            cache: &mut TessellationCache,
+        ) -> Vec<WorldMesh> {
+            (0..assembly.instances.len())
+                .flat_map(|i| pose_instance(grammar, assembly, i, cache))
+                .collect()
+        }
+
+        pub fn pose_instance(
+            grammar: &CompiledGrammar,
+            assembly: &AssemblyData,
+            instance: usize,
+            cache: &mut TessellationCache,
+        ) -> Vec<WorldMesh> {
+            let Some(inst) = assembly.instances.get(instance) else {
+                return Vec::new();
+            };
+            let Some(current) = inst
+                .vertices
+                .iter()
+                .map(|&v| assembly.positions.get(v).copied())
+                .collect::<Option<Vec<DVec2>>>()
+            else {
+                return Vec::new();
+            };
+            pose_piece(grammar, inst.piece, inst.state, &current, cache)
+                .into_iter()
+                .map(|mut m| {
+                    m.instance = instance;
+                    m
+                })
+                .collect()
+        }
+
+        pub fn pose_piece(
+            grammar: &CompiledGrammar,
+            piece: usize,
+            state: usize,
+            current: &[DVec2],
+            cache: &mut TessellationCache,
+        ) -> Vec<WorldMesh> {
+            let Some((_, frame)) = shown_geometry(grammar, piece, state) else {
+                return Vec::new();
+            };
+            let p = &grammar.pieces[piece];
+            let rest = &p.states[frame].positions;
+            let rigid = rigid_motion(rest, current);
+            let skin = p.axis.and_then(|[a, b]| {
+                skin_new(
+                    rest,
+                    current,
+                    &p.sites.get(a)?.vertices,
+                    &p.sites.get(b)?.vertices,
+                )
+            });
+            let meshes = cache.meshes(grammar, piece, state);
+            meshes
+                .iter()
+                .filter_map(|mesh| {
+                    let map = |q: DVec2| match (mesh.binding, skin, rigid) {
+                        (Binding::Skinned, Some(s), _) => Some(s.apply(q)),
+                        (_, _, Some(r)) => Some(r.apply(q)),
+                        _ => None,
+                    };
+                    world_mesh(mesh, map)
+                })
+                .collect()
+        }
+
+        /// Builds the skin from rest and current positions of the piece's vertices; `None` when the
+        /// sites are empty, out of range, coincide, or positions are not finite.
+        pub fn skin_new(
+            rest: &[DVec2],
+            current: &[DVec2],
+            from_site: &[usize],
+            to_site: &[usize],
+        ) -> Option<Skin> {
+            let centroid = |pos: &[DVec2], site: &[usize]| -> Option<DVec2> {
+                let mut sum = DVec2::ZERO;
+                for &v in site {
+                    sum += *pos.get(v)?;
+                }
+                (!site.is_empty()).then(|| sum / site.len() as f64)
+            };
+            let (r0, r1) = (centroid(rest, from_site)?, centroid(rest, to_site)?);
+            let (c0, c1) = (centroid(current, from_site)?, centroid(current, to_site)?);
+            let rest_axis = (r1 - r0).try_normalize()?;
+            let axis = (c1 - c0).try_normalize()?;
+            let frame = |site: &[usize], rest_origin: DVec2, origin: DVec2| -> SiteFrame {
+                let (first, last) = (site[0], site[site.len() - 1]);
+                let rest_span = rest[last] - rest[first];
+                let span = current[last] - current[first];
+                match (rest_span.try_normalize(), span.try_normalize()) {
+                    (Some(rest_tangent), Some(tangent)) => SiteFrame {
+                        rest_origin,
+                        rest_tangent,
+                        origin,
+                        tangent,
+                        stretch: span.length() / rest_span.length(),
+                    },
+                    // A one-vertex site has no tangent of its own: the axis turns it instead.
+                    _ => SiteFrame {
+                        rest_origin,
+                        rest_tangent: rest_axis.perp(),
+                        origin,
+                        tangent: axis.perp(),
+                        stretch: 1.0,
+                    },
+                }
+            };
+            let skin = Skin {
+                from: frame(from_site, r0, c0),
+                to: frame(to_site, r1, c1),
+            };
+            let finite = |f: &SiteFrame| {
+                f.tangent.is_finite() && f.rest_tangent.is_finite() && f.stretch.is_finite()
+            };
+            (finite(&skin.from) && finite(&skin.to)).then_some(skin)
+        }
+
+        fn world_mesh(mesh: &Mesh, map: impl Fn(DVec2) -> Option<DVec2>) -> Option<WorldMesh> {
+            let mapped: Vec<Option<[f32; 2]>> = mesh
+                .vertices
+                .iter()
+                .map(|&q| {
+                    let w = map(q)?;
+                    let f = [w.x as f32, w.y as f32];
+                    (f[0].is_finite() && f[1].is_finite()).then_some(f)
+                })
+                .collect();
+            let ok = |i: &u32| mapped[*i as usize].is_some();
+            let triangles: Vec<[u32; 3]> = mesh
+                .triangles
+                .iter()
+                .copied()
+                .filter(|t| t.iter().all(ok))
+                .collect();
+            if triangles.is_empty() {
+                return None;
+            }
+            let outline = mesh
+                .outline
+                .iter()
+                .copied()
+                .filter(|e| e.iter().all(ok))
+                .collect();
+            let positions = mapped
+                .into_iter()
+                .map(|p| p.unwrap_or([0.0, 0.0]))
+                .collect();
+            Some(WorldMesh {
+                positions,
+                triangles,
+                outline,
+                fill: mesh.fill,
+                instance: 0,
+            })
+        }
+    }
+
+    fn grammar(name: &str) -> CompiledGrammar {
+        let path = format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"));
+        let source = std::fs::read_to_string(&path).unwrap();
+        match clay_dsl::compile(&source, &path) {
+            Ok(c) => c.grammar,
+            Err(d) => panic!("{}", clay_dsl::render(&d, &source, &path, false)),
+        }
+    }
+
+    /// Moves every vertex by a different small amount and swings the east half of the model
+    /// round, so walls stretch, bend and turn and every rigid motion is a real rotation.
+    fn sculpted(assembly: &AssemblyData) -> AssemblyData {
+        let mut a = assembly.clone();
+        for (i, p) in a.positions.iter_mut().enumerate() {
+            let k = i as f64;
+            *p += DVec2::new(0.05 * (k * 0.37).sin(), 0.05 * (k * 0.91).cos());
+            if p.x > 0.0 {
+                *p = DVec2::from_angle(0.3).rotate(*p) * 1.2;
+            }
+        }
+        a
+    }
+
+    /// Compares the fast posing with the reference: the fresh `Vec`, the per-instance and
+    /// per-piece entry points, and `pose_assembly_into` over a `Vec` already holding other
+    /// meshes (more than needed, so reuse and truncation are both exercised).
+    fn assert_matches_reference(g: &CompiledGrammar, a: &AssemblyData, stale: &[WorldMesh]) {
+        let mut cache = TessellationCache::new();
+        let expected = reference::pose_assembly(g, a, &mut cache);
+        assert!(!expected.is_empty());
+        assert_eq!(pose_assembly(g, a, &mut cache), expected);
+        let mut out = stale.to_vec();
+        out.extend_from_slice(stale);
+        pose_assembly_into(g, a, &mut TessellationCache::new(), &mut out);
+        assert_eq!(out, expected);
+        for i in 0..a.instances.len() + 1 {
+            assert_eq!(
+                pose_instance(g, a, i, &mut cache),
+                reference::pose_instance(g, a, i, &mut cache)
+            );
+        }
+        for (pi, piece) in g.pieces.iter().enumerate() {
+            for (si, state) in piece.states.iter().enumerate() {
+                let moved: Vec<DVec2> = state.positions.iter().map(|p| *p * 1.1).collect();
+                assert_eq!(
+                    pose_piece(g, pi, si, &moved, &mut cache),
+                    reference::pose_piece(g, pi, si, &moved, &mut cache)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn fast_posing_matches_the_reference_on_a_sculpted_castle() {
+        let g = grammar("castle.clay");
+        let stale = pose_assembly(&g, &g.assembly, &mut TessellationCache::new());
+        let a = sculpted(&g.assembly);
+        assert_ne!(pose_assembly(&g, &a, &mut TessellationCache::new()), stale);
+        assert_matches_reference(&g, &a, &stale);
+        // Streets switch rest states, so several (piece, state) geometries are shown.
+        let streets = grammar("streets.clay");
+        assert_matches_reference(&streets, &sculpted(&streets.assembly), &stale);
+    }
+
+    #[test]
+    fn skin_from_its_rest_half_matches_the_reference() {
+        let rest = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 0.5),
+            DVec2::new(0.0, 0.5),
+            DVec2::new(0.5, 0.25),
+        ];
+        let now = [
+            DVec2::new(0.1, -0.2),
+            DVec2::new(1.5, 0.1),
+            DVec2::new(1.4, 0.7),
+            DVec2::new(0.0, 0.5),
+            DVec2::new(0.7, 0.3),
+        ];
+        let sites: [(&[usize], &[usize]); 6] = [
+            (&[3, 0], &[1, 2]),
+            // One-vertex sites turn with the axis.
+            (&[4], &[1, 2]),
+            (&[3, 0], &[4]),
+            // Coinciding sites, an empty site and an out-of-range vertex give no skin.
+            (&[3, 0], &[0, 3]),
+            (&[], &[1, 2]),
+            (&[3, 9], &[1, 2]),
+        ];
+        for (from, to) in sites {
+            assert_eq!(
+                Skin::new(&rest, &now, from, to),
+                reference::skin_new(&rest, &now, from, to),
+                "{from:?} {to:?}"
+            );
+        }
+        let flat = [DVec2::new(f64::NAN, 0.0); 5];
+        assert_eq!(Skin::new(&rest, &flat, &[3, 0], &[1, 2]), None);
+    }
+
+    #[test]
+    fn fast_posing_matches_the_reference_with_broken_vertices() {
+        let g = grammar("castle.clay");
+        let mut a = sculpted(&g.assembly);
+        // Non-finite and f32-overflowing positions drop only the triangles that touch them;
+        // an out-of-range vertex index hides its instance.
+        let last = a.instances.len() - 1;
+        a.positions[a.instances[0].vertices[0]] = DVec2::new(f64::NAN, 0.0);
+        a.positions[a.instances[1].vertices[1]] = DVec2::new(1e39, 0.0);
+        a.instances[last].vertices[0] = a.positions.len();
+        let stale = pose_assembly(&g, &g.assembly, &mut TessellationCache::new());
+        assert_matches_reference(&g, &a, &stale);
+    }
 
     #[test]
     fn procrustes_recovers_a_rotation() {

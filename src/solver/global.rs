@@ -32,6 +32,9 @@ pub struct Pattern {
     pub row_idx: Vec<usize>,
     /// Every edge of every part, part by part.
     pub edges: Vec<EdgeSlot>,
+    /// The global ends `[x, y]` of `edges`, packed: the per-iteration loops stream these
+    /// instead of the whole slots.
+    pub ends: Vec<[usize; 2]>,
 }
 
 impl Pattern {
@@ -77,11 +80,13 @@ impl Pattern {
                 });
             }
         }
+        let ends = edges.iter().map(|e| [e.x, e.y]).collect();
         Self {
             n,
             col_ptr,
             row_idx,
             edges,
+            ends,
         }
     }
 
@@ -151,6 +156,28 @@ pub fn fill_rhs(
             rhs[n + e.x] += c.y;
             rhs[e.y] -= c.x;
             rhs[n + e.y] -= c.y;
+        }
+    }
+}
+
+/// [`fill_rhs`] with every weight 1 (the least-squares pass), over the packed edge ends. An
+/// edge whose ends are one vertex adds and removes the same target at one row, so it is
+/// skipped as `fill_rhs` skips it.
+pub fn fill_rhs_unit(ends: &[[usize; 2]], targets: &[DVec2], extra: &[DVec2], rhs: &mut Vec<f64>) {
+    let n = extra.len();
+    rhs.clear();
+    rhs.resize(2 * n, 0.0);
+    let (xs, ys) = rhs.split_at_mut(n);
+    for (i, e) in extra.iter().enumerate() {
+        xs[i] = e.x;
+        ys[i] = e.y;
+    }
+    for (&[x, y], &t) in ends.iter().zip(targets) {
+        if x != y {
+            xs[x] += t.x;
+            ys[x] += t.y;
+            xs[y] -= t.x;
+            ys[y] -= t.y;
         }
     }
 }

@@ -737,9 +737,9 @@ impl Solver {
             let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
             let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
             let held = &self.work.handle_count;
-            for (k, e) in self.pattern.edges.iter().enumerate() {
-                let v = (next[e.x] - next[e.y]) - self.work.targets[k] + split.u[k];
-                let z = if held[e.x] > 0.0 || held[e.y] > 0.0 {
+            for (k, &[x, y]) in self.pattern.ends.iter().enumerate() {
+                let v = (next[x] - next[y]) - self.work.targets[k] + split.u[k];
+                let z = if held[x] > 0.0 || held[y] > 0.0 {
                     at_handle.apply(v)
                 } else {
                     shrink.apply(v)
@@ -905,20 +905,25 @@ impl Solver {
             w.extra.push(lambda * sum + mu * p);
         }
         let weights: &[f64] = match pass {
-            Pass::Irls => &w.weights,
+            Pass::Irls => {
+                global::fill_rhs(
+                    &self.pattern.edges,
+                    &w.weights,
+                    &w.targets,
+                    &w.extra,
+                    &mut w.rhs,
+                );
+                &w.weights
+            }
             Pass::LeastSquares => {
-                w.ones.clear();
-                w.ones.resize(self.pattern.edges.len(), 1.0);
+                global::fill_rhs_unit(&self.pattern.ends, &w.targets, &w.extra, &mut w.rhs);
+                if w.ones.len() != self.pattern.edges.len() {
+                    w.ones.clear();
+                    w.ones.resize(self.pattern.edges.len(), 1.0);
+                }
                 &w.ones
             }
         };
-        global::fill_rhs(
-            &self.pattern.edges,
-            weights,
-            &w.targets,
-            &w.extra,
-            &mut w.rhs,
-        );
         // The least-squares matrix depends only on the handles' vertices: reuse its values and
         // factor while they stay the same.
         let l2_reusable =
