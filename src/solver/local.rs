@@ -97,6 +97,18 @@ pub fn choose_state(part: &Part, positions: &[DVec2], hysteresis: f64) -> (usize
             best = (j, a);
         }
     }
+    with_hysteresis(active, here, best, hysteresis)
+}
+
+/// Paper 4.3: the nearest state `best` replaces the active one only when it is closer than
+/// `(1 - hysteresis)` times the active state's distance `here`. Returns the state and its
+/// rotation onto the pose.
+fn with_hysteresis(
+    active: usize,
+    here: Alignment,
+    best: (usize, Alignment),
+    hysteresis: f64,
+) -> (usize, DVec2) {
     if best.0 != active && best.1.distance < (1.0 - hysteresis) * here.distance {
         (best.0, best.1.rotation)
     } else {
@@ -450,11 +462,7 @@ impl RestCache {
                         best = (j, a);
                     }
                 }
-                if best.0 != active && best.1.distance < (1.0 - hysteresis) * here.distance {
-                    (best.0, best.1.rotation)
-                } else {
-                    (active, here.rotation)
-                }
+                with_hysteresis(active, here, best, hysteresis)
             }
         }
     }

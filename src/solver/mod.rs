@@ -459,25 +459,14 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            // The first local step looks at the displayed pose, before the handles moved:
-            // judged with only the handles moved,
-            // the parts next to a handle look rotated and the first solve would bend a model
-            // that should just follow rigidly.
             let pose = if it == 0 { &warm } else { &f };
-            self.local_step_switching(
+            self.judge_states(
                 &mut asm.data.parts,
                 pose,
-                cfg.hysteresis,
-                &mut report.switches,
+                it == 0,
+                &mut report,
+                &mut warm_cached,
             );
-            self.edge_targets(&asm.data.parts);
-            if it == 0 {
-                self.work.warm_rotations.clone_from(&self.work.rotations);
-                self.work.warm_targets.clone_from(&self.work.targets);
-                warm_cached = true;
-            } else if report.switches.len() > switched_before {
-                warm_cached = false;
-            }
             report.phases.local += ms_since(t);
             let t = Instant::now();
             let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
@@ -679,24 +668,8 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            // As in IRLS, the first local step judges the displayed pose (before the handles
-            // moved); it also gives pass 2 its warm-start rotations.
-            let on_shown = it == 0;
-            let pose: &[DVec2] = if on_shown { warm } else { f };
-            self.local_step_switching(
-                &mut asm.data.parts,
-                pose,
-                cfg.hysteresis,
-                &mut report.switches,
-            );
-            self.edge_targets(&asm.data.parts);
-            if on_shown {
-                self.work.warm_rotations.clone_from(&self.work.rotations);
-                self.work.warm_targets.clone_from(&self.work.targets);
-                *warm_cached = true;
-            } else if report.switches.len() > switched_before {
-                *warm_cached = false;
-            }
+            let pose: &[DVec2] = if it == 0 { warm } else { f };
+            self.judge_states(&mut asm.data.parts, pose, it == 0, report, warm_cached);
             // A part that switched state has new rest edges: its gaps and duals start over.
             let edges = &self.pattern.edges;
             for s in &report.switches[switched_before..] {
@@ -759,6 +732,32 @@ impl Solver {
         split.pose.clone_from(f);
         self.splitting = split;
         result.map(|()| converged)
+    }
+
+    /// A pass-1 local step: rotations and state choice at `pose`, then the edge targets.
+    /// The first of a frame (`first`) judges the displayed pose, before the handles moved
+    /// (judged with only the handles moved, the parts next to a handle look rotated and the
+    /// first solve would bend a model that should just follow rigidly); its rotations and
+    /// targets are also pass 2's warm start, kept in `warm_*` until a later step switches a
+    /// state.
+    fn judge_states(
+        &mut self,
+        parts: &mut [Part],
+        pose: &[DVec2],
+        first: bool,
+        report: &mut FrameReport,
+        warm_cached: &mut bool,
+    ) {
+        let switched_before = report.switches.len();
+        self.local_step_switching(parts, pose, self.config.hysteresis, &mut report.switches);
+        self.edge_targets(parts);
+        if first {
+            self.work.warm_rotations.clone_from(&self.work.rotations);
+            self.work.warm_targets.clone_from(&self.work.targets);
+            *warm_cached = true;
+        } else if report.switches.len() > switched_before {
+            *warm_cached = false;
+        }
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
