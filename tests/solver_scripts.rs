@@ -187,7 +187,9 @@ fn settings_are_validated_and_applied() {
         "colour=red",
         "norm",
         "irls_iterations=2.5",
+        "admm_iterations=-1",
         "solver=lu",
+        "pass1=newton",
     ] {
         let (code, _, err) = clayc(&["run", &g, "--set", bad]);
         assert_eq!(code, 2, "--set {bad}: {err}");

@@ -622,7 +622,6 @@ impl Solver {
     /// the assembly is the same generation and shows what the solver last displayed; else
     /// starts from the displayed pose with no gaps. Leaves the pass-1 pose in `f`; returns
     /// whether it converged.
-    #[allow(clippy::too_many_arguments)]
     fn split_pass(
         &mut self,
         asm: &mut Assembly,
