@@ -141,6 +141,35 @@ impl Assembly {
         self.generation
     }
 
+    /// Makes this assembly equal to `other` without reallocating, when `other` is this one's
+    /// structure a solver frame later: same grammar, same generation and the same counts. A
+    /// frame only moves positions, switches active states, turns rotations and moves handle
+    /// targets, so only those are copied. Returns false and changes nothing otherwise (the
+    /// caller clones). Both must descend from one assembly: generations count from 0 in
+    /// every assembly, so two unrelated ones can share one.
+    pub fn sync_from(&mut self, other: &Assembly) -> bool {
+        let same = Arc::ptr_eq(&self.grammar, &other.grammar)
+            && self.generation == other.generation
+            && self.data.positions.len() == other.data.positions.len()
+            && self.data.parts.len() == other.data.parts.len()
+            && self.data.instances.len() == other.data.instances.len()
+            && self.rotations.len() == other.rotations.len();
+        if !same {
+            return false;
+        }
+        self.data.positions.copy_from_slice(&other.data.positions);
+        for (mine, theirs) in self.data.parts.iter_mut().zip(&other.data.parts) {
+            mine.active = theirs.active;
+        }
+        for (mine, theirs) in self.data.instances.iter_mut().zip(&other.data.instances) {
+            mine.state = theirs.state;
+        }
+        self.rotations.copy_from_slice(&other.rotations);
+        self.handles.clone_from(&other.handles);
+        self.next_handle = other.next_handle;
+        true
+    }
+
     /// Rules call this after rewriting `data` (parts, vertices, docks). Bumps the generation so
     /// the solver rebuilds its pattern, resizes the rotations, re-reads the vertices of handles
     /// that hold an instance (see [`HeldInstance`]), and drops handles whose vertices no longer

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, SolverParams};
 use egui::{Key, Modifiers};
@@ -20,26 +20,19 @@ use crate::sculpt::{Command, Sculpt};
 use crate::session::{self, Session};
 use crate::watch::FileWatch;
 
-/// Most solver time per UI frame; the rest of a 60 Hz frame is left for drawing.
+/// Budget of solver work per UI frame when the solver runs on the UI thread; the rest of a
+/// 60 Hz frame is left for drawing.
 pub const SOLVER_BUDGET: Duration = Duration::from_millis(12);
 
-/// The UI frame the editor aims for (60 Hz).
-const FRAME: Duration = Duration::from_micros(16_667);
+/// A model whose solver frames cost more than this solves on its own thread
+/// ([`Sculpt::step_in_background`]) so that drawing never waits for it: the model shown is one
+/// solver frame behind, the window keeps 60 Hz. Smaller models solve on the UI thread, where
+/// every frame shows the latest solve.
+pub const BACKGROUND_ABOVE: Duration = Duration::from_millis(4);
 
-/// Slack kept free of both solver and drawing in every UI frame (input, egui's own work, the
-/// GPU upload).
-const FRAME_SLACK: Duration = Duration::from_micros(1_500);
-
-/// The solver's budget for a UI frame: what a 60 Hz frame leaves after drawing took
-/// `draw` (smoothed), never more than [`SOLVER_BUDGET`]. A large model that draws slowly gets
-/// a smaller budget, so the frame still fits; the solver then runs fewer iterations per UI
-/// frame and continues on the next one.
-pub fn solver_budget(draw: Duration) -> Duration {
-    FRAME
-        .saturating_sub(draw)
-        .saturating_sub(FRAME_SLACK)
-        .min(SOLVER_BUDGET)
-}
+/// Budget of one background solver frame: about one 60 Hz frame, so the model follows the
+/// mouse at up to 60 solver frames per second.
+pub const BACKGROUND_BUDGET: Duration = Duration::from_micros(16_667);
 
 /// A file operation the user asked for.
 #[derive(Clone, Debug, PartialEq)]
@@ -136,8 +129,6 @@ pub struct EditorApp {
     author_commands: Vec<AuthorCommand>,
     /// Tab was pressed (taken out of the input before egui moves keyboard focus with it).
     mode_key: bool,
-    /// How long `ui` (drawing, posing the model) took, smoothed over recent frames.
-    draw_time: Duration,
 }
 
 /// A grammar with nothing in it: the model shown when the first compile fails.
@@ -192,7 +183,6 @@ impl EditorApp {
             author_form: AuthorForm::default(),
             author_commands: Vec::new(),
             mode_key: false,
-            draw_time: Duration::ZERO,
         }
     }
 
@@ -334,7 +324,16 @@ impl EditorApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.confirm = Some(Action::Quit);
         }
-        if self.sculpt.step(solver_budget(self.draw_time)) {
+        let heavy = self
+            .sculpt
+            .last_report()
+            .is_some_and(|r| r.ms > BACKGROUND_ABOVE.as_secs_f64() * 1e3);
+        let more = if heavy {
+            self.sculpt.step_in_background(BACKGROUND_BUDGET)
+        } else {
+            self.sculpt.step(SOLVER_BUDGET)
+        };
+        if more {
             ctx.request_repaint();
         }
     }
@@ -347,15 +346,6 @@ impl EditorApp {
 
     /// Draws the editor and applies what the user asked for.
     pub fn ui(&mut self, ui: &mut egui::Ui) {
-        let start = Instant::now();
-        self.draw(ui);
-        // smoothed, so one slow frame (a rebuild after a rule fired) does not starve the solver
-        let took = start.elapsed().as_secs_f64();
-        let smoothed = 0.8 * self.draw_time.as_secs_f64() + 0.2 * took;
-        self.draw_time = Duration::from_secs_f64(smoothed.clamp(0.0, 1.0));
-    }
-
-    fn draw(&mut self, ui: &mut egui::Ui) {
         self.shortcuts(ui);
         self.menu(ui);
         self.status_bar(ui);
@@ -893,23 +883,5 @@ impl eframe::App for EditorApp {
             }
             _ => true,
         });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_solver_budget_leaves_room_for_drawing_within_a_60_hz_frame() {
-        // a model that draws fast gets the full budget
-        assert_eq!(solver_budget(Duration::from_millis(1)), SOLVER_BUDGET);
-        // a slow one gets what is left of the frame
-        let draw = Duration::from_millis(6);
-        let budget = solver_budget(draw);
-        assert!(budget < SOLVER_BUDGET);
-        assert_eq!(budget + draw + FRAME_SLACK, FRAME);
-        // drawing alone over the frame: no budget (the solver still runs its least frame)
-        assert_eq!(solver_budget(Duration::from_millis(30)), Duration::ZERO);
     }
 }

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use clay::assembly::{Assembly, HandleId, HandleKind};
 use clay::rules::{Rules, cut::CUT_REACH, site_centre};
 use clay::solver::local::align;
-use clay::solver::{FrameReport, Solver, SolverConfig};
+use clay::solver::{FrameReport, Solver, SolverConfig, SolverError};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
@@ -123,6 +123,85 @@ pub struct Sculpt {
     pub frames_last_step: usize,
     error: Option<String>,
     log: Vec<LogEntry>,
+    /// A solver frame running on another thread ([`Sculpt::step_in_background`]).
+    job: Option<std::thread::JoinHandle<Job>>,
+    /// The model the last background frame started from, reused for the next one.
+    spare: Option<Assembly>,
+    /// The grab moved while a background frame ran (its result is then not a fixed point).
+    moved_while_solving: bool,
+    /// A model no longer needed, freed by the next background frame's thread.
+    stale: Option<Assembly>,
+}
+
+/// What a background solver frame hands back: the model, solver and rules it worked on.
+struct Job {
+    model: Assembly,
+    /// A copy of `model`, made when a rule rewrote it (the next frame starts from it).
+    spare: Option<Assembly>,
+    solver: Solver,
+    rules: Rules,
+    outcome: FrameOutcome,
+}
+
+/// What one solver frame and the rules after it did.
+struct FrameOutcome {
+    report: Result<FrameReport, SolverError>,
+    /// Log lines of the frame (state switches of stretch parts, rule events), in order.
+    notes: Vec<(String, Option<DVec2>)>,
+    /// A rule rewrote the model.
+    rewrote: bool,
+}
+
+/// One solver frame within `budget`, then the rules (paper 5.1), on whichever thread.
+fn solve_frame(
+    assembly: &mut Assembly,
+    solver: &mut Solver,
+    rules: &mut Rules,
+    budget: Duration,
+) -> FrameOutcome {
+    let report = match solver.frame_budgeted(assembly, budget) {
+        Ok(report) => report,
+        Err(e) => {
+            return FrameOutcome {
+                report: Err(e),
+                notes: Vec::new(),
+                rewrote: false,
+            };
+        }
+    };
+    // Piece parts' switches come back from the rules as replacement events; stretch parts'
+    // switches are logged here, before the rules renumber the parts.
+    let mut notes = Vec::new();
+    for s in &report.switches {
+        let Some(p) = assembly.data.parts.get(s.part) else {
+            continue;
+        };
+        if !matches!(p.kind, PartKind::Stretch { .. }) {
+            continue;
+        }
+        let name = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str()).to_string();
+        let (from, to) = (name(s.from), name(s.to));
+        let at = assembly.part_centroid(s.part);
+        notes.push((
+            format!("state switch: part {} {from} -> {to}", s.part),
+            Some(at),
+        ));
+    }
+    // Stretch, shrink, merge and replacement after every frame.
+    let events = rules.after_frame(assembly, &report);
+    rules.log.clear();
+    let rewrote = !events.is_empty();
+    for e in events {
+        notes.push((
+            format!("{:?}: {}", e.kind, e.detail).to_lowercase(),
+            Some(e.at),
+        ));
+    }
+    FrameOutcome {
+        report: Ok(report),
+        notes,
+        rewrote,
+    }
 }
 
 impl Sculpt {
@@ -150,6 +229,10 @@ impl Sculpt {
             frames_last_step: 0,
             error: None,
             log: Vec::new(),
+            job: None,
+            spare: None,
+            moved_while_solving: false,
+            stale: None,
         };
         sculpt.configure_solver();
         sculpt
@@ -242,7 +325,7 @@ impl Sculpt {
 
     /// Whether the solver has work left; the app keeps repainting while it has.
     pub fn needs_work(&self) -> bool {
-        self.unsettled && self.error.is_none()
+        (self.unsettled || self.job.is_some()) && self.error.is_none()
     }
 
     /// The pins, with where they hold their vertices.
@@ -319,6 +402,12 @@ impl Sculpt {
 
     /// Applies one command.
     pub fn apply(&mut self, command: Command) {
+        if matches!(command, Command::MoveGrab { .. }) {
+            // applied to the model shown; a running frame picks the new target up when done
+            self.moved_while_solving |= self.job.is_some();
+        } else {
+            self.collect_job(true);
+        }
         match command {
             Command::Grab { part, at } => self.grab(part, at),
             Command::MoveGrab { translation, angle } => {
@@ -407,6 +496,7 @@ impl Sculpt {
     /// shape or colours shows on the sculpted model; otherwise the new grammar's initial model.
     /// Returns whether the sculpt was kept.
     pub fn replace_grammar(&mut self, grammar: Arc<CompiledGrammar>) -> bool {
+        self.collect_job(true);
         self.release();
         // A reload alone is not unsaved work: the session file would restore the same sculpt.
         let dirty = self.dirty;
@@ -459,8 +549,9 @@ impl Sculpt {
     }
 
     /// Runs solver frames until the model settles or `budget` is spent (at least one frame when
-    /// there is work). Returns whether work remains.
+    /// there is work), on this thread. Returns whether work remains.
     pub fn step(&mut self, budget: Duration) -> bool {
+        self.collect_job(true);
         let start = Instant::now();
         self.frames_last_step = 0;
         while self.needs_work() {
@@ -468,64 +559,137 @@ impl Sculpt {
             // finish in time stops early with a proper least-squares pose and continues on the
             // next call, so a large model never blocks the window.
             let left = budget.saturating_sub(start.elapsed());
-            match self.solver.frame_budgeted(&mut self.assembly, left) {
-                Ok(report) => {
-                    self.frame += 1;
-                    self.revision += 1;
-                    self.frames_last_step += 1;
-                    // Piece parts' switches come back from the rules as replacement events;
-                    // stretch parts' switches are logged here.
-                    let stretch_switches: Vec<_> = report
-                        .switches
-                        .iter()
-                        .filter(|s| {
-                            self.assembly
-                                .data
-                                .parts
-                                .get(s.part)
-                                .is_some_and(|p| matches!(p.kind, PartKind::Stretch { .. }))
-                        })
-                        .copied()
-                        .collect();
-                    for s in &stretch_switches {
-                        let at = (s.part < self.assembly.data.parts.len())
-                            .then(|| self.assembly.part_centroid(s.part));
-                        let names = &self.assembly.data.parts.get(s.part).map(|p| {
-                            let n = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str());
-                            (n(s.from).to_string(), n(s.to).to_string())
-                        });
-                        let (from, to) = names.clone().unwrap_or_default();
-                        self.note(format!("state switch: part {} {from} -> {to}", s.part), at);
-                    }
-                    // Stretch, shrink, merge and replacement after every frame (paper 5.1).
-                    let events = self.rules.after_frame(&mut self.assembly, &report);
-                    self.rules.log.clear();
-                    let changed = !events.is_empty();
-                    for e in events {
-                        self.note(
-                            format!("{:?}: {}", e.kind, e.detail).to_lowercase(),
-                            Some(e.at),
-                        );
-                    }
-                    if changed && self.grab.is_some() {
-                        self.follow_grab();
-                    }
-                    // `converged`: a complete frame with no state switch that moved no vertex
-                    // beyond the solver's settle tolerance, i.e. a fixed point.
-                    if report.converged && !changed {
-                        self.unsettled = false;
-                    }
-                    self.last_report = Some(report);
-                }
-                Err(e) => {
-                    self.error = Some(e.to_string());
-                }
-            }
+            let outcome = solve_frame(&mut self.assembly, &mut self.solver, &mut self.rules, left);
+            self.integrate(outcome);
             if start.elapsed() >= budget {
                 break;
             }
         }
         self.needs_work()
+    }
+
+    /// Runs the solver on another thread (the machine's second core) so that drawing never
+    /// waits for it: takes in the frame that finished since the last call, if any, and starts
+    /// the next one (budgeted by `budget`) on a copy of the model as it is now. The model shown
+    /// is the last finished frame, one frame behind the solver. Commands other than moving the
+    /// grab wait for a running frame first, so they always act on the latest model. Returns
+    /// whether work remains (call again next UI frame).
+    pub fn step_in_background(&mut self, budget: Duration) -> bool {
+        self.frames_last_step = 0;
+        self.collect_job(false);
+        if self.job.is_none() && self.needs_work() {
+            // A frame moves positions, states, rotations and handles only: the spare copy of
+            // the last frame is brought up to date in place; after a rule rewrote the model
+            // (new generation) it is cloned afresh.
+            let mut model = match self.spare.take() {
+                Some(mut spare) => {
+                    if spare.sync_from(&self.assembly) {
+                        spare
+                    } else {
+                        self.stale = Some(spare);
+                        self.assembly.clone()
+                    }
+                }
+                None => self.assembly.clone(),
+            };
+            let placeholder = Solver::new(self.solver.config);
+            let mut solver = std::mem::replace(&mut self.solver, placeholder);
+            let mut rules = std::mem::take(&mut self.rules);
+            let stale = self.stale.take();
+            self.moved_while_solving = false;
+            self.job = Some(std::thread::spawn(move || {
+                // freeing a whole model costs milliseconds at 10k parts: not on the UI thread
+                drop(stale);
+                let generation = model.generation();
+                let outcome = solve_frame(&mut model, &mut solver, &mut rules, budget);
+                // After a rewrite the model shown now can no longer be brought up to date in
+                // place for the next frame: copy the result here, off the UI thread.
+                let spare = (model.generation() != generation).then(|| model.clone());
+                Job {
+                    model,
+                    spare,
+                    solver,
+                    rules,
+                    outcome,
+                }
+            }));
+        }
+        self.needs_work()
+    }
+
+    /// Whether a solver frame is running on another thread.
+    pub fn solving_in_background(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// Takes in the background frame, waiting for it when `wait` (before any command that
+    /// changes the model), else only if it has finished.
+    fn collect_job(&mut self, wait: bool) {
+        let Some(handle) = self.job.take() else {
+            return;
+        };
+        if !wait && !handle.is_finished() {
+            self.job = Some(handle);
+            return;
+        }
+        match handle.join() {
+            Ok(job) => {
+                let mut solved = job.model;
+                // The grab moved on while the frame ran: its latest target wins.
+                if let Some(g) = &self.grab
+                    && let Some(now) = self.assembly.handle(g.handle)
+                    && let Some(h) = solved.handle_mut(g.handle)
+                {
+                    h.translation = now.translation;
+                    h.angle = now.angle;
+                }
+                let shown = std::mem::replace(&mut self.assembly, solved);
+                match job.spare {
+                    Some(spare) => {
+                        self.spare = Some(spare);
+                        self.stale = Some(shown);
+                    }
+                    None => self.spare = Some(shown),
+                }
+                self.solver = job.solver;
+                self.rules = job.rules;
+                self.integrate(job.outcome);
+                if self.moved_while_solving {
+                    self.unsettled = true;
+                }
+            }
+            Err(_) => {
+                // The frame's model is lost with the thread; the one shown stays.
+                self.error = Some("the solver stopped unexpectedly".to_string());
+            }
+        }
+    }
+
+    /// Records what a solver frame did: counters, the log, the grab after rewrites, and
+    /// whether the model has settled.
+    fn integrate(&mut self, outcome: FrameOutcome) {
+        match outcome.report {
+            Ok(report) => {
+                self.frame += 1;
+                self.revision += 1;
+                self.frames_last_step += 1;
+                for (message, at) in outcome.notes {
+                    self.note(message, at);
+                }
+                if outcome.rewrote && self.grab.is_some() {
+                    self.follow_grab();
+                }
+                // `converged`: a complete frame with no state switch that moved no vertex
+                // beyond the solver's settle tolerance, i.e. a fixed point.
+                if report.converged && !outcome.rewrote {
+                    self.unsettled = false;
+                }
+                self.last_report = Some(report);
+            }
+            Err(e) => {
+                self.error = Some(e.to_string());
+            }
+        }
     }
 
     /// Why `part` is in the state it is in.
@@ -608,6 +772,21 @@ impl Sculpt {
 
     /// Ends the gesture: a pinned part stays pinned where it was dropped.
     fn release(&mut self) {
+        if self.grab.is_none() {
+            return;
+        }
+        if self.moved_while_solving {
+            // The last moves came while a background frame ran: solve once more here, so the
+            // part is dropped where the pointer let go, not a frame behind it.
+            self.moved_while_solving = false;
+            let outcome = solve_frame(
+                &mut self.assembly,
+                &mut self.solver,
+                &mut self.rules,
+                Duration::MAX,
+            );
+            self.integrate(outcome);
+        }
         let Some(g) = self.grab.take() else {
             return;
         };
@@ -667,8 +846,10 @@ impl Sculpt {
                 h.anchor = pin.at;
             }
         }
-        // A fresh solver: the old one's pattern belongs to another topology.
+        // A fresh solver: the old one's pattern belongs to another topology. The spare copy
+        // belongs to it too (and a restored model counts its generations from 0 again).
         self.solver = Solver::new(self.solver.config);
+        self.spare = None;
         self.error = None;
         self.unsettled = true;
     }

@@ -404,3 +404,83 @@ fn a_handle_on_a_stretch_chain_holds_the_brick_under_the_cursor() {
     });
     assert!(s.pins().is_empty());
 }
+
+/// Runs background frames until the model settles (each call takes in the finished frame).
+fn settle_in_background(s: &mut Sculpt) {
+    for _ in 0..20_000 {
+        if !s.step_in_background(Duration::from_secs(1)) {
+            return;
+        }
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    panic!("the background solver did not settle");
+}
+
+#[test]
+fn solving_in_the_background_gives_the_same_model_as_on_the_ui_thread() {
+    // The same gesture, solved frame by frame on this thread and on the worker: with every
+    // frame complete, the frames are the same computations, so the models agree exactly.
+    let mut models = Vec::new();
+    for background in [false, true] {
+        let mut s = castle();
+        let part = tower(&s);
+        let at = s.assembly().part_centroid(part);
+        s.apply(Command::Grab { part, at });
+        s.apply(Command::MoveGrab {
+            translation: DVec2::new(3.0, -2.0),
+            angle: 0.3,
+        });
+        if background {
+            settle_in_background(&mut s);
+            assert!(!s.solving_in_background());
+        } else {
+            // one call: frames until settled, none cut short by the budget
+            assert!(!s.step(Duration::from_secs(60)));
+        }
+        s.apply(Command::Release);
+        models.push((s.data().clone(), s.frame()));
+    }
+    assert!(models[0].1 > 1, "the gesture took solver frames");
+    assert_eq!(models[0].1, models[1].1, "both ran the same frames");
+    assert!(models[0].0 == models[1].0, "the models differ");
+}
+
+#[test]
+fn commands_wait_for_a_background_frame_and_a_drop_lands_at_the_pointer() {
+    let mut s = castle();
+    let before = s.data().clone();
+    let part = tower(&s);
+    let at = s.assembly().part_centroid(part);
+    s.apply(Command::Grab { part, at });
+    s.apply(Command::MoveGrab {
+        translation: DVec2::new(2.0, 0.0),
+        angle: 0.0,
+    });
+    assert!(s.step_in_background(Duration::from_secs(1)));
+    assert!(s.solving_in_background());
+    // the pointer moves on while the frame runs, and lets go before it is taken in
+    let last = DVec2::new(5.0, 1.0);
+    s.apply(Command::MoveGrab {
+        translation: last,
+        angle: 0.0,
+    });
+    let target = s.grab_target().unwrap().0;
+    s.apply(Command::Release);
+    assert!(
+        !s.solving_in_background(),
+        "the release waited for the frame"
+    );
+    let now = s.assembly().part_centroid(part);
+    assert!(
+        now.distance(target) < 1e-3,
+        "dropped at {now}, the pointer let go at {target}"
+    );
+    assert!(now.distance(at + last) < 1e-3);
+    // undo, with a frame running, restores the model from before the gesture
+    s.apply(Command::TogglePin { part, at: now });
+    s.step_in_background(Duration::from_secs(1));
+    s.apply(Command::Undo);
+    s.apply(Command::Undo);
+    assert!(!s.solving_in_background());
+    assert!(s.data() == &before, "two undos restore the castle");
+}
