@@ -5,6 +5,7 @@ pub mod fit;
 pub mod render;
 pub mod rules;
 pub mod script;
+pub mod segment;
 pub mod solver;
 pub mod summary;
 pub mod synthetic;

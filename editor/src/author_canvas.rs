@@ -6,6 +6,7 @@
 //! making). It never changes the work itself.
 
 use clay::authoring::Polyline;
+use clay::segment::nearest_on_segment;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
@@ -124,16 +125,6 @@ impl Default for AuthorCanvas {
     }
 }
 
-fn nearest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> DVec2 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    a + ab * t
-}
-
 /// The segments of a stroke, closing segment included.
 fn segments(p: &Polyline) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
     let n = p.points.len();
@@ -206,7 +197,7 @@ impl AuthorCanvas {
             .polylines
             .iter()
             .flat_map(segments)
-            .map(|(a, b)| nearest_on_segment(w, a, b))
+            .map(|(a, b)| nearest_on_segment(w, a, b).0)
             .filter(|p| p.distance(w) <= radius)
             .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)))
     }

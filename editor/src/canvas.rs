@@ -6,6 +6,7 @@ use std::collections::HashSet;
 
 use clay::render::pose::pose_assembly_into;
 use clay::render::{TessellationCache, WorldMesh};
+use clay::segment::nearest_on_segment;
 use clay_dsl::compiled::{AssemblyData, PartKind};
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
@@ -472,11 +473,5 @@ fn triangle_contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
 }
 
 fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
+    p.distance(nearest_on_segment(p, a, b).0)
 }

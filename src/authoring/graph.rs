@@ -68,14 +68,8 @@ fn key(a: usize, b: usize) -> [usize; 2] {
 
 /// Distance from `p` to the segment `a-b` and the parameter of the nearest point.
 fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
-    let d = b - a;
-    let len2 = d.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((a + d * t - p).length(), t)
+    let (q, t) = crate::segment::nearest_on_segment(p, a, b);
+    ((q - p).length(), t)
 }
 
 impl Graph {
