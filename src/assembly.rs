@@ -390,25 +390,22 @@ impl Assembly {
     /// the lowest index). `None` without parts.
     pub fn part_extreme(&self, dir: Compass) -> Option<usize> {
         let d = dir.direction();
-        let key = |i: usize| {
-            let p = &self.data.parts[i];
-            let reach = p
-                .vertices
-                .iter()
-                .map(|&v| self.data.positions[v].dot(d))
-                .fold(f64::MIN, f64::max);
-            (reach, self.part_centroid(i).dot(d))
-        };
-        (0..self.data.parts.len())
-            .filter(|&i| !self.data.parts[i].vertices.is_empty())
-            .map(|i| (i, key(i)))
-            .max_by(|a, b| {
-                a.1.0
-                    .total_cmp(&b.1.0)
-                    .then(a.1.1.total_cmp(&b.1.1))
-                    .then(b.0.cmp(&a.0))
-            })
-            .map(|(i, _)| i)
+        furthest(
+            (0..self.data.parts.len())
+                .filter(|&i| !self.data.parts[i].vertices.is_empty())
+                .map(|i| {
+                    let reach = self.reach(&self.data.parts[i].vertices, d);
+                    (i, reach, self.part_centroid(i).dot(d))
+                }),
+        )
+    }
+
+    /// How far the furthest of `vertices` reaches along `d`.
+    fn reach(&self, vertices: &[usize], d: DVec2) -> f64 {
+        vertices
+            .iter()
+            .map(|&v| self.data.positions[v].dot(d))
+            .fold(f64::MIN, f64::max)
     }
 
     /// Centroid of an instance's current vertex positions (`None`: no such instance or no
@@ -435,23 +432,11 @@ impl Assembly {
     /// then the lowest index). `None` without instances.
     pub fn instance_extreme(&self, dir: Compass) -> Option<usize> {
         let d = dir.direction();
-        (0..self.data.instances.len())
-            .filter_map(|i| {
-                let centre = self.instance_centroid(i)?;
-                let reach = self.data.instances[i]
-                    .vertices
-                    .iter()
-                    .map(|&v| self.data.positions[v].dot(d))
-                    .fold(f64::MIN, f64::max);
-                Some((i, (reach, centre.dot(d))))
-            })
-            .max_by(|a, b| {
-                a.1.0
-                    .total_cmp(&b.1.0)
-                    .then(a.1.1.total_cmp(&b.1.1))
-                    .then(b.0.cmp(&a.0))
-            })
-            .map(|(i, _)| i)
+        furthest((0..self.data.instances.len()).filter_map(|i| {
+            let centre = self.instance_centroid(i)?;
+            let reach = self.reach(&self.data.instances[i].vertices, d);
+            Some((i, reach, centre.dot(d)))
+        }))
     }
 
     /// Checks indices and invariants of the data, the rotations and the handles. Returns every
@@ -589,4 +574,16 @@ impl Assembly {
             Err(errors)
         }
     }
+}
+
+/// The index whose `(reach, centre)` is largest: the furthest reach, ties broken by the
+/// centre, then by the lowest index (so the choice does not depend on iteration order).
+fn furthest(candidates: impl Iterator<Item = (usize, f64, f64)>) -> Option<usize> {
+    candidates
+        .max_by(|a, b| {
+            a.1.total_cmp(&b.1)
+                .then(a.2.total_cmp(&b.2))
+                .then(b.0.cmp(&a.0))
+        })
+        .map(|(i, _, _)| i)
 }
