@@ -101,11 +101,6 @@ impl Shrink {
         }
     }
 
-    /// Residuals no longer than this close to zero.
-    pub fn threshold(&self) -> f64 {
-        self.threshold
-    }
-
     /// `s^(p - 1)` and `s^(p - 2)`, with p = 0.5 spelled out (powf would dominate).
     fn powers(&self, s: f64) -> (f64, f64) {
         if self.p == 0.5 {
@@ -177,14 +172,13 @@ impl Shrink {
     }
 }
 
-/// [`Shrink::apply`] for one residual (tests and one-off use).
-pub fn shrink(v: DVec2, rho: f64, p: f64) -> DVec2 {
-    Shrink::new(rho, p).apply(v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn shrink(v: DVec2, rho: f64, p: f64) -> DVec2 {
+        Shrink::new(rho, p).apply(v)
+    }
 
     /// Brute-force 1D minimiser of `s^p + rho/2 (s - n)^2` over `[0, n]`.
     fn brute(n: f64, rho: f64, p: f64) -> f64 {
@@ -226,7 +220,7 @@ mod tests {
         for &rho in &[0.01, 1.0, 164.0, 1e4] {
             let shrink = Shrink::new(rho, 0.5);
             for k in 0..200 {
-                let n = shrink.threshold() * (1.0 + 1e-9 + 0.05 * k as f64);
+                let n = shrink.threshold * (1.0 + 1e-9 + 0.05 * k as f64);
                 let s = shrink.apply(DVec2::new(0.0, n)).length();
                 let phi = s + 0.5 / rho / s.sqrt() - n;
                 assert!(phi.abs() <= 1e-10 * n, "rho {rho} n {n}: s {s}, phi {phi}");

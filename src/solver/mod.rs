@@ -417,7 +417,6 @@ impl Solver {
             }
         }
         let mut f = std::mem::take(&mut self.work.f);
-        f.clone_from(&warm_held);
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
         next.resize(n, DVec2::ZERO);
@@ -429,8 +428,11 @@ impl Solver {
             Pass1::Irls => cfg.irls_iterations,
             Pass1::Admm => cfg.admm_iterations,
         };
-        let mut irls_iterations = cfg.irls_iterations;
-        if cfg.pass1 == Pass1::Admm {
+        let irls_iterations = match cfg.pass1 {
+            Pass1::Irls => cfg.irls_iterations,
+            Pass1::Admm => 0,
+        };
+        if cfg.pass1 == Pass1::Admm && cfg.admm_iterations > 0 {
             let carry = self.work.shown == warm;
             pass1_converged = self.split_pass(
                 asm,
@@ -445,7 +447,10 @@ impl Solver {
                 &mut report,
                 &mut warm_cached,
             )?;
-            irls_iterations = 0;
+        } else {
+            f.clone_from(&warm_held);
+            // the splitting variables did not follow this frame
+            self.splitting.generation = None;
         }
 
         // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
