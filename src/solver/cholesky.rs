@@ -33,10 +33,11 @@ pub struct SymbolicFactor {
 struct SupernodalLayout {
     /// Supernode `s` holds columns `begin[s]..begin[s + 1]` (permuted order).
     begin: Vec<usize>,
-    /// Rows below the supernode's diagonal block: `row_idx[row_start[s]..][..below[s]]`.
+    /// Rows below the supernode's diagonal block: `row_idx[row_start[s]..][..below[s]]`
+    /// (compact: they are streamed on every solve).
     row_start: Vec<usize>,
     below: Vec<usize>,
-    row_idx: Vec<usize>,
+    row_idx: Vec<u32>,
     /// The dense block (diagonal block on top of the rows below, column-major) starts at
     /// `val_start[s]` in the factor's values.
     val_start: Vec<usize>,
@@ -48,6 +49,11 @@ struct SupernodalLayout {
 #[derive(Debug, Default, Clone)]
 pub struct NumericFactor {
     values: Vec<f64>,
+    /// The same values in the order [`SymbolicFactor::solve_in_place`] reads them: each
+    /// supernode's diagonal block as faer stores it, then the rows below it row by row (faer
+    /// stores them column by column), so a below row is read once per substitution rather
+    /// than once per column of its supernode.
+    solve_order: Vec<f64>,
     valid: bool,
 }
 
@@ -93,11 +99,17 @@ impl SymbolicFactor {
                 let ns = sn.n_supernodes();
                 let mut begin = sn.supernode_begin().to_vec();
                 begin.push(n);
+                let row_idx = sn
+                    .row_idx()
+                    .iter()
+                    .map(|&i| u32::try_from(i).ok().filter(|&i| (i as usize) < n))
+                    .collect::<Option<Vec<u32>>>()
+                    .ok_or_else(|| FactorError("the factor has more rows than fit".into()))?;
                 Some(SupernodalLayout {
                     begin,
                     row_start: sn.col_ptr_for_row_idx()[..ns].to_vec(),
                     below: sn.nnz_per_super()[..ns].to_vec(),
-                    row_idx: sn.row_idx().to_vec(),
+                    row_idx,
                     val_start: sn.col_ptr_for_val()[..ns].to_vec(),
                     perm: match symbolic.perm() {
                         Some(p) => p.arrays().0.to_vec(),
@@ -139,6 +151,9 @@ impl SymbolicFactor {
                 Default::default(),
             )
             .map_err(|e| FactorError(format!("numeric Cholesky failed: {e:?}")))?;
+        if let Some(layout) = &self.layout {
+            layout.reorder_for_solve(&factor.values, &mut factor.solve_order);
+        }
         factor.valid = true;
         Ok(())
     }
@@ -154,10 +169,32 @@ impl SymbolicFactor {
         if ncols == 2
             && let Some(layout) = &self.layout
         {
-            layout.solve_pairs(&factor.values, rhs, &mut self.pairs);
+            layout.solve_pairs(&factor.solve_order, rhs, &mut self.pairs);
             return;
         }
         self.solve_with_faer(factor, rhs, ncols);
+    }
+
+    /// The fill-reducing order of the two-column solve: position `i` of a vector in factor
+    /// order holds original row `order[i]`. `None` when the factor is not supernodal (then
+    /// only [`SymbolicFactor::solve_in_place`] solves).
+    pub fn factor_order(&self) -> Option<&[usize]> {
+        self.layout.as_ref().map(|l| l.perm.as_slice())
+    }
+
+    /// Solves `A X = B` for two columns given as `(x, y)` pairs already in
+    /// [`SymbolicFactor::factor_order`], in place: the caller builds the right-hand side in
+    /// that order and reads the solution from it, with no permuting copies. Returns `false`
+    /// (and leaves `x` alone) when there is no such order or `x` is not one pair per row.
+    pub fn solve_in_factor_order(&self, factor: &NumericFactor, x: &mut [[f64; 2]]) -> bool {
+        debug_assert!(factor.valid);
+        match &self.layout {
+            Some(layout) if x.len() == layout.perm.len() => {
+                layout.substitute(&factor.solve_order, x);
+                true
+            }
+            _ => false,
+        }
     }
 
     /// faer's own solve (any number of columns).
@@ -171,64 +208,181 @@ impl SymbolicFactor {
 }
 
 impl SupernodalLayout {
-    /// `rhs` (two columns of length n) <- `A^-1 rhs` with `A = P^T L L^T P`.
+    /// Supernode `s`: its first column, its width, its rows below the diagonal block and
+    /// where its values start.
+    fn supernode(&self, s: usize) -> (usize, usize, &[u32], usize) {
+        let (start, end) = (self.begin[s], self.begin[s + 1]);
+        let below = &self.row_idx[self.row_start[s]..][..self.below[s]];
+        (start, end - start, below, self.val_start[s])
+    }
+
+    /// Copies faer's supernodal values `l` into `out` in solve order (see
+    /// [`NumericFactor::solve_order`]): same offsets per supernode, the diagonal block
+    /// unchanged, the block below it transposed to row-major.
+    fn reorder_for_solve(&self, l: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(l.len(), 0.0);
+        for s in 0..self.val_start.len() {
+            let (_, size, below, at) = self.supernode(s);
+            let rows = size + below.len();
+            let block = &l[at..][..rows * size];
+            let target = &mut out[at..][..rows * size];
+            let (diagonal, rest) = target.split_at_mut(size * size);
+            for c in 0..size {
+                diagonal[c * size..][..size].copy_from_slice(&block[c * rows..][..size]);
+                for (b, row) in rest.chunks_exact_mut(size).enumerate() {
+                    row[c] = block[c * rows + size + b];
+                }
+            }
+        }
+    }
+
+    /// `rhs` (two columns of length n) <- `A^-1 rhs` with `A = P^T L L^T P`; `l` in solve
+    /// order (see [`SupernodalLayout::substitute`]).
     fn solve_pairs(&self, l: &[f64], rhs: &mut [f64], x: &mut Vec<[f64; 2]>) {
         let n = self.perm.len();
         x.clear();
         x.extend(self.perm.iter().map(|&p| [rhs[p], rhs[n + p]]));
-        let supernodes = self.val_start.len();
-        // L y = P b, supernode by supernode
-        for s in 0..supernodes {
-            let (start, end) = (self.begin[s], self.begin[s + 1]);
-            let size = end - start;
-            let below = &self.row_idx[self.row_start[s]..][..self.below[s]];
-            let rows = size + below.len();
-            let block = &l[self.val_start[s]..][..rows * size];
-            for c in 0..size {
-                let col = &block[c * rows..(c + 1) * rows];
-                let d = col[c];
-                let xc = [x[start + c][0] / d, x[start + c][1] / d];
-                x[start + c] = xc;
-                for r in c + 1..size {
-                    let xr = &mut x[start + r];
-                    xr[0] -= col[r] * xc[0];
-                    xr[1] -= col[r] * xc[1];
-                }
-                for (&i, &v) in below.iter().zip(&col[size..]) {
-                    let xi = &mut x[i];
-                    xi[0] -= v * xc[0];
-                    xi[1] -= v * xc[1];
-                }
-            }
-        }
-        // L^T z = y, in reverse
-        for s in (0..supernodes).rev() {
-            let (start, end) = (self.begin[s], self.begin[s + 1]);
-            let size = end - start;
-            let below = &self.row_idx[self.row_start[s]..][..self.below[s]];
-            let rows = size + below.len();
-            let block = &l[self.val_start[s]..][..rows * size];
-            for c in (0..size).rev() {
-                let col = &block[c * rows..(c + 1) * rows];
-                let mut acc = x[start + c];
-                for r in c + 1..size {
-                    let xr = x[start + r];
-                    acc[0] -= col[r] * xr[0];
-                    acc[1] -= col[r] * xr[1];
-                }
-                for (&i, &v) in below.iter().zip(&col[size..]) {
-                    let xi = x[i];
-                    acc[0] -= v * xi[0];
-                    acc[1] -= v * xi[1];
-                }
-                let d = col[c];
-                x[start + c] = [acc[0] / d, acc[1] / d];
-            }
-        }
+        self.substitute(l, x);
         for (xi, &p) in x.iter().zip(&self.perm) {
             rhs[p] = xi[0];
             rhs[n + p] = xi[1];
         }
+    }
+
+    /// `x <- L^-T L^-1 x` for pairs in factor order; `l` in solve order. Supernodes up to 8
+    /// wide (nearly all of them in these planar Laplacians) run with their width known to
+    /// the compiler, so a below row's update stays in registers.
+    fn substitute(&self, l: &[f64], x: &mut [[f64; 2]]) {
+        let supernodes = self.val_start.len();
+        for s in 0..supernodes {
+            let (start, size, below, at) = self.supernode(s);
+            let block = &l[at..][..(size + below.len()) * size];
+            match size {
+                1 => forward::<1>(block, start, below, x),
+                2 => forward::<2>(block, start, below, x),
+                3 => forward::<3>(block, start, below, x),
+                4 => forward::<4>(block, start, below, x),
+                5 => forward::<5>(block, start, below, x),
+                6 => forward::<6>(block, start, below, x),
+                7 => forward::<7>(block, start, below, x),
+                8 => forward::<8>(block, start, below, x),
+                _ => forward_wide(block, start, size, below, x),
+            }
+        }
+        for s in (0..supernodes).rev() {
+            let (start, size, below, at) = self.supernode(s);
+            let block = &l[at..][..(size + below.len()) * size];
+            match size {
+                1 => backward::<1>(block, start, below, x),
+                2 => backward::<2>(block, start, below, x),
+                3 => backward::<3>(block, start, below, x),
+                4 => backward::<4>(block, start, below, x),
+                5 => backward::<5>(block, start, below, x),
+                6 => backward::<6>(block, start, below, x),
+                7 => backward::<7>(block, start, below, x),
+                8 => backward::<8>(block, start, below, x),
+                _ => backward_wide(block, start, size, below, x),
+            }
+        }
+    }
+}
+
+/// Forward substitution `L y = b` through one supernode `S` columns wide starting at column
+/// `start`: its diagonal block (column-major, `S x S`), then each row below it (row-major).
+#[inline]
+fn forward<const S: usize>(block: &[f64], start: usize, below: &[u32], x: &mut [[f64; 2]]) {
+    let (diagonal, rows) = block.split_at(S * S);
+    let xs: &mut [[f64; 2]; S] = (&mut x[start..start + S]).try_into().expect("S columns");
+    for c in 0..S {
+        let col = &diagonal[c * S..][..S];
+        let d = col[c];
+        let xc = [xs[c][0] / d, xs[c][1] / d];
+        xs[c] = xc;
+        for r in c + 1..S {
+            xs[r][0] -= col[r] * xc[0];
+            xs[r][1] -= col[r] * xc[1];
+        }
+    }
+    let xs = *xs;
+    for (&i, row) in below.iter().zip(rows.chunks_exact(S)) {
+        let xi = &mut x[i as usize];
+        let mut a = *xi;
+        for c in 0..S {
+            a[0] -= row[c] * xs[c][0];
+            a[1] -= row[c] * xs[c][1];
+        }
+        *xi = a;
+    }
+}
+
+/// Backward substitution `L^T z = y` through one supernode (see [`forward`]).
+#[inline]
+fn backward<const S: usize>(block: &[f64], start: usize, below: &[u32], x: &mut [[f64; 2]]) {
+    let (diagonal, rows) = block.split_at(S * S);
+    let mut acc: [[f64; 2]; S] = x[start..start + S].try_into().expect("S columns");
+    for (&i, row) in below.iter().zip(rows.chunks_exact(S)) {
+        let xi = x[i as usize];
+        for c in 0..S {
+            acc[c][0] -= row[c] * xi[0];
+            acc[c][1] -= row[c] * xi[1];
+        }
+    }
+    for c in (0..S).rev() {
+        let col = &diagonal[c * S..][..S];
+        let mut a = acc[c];
+        for r in c + 1..S {
+            a[0] -= col[r] * acc[r][0];
+            a[1] -= col[r] * acc[r][1];
+        }
+        let d = col[c];
+        acc[c] = [a[0] / d, a[1] / d];
+    }
+    x[start..start + S].copy_from_slice(&acc);
+}
+
+/// [`forward`] for a supernode of any width.
+fn forward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mut [[f64; 2]]) {
+    let (diagonal, rows) = block.split_at(size * size);
+    for c in 0..size {
+        let col = &diagonal[c * size..][..size];
+        let d = col[c];
+        let xc = [x[start + c][0] / d, x[start + c][1] / d];
+        x[start + c] = xc;
+        for r in c + 1..size {
+            x[start + r][0] -= col[r] * xc[0];
+            x[start + r][1] -= col[r] * xc[1];
+        }
+    }
+    for (&i, row) in below.iter().zip(rows.chunks_exact(size)) {
+        let mut a = x[i as usize];
+        for (&v, xc) in row.iter().zip(&x[start..start + size]) {
+            a[0] -= v * xc[0];
+            a[1] -= v * xc[1];
+        }
+        x[i as usize] = a;
+    }
+}
+
+/// [`backward`] for a supernode of any width.
+fn backward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mut [[f64; 2]]) {
+    let (diagonal, rows) = block.split_at(size * size);
+    for (&i, row) in below.iter().zip(rows.chunks_exact(size)) {
+        let xi = x[i as usize];
+        for (&v, a) in row.iter().zip(&mut x[start..start + size]) {
+            a[0] -= v * xi[0];
+            a[1] -= v * xi[1];
+        }
+    }
+    for c in (0..size).rev() {
+        let col = &diagonal[c * size..][..size];
+        let mut a = x[start + c];
+        for r in c + 1..size {
+            a[0] -= col[r] * x[start + r][0];
+            a[1] -= col[r] * x[start + r][1];
+        }
+        let d = col[c];
+        x[start + c] = [a[0] / d, a[1] / d];
     }
 }
 
@@ -284,6 +438,75 @@ mod tests {
         let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (a, t) in ours.iter().zip(&theirs) {
             assert!((a - t).abs() <= 1e-12 * scale, "{a} vs {t}");
+        }
+    }
+
+    /// A grid Laplacian (the shape of the solver's matrices) with one dense clique, so that
+    /// the factor has narrow supernodes (the fixed-width substitutions) and at least one
+    /// wider than 8 columns (the any-width one).
+    #[test]
+    fn every_supernode_width_solves_as_faer_does() {
+        let side = 24;
+        let n = side * side;
+        let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        let mut diag = vec![1e-3; n];
+        let mut edge = |a: usize, b: usize, w: f64| {
+            let (lo, hi) = (a.min(b), a.max(b));
+            cols[lo].push((hi, -w));
+            diag[a] += w;
+            diag[b] += w;
+        };
+        for i in 0..side {
+            for j in 0..side {
+                let v = i * side + j;
+                if i + 1 < side {
+                    edge(v, v + side, 1.0 + (j % 3) as f64);
+                }
+                if j + 1 < side {
+                    edge(v, v + 1, 0.5);
+                }
+            }
+        }
+        let clique: Vec<usize> = (0..14).map(|k| 100 + 17 * k).collect();
+        for (a, &x) in clique.iter().enumerate() {
+            for &y in &clique[a + 1..] {
+                edge(x, y, 0.25);
+            }
+        }
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for (j, col) in cols.iter_mut().enumerate() {
+            col.sort_by_key(|e| e.0);
+            col.dedup_by(|a, b| {
+                let same = a.0 == b.0;
+                if same {
+                    b.1 += a.1;
+                }
+                same
+            });
+            row_idx.push(j);
+            values.push(diag[j]);
+            for &(i, v) in col.iter() {
+                row_idx.push(i);
+                values.push(v);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
+        let layout = symbolic.layout.as_ref().unwrap();
+        let widths: Vec<usize> = layout.begin.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(widths.iter().any(|&w| w > 8), "{widths:?}");
+        assert!(widths.iter().any(|&w| w <= 8), "{widths:?}");
+        let mut factor = NumericFactor::default();
+        symbolic
+            .factorize(&mut factor, &col_ptr, &row_idx, &values)
+            .unwrap();
+        let b: Vec<f64> = (0..2 * n).map(|i| ((i * 53) % 13) as f64 - 6.0).collect();
+        let (mut ours, mut theirs) = (b.clone(), b.clone());
+        symbolic.solve_in_place(&factor, &mut ours, 2);
+        symbolic.solve_with_faer(&factor, &mut theirs, 2);
+        let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, t) in ours.iter().zip(&theirs) {
+            assert!((a - t).abs() <= 1e-10 * scale, "{a} vs {t}");
         }
     }
 }

@@ -515,44 +515,76 @@ impl RestCache {
         // every target is written below: no clearing pass over them
         targets.resize(self.spans[count].edge as usize, DVec2::ZERO);
         for pi in 0..count {
-            let own = rotations[pi];
-            let active = self.active[pi];
-            let (s, next) = (self.spans[pi], self.spans[pi + 1]);
-            let (e0, e1) = (s.edge as usize, next.edge as usize);
-            let edges = &self.edge_local[e0..e1];
-            let out = &mut targets[e0..e1];
-            let rest = &mut self.active_rest_edges[e0..e1];
-            if self.copied_state[pi] != active {
-                // a part without its active state gets zero rest edges, as in the reference
-                if active < (next.state - s.state) as usize {
-                    let start = self.edge_rest_start[s.state as usize + active] as usize;
-                    rest.copy_from_slice(&self.rest_edges[start..][..edges.len()]);
-                } else {
-                    rest.fill(DVec2::ZERO);
-                }
-                self.copied_state[pi] = active;
-            }
-            let rest = &*rest;
-            if cos_cone >= 1.0 {
-                for (t, &d) in out.iter_mut().zip(rest) {
-                    *t = own.rotate(d);
-                }
-                continue;
-            }
-            let m = (next.vertex - s.vertex) as usize;
-            let neighbours = &self.neighbours[s.neighbour as usize..next.neighbour as usize];
-            // small parts sum on the stack: a fixed-size zeroing is a few stores, where the
-            // slice's would be a call to memset per part
-            let mut small = [DVec2::ZERO; 8];
-            let sums = if m <= small.len() {
-                &mut small[..m]
-            } else {
-                let sums = &mut self.sums[..m];
-                sums.fill(DVec2::ZERO);
-                sums
-            };
-            part_targets(sums, neighbours, rotations, own, cos_cone, edges, rest, out);
+            self.part_edge_targets(pi, self.active[pi], rotations, cos_cone, targets);
         }
+    }
+
+    /// [`RestCache::edge_targets`] for the parts in `which` only (each with its active state
+    /// read from `parts`), leaving the other targets as they are: after a few parts switched
+    /// state, only theirs and their neighbours' targets change.
+    pub fn edge_targets_of(
+        &mut self,
+        parts: &[Part],
+        which: &[usize],
+        rotations: &[DVec2],
+        cos_cone: f64,
+        targets: &mut [DVec2],
+    ) {
+        for &pi in which {
+            if let Some(part) = parts.get(pi).filter(|_| pi < self.parts()) {
+                self.part_edge_targets(pi, part.active, rotations, cos_cone, targets);
+            }
+        }
+        // the active states were not all noted by a rotation step: read them from the parts
+        self.noted = usize::MAX;
+    }
+
+    /// The targets of part `pi`'s edges, with its active state `active`, into `targets`.
+    #[inline]
+    fn part_edge_targets(
+        &mut self,
+        pi: usize,
+        active: usize,
+        rotations: &[DVec2],
+        cos_cone: f64,
+        targets: &mut [DVec2],
+    ) {
+        let own = rotations[pi];
+        let (s, next) = (self.spans[pi], self.spans[pi + 1]);
+        let (e0, e1) = (s.edge as usize, next.edge as usize);
+        let edges = &self.edge_local[e0..e1];
+        let out = &mut targets[e0..e1];
+        let rest = &mut self.active_rest_edges[e0..e1];
+        if self.copied_state[pi] != active {
+            // a part without its active state gets zero rest edges, as in the reference
+            if active < (next.state - s.state) as usize {
+                let start = self.edge_rest_start[s.state as usize + active] as usize;
+                rest.copy_from_slice(&self.rest_edges[start..][..edges.len()]);
+            } else {
+                rest.fill(DVec2::ZERO);
+            }
+            self.copied_state[pi] = active;
+        }
+        let rest = &*rest;
+        if cos_cone >= 1.0 {
+            for (t, &d) in out.iter_mut().zip(rest) {
+                *t = own.rotate(d);
+            }
+            return;
+        }
+        let m = (next.vertex - s.vertex) as usize;
+        let neighbours = &self.neighbours[s.neighbour as usize..next.neighbour as usize];
+        // small parts sum on the stack: a fixed-size zeroing is a few stores, where the
+        // slice's would be a call to memset per part
+        let mut small = [DVec2::ZERO; 8];
+        let sums = if m <= small.len() {
+            &mut small[..m]
+        } else {
+            let sums = &mut self.sums[..m];
+            sums.fill(DVec2::ZERO);
+            sums
+        };
+        part_targets(sums, neighbours, rotations, own, cos_cone, edges, rest, out);
     }
 }
 

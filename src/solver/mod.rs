@@ -269,6 +269,13 @@ struct Work {
     warm_held: Vec<DVec2>,
     /// The positions the last frame displayed (the splitting pass continues only from them).
     shown: Vec<DVec2>,
+    /// The generation and active states for which `rotations` and `targets` are those of
+    /// `shown` (set by a frame that finished, taken by the next one): the first local step
+    /// then only judges the parts that have a state to switch to.
+    carried: Option<u64>,
+    carried_states: Vec<usize>,
+    /// Scratch: the parts whose edge targets a state switch changed.
+    touched: Vec<usize>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
 }
@@ -288,6 +295,13 @@ pub struct Solver {
     splitting: admm::Splitting,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
+    /// Per vertex, its row in the factor's fill-reducing order, and the part-edges' ends in
+    /// that order (empty when the factor has no such order): the least-squares solve builds
+    /// its right-hand side there directly.
+    factor_slot: Vec<usize>,
+    ordered_ends: Vec<[usize; 2]>,
+    /// The least-squares right-hand side and solution, `(x, y)` per row in factor order.
+    ordered: Vec<[f64; 2]>,
 }
 
 impl Solver {
@@ -302,6 +316,9 @@ impl Solver {
             work: Work::default(),
             splitting: admm::Splitting::default(),
             shifted: Vec::new(),
+            factor_slot: Vec::new(),
+            ordered_ends: Vec::new(),
+            ordered: Vec::new(),
         }
     }
 
@@ -344,6 +361,17 @@ impl Solver {
             ),
             _ => None,
         };
+        self.factor_slot.clear();
+        self.ordered_ends.clear();
+        if let Some(order) = self.symbolic.as_ref().and_then(|s| s.factor_order()) {
+            self.factor_slot.resize(n, 0);
+            for (i, &v) in order.iter().enumerate() {
+                self.factor_slot[v] = i;
+            }
+            let slot = &self.factor_slot;
+            self.ordered_ends
+                .extend(self.pattern.ends.iter().map(|&[x, y]| [slot[x], slot[y]]));
+        }
         self.irls_factor.invalidate();
         self.l2_factor.invalidate();
         self.work.l2_diagonal.clear();
@@ -432,6 +460,16 @@ impl Solver {
             Pass1::Irls => cfg.irls_iterations,
             Pass1::Admm => 0,
         };
+        let carried = self.work.carried.take() == Some(asm.generation())
+            && self.work.carried_states.len() == asm.data.parts.len()
+            && self
+                .work
+                .carried_states
+                .iter()
+                .zip(&asm.data.parts)
+                .all(|(&s, p)| s == p.active)
+            && self.work.rotations.len() == asm.data.parts.len()
+            && self.work.targets.len() == self.pattern.edges.len();
         if cfg.pass1 == Pass1::Admm && cfg.admm_iterations > 0 {
             let carry = self.work.shown == warm;
             pass1_converged = self.split_pass(
@@ -439,6 +477,7 @@ impl Solver {
                 SplitStart {
                     warm: &warm,
                     carry,
+                    carried: carry && carried,
                     step_tolerance,
                     deadline,
                 },
@@ -516,14 +555,7 @@ impl Solver {
             self.work.warm_rotations.clone_from(&self.work.rotations);
             self.work.warm_targets.clone_from(&self.work.targets);
         }
-        let hw = cfg.handle_weight;
-        let warm_terms = terms(
-            &self.pattern.edges,
-            &self.work.warm_targets,
-            handles,
-            &warm,
-            hw,
-        );
+        let warm_terms = self.terms_at(&self.work.warm_targets, handles, &warm);
         // objective() leaves f's rotations and edge targets in the work buffers
         let mut terms = self.objective(parts, handles, &f);
         report.warm_objective = warm_terms.total();
@@ -554,6 +586,9 @@ impl Solver {
             std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
             std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
         }
+        // Whether the work buffers hold the rotations and edge targets of `f` itself (not
+        // so for the handles-moved start, which borrows the displayed pose's).
+        let mut exact = chosen == 2 || (chosen == 0 && report.pass1_iterations > 0);
         report.phases.local += ms_since(t);
         let mut pass2_converged = cfg.l2_iterations == 0;
         let mut last_iteration = Duration::ZERO;
@@ -587,6 +622,7 @@ impl Solver {
             let delta = max_move(&f, &next);
             std::mem::swap(&mut f, &mut next);
             terms = new_terms;
+            exact = true;
             last_iteration = iteration_start.elapsed();
             if delta <= step_tolerance {
                 pass2_converged = true;
@@ -611,6 +647,11 @@ impl Solver {
         let settled = report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
         report.converged = report.complete && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
+        self.work.carried = exact.then_some(asm.generation());
+        self.work.carried_states.clear();
+        self.work
+            .carried_states
+            .extend(asm.data.parts.iter().map(|p| p.active));
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         (
             self.work.warm,
@@ -672,8 +713,12 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            let pose: &[DVec2] = if it == 0 { warm } else { f };
-            self.judge_states(&mut asm.data.parts, pose, it == 0, report, warm_cached);
+            if it == 0 && start.carried {
+                self.judge_carried(&mut asm.data.parts, warm, report, warm_cached);
+            } else {
+                let pose: &[DVec2] = if it == 0 { warm } else { f };
+                self.judge_states(&mut asm.data.parts, pose, it == 0, report, warm_cached);
+            }
             // A part that switched state has new rest edges: its gaps and duals start over.
             let edges = &self.pattern.edges;
             for s in &report.switches[switched_before..] {
@@ -762,6 +807,98 @@ impl Solver {
         } else if report.switches.len() > switched_before {
             *warm_cached = false;
         }
+    }
+
+    /// The first local step of a frame that starts where the last one ended, whose
+    /// rotations and edge targets are still in the work buffers: only parts with more than
+    /// one rest state are judged (a part keeping its state gets the same rotation, bit for
+    /// bit, since both come from the same sums), and the edge targets are recomputed only
+    /// when one switched. Otherwise as [`Solver::judge_states`] with `first`.
+    fn judge_carried(
+        &mut self,
+        parts: &mut [Part],
+        pose: &[DVec2],
+        report: &mut FrameReport,
+        warm_cached: &mut bool,
+    ) {
+        let switched_before = report.switches.len();
+        let hysteresis = self.config.hysteresis;
+        let w = &mut self.work;
+        for (i, part) in parts.iter_mut().enumerate() {
+            if part.states.len() < 2 {
+                continue;
+            }
+            let (state, r) = match &mut w.rest {
+                Some(cache) => cache.choose_state(i, part, pose, hysteresis),
+                None => local::choose_state(part, pose, hysteresis),
+            };
+            if state != part.active {
+                report.switches.push(StateSwitch {
+                    part: i,
+                    from: part.active,
+                    to: state,
+                });
+                part.active = state;
+            }
+            w.rotations[i] = r;
+        }
+        if report.switches.len() > switched_before {
+            // A switch changes the part's rest edges and rotation, hence its own targets and
+            // those of every part sharing a vertex with it (their R_xy); no other target.
+            let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+            let w = &mut self.work;
+            match &mut w.rest {
+                Some(cache) if cache.parts() == parts.len() && cache.edges() == w.targets.len() => {
+                    w.touched.clear();
+                    for s in &report.switches[switched_before..] {
+                        w.touched.push(s.part);
+                        for &v in &parts[s.part].vertices {
+                            w.touched.extend_from_slice(w.vertex_parts.of(v));
+                        }
+                    }
+                    w.touched.sort_unstable();
+                    w.touched.dedup();
+                    cache.edge_targets_of(
+                        parts,
+                        &w.touched,
+                        &w.rotations,
+                        cos_cone,
+                        &mut w.targets,
+                    );
+                }
+                _ => self.edge_targets(parts),
+            }
+        }
+        debug_assert!(self.carried_is_exact(parts, pose));
+        self.work.warm_rotations.clone_from(&self.work.rotations);
+        self.work.warm_targets.clone_from(&self.work.targets);
+        *warm_cached = true;
+    }
+
+    /// Debug check of [`Solver::judge_carried`]: the carried rotations and edge targets
+    /// equal, bit for bit, those recomputed at `pose` (checked on models small enough to
+    /// afford it).
+    fn carried_is_exact(&mut self, parts: &[Part], pose: &[DVec2]) -> bool {
+        if parts.len() > 5000 {
+            return true;
+        }
+        let (rotations, targets) = (self.work.rotations.clone(), self.work.targets.clone());
+        let bits = |v: &[DVec2]| -> Vec<[u64; 2]> {
+            v.iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect()
+        };
+        self.work.rotations.clear();
+        for (i, part) in parts.iter().enumerate() {
+            let r = match &mut self.work.rest {
+                Some(cache) => cache.part_rotation(i, part, pose),
+                None => local::part_rotation(part, pose),
+            };
+            self.work.rotations.push(r);
+        }
+        self.edge_targets(parts);
+        let exact = bits(&rotations) == bits(&self.work.rotations)
+            && bits(&targets) == bits(&self.work.targets);
+        (self.work.rotations, self.work.targets) = (rotations, targets);
+        exact
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
@@ -874,15 +1011,19 @@ impl Solver {
             });
         }
         self.edge_targets(parts);
+        self.terms_at(&self.work.targets, handles, f)
+    }
+
+    /// The pass-2 objective's terms at `f` for the given edge targets.
+    fn terms_at(&self, targets: &[DVec2], handles: &[Handle], f: &[DVec2]) -> Terms {
         let hw = self.config.handle_weight;
-        let w = &self.work;
         // the compact edge ends of the rest cache instead of the wide edge slots
-        match w.rest.as_ref().and_then(|c| c.elastic(&w.targets, f)) {
+        match self.work.rest.as_ref().and_then(|c| c.elastic(targets, f)) {
             Some(elastic) => Terms {
                 elastic,
                 ..terms(&[], &[], handles, f, hw)
             },
-            None => terms(&self.pattern.edges, &w.targets, handles, f, hw),
+            None => terms(&self.pattern.edges, targets, handles, f, hw),
         }
     }
 
@@ -897,6 +1038,13 @@ impl Solver {
     ) -> Result<(), SolverError> {
         let cfg = self.config;
         let n = f.len();
+        if pass == Pass::LeastSquares
+            && cfg.kind == SolverKind::Cholesky
+            && !cfg.measure_residual
+            && self.factor_slot.len() == n
+        {
+            return self.solve_least_squares_ordered(f, next, report);
+        }
         let t = Instant::now();
         let w = &mut self.work;
         let lambda = cfg.handle_weight * mean_weight;
@@ -1038,6 +1186,79 @@ impl Solver {
     }
 }
 
+impl Solver {
+    /// The least-squares global step (unit weights) by Cholesky, with the right-hand side
+    /// built and solved in the factor's order ([`SymbolicFactor::solve_in_factor_order`]):
+    /// the same numbers as the general path, without its permuting and column copies.
+    fn solve_least_squares_ordered(
+        &mut self,
+        f: &[DVec2],
+        next: &mut [DVec2],
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let t = Instant::now();
+        let w = &mut self.work;
+        let slot = &self.factor_slot;
+        let (lambda, mu) = (cfg.handle_weight, cfg.proximal_weight);
+        w.diagonal.clear();
+        self.ordered.resize(f.len(), [0.0; 2]);
+        let x = &mut self.ordered;
+        for (((&count, &sum), &p), &i) in w.handle_count.iter().zip(&w.handle_sum).zip(f).zip(slot)
+        {
+            w.diagonal.push(lambda * count + mu);
+            let extra = lambda * sum + mu * p;
+            x[i] = [extra.x, extra.y];
+        }
+        for (&[a, b], &t) in self.ordered_ends.iter().zip(&w.targets) {
+            if a != b {
+                x[a][0] += t.x;
+                x[a][1] += t.y;
+                x[b][0] -= t.x;
+                x[b][1] -= t.y;
+            }
+        }
+        // The least-squares matrix depends only on the handles' vertices: reuse its values
+        // and factor while they stay the same.
+        if w.l2_diagonal != w.diagonal || w.l2_values.is_empty() {
+            if w.ones.len() != self.pattern.edges.len() {
+                w.ones.clear();
+                w.ones.resize(self.pattern.edges.len(), 1.0);
+            }
+            self.pattern
+                .fill_values(&w.ones, &w.diagonal, &mut w.l2_values);
+            w.l2_diagonal.clone_from(&w.diagonal);
+            self.l2_factor.invalidate();
+        }
+        report.phases.assembly += ms_since(t);
+        let Some(symbolic) = self.symbolic.as_mut() else {
+            return Err(SolverError("no symbolic factorisation".into()));
+        };
+        if !self.l2_factor.is_valid() {
+            let t = Instant::now();
+            symbolic
+                .factorize(
+                    &mut self.l2_factor,
+                    &self.pattern.col_ptr,
+                    &self.pattern.row_idx,
+                    &w.l2_values,
+                )
+                .map_err(|e| SolverError(e.0))?;
+            report.factorizations += 1;
+            report.phases.factorization += ms_since(t);
+        }
+        let t = Instant::now();
+        if !symbolic.solve_in_factor_order(&self.l2_factor, x) {
+            return Err(SolverError("the factor has no supernodal order".into()));
+        }
+        report.phases.solve += ms_since(t);
+        for (p, &i) in next.iter_mut().zip(slot) {
+            *p = DVec2::from(x[i]);
+        }
+        Ok(())
+    }
+}
+
 /// Splitting iterations a budgeted frame always runs (when configured to run that many).
 const MIN_SPLIT_ITERATIONS: usize = 2;
 
@@ -1048,6 +1269,9 @@ struct SplitStart<'a> {
     /// Whether the displayed pose is the one this solver last produced (so the splitting
     /// variables may continue).
     carry: bool,
+    /// Whether, besides, the work buffers still hold that pose's rotations and edge targets
+    /// for the current states.
+    carried: bool,
     step_tolerance: f64,
     deadline: Option<Instant>,
 }
