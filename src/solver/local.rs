@@ -467,7 +467,18 @@ impl RestCache {
         }
     }
 
+    /// [`RestCache::part_rotation`] for every part, in order, into `out` (one loop with the
+    /// body inlined, rather than a call per part from the solver).
+    pub fn part_rotations(&mut self, parts: &[Part], positions: &[DVec2], out: &mut Vec<DVec2>) {
+        out.clear();
+        for (pi, part) in parts.iter().enumerate() {
+            let r = self.part_rotation(pi, part, positions);
+            out.push(r);
+        }
+    }
+
     /// [`part_rotation`] for part `pi` (which is `part`), from the cached rest data.
+    #[inline]
     pub fn part_rotation(&mut self, pi: usize, part: &Part, positions: &[DVec2]) -> DVec2 {
         self.note(pi, part.active);
         let Some((s, count)) = self.dense_span(pi, part) else {

@@ -295,11 +295,11 @@ pub struct Solver {
     splitting: admm::Splitting,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
-    /// Per vertex, its row in the factor's fill-reducing order, and the part-edges' ends in
-    /// that order (empty when the factor has no such order): the least-squares solve builds
-    /// its right-hand side there directly.
+    /// Per vertex, its row in the factor's fill-reducing order, and per row its vertex
+    /// (both empty when the factor has no such order): the least-squares solve gathers its
+    /// right-hand side into that order and reads the solution from it.
     factor_slot: Vec<usize>,
-    ordered_ends: Vec<[usize; 2]>,
+    factor_order: Vec<usize>,
     /// The least-squares right-hand side and solution, `(x, y)` per row in factor order.
     ordered: Vec<[f64; 2]>,
 }
@@ -317,7 +317,7 @@ impl Solver {
             splitting: admm::Splitting::default(),
             shifted: Vec::new(),
             factor_slot: Vec::new(),
-            ordered_ends: Vec::new(),
+            factor_order: Vec::new(),
             ordered: Vec::new(),
         }
     }
@@ -362,15 +362,13 @@ impl Solver {
             _ => None,
         };
         self.factor_slot.clear();
-        self.ordered_ends.clear();
+        self.factor_order.clear();
         if let Some(order) = self.symbolic.as_ref().and_then(|s| s.factor_order()) {
             self.factor_slot.resize(n, 0);
             for (i, &v) in order.iter().enumerate() {
                 self.factor_slot[v] = i;
             }
-            let slot = &self.factor_slot;
-            self.ordered_ends
-                .extend(self.pattern.ends.iter().map(|&[x, y]| [slot[x], slot[y]]));
+            self.factor_order.extend_from_slice(order);
         }
         self.irls_factor.invalidate();
         self.l2_factor.invalidate();
@@ -1003,12 +1001,13 @@ impl Solver {
     /// in the work buffers.
     fn objective(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
         let w = &mut self.work;
-        w.rotations.clear();
-        for (i, part) in parts.iter().enumerate() {
-            w.rotations.push(match &mut w.rest {
-                Some(cache) => cache.part_rotation(i, part, f),
-                None => local::part_rotation(part, f),
-            });
+        match &mut w.rest {
+            Some(cache) => cache.part_rotations(parts, f, &mut w.rotations),
+            None => {
+                w.rotations.clear();
+                w.rotations
+                    .extend(parts.iter().map(|part| local::part_rotation(part, f)));
+            }
         }
         self.edge_targets(parts);
         self.terms_at(&self.work.targets, handles, f)
@@ -1188,8 +1187,9 @@ impl Solver {
 
 impl Solver {
     /// The least-squares global step (unit weights) by Cholesky, with the right-hand side
-    /// built and solved in the factor's order ([`SymbolicFactor::solve_in_factor_order`]):
-    /// the same numbers as the general path, without its permuting and column copies.
+    /// gathered into and solved in the factor's order
+    /// ([`SymbolicFactor::solve_in_factor_order`]): the same numbers as the general path,
+    /// without its column copies.
     fn solve_least_squares_ordered(
         &mut self,
         f: &[DVec2],
@@ -1203,20 +1203,22 @@ impl Solver {
         let (lambda, mu) = (cfg.handle_weight, cfg.proximal_weight);
         w.diagonal.clear();
         self.ordered.resize(f.len(), [0.0; 2]);
-        let x = &mut self.ordered;
-        for (((&count, &sum), &p), &i) in w.handle_count.iter().zip(&w.handle_sum).zip(f).zip(slot)
-        {
+        // Summed in vertex order first (edges touch nearby vertices there, while the
+        // factor's order scatters them: the difference shows at 100k parts), then gathered.
+        w.extra.clear();
+        for ((&count, &sum), &p) in w.handle_count.iter().zip(&w.handle_sum).zip(f) {
             w.diagonal.push(lambda * count + mu);
-            let extra = lambda * sum + mu * p;
-            x[i] = [extra.x, extra.y];
+            w.extra.push(lambda * sum + mu * p);
         }
-        for (&[a, b], &t) in self.ordered_ends.iter().zip(&w.targets) {
+        for (&[a, b], &t) in self.pattern.ends.iter().zip(&w.targets) {
             if a != b {
-                x[a][0] += t.x;
-                x[a][1] += t.y;
-                x[b][0] -= t.x;
-                x[b][1] -= t.y;
+                w.extra[a] += t;
+                w.extra[b] -= t;
             }
+        }
+        let x = &mut self.ordered;
+        for (xi, &v) in x.iter_mut().zip(&self.factor_order) {
+            *xi = w.extra[v].to_array();
         }
         // The least-squares matrix depends only on the handles' vertices: reuse its values
         // and factor while they stay the same.
