@@ -1364,10 +1364,13 @@ fn mean_or_one(values: &[f64]) -> f64 {
 }
 
 fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
+    // one square root for the largest, not one per vertex (the same value: sqrt is monotonic
+    // and correctly rounded)
     a.iter()
         .zip(b)
-        .map(|(p, q)| p.distance(*q))
+        .map(|(p, q)| p.distance_squared(*q))
         .fold(0.0, f64::max)
+        .sqrt()
 }
 
 /// Length of the diagonal of the positions' bounding box (0 for no or non-finite positions).
