@@ -143,7 +143,7 @@ impl Shrink {
                 let step = (h * h * h - h + e) / (3.0 * h * h - 1.0);
                 h -= step;
                 // converged (or NaN)
-                if !(step > 1e-9 * h) {
+                if step.is_nan() || step <= 1e-9 * h {
                     break;
                 }
             }
