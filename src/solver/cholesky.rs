@@ -508,5 +508,15 @@ mod tests {
         for (a, t) in ours.iter().zip(&theirs) {
             assert!((a - t).abs() <= 1e-10 * scale, "{a} vs {t}");
         }
+        // the same solve with the caller gathering into and reading from the factor's order
+        let order = symbolic.factor_order().unwrap().to_vec();
+        let mut pairs: Vec<[f64; 2]> = order.iter().map(|&v| [b[v], b[n + v]]).collect();
+        assert!(symbolic.solve_in_factor_order(&factor, &mut pairs));
+        for (pair, &v) in pairs.iter().zip(&order) {
+            assert_eq!(pair[0].to_bits(), ours[v].to_bits());
+            assert_eq!(pair[1].to_bits(), ours[n + v].to_bits());
+        }
+        // a vector of the wrong length is refused, not solved
+        assert!(!symbolic.solve_in_factor_order(&factor, &mut pairs[1..]));
     }
 }
