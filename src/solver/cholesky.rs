@@ -258,35 +258,33 @@ impl SupernodalLayout {
         for s in 0..supernodes {
             let (start, size, below, at) = self.supernode(s);
             let block = &l[at..][..(size + below.len()) * size];
-            match size {
-                1 => forward::<1>(block, start, below, x),
-                2 => forward::<2>(block, start, below, x),
-                3 => forward::<3>(block, start, below, x),
-                4 => forward::<4>(block, start, below, x),
-                5 => forward::<5>(block, start, below, x),
-                6 => forward::<6>(block, start, below, x),
-                7 => forward::<7>(block, start, below, x),
-                8 => forward::<8>(block, start, below, x),
-                _ => forward_wide(block, start, size, below, x),
-            }
+            by_width!(size, forward, forward_wide, block, start, below, x);
         }
         for s in (0..supernodes).rev() {
             let (start, size, below, at) = self.supernode(s);
             let block = &l[at..][..(size + below.len()) * size];
-            match size {
-                1 => backward::<1>(block, start, below, x),
-                2 => backward::<2>(block, start, below, x),
-                3 => backward::<3>(block, start, below, x),
-                4 => backward::<4>(block, start, below, x),
-                5 => backward::<5>(block, start, below, x),
-                6 => backward::<6>(block, start, below, x),
-                7 => backward::<7>(block, start, below, x),
-                8 => backward::<8>(block, start, below, x),
-                _ => backward_wide(block, start, size, below, x),
-            }
+            by_width!(size, backward, backward_wide, block, start, below, x);
         }
     }
 }
+
+/// Calls `$fixed::<W>(args)` for a supernode width `W` of 1 to 8, else `$wide(width, args)`.
+macro_rules! by_width {
+    ($width:expr, $fixed:ident, $wide:ident, $($arg:expr),*) => {
+        match $width {
+            1 => $fixed::<1>($($arg),*),
+            2 => $fixed::<2>($($arg),*),
+            3 => $fixed::<3>($($arg),*),
+            4 => $fixed::<4>($($arg),*),
+            5 => $fixed::<5>($($arg),*),
+            6 => $fixed::<6>($($arg),*),
+            7 => $fixed::<7>($($arg),*),
+            8 => $fixed::<8>($($arg),*),
+            width => $wide(width, $($arg),*),
+        }
+    };
+}
+use by_width;
 
 /// Forward substitution `L y = b` through one supernode `S` columns wide starting at column
 /// `start`: its diagonal block (column-major, `S x S`), then each row below it (row-major).
@@ -342,7 +340,7 @@ fn backward<const S: usize>(block: &[f64], start: usize, below: &[u32], x: &mut 
 }
 
 /// [`forward`] for a supernode of any width.
-fn forward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mut [[f64; 2]]) {
+fn forward_wide(size: usize, block: &[f64], start: usize, below: &[u32], x: &mut [[f64; 2]]) {
     let (diagonal, rows) = block.split_at(size * size);
     for c in 0..size {
         let col = &diagonal[c * size..][..size];
@@ -365,7 +363,7 @@ fn forward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mut
 }
 
 /// [`backward`] for a supernode of any width.
-fn backward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mut [[f64; 2]]) {
+fn backward_wide(size: usize, block: &[f64], start: usize, below: &[u32], x: &mut [[f64; 2]]) {
     let (diagonal, rows) = block.split_at(size * size);
     for (&i, row) in below.iter().zip(rows.chunks_exact(size)) {
         let xi = x[i as usize];
@@ -390,88 +388,19 @@ fn backward_wide(block: &[f64], start: usize, size: usize, below: &[u32], x: &mu
 mod tests {
     use super::*;
 
-    /// A path graph Laplacian plus a diagonal, with extra long-range edges so the supernodes
-    /// get rows below their diagonal blocks.
-    fn matrix(n: usize) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+    /// The lower triangle (compressed columns) of a weighted graph Laplacian on `n` vertices
+    /// plus `shift` on the diagonal; repeated edges add up.
+    fn laplacian(
+        n: usize,
+        shift: f64,
+        edges: &[(usize, usize, f64)],
+    ) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
         let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        let mut diag = vec![0.5; n];
-        let mut edge = |a: usize, b: usize, w: f64| {
-            let (lo, hi) = (a.min(b), a.max(b));
-            cols[lo].push((hi, -w));
+        let mut diag = vec![shift; n];
+        for &(a, b, w) in edges {
+            cols[a.min(b)].push((a.max(b), -w));
             diag[a] += w;
             diag[b] += w;
-        };
-        for i in 0..n - 1 {
-            edge(i, i + 1, 1.0 + (i % 7) as f64);
-        }
-        for i in (0..n - 9).step_by(3) {
-            edge(i, i + 9, 0.25);
-        }
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
-        for (j, col) in cols.iter_mut().enumerate() {
-            col.sort_by_key(|e| e.0);
-            row_idx.push(j);
-            values.push(diag[j]);
-            for &(i, v) in col.iter() {
-                row_idx.push(i);
-                values.push(v);
-            }
-            col_ptr.push(row_idx.len());
-        }
-        (col_ptr, row_idx, values)
-    }
-
-    #[test]
-    fn our_supernodal_solve_matches_faers() {
-        let n = 300;
-        let (col_ptr, row_idx, values) = matrix(n);
-        let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
-        assert!(symbolic.layout.is_some());
-        let mut factor = NumericFactor::default();
-        symbolic
-            .factorize(&mut factor, &col_ptr, &row_idx, &values)
-            .unwrap();
-        let b: Vec<f64> = (0..2 * n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
-        let (mut ours, mut theirs) = (b.clone(), b.clone());
-        symbolic.solve_in_place(&factor, &mut ours, 2);
-        symbolic.solve_with_faer(&factor, &mut theirs, 2);
-        let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (a, t) in ours.iter().zip(&theirs) {
-            assert!((a - t).abs() <= 1e-12 * scale, "{a} vs {t}");
-        }
-    }
-
-    /// A grid Laplacian (the shape of the solver's matrices) with one dense clique, so that
-    /// the factor has narrow supernodes (the fixed-width substitutions) and at least one
-    /// wider than 8 columns (the any-width one).
-    #[test]
-    fn every_supernode_width_solves_as_faer_does() {
-        let side = 24;
-        let n = side * side;
-        let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        let mut diag = vec![1e-3; n];
-        let mut edge = |a: usize, b: usize, w: f64| {
-            let (lo, hi) = (a.min(b), a.max(b));
-            cols[lo].push((hi, -w));
-            diag[a] += w;
-            diag[b] += w;
-        };
-        for i in 0..side {
-            for j in 0..side {
-                let v = i * side + j;
-                if i + 1 < side {
-                    edge(v, v + side, 1.0 + (j % 3) as f64);
-                }
-                if j + 1 < side {
-                    edge(v, v + 1, 0.5);
-                }
-            }
-        }
-        let clique: Vec<usize> = (0..14).map(|k| 100 + 17 * k).collect();
-        for (a, &x) in clique.iter().enumerate() {
-            for &y in &clique[a + 1..] {
-                edge(x, y, 0.25);
-            }
         }
         let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
         for (j, col) in cols.iter_mut().enumerate() {
@@ -491,23 +420,86 @@ mod tests {
             }
             col_ptr.push(row_idx.len());
         }
+        (col_ptr, row_idx, values)
+    }
+
+    /// A path graph Laplacian plus a diagonal, with extra long-range edges so the supernodes
+    /// get rows below their diagonal blocks.
+    fn matrix(n: usize) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let mut edges: Vec<(usize, usize, f64)> = (0..n - 1)
+            .map(|i| (i, i + 1, 1.0 + (i % 7) as f64))
+            .collect();
+        edges.extend((0..n - 9).step_by(3).map(|i| (i, i + 9, 0.25)));
+        laplacian(n, 0.5, &edges)
+    }
+
+    #[test]
+    fn our_supernodal_solve_matches_faers() {
+        let n = 300;
+        let (col_ptr, row_idx, values) = matrix(n);
+        let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
+        assert!(symbolic.layout.is_some());
+        let b: Vec<f64> = (0..2 * n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+        solves_as_faer(&mut symbolic, (&col_ptr, &row_idx, &values), &b, 1e-12);
+    }
+
+    /// Factorises the matrix (`col_ptr`, `row_idx`, `values`), solves for `b` (two columns)
+    /// with our substitution and with faer's, asserts they agree to `tolerance` of the
+    /// largest entry, and returns the factor and our solution.
+    fn solves_as_faer(
+        symbolic: &mut SymbolicFactor,
+        (col_ptr, row_idx, values): (&[usize], &[usize], &[f64]),
+        b: &[f64],
+        tolerance: f64,
+    ) -> (NumericFactor, Vec<f64>) {
+        let mut factor = NumericFactor::default();
+        symbolic
+            .factorize(&mut factor, col_ptr, row_idx, values)
+            .unwrap();
+        let (mut ours, mut theirs) = (b.to_vec(), b.to_vec());
+        symbolic.solve_in_place(&factor, &mut ours, 2);
+        symbolic.solve_with_faer(&factor, &mut theirs, 2);
+        let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, t) in ours.iter().zip(&theirs) {
+            assert!((a - t).abs() <= tolerance * scale, "{a} vs {t}");
+        }
+        (factor, ours)
+    }
+
+    /// A grid Laplacian (the shape of the solver's matrices) with one dense clique, so that
+    /// the factor has narrow supernodes (the fixed-width substitutions) and at least one
+    /// wider than 8 columns (the any-width one).
+    #[test]
+    fn every_supernode_width_solves_as_faer_does() {
+        let side = 24;
+        let n = side * side;
+        let mut edges = Vec::new();
+        for i in 0..side {
+            for j in 0..side {
+                let v = i * side + j;
+                if i + 1 < side {
+                    edges.push((v, v + side, 1.0 + (j % 3) as f64));
+                }
+                if j + 1 < side {
+                    edges.push((v, v + 1, 0.5));
+                }
+            }
+        }
+        let clique: Vec<usize> = (0..14).map(|k| 100 + 17 * k).collect();
+        for (a, &x) in clique.iter().enumerate() {
+            for &y in &clique[a + 1..] {
+                edges.push((x, y, 0.25));
+            }
+        }
+        let (col_ptr, row_idx, values) = laplacian(n, 1e-3, &edges);
         let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
         let layout = symbolic.layout.as_ref().unwrap();
         let widths: Vec<usize> = layout.begin.windows(2).map(|w| w[1] - w[0]).collect();
         assert!(widths.iter().any(|&w| w > 8), "{widths:?}");
         assert!(widths.iter().any(|&w| w <= 8), "{widths:?}");
-        let mut factor = NumericFactor::default();
-        symbolic
-            .factorize(&mut factor, &col_ptr, &row_idx, &values)
-            .unwrap();
         let b: Vec<f64> = (0..2 * n).map(|i| ((i * 53) % 13) as f64 - 6.0).collect();
-        let (mut ours, mut theirs) = (b.clone(), b.clone());
-        symbolic.solve_in_place(&factor, &mut ours, 2);
-        symbolic.solve_with_faer(&factor, &mut theirs, 2);
-        let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (a, t) in ours.iter().zip(&theirs) {
-            assert!((a - t).abs() <= 1e-10 * scale, "{a} vs {t}");
-        }
+        let (factor, ours) =
+            solves_as_faer(&mut symbolic, (&col_ptr, &row_idx, &values), &b, 1e-10);
         // the same solve with the caller gathering into and reading from the factor's order
         let order = symbolic.factor_order().unwrap().to_vec();
         let mut pairs: Vec<[f64; 2]> = order.iter().map(|&v| [b[v], b[n + v]]).collect();
