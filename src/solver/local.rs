@@ -467,8 +467,7 @@ impl RestCache {
         }
     }
 
-    /// [`RestCache::part_rotation`] for every part, in order, into `out` (one loop with the
-    /// body inlined, rather than a call per part from the solver).
+    /// [`RestCache::part_rotation`] for every part, in order, into `out`.
     pub fn part_rotations(&mut self, parts: &[Part], positions: &[DVec2], out: &mut Vec<DVec2>) {
         out.clear();
         for (pi, part) in parts.iter().enumerate() {

@@ -253,6 +253,8 @@ struct Work {
     l2_values: Vec<f64>,
     l2_diagonal: Vec<f64>,
     rhs: Vec<f64>,
+    /// The least-squares right-hand side, one `(x, y)` per vertex in vertex order.
+    vertex_rhs: Vec<DVec2>,
     solution: Vec<f64>,
     scratch: Vec<f64>,
     cg: cg::CgWork,
@@ -1203,22 +1205,23 @@ impl Solver {
         let (lambda, mu) = (cfg.handle_weight, cfg.proximal_weight);
         w.diagonal.clear();
         self.ordered.resize(f.len(), [0.0; 2]);
-        // Summed in vertex order first (edges touch nearby vertices there, while the
-        // factor's order scatters them: the difference shows at 100k parts), then gathered.
-        w.extra.clear();
+        // Summed in vertex order (where an edge's ends are near each other; the factor's
+        // order scatters them), then gathered into the factor's order.
+        let b = &mut w.vertex_rhs;
+        b.clear();
         for ((&count, &sum), &p) in w.handle_count.iter().zip(&w.handle_sum).zip(f) {
             w.diagonal.push(lambda * count + mu);
-            w.extra.push(lambda * sum + mu * p);
+            b.push(lambda * sum + mu * p);
         }
-        for (&[a, b], &t) in self.pattern.ends.iter().zip(&w.targets) {
-            if a != b {
-                w.extra[a] += t;
-                w.extra[b] -= t;
+        for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
+            if x != y {
+                b[x] += t;
+                b[y] -= t;
             }
         }
         let x = &mut self.ordered;
         for (xi, &v) in x.iter_mut().zip(&self.factor_order) {
-            *xi = w.extra[v].to_array();
+            *xi = b[v].to_array();
         }
         // The least-squares matrix depends only on the handles' vertices: reuse its values
         // and factor while they stay the same.
