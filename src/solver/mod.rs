@@ -297,11 +297,10 @@ pub struct Solver {
     splitting: admm::Splitting,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
-    /// Per vertex, its row in the factor's fill-reducing order, and per row its vertex
-    /// (both empty when the factor has no such order): the least-squares solve gathers its
-    /// right-hand side into that order and reads the solution from it.
+    /// Per vertex, its row in the factor's fill-reducing order (the inverse of
+    /// [`SymbolicFactor::factor_order`]; empty when the factor has no such order): the
+    /// least-squares solve reads its solution from there.
     factor_slot: Vec<usize>,
-    factor_order: Vec<usize>,
     /// The least-squares right-hand side and solution, `(x, y)` per row in factor order.
     ordered: Vec<[f64; 2]>,
 }
@@ -319,7 +318,6 @@ impl Solver {
             splitting: admm::Splitting::default(),
             shifted: Vec::new(),
             factor_slot: Vec::new(),
-            factor_order: Vec::new(),
             ordered: Vec::new(),
         }
     }
@@ -364,13 +362,11 @@ impl Solver {
             _ => None,
         };
         self.factor_slot.clear();
-        self.factor_order.clear();
         if let Some(order) = self.symbolic.as_ref().and_then(|s| s.factor_order()) {
             self.factor_slot.resize(n, 0);
             for (i, &v) in order.iter().enumerate() {
                 self.factor_slot[v] = i;
             }
-            self.factor_order.extend_from_slice(order);
         }
         self.irls_factor.invalidate();
         self.l2_factor.invalidate();
@@ -1220,7 +1216,8 @@ impl Solver {
             }
         }
         let x = &mut self.ordered;
-        for (xi, &v) in x.iter_mut().zip(&self.factor_order) {
+        let order = self.symbolic.as_ref().and_then(|s| s.factor_order());
+        for (xi, &v) in x.iter_mut().zip(order.unwrap_or_default()) {
             *xi = b[v].to_array();
         }
         // The least-squares matrix depends only on the handles' vertices: reuse its values
