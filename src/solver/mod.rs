@@ -1037,7 +1037,6 @@ impl Solver {
         let n = f.len();
         if pass == Pass::LeastSquares
             && cfg.kind == SolverKind::Cholesky
-            && !cfg.measure_residual
             && self.factor_slot.len() == n
         {
             return self.solve_least_squares_ordered(f, next, report);
@@ -1065,28 +1064,14 @@ impl Solver {
             }
             Pass::LeastSquares => {
                 global::fill_rhs_unit(&self.pattern.ends, &w.targets, &w.extra, &mut w.rhs);
-                if w.ones.len() != self.pattern.edges.len() {
-                    w.ones.clear();
-                    w.ones.resize(self.pattern.edges.len(), 1.0);
-                }
-                &w.ones
+                &[]
             }
         };
-        // The least-squares matrix depends only on the handles' vertices: reuse its values and
-        // factor while they stay the same.
-        let l2_reusable =
-            pass == Pass::LeastSquares && w.l2_diagonal == w.diagonal && !w.l2_values.is_empty();
-        if !l2_reusable {
-            let target = if pass == Pass::LeastSquares {
-                &mut w.l2_values
-            } else {
-                &mut w.values
-            };
-            self.pattern.fill_values(weights, &w.diagonal, target);
-            if pass == Pass::LeastSquares {
-                w.l2_diagonal.clone_from(&w.diagonal);
-                self.l2_factor.invalidate();
-            }
+        match pass {
+            Pass::Irls => self
+                .pattern
+                .fill_values(weights, &w.diagonal, &mut w.values),
+            Pass::LeastSquares => refresh_least_squares(&self.pattern, w, &mut self.l2_factor),
         }
         let values = if pass == Pass::LeastSquares {
             &w.l2_values
@@ -1220,18 +1205,7 @@ impl Solver {
         for (xi, &v) in x.iter_mut().zip(order.unwrap_or_default()) {
             *xi = b[v].to_array();
         }
-        // The least-squares matrix depends only on the handles' vertices: reuse its values
-        // and factor while they stay the same.
-        if w.l2_diagonal != w.diagonal || w.l2_values.is_empty() {
-            if w.ones.len() != self.pattern.edges.len() {
-                w.ones.clear();
-                w.ones.resize(self.pattern.edges.len(), 1.0);
-            }
-            self.pattern
-                .fill_values(&w.ones, &w.diagonal, &mut w.l2_values);
-            w.l2_diagonal.clone_from(&w.diagonal);
-            self.l2_factor.invalidate();
-        }
+        refresh_least_squares(&self.pattern, w, &mut self.l2_factor);
         report.phases.assembly += ms_since(t);
         let Some(symbolic) = self.symbolic.as_mut() else {
             return Err(SolverError("no symbolic factorisation".into()));
@@ -1257,8 +1231,42 @@ impl Solver {
         for (p, &i) in next.iter_mut().zip(slot) {
             *p = DVec2::from(x[i]);
         }
+        if cfg.measure_residual {
+            // the general path's columns, only to measure (tests)
+            let columns = |v: &[DVec2], out: &mut Vec<f64>| {
+                out.clear();
+                out.extend(v.iter().map(|p| p.x));
+                out.extend(v.iter().map(|p| p.y));
+            };
+            columns(&w.vertex_rhs, &mut w.rhs);
+            columns(next, &mut w.solution);
+            let r = global::relative_residual(
+                &self.pattern,
+                &w.l2_values,
+                &w.solution,
+                &w.rhs,
+                &mut w.scratch,
+            );
+            report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
+        }
         Ok(())
     }
+}
+
+/// Brings the least-squares matrix up to date with `w.diagonal`: its values depend only on
+/// the handles' vertices, so they, and the factor, are kept while the diagonal stays the same;
+/// otherwise refilled, and the factor marked for refactorisation.
+fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFactor) {
+    if w.l2_diagonal == w.diagonal && !w.l2_values.is_empty() {
+        return;
+    }
+    if w.ones.len() != pattern.edges.len() {
+        w.ones.clear();
+        w.ones.resize(pattern.edges.len(), 1.0);
+    }
+    pattern.fill_values(&w.ones, &w.diagonal, &mut w.l2_values);
+    w.l2_diagonal.clone_from(&w.diagonal);
+    factor.invalidate();
 }
 
 /// Splitting iterations a budgeted frame always runs (when configured to run that many).
