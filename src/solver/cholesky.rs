@@ -4,13 +4,24 @@
 //! side. The matrix is passed as its lower triangle in compressed sparse column form.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
+use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
+
+/// Supernode amalgamation: two adjacent supernodes of `n` columns in all merge when
+/// `n <= w` and less than a fraction `z` of the merged block would be explicit zeros, for
+/// the first `(w, z)` that holds. faer's default, `[(4, 1.0), (16, 0.8), (48, 0.1), ..]`,
+/// suits factorisation, whose dense kernels like wide blocks; here a factor serves four
+/// solves (eight substitutions) per frame and is refactorised only when the held vertices
+/// change, and a substitution streams every stored value, zero or not. With the default a third of the city's
+/// factor is padding (4.73M values at 100k parts, 2.95M nonzeros); these thresholds keep
+/// supernodes of a few columns (width-1 supernodes cost more per value than they save) and
+/// cut the solve by about a fifth at 10k and a third at 100k (docs/performance.md).
+const RELAX: &[(usize, f64)] = &[(4, 0.25), (16, 0.1), (usize::MAX, 0.02)];
 
 /// Why a factorisation failed (the matrix was not numerically positive definite, or faer could
 /// not allocate).
@@ -86,6 +97,7 @@ impl SymbolicFactor {
             CholeskySymbolicParams {
                 // faer's automatic choice picks simplicial at ~10k vertices, 3x slower here.
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                supernodal_params: SymbolicSupernodalParams { relax: Some(RELAX) },
                 ..Default::default()
             },
         )
@@ -125,6 +137,11 @@ impl SymbolicFactor {
             layout,
             pairs: Vec::new(),
         })
+    }
+
+    /// Values a numeric factor stores (nonzeros, and the zeros of amalgamated supernodes).
+    pub fn stored_values(&self) -> usize {
+        self.symbolic.len_val()
     }
 
     /// Numerically factorises the matrix (same pattern as analysed) into `factor`.

@@ -227,14 +227,33 @@ struct Span {
     vertex: u32,
     /// Into `neighbours`.
     neighbour: u32,
-    /// Into `edge_local` (the solver's edge order).
+    /// Into `edge_ends` (the solver's edge order).
     edge: u32,
-    /// Into the per-state arrays `pp` and `edge_rest_start`.
-    state: u32,
-    /// Into `rest`: the part's states' centred positions, state `j` at `rest + j * m`, or
-    /// [`SHORT`] when a state has fewer positions than the part has vertices ([`align`] then
-    /// centres the pose over a prefix of the vertices, so the part takes the reference path).
+    /// Into `shapes`.
+    shape: u32,
+}
+
+/// The rest data of a part that does not depend on where the part is: its edges between
+/// local vertices and its states' centred positions and rest edges. Parts with the same
+/// data (the instances of one piece, the elements of one chain) share one shape, so the
+/// local step streams each part's vertices and neighbours but reads the rest data of a few
+/// shapes that stay in cache.
+#[derive(Clone, Copy, Debug)]
+struct Shape {
+    /// Vertex, edge and rest-state counts.
+    m: u32,
+    edges: u32,
+    states: u32,
+    /// Into `rest`: state `j`'s centred positions at `rest + j * m`, or [`SHORT`] when a
+    /// state has fewer positions than the part has vertices ([`align`] then centres the pose
+    /// over a prefix of the vertices, so the part takes the reference path).
     rest: u32,
+    /// Into `pp` (one per state).
+    pp: u32,
+    /// Into `rest_edges`: state `j`'s rest edge vectors `x0 - y0` at `rest_edges + j * edges`.
+    rest_edges: u32,
+    /// Into `edge_local`.
+    edge_local: u32,
 }
 
 const SHORT: u32 = u32::MAX;
@@ -242,7 +261,8 @@ const SHORT: u32 = u32::MAX;
 /// The rest data of every part, flattened once per assembly generation, so the local step
 /// reads contiguous arrays instead of chasing each part's and each state's own allocations,
 /// gathers and centres the pose once per part instead of once per rest state, and does not
-/// recompute the rest centres and norms (they only change with the generation).
+/// recompute the rest centres and norms (they only change with the generation). Parts with
+/// bit-identical rest data share it ([`Shape`]).
 ///
 /// Every result equals the reference functions' ([`choose_state`], [`part_rotation`],
 /// [`edge_rotation`]) bit for bit: the same numbers are summed in the same order, only
@@ -251,20 +271,16 @@ const SHORT: u32 = u32::MAX;
 #[derive(Clone, Debug, Default)]
 pub struct RestCache {
     spans: Vec<Span>,
+    shapes: Vec<Shape>,
     vertices: Vec<u32>,
     rest: Vec<DVec2>,
-    /// Per state: the squared norm of its centred positions.
+    /// Per shape and state: the squared norm of its centred positions.
     pp: Vec<f64>,
-    /// Per state: where its rest edge vectors `x0 - y0` (one per edge of the part) start in
-    /// `rest_edges`.
-    edge_rest_start: Vec<u32>,
     rest_edges: Vec<DVec2>,
     edge_local: Vec<[u32; 2]>,
-    /// Per part-edge, the rest edge of its part's active state (zero when the part has no
-    /// such state), and per part the state it was copied from: the edge targets then read
-    /// one contiguous array instead of picking each part's block among all its states'.
-    active_rest_edges: Vec<DVec2>,
-    copied_state: Vec<usize>,
+    /// Zero rest edges, as many as the largest part has edges: the targets of a part without
+    /// its active state (as in the reference).
+    zeros: Vec<DVec2>,
     /// Per part-edge, its ends' global vertices (the solver's `EdgeSlot::x`, `y`, compact).
     edge_ends: Vec<[u32; 2]>,
     /// Per part, `[k, j]` for every part `j` containing the part's vertex `k`: vertex by
@@ -282,71 +298,120 @@ pub struct RestCache {
     noted: usize,
 }
 
+/// Converts an index into the cache's compact form (`None` when it does not fit).
+fn compact(i: usize) -> Option<u32> {
+    u32::try_from(i).ok().filter(|&i| i != SHORT)
+}
+
 impl RestCache {
     /// Flattens `parts`; `None` when an index would not fit the compact `u32` arrays (the
     /// solver then uses the reference functions).
     pub fn build(parts: &[Part], vertex_parts: &VertexParts) -> Option<Self> {
-        let index = |i: usize| u32::try_from(i).ok().filter(|&i| i != SHORT);
         let mut c = Self::default();
-        let mut most = 0;
+        // the shape of each distinct rest data, keyed by its bits
+        let mut shape_of: std::collections::HashMap<Vec<u64>, u32> = Default::default();
+        let mut key = Vec::new();
+        let (mut most, mut most_edges) = (0, 0);
         for part in parts {
             let m = part.vertices.len();
             most = most.max(m);
-            let dense = m > 0 && part.states.iter().all(|s| s.positions.len() >= m);
+            most_edges = most_edges.max(part.edges.len());
+            key.clear();
+            key.extend([m, part.edges.len(), part.states.len()].map(|k| k as u64));
+            key.extend(part.edges.iter().flatten().map(|&k| k as u64));
+            for state in &part.states {
+                key.push(state.positions.len() as u64);
+                key.extend(
+                    state
+                        .positions
+                        .iter()
+                        .flat_map(|p| [p.x, p.y].map(f64::to_bits)),
+                );
+            }
+            let shape = match shape_of.get(key.as_slice()) {
+                Some(&s) => s,
+                None => {
+                    let s = c.push_shape(part)?;
+                    shape_of.insert(key.clone(), s);
+                    s
+                }
+            };
             c.spans.push(Span {
-                vertex: index(c.vertices.len())?,
-                neighbour: index(c.neighbours.len())?,
-                edge: index(c.edge_local.len())?,
-                state: index(c.pp.len())?,
-                rest: if dense { index(c.rest.len())? } else { SHORT },
+                vertex: compact(c.vertices.len())?,
+                neighbour: compact(c.neighbours.len())?,
+                edge: compact(c.edge_ends.len())?,
+                shape,
             });
             for (k, &v) in part.vertices.iter().enumerate() {
-                c.vertices.push(index(v)?);
+                c.vertices.push(compact(v)?);
                 for &j in vertex_parts.of(v) {
-                    c.neighbours.push([index(k)?, index(j)?]);
+                    c.neighbours.push([compact(k)?, compact(j)?]);
                 }
             }
             for e in &part.edges {
-                c.edge_local.push([index(e[0])?, index(e[1])?]);
-                let end = |k: usize| part.vertices.get(k).copied().and_then(index);
+                let end = |k: usize| part.vertices.get(k).copied().and_then(compact);
                 c.edge_ends.push([end(e[0])?, end(e[1])?]);
-            }
-            for state in &part.states {
-                let rest = &state.positions;
-                let mut pp = 0.0;
-                if dense {
-                    // the same expressions, in the same order, as `align`
-                    let inv = 1.0 / m as f64;
-                    let centre = rest[..m].iter().copied().sum::<DVec2>() * inv;
-                    for &r in &rest[..m] {
-                        let p = r - centre;
-                        pp += p.length_squared();
-                        c.rest.push(p);
-                    }
-                }
-                c.pp.push(pp);
-                c.edge_rest_start.push(index(c.rest_edges.len())?);
-                for e in &part.edges {
-                    c.rest_edges.push(match (rest.get(e[0]), rest.get(e[1])) {
-                        (Some(&a), Some(&b)) => a - b,
-                        _ => DVec2::ZERO,
-                    });
-                }
             }
         }
         c.spans.push(Span {
-            vertex: index(c.vertices.len())?,
-            neighbour: index(c.neighbours.len())?,
-            edge: index(c.edge_local.len())?,
-            state: index(c.pp.len())?,
-            rest: index(c.rest.len())?,
+            vertex: compact(c.vertices.len())?,
+            neighbour: compact(c.neighbours.len())?,
+            edge: compact(c.edge_ends.len())?,
+            shape: SHORT,
         });
         c.active = vec![0; parts.len()];
-        c.active_rest_edges = vec![DVec2::ZERO; c.edge_local.len()];
-        c.copied_state = vec![usize::MAX; parts.len()];
+        c.zeros = vec![DVec2::ZERO; most_edges];
         c.pose = vec![DVec2::ZERO; most];
         c.sums = vec![DVec2::ZERO; most];
         Some(c)
+    }
+
+    /// Appends `part`'s rest data as a new shape; returns its index.
+    fn push_shape(&mut self, part: &Part) -> Option<u32> {
+        let m = part.vertices.len();
+        let dense = m > 0 && part.states.iter().all(|s| s.positions.len() >= m);
+        let shape = Shape {
+            m: compact(m)?,
+            edges: compact(part.edges.len())?,
+            states: compact(part.states.len())?,
+            rest: if dense {
+                compact(self.rest.len())?
+            } else {
+                SHORT
+            },
+            pp: compact(self.pp.len())?,
+            rest_edges: compact(self.rest_edges.len())?,
+            edge_local: compact(self.edge_local.len())?,
+        };
+        for e in &part.edges {
+            self.edge_local.push([compact(e[0])?, compact(e[1])?]);
+        }
+        for state in &part.states {
+            let rest = &state.positions;
+            let mut pp = 0.0;
+            if dense {
+                // the same expressions, in the same order, as `align`
+                let inv = 1.0 / m as f64;
+                let centre = rest[..m].iter().copied().sum::<DVec2>() * inv;
+                for &r in &rest[..m] {
+                    let p = r - centre;
+                    pp += p.length_squared();
+                    self.rest.push(p);
+                }
+            }
+            self.pp.push(pp);
+            for e in &part.edges {
+                self.rest_edges
+                    .push(match (rest.get(e[0]), rest.get(e[1])) {
+                        (Some(&a), Some(&b)) => a - b,
+                        _ => DVec2::ZERO,
+                    });
+            }
+        }
+        compact(self.rest_edges.len())?;
+        let index = compact(self.shapes.len())?;
+        self.shapes.push(shape);
+        Some(index)
     }
 
     /// Number of parts the cache was built for.
@@ -354,9 +419,14 @@ impl RestCache {
         self.spans.len().saturating_sub(1)
     }
 
+    /// Number of distinct rest data ([`Shape`]s) among the parts.
+    pub fn shapes(&self) -> usize {
+        self.shapes.len()
+    }
+
     /// Number of part-edges the cache was built for.
     pub fn edges(&self) -> usize {
-        self.edge_local.len()
+        self.edge_ends.len()
     }
 
     /// The elastic energy `sum |t - (f_x - f_y)|^2` of `targets` (one per part-edge, in the
@@ -373,15 +443,15 @@ impl RestCache {
         Some(elastic)
     }
 
-    /// Part `pi`'s span and the number of its states, when `part` still has the vertex and
-    /// state counts the cache was built with and dense rest data (else the reference path).
-    fn dense_span(&self, pi: usize, part: &Part) -> Option<(Span, usize)> {
-        let (s, next) = (*self.spans.get(pi)?, *self.spans.get(pi + 1)?);
-        let count = (next.state - s.state) as usize;
-        let fits = s.rest != SHORT
-            && (next.vertex - s.vertex) as usize == part.vertices.len()
-            && count == part.states.len();
-        fits.then_some((s, count))
+    /// Part `pi`'s span and shape, when `part` still has the vertex and state counts the
+    /// cache was built with and dense rest data (else the reference path).
+    fn dense_span(&self, pi: usize, part: &Part) -> Option<(Span, Shape)> {
+        let s = *self.spans.get(pi)?;
+        let shape = *self.shapes.get(s.shape as usize)?;
+        let fits = shape.rest != SHORT
+            && shape.m as usize == part.vertices.len()
+            && shape.states as usize == part.states.len();
+        fits.then_some((s, shape))
     }
 
     /// Gathers and centres the pose of the part with span `s` into `self.pose[..m]`;
@@ -430,9 +500,10 @@ impl RestCache {
         positions: &[DVec2],
         hysteresis: f64,
     ) -> (usize, DVec2) {
-        let Some((s, count)) = self.dense_span(pi, part) else {
+        let Some((s, shape)) = self.dense_span(pi, part) else {
             return choose_state(part, positions, hysteresis);
         };
+        let count = shape.states as usize;
         if count == 0 {
             return choose_state(part, positions, hysteresis);
         }
@@ -440,8 +511,8 @@ impl RestCache {
         let active = part.active.min(count - 1);
         let qq = self.gather_pose(s, m, positions);
         let pose = &self.pose[..m];
-        let rest = &self.rest[s.rest as usize..][..count * m];
-        let pp = &self.pp[s.state as usize..][..count];
+        let rest = &self.rest[shape.rest as usize..][..count * m];
+        let pp = &self.pp[shape.pp as usize..][..count];
         // One pass over the pose for all states (each state's sums still run in vertex
         // order), then the reference's comparisons on the distances.
         match count {
@@ -480,15 +551,15 @@ impl RestCache {
     #[inline]
     pub fn part_rotation(&mut self, pi: usize, part: &Part, positions: &[DVec2]) -> DVec2 {
         self.note(pi, part.active);
-        let Some((s, count)) = self.dense_span(pi, part) else {
+        let Some((s, shape)) = self.dense_span(pi, part) else {
             return part_rotation(part, positions);
         };
-        if part.active >= count {
+        if part.active >= shape.states as usize {
             return part_rotation(part, positions);
         }
         let m = part.vertices.len();
         let verts = &self.vertices[s.vertex as usize..][..m];
-        let rest = &self.rest[s.rest as usize + part.active * m..][..m];
+        let rest = &self.rest[shape.rest as usize + part.active * m..][..m];
         // the same expressions, in the same order, as `align`, without storing the pose
         let inv = 1.0 / m as f64;
         let centre = verts.iter().map(|&v| positions[v as usize]).sum::<DVec2>() * inv;
@@ -499,7 +570,7 @@ impl RestCache {
             cross += p.perp_dot(q);
             qq += q.length_squared();
         }
-        finish(dot, cross, self.pp[s.state as usize + part.active], qq).rotation
+        finish(dot, cross, self.pp[shape.pp as usize + part.active], qq).rotation
     }
 
     /// `R_xy (x0 - y0)` for every part-edge, in the solver's edge order, into `targets`: the
@@ -561,28 +632,23 @@ impl RestCache {
     ) {
         let own = rotations[pi];
         let (s, next) = (self.spans[pi], self.spans[pi + 1]);
-        let (e0, e1) = (s.edge as usize, next.edge as usize);
-        let edges = &self.edge_local[e0..e1];
-        let out = &mut targets[e0..e1];
-        let rest = &mut self.active_rest_edges[e0..e1];
-        if self.copied_state[pi] != active {
-            // a part without its active state gets zero rest edges, as in the reference
-            if active < (next.state - s.state) as usize {
-                let start = self.edge_rest_start[s.state as usize + active] as usize;
-                rest.copy_from_slice(&self.rest_edges[start..][..edges.len()]);
-            } else {
-                rest.fill(DVec2::ZERO);
-            }
-            self.copied_state[pi] = active;
-        }
-        let rest = &*rest;
+        let shape = self.shapes[s.shape as usize];
+        let count = shape.edges as usize;
+        let edges = &self.edge_local[shape.edge_local as usize..][..count];
+        let out = &mut targets[s.edge as usize..][..count];
+        // a part without its active state gets zero rest edges, as in the reference
+        let rest = if active < shape.states as usize {
+            &self.rest_edges[shape.rest_edges as usize + active * count..][..count]
+        } else {
+            &self.zeros[..count]
+        };
         if cos_cone >= 1.0 {
             for (t, &d) in out.iter_mut().zip(rest) {
                 *t = own.rotate(d);
             }
             return;
         }
-        let m = (next.vertex - s.vertex) as usize;
+        let m = shape.m as usize;
         let neighbours = &self.neighbours[s.neighbour as usize..next.neighbour as usize];
         // small parts sum on the stack: a fixed-size zeroing is a few stores, where the
         // slice's would be a call to memset per part
@@ -718,6 +784,23 @@ mod tests {
     }
 
     #[test]
+    fn parts_with_the_same_rest_data_share_one_shape() {
+        let square = vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let mut bent = square.clone();
+        bent[2].0 = 1.5;
+        let parts = vec![
+            arbitrary_part(vec![0, 1, 2, 3], vec![square.clone(), bent.clone()], 0),
+            arbitrary_part(vec![4, 5, 6, 7], vec![square.clone(), bent.clone()], 1),
+            // the same states in another order are other rest data
+            arbitrary_part(vec![8, 9, 10, 11], vec![bent, square], 0),
+        ];
+        let vp = VertexParts::build(&parts, 12);
+        let cache = RestCache::build(&parts, &vp).unwrap();
+        assert_eq!(cache.parts(), 3);
+        assert_eq!(cache.shapes(), 2);
+    }
+
+    #[test]
     fn edge_rotation_averages_nearby_rotations_as_unit_complex_numbers() {
         let rotations = [DVec2::from_angle(0.1), DVec2::from_angle(0.3)];
         let (_, vp) = two_parts(&rotations);
@@ -791,8 +874,21 @@ mod tests {
             proptest::collection::vec((coordinate.clone(), coordinate), n),
             0.0..0.5f64,
             0.0..200.0f64,
+            proptest::collection::vec(any::<bool>(), 8),
         )
-            .prop_map(|(parts, positions, hysteresis, cone)| {
+            .prop_map(move |(mut parts, positions, hysteresis, cone, twins)| {
+                // some parts get a twin elsewhere with the same rest data (as the instances
+                // of one piece have), so the cache's shared shapes are exercised
+                for (i, &twin) in twins.iter().enumerate().take(parts.len()) {
+                    if twin {
+                        let mut copy = parts[i].clone();
+                        for v in &mut copy.vertices {
+                            *v = (*v + 5) % n;
+                        }
+                        copy.active = (copy.active + i) % 7;
+                        parts.push(copy);
+                    }
+                }
                 let positions = positions
                     .into_iter()
                     .map(|(x, y)| DVec2::new(x, y))

@@ -327,6 +327,12 @@ impl Solver {
         self.pattern.nnz()
     }
 
+    /// Number of values a Cholesky factor of the normal matrix stores (after the first frame;
+    /// 0 for the CG solver).
+    pub fn factor_values(&self) -> usize {
+        self.symbolic.as_ref().map_or(0, |s| s.stored_values())
+    }
+
     /// Rebuilds the pattern and symbolic factorisation if the assembly changed structurally.
     fn prepare(&mut self, asm: &Assembly) -> Result<(), SolverError> {
         let n = asm.data.positions.len();

@@ -68,6 +68,8 @@ struct BenchResult {
     parts: usize,
     vertices: usize,
     matrix_nonzeros: usize,
+    /// Values stored by the Cholesky factor (0 with `--solver cg`).
+    factor_values: usize,
     solver: &'static str,
     pass1: &'static str,
     frames: usize,
@@ -208,6 +210,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         parts: asm.data.parts.len(),
         vertices: asm.data.positions.len(),
         matrix_nonzeros: solver.matrix_nonzeros(),
+        factor_values: solver.factor_values(),
         solver: match kind {
             SolverKind::Cholesky => "cholesky",
             SolverKind::Cg => "cg",
