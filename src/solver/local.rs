@@ -311,6 +311,7 @@ impl RestCache {
         // the shape of each distinct rest data, keyed by its bits
         let mut shape_of: std::collections::HashMap<Vec<u64>, u32> = Default::default();
         let mut key = Vec::new();
+        let mut last = (Vec::new(), SHORT);
         let (mut most, mut most_edges) = (0, 0);
         for part in parts {
             let m = part.vertices.len();
@@ -328,13 +329,22 @@ impl RestCache {
                         .flat_map(|p| [p.x, p.y].map(f64::to_bits)),
                 );
             }
-            let shape = match shape_of.get(key.as_slice()) {
-                Some(&s) => s,
-                None => {
-                    let s = c.push_shape(part)?;
-                    shape_of.insert(key.clone(), s);
-                    s
-                }
+            // consecutive parts are mostly instances of one piece: compare with the last
+            // part's key before hashing
+            let shape = if key == last.0 {
+                last.1
+            } else {
+                let shape = match shape_of.get(key.as_slice()) {
+                    Some(&s) => s,
+                    None => {
+                        let s = c.push_shape(part)?;
+                        shape_of.insert(key.clone(), s);
+                        s
+                    }
+                };
+                last.0.clone_from(&key);
+                last.1 = shape;
+                shape
             };
             c.spans.push(Span {
                 vertex: compact(c.vertices.len())?,
