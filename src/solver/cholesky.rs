@@ -61,7 +61,8 @@ struct SupernodalLayout {
 pub struct NumericFactor {
     values: Vec<f64>,
     /// The same values in the order [`SymbolicFactor::solve_in_place`] reads them: each
-    /// supernode's diagonal block as faer stores it, then the rows below it row by row (faer
+    /// supernode's diagonal block as faer stores it but with reciprocal diagonal entries
+    /// (the substitutions multiply), then the rows below it row by row (faer
     /// stores them column by column), so a below row is read once per substitution rather
     /// than once per column of its supernode.
     solve_order: Vec<f64>,
@@ -234,8 +235,8 @@ impl SupernodalLayout {
     }
 
     /// Copies faer's supernodal values `l` into `out` in solve order (see
-    /// [`NumericFactor::solve_order`]): same offsets per supernode, the diagonal block
-    /// unchanged, the block below it transposed to row-major.
+    /// [`NumericFactor::solve_order`]): same offsets per supernode, the diagonal block with
+    /// the reciprocals of its diagonal entries, the block below it transposed to row-major.
     fn reorder_for_solve(&self, l: &[f64], out: &mut Vec<f64>) {
         out.clear();
         out.resize(l.len(), 0.0);
@@ -247,6 +248,9 @@ impl SupernodalLayout {
             let (diagonal, rest) = target.split_at_mut(size * size);
             for c in 0..size {
                 diagonal[c * size..][..size].copy_from_slice(&block[c * rows..][..size]);
+                // the substitutions multiply by the reciprocal: every column's division sat
+                // on the dependency chain (solve at 10k parts: 0.67 -> 0.57-0.60 ms median)
+                diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
                 for (b, row) in rest.chunks_exact_mut(size).enumerate() {
                     row[c] = block[c * rows + size + b];
                 }
@@ -311,8 +315,8 @@ fn forward<const S: usize>(block: &[f64], start: usize, below: &[u32], x: &mut [
     let xs: &mut [[f64; 2]; S] = (&mut x[start..start + S]).try_into().expect("S columns");
     for c in 0..S {
         let col = &diagonal[c * S..][..S];
-        let d = col[c];
-        let xc = [xs[c][0] / d, xs[c][1] / d];
+        let inv = col[c]; // 1 / L_cc (see `reorder_for_solve`)
+        let xc = [xs[c][0] * inv, xs[c][1] * inv];
         xs[c] = xc;
         for r in c + 1..S {
             xs[r][0] -= col[r] * xc[0];
@@ -350,8 +354,8 @@ fn backward<const S: usize>(block: &[f64], start: usize, below: &[u32], x: &mut 
             a[0] -= col[r] * acc[r][0];
             a[1] -= col[r] * acc[r][1];
         }
-        let d = col[c];
-        acc[c] = [a[0] / d, a[1] / d];
+        let inv = col[c]; // 1 / L_cc (see `reorder_for_solve`)
+        acc[c] = [a[0] * inv, a[1] * inv];
     }
     x[start..start + S].copy_from_slice(&acc);
 }
@@ -361,8 +365,8 @@ fn forward_wide(size: usize, block: &[f64], start: usize, below: &[u32], x: &mut
     let (diagonal, rows) = block.split_at(size * size);
     for c in 0..size {
         let col = &diagonal[c * size..][..size];
-        let d = col[c];
-        let xc = [x[start + c][0] / d, x[start + c][1] / d];
+        let inv = col[c]; // 1 / L_cc (see `reorder_for_solve`)
+        let xc = [x[start + c][0] * inv, x[start + c][1] * inv];
         x[start + c] = xc;
         for r in c + 1..size {
             x[start + r][0] -= col[r] * xc[0];
@@ -396,8 +400,8 @@ fn backward_wide(size: usize, block: &[f64], start: usize, below: &[u32], x: &mu
             a[0] -= col[r] * x[start + r][0];
             a[1] -= col[r] * x[start + r][1];
         }
-        let d = col[c];
-        x[start + c] = [a[0] / d, a[1] / d];
+        let inv = col[c]; // 1 / L_cc (see `reorder_for_solve`)
+        x[start + c] = [a[0] * inv, a[1] * inv];
     }
 }
 
