@@ -418,7 +418,6 @@ impl RestCache {
                     });
             }
         }
-        compact(self.rest_edges.len())?;
         let index = compact(self.shapes.len())?;
         self.shapes.push(shape);
         Some(index)
