@@ -15,12 +15,13 @@ use faer::{Conj, MatMut, Par, Side};
 /// Supernode amalgamation: two adjacent supernodes of `n` columns in all merge when
 /// `n <= w` and less than a fraction `z` of the merged block would be explicit zeros, for
 /// the first `(w, z)` that holds. faer's default, `[(4, 1.0), (16, 0.8), (48, 0.1), ..]`,
-/// suits factorisation, whose dense kernels like wide blocks; here a factor serves four
+/// suits factorisation, whose dense kernels like wide blocks. Here a factor serves four
 /// solves (eight substitutions) per frame and is refactorised only when the held vertices
-/// change, and a substitution streams every stored value, zero or not. With the default a third of the city's
-/// factor is padding (4.73M values at 100k parts, 2.95M nonzeros); these thresholds keep
-/// supernodes of a few columns (width-1 supernodes cost more per value than they save) and
-/// cut the solve by about a fifth at 10k and a third at 100k (docs/performance.md).
+/// change, and a substitution streams every stored value, zero or not: with the default a
+/// third of the city's factor is padding (4.73M values at 100k parts, 2.95M nonzeros). These
+/// thresholds keep supernodes of a few columns (width-1 supernodes cost more per value than
+/// they save) and cut the solve by about a fifth at 10k parts and a third at 100k
+/// (docs/performance.md).
 const RELAX: &[(usize, f64)] = &[(4, 0.25), (16, 0.1), (usize::MAX, 0.02)];
 
 /// Why a factorisation failed (the matrix was not numerically positive definite, or faer could
