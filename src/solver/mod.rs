@@ -451,7 +451,9 @@ impl Solver {
         next.clear();
         next.resize(n, DVec2::ZERO);
         let mut pass1_converged = false;
-        let mut warm_cached = false;
+        // Set once `work.warm_*` hold the displayed pose's rotations and edge targets, with
+        // the states as they were after that many of this frame's switches.
+        let mut warm_cached: Option<usize> = None;
 
         // Pass 1 by splitting: least-squares solves with the pass-2 factor.
         let pass1_iterations = match cfg.pass1 {
@@ -552,10 +554,16 @@ impl Solver {
         // handles-moved start is judged only when the pass-1 result does not beat the warm
         // start (while dragging it nearly always does: one local step saved).
         let parts = &asm.data.parts;
-        if !warm_cached {
-            self.objective(parts, handles, &warm);
-            self.work.warm_rotations.clone_from(&self.work.rotations);
-            self.work.warm_targets.clone_from(&self.work.targets);
+        match warm_cached {
+            Some(k) if k == report.switches.len() => {}
+            // Later local steps switched a few parts: only theirs and their neighbours'
+            // rotations and targets at the warm start changed.
+            Some(k) if self.retarget_warm(parts, &warm, &report.switches[k..]) => {}
+            _ => {
+                self.objective(parts, handles, &warm);
+                self.work.warm_rotations.clone_from(&self.work.rotations);
+                self.work.warm_targets.clone_from(&self.work.targets);
+            }
         }
         let warm_terms = self.terms_at(&self.work.warm_targets, handles, &warm);
         // objective() leaves f's rotations and edge targets in the work buffers
@@ -677,7 +685,7 @@ impl Solver {
         f: &mut Vec<DVec2>,
         next: &mut Vec<DVec2>,
         report: &mut FrameReport,
-        warm_cached: &mut bool,
+        warm_cached: &mut Option<usize>,
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
         let warm = start.warm;
@@ -797,17 +805,14 @@ impl Solver {
         pose: &[DVec2],
         first: bool,
         report: &mut FrameReport,
-        warm_cached: &mut bool,
+        warm_cached: &mut Option<usize>,
     ) {
-        let switched_before = report.switches.len();
         self.local_step_switching(parts, pose, self.config.hysteresis, &mut report.switches);
         self.edge_targets(parts);
         if first {
             self.work.warm_rotations.clone_from(&self.work.rotations);
             self.work.warm_targets.clone_from(&self.work.targets);
-            *warm_cached = true;
-        } else if report.switches.len() > switched_before {
-            *warm_cached = false;
+            *warm_cached = Some(report.switches.len());
         }
     }
 
@@ -821,7 +826,7 @@ impl Solver {
         parts: &mut [Part],
         pose: &[DVec2],
         report: &mut FrameReport,
-        warm_cached: &mut bool,
+        warm_cached: &mut Option<usize>,
     ) {
         let switched_before = report.switches.len();
         let hysteresis = self.config.hysteresis;
@@ -844,37 +849,69 @@ impl Solver {
             }
             w.rotations[i] = r;
         }
-        if report.switches.len() > switched_before {
-            // A switch changes the part's rest edges and rotation, hence its own targets and
-            // those of every part sharing a vertex with it (their R_xy); no other target.
-            let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
-            let w = &mut self.work;
-            match &mut w.rest {
-                Some(cache) if cache.parts() == parts.len() && cache.edges() == w.targets.len() => {
-                    w.touched.clear();
-                    for s in &report.switches[switched_before..] {
-                        w.touched.push(s.part);
-                        for &v in &parts[s.part].vertices {
-                            w.touched.extend_from_slice(w.vertex_parts.of(v));
-                        }
-                    }
-                    w.touched.sort_unstable();
-                    w.touched.dedup();
-                    cache.edge_targets_of(
-                        parts,
-                        &w.touched,
-                        &w.rotations,
-                        cos_cone,
-                        &mut w.targets,
-                    );
-                }
-                _ => self.edge_targets(parts),
-            }
+        if report.switches.len() > switched_before
+            && !self.retarget_switched(parts, &report.switches[switched_before..])
+        {
+            self.edge_targets(parts);
         }
         debug_assert!(self.carried_is_exact(parts, pose));
         self.work.warm_rotations.clone_from(&self.work.rotations);
         self.work.warm_targets.clone_from(&self.work.targets);
-        *warm_cached = true;
+        *warm_cached = Some(report.switches.len());
+    }
+
+    /// Brings `work.rotations` and `work.targets`, which hold some pose's values with the
+    /// states before `switches`, up to date after them, given that the switched parts'
+    /// rotations already are: a switch changes the part's rest edges and rotation, hence its
+    /// own targets and those of every part sharing a vertex with it (their `R_xy`); no
+    /// other target. `false` (nothing done) without a rest cache that fits the parts.
+    fn retarget_switched(&mut self, parts: &[Part], switches: &[StateSwitch]) -> bool {
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let w = &mut self.work;
+        match &mut w.rest {
+            Some(cache) if cache.parts() == parts.len() && cache.edges() == w.targets.len() => {
+                w.touched.clear();
+                for s in switches {
+                    w.touched.push(s.part);
+                    for &v in &parts[s.part].vertices {
+                        w.touched.extend_from_slice(w.vertex_parts.of(v));
+                    }
+                }
+                w.touched.sort_unstable();
+                w.touched.dedup();
+                cache.edge_targets_of(parts, &w.touched, &w.rotations, cos_cone, &mut w.targets);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Brings the warm start's rotations and edge targets (`work.warm_*`, computed at `warm`
+    /// before `switches`) up to date with the parts' states, recomputing only what the
+    /// switches changed: the same values, bit for bit, as a full local step at `warm`.
+    /// Leaves `work.rotations` and `work.targets` unspecified. `false` when it could not.
+    fn retarget_warm(&mut self, parts: &[Part], warm: &[DVec2], switches: &[StateSwitch]) -> bool {
+        let w = &mut self.work;
+        if w.rest.is_none()
+            || w.warm_rotations.len() != parts.len()
+            || switches.iter().any(|s| s.part >= parts.len())
+        {
+            return false;
+        }
+        std::mem::swap(&mut w.rotations, &mut w.warm_rotations);
+        std::mem::swap(&mut w.targets, &mut w.warm_targets);
+        if let Some(cache) = &mut w.rest {
+            for s in switches {
+                let part = &parts[s.part];
+                w.rotations[s.part] = cache.part_rotation(s.part, part, warm);
+            }
+        }
+        let done = self.retarget_switched(parts, switches);
+        debug_assert!(!done || self.carried_is_exact(parts, warm));
+        let w = &mut self.work;
+        std::mem::swap(&mut w.rotations, &mut w.warm_rotations);
+        std::mem::swap(&mut w.targets, &mut w.warm_targets);
+        done
     }
 
     /// Debug check of [`Solver::judge_carried`]: the carried rotations and edge targets

@@ -91,6 +91,11 @@ struct BenchResult {
     #[serde(skip_serializing_if = "Option::is_none")]
     iteration_ms: Option<Ms>,
     converged_frames: usize,
+    /// The last frame's elastic energy and the sum of every vertex's coordinates at the end:
+    /// two runs that give the same figures here computed the same frames (to compare
+    /// builds).
+    energy: f64,
+    checksum: f64,
 }
 
 fn stats(values: &[f64]) -> Ms {
@@ -238,6 +243,8 @@ pub fn bench(args: BenchArgs) -> u8 {
         rules_ms: stats(&rules_ms),
         rules_fired,
         converged_frames: reports.iter().filter(|r| r.converged).count(),
+        energy: reports.last().map_or(0.0, |r| r.energy),
+        checksum: asm.data.positions.iter().map(|p| p.x + p.y).sum(),
     };
     if args.json {
         match serde_json::to_string_pretty(&result) {
