@@ -32,9 +32,10 @@ pub struct Pattern {
     pub row_idx: Vec<usize>,
     /// Every edge of every part, part by part.
     pub edges: Vec<EdgeSlot>,
-    /// The global ends `[x, y]` of `edges`, packed: the per-iteration loops stream these
-    /// instead of the whole slots.
-    pub ends: Vec<[usize; 2]>,
+    /// The global ends `[x, y]` of `edges`, packed and compact (the solver takes no model
+    /// with more vertices than `u32` counts): the per-iteration loops stream these instead
+    /// of the whole slots.
+    pub ends: Vec<[u32; 2]>,
 }
 
 impl Pattern {
@@ -80,7 +81,9 @@ impl Pattern {
                 });
             }
         }
-        let ends = edges.iter().map(|e| [e.x, e.y]).collect();
+        // the solver checks that every vertex index fits before it builds a pattern
+        let compact = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+        let ends = edges.iter().map(|e| [compact(e.x), compact(e.y)]).collect();
         Self {
             n,
             col_ptr,
@@ -163,7 +166,7 @@ pub fn fill_rhs(
 /// [`fill_rhs`] with every weight 1 (the least-squares pass), over the packed edge ends. An
 /// edge whose ends are one vertex adds and removes the same target at one row, so it is
 /// skipped as `fill_rhs` skips it.
-pub fn fill_rhs_unit(ends: &[[usize; 2]], targets: &[DVec2], extra: &[DVec2], rhs: &mut Vec<f64>) {
+pub fn fill_rhs_unit(ends: &[[u32; 2]], targets: &[DVec2], extra: &[DVec2], rhs: &mut Vec<f64>) {
     let n = extra.len();
     rhs.clear();
     rhs.resize(2 * n, 0.0);
@@ -173,6 +176,7 @@ pub fn fill_rhs_unit(ends: &[[usize; 2]], targets: &[DVec2], extra: &[DVec2], rh
         ys[i] = e.y;
     }
     for (&[x, y], &t) in ends.iter().zip(targets) {
+        let (x, y) = (x as usize, y as usize);
         if x != y {
             xs[x] += t.x;
             ys[x] += t.y;

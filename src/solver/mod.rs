@@ -348,6 +348,12 @@ impl Solver {
         if !stale {
             return Ok(());
         }
+        // the pattern and the rest cache keep vertex indices as u32
+        if u32::try_from(n).is_err() {
+            return Err(SolverError(format!(
+                "the model has {n} vertices, more than the solver can index"
+            )));
+        }
         for (i, p) in asm.data.parts.iter().enumerate() {
             let m = p.vertices.len();
             if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m)
@@ -770,6 +776,7 @@ impl Solver {
             let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
             let held = &self.work.handle_count;
             for (k, &[x, y]) in self.pattern.ends.iter().enumerate() {
+                let (x, y) = (x as usize, y as usize);
                 let v = (next[x] - next[y]) - self.work.targets[k] + split.u[k];
                 let z = if held[x] > 0.0 || held[y] > 0.0 {
                     at_handle.apply(v)
@@ -1227,17 +1234,22 @@ impl Solver {
         let w = &mut self.work;
         let slot = &self.factor_slot;
         let (lambda, mu) = (cfg.handle_weight, cfg.proximal_weight);
-        w.diagonal.clear();
         self.ordered.resize(f.len(), [0.0; 2]);
         // Summed in vertex order (where an edge's ends are near each other; the factor's
-        // order scatters them), then gathered into the factor's order.
+        // order scatters them), then gathered into the factor's order. Sized first and then
+        // written: a push per vertex would check the capacity every time.
+        let n = f.len();
         let b = &mut w.vertex_rhs;
-        b.clear();
-        for ((&count, &sum), &p) in w.handle_count.iter().zip(&w.handle_sum).zip(f) {
-            w.diagonal.push(lambda * count + mu);
-            b.push(lambda * sum + mu * p);
+        w.diagonal.resize(n, 0.0);
+        b.resize(n, DVec2::ZERO);
+        let handles = w.handle_count.iter().zip(&w.handle_sum).zip(f);
+        for ((d, bi), ((&count, &sum), &p)) in w.diagonal.iter_mut().zip(b.iter_mut()).zip(handles)
+        {
+            *d = lambda * count + mu;
+            *bi = lambda * sum + mu * p;
         }
         for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
+            let (x, y) = (x as usize, y as usize);
             if x != y {
                 b[x] += t;
                 b[y] -= t;
