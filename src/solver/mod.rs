@@ -896,7 +896,8 @@ impl Solver {
     /// Brings the warm start's rotations and edge targets (`work.warm_*`, computed at `warm`
     /// before `switches`) up to date with the parts' states, recomputing only what the
     /// switches changed: the same values, bit for bit, as a full local step at `warm`.
-    /// Leaves `work.rotations` and `work.targets` unspecified. `false` when it could not.
+    /// `work.rotations` and `work.targets` are left as they were. `false` when it could not
+    /// (the caller then redoes the local step at `warm`).
     fn retarget_warm(&mut self, parts: &[Part], warm: &[DVec2], switches: &[StateSwitch]) -> bool {
         let w = &mut self.work;
         if w.rest.is_none()
