@@ -81,6 +81,9 @@ pub struct Shrink {
     /// Lower end of the bracket of the shrunk length (`p < 1`: where the 1D objective's
     /// nonzero branch starts; 0 otherwise).
     lower: f64,
+    /// `1 / (2 rho)`, the cubic's coefficient at `p = 1/2`: divided once here rather than
+    /// once per open edge.
+    half_over_rho: f64,
 }
 
 impl Shrink {
@@ -98,6 +101,7 @@ impl Shrink {
             p,
             threshold,
             lower,
+            half_over_rho: 0.5 / rho,
         }
     }
 
@@ -146,7 +150,7 @@ impl Shrink {
             // descend to it monotonically, and once one is below 1e-9 the next error is below
             // 1e-17 (quadratic convergence) and the loop stops. Two to four divisions, where
             // the trigonometric formula took an acos and a cos per open edge.
-            let e = 0.5 / rho / (n * n2).sqrt();
+            let e = self.half_over_rho / (n * n2).sqrt();
             let mut h = 1.0 - e * (0.5 + e * (0.375 + e * (0.5 + e * (105.0 / 128.0))));
             for _ in 0..64 {
                 let step = (h * h * h - h + e) / (3.0 * h * h - 1.0);
