@@ -900,19 +900,16 @@ impl Solver {
     /// (the caller then redoes the local step at `warm`).
     fn retarget_warm(&mut self, parts: &[Part], warm: &[DVec2], switches: &[StateSwitch]) -> bool {
         let w = &mut self.work;
-        if w.rest.is_none()
-            || w.warm_rotations.len() != parts.len()
-            || switches.iter().any(|s| s.part >= parts.len())
-        {
+        if w.warm_rotations.len() != parts.len() || switches.iter().any(|s| s.part >= parts.len()) {
             return false;
         }
+        let Some(cache) = &mut w.rest else {
+            return false;
+        };
         std::mem::swap(&mut w.rotations, &mut w.warm_rotations);
         std::mem::swap(&mut w.targets, &mut w.warm_targets);
-        if let Some(cache) = &mut w.rest {
-            for s in switches {
-                let part = &parts[s.part];
-                w.rotations[s.part] = cache.part_rotation(s.part, part, warm);
-            }
+        for s in switches {
+            w.rotations[s.part] = cache.part_rotation(s.part, &parts[s.part], warm);
         }
         let done = self.retarget_switched(parts, switches);
         debug_assert!(!done || self.carried_is_exact(parts, warm));
