@@ -32,6 +32,16 @@ fn docked_sites(data: &AssemblyData) -> HashSet<InstanceSite> {
 /// The closest mover/target pair over all merge rules, if any is within its rule's distance.
 /// O(instances + docks) to list the free sites, then O(1) per free mover site (grid lookup).
 pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch> {
+    find_where(grammar, data, |_, _| true)
+}
+
+/// [`find`] among the mover/target instance pairs (by stable id) that `accept` allows: the
+/// rules keep a connection that was cut from welding again until its sides have parted.
+pub fn find_where(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    accept_ids: impl Fn(u64, u64) -> bool,
+) -> Option<MergeMatch> {
     if grammar.merge_rules.is_empty() {
         return None;
     }
@@ -86,8 +96,11 @@ pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch
             let Some(c) = site_centre(grammar, data, m) else {
                 continue;
             };
-            let accept =
-                |t: InstanceSite| t.instance != i && !neighbours.contains(&(i, t.instance));
+            let accept = |t: InstanceSite| {
+                t.instance != i
+                    && !neighbours.contains(&(i, t.instance))
+                    && accept_ids(inst.id, data.instances[t.instance].id)
+            };
             if let Some((t, d)) = grid.nearest(c, distance, accept)
                 && best.is_none_or(|b| d < b.distance)
             {

@@ -379,6 +379,14 @@ pub struct Rules {
     pub log: Vec<RuleEvent>,
     /// Why requested operations did nothing (a cut with nothing near), in order.
     pub notes: Vec<String>,
+    /// Pairs of instances (stable ids, smaller first) a cut separated: they do not weld
+    /// again until their sites have moved beyond the merge distance (paper 5.1: a
+    /// connection is fixed until cut, and a cut is the user's explicit wish to part them).
+    parted: Vec<(u64, u64)>,
+}
+
+fn unordered(a: u64, b: u64) -> (u64, u64) {
+    (a.min(b), a.max(b))
 }
 
 impl Rules {
@@ -403,8 +411,14 @@ impl Rules {
                 rewrites.push(r.event);
             }
         }
-        if let Some(found) = merge::find(&grammar, &asm.data)
-            && let Ok(r) = merge::apply(&grammar, &mut asm.data, &found)
+        // a cut pair parts once no merge rule finds its sides within reach
+        self.parted.retain(|&pair| {
+            merge::find_where(&grammar, &asm.data, |m, t| unordered(m, t) == pair).is_some()
+        });
+        let parted = &self.parted;
+        if let Some(found) = merge::find_where(&grammar, &asm.data, |m, t| {
+            !parted.contains(&unordered(m, t))
+        }) && let Ok(r) = merge::apply(&grammar, &mut asm.data, &found)
         {
             self.carry(asm, &r);
             rewrites.push(r.event);
@@ -426,6 +440,13 @@ impl Rules {
     pub fn cut(&mut self, asm: &mut Assembly, point: DVec2) -> Result<RuleEvent, String> {
         let grammar = asm.grammar_arc().clone();
         let r = cut::cut_at(&grammar, &mut asm.data, point)?;
+        // every pair among the instances on the cut's sides (its new instance included)
+        let ids = &r.event.instances;
+        for (k, &a) in ids.iter().enumerate() {
+            for &b in &ids[k + 1..] {
+                self.parted.push(unordered(a, b));
+            }
+        }
         self.carry(asm, &r);
         let mut e = r.event;
         e.frame = self.frame;
