@@ -105,6 +105,17 @@ impl Shrink {
         }
     }
 
+    /// The factor the shrink scales a residual of squared length `n2` by (in [0, 1]): the
+    /// same map for a stacked residual (a part's edges) as for one edge.
+    pub fn factor(&self, n2: f64) -> f64 {
+        let n = n2.sqrt();
+        if n > 0.0 {
+            (self.apply(DVec2::new(n, 0.0)).x / n).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
     /// `s^(p - 1)` and `s^(p - 2)`, with p = 0.5 spelled out (powf would dominate).
     fn powers(&self, s: f64) -> (f64, f64) {
         if self.p == 0.5 {

@@ -7,6 +7,7 @@
 pub mod admm;
 pub mod cg;
 pub mod cholesky;
+pub mod follow;
 pub mod global;
 pub mod local;
 
@@ -34,12 +35,12 @@ pub enum SolverKind {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Pass1 {
     /// Iteratively reweighted least squares (the paper's 5.2), restarted from the displayed
-    /// pose every frame: a numeric factorisation per iteration.
+    /// pose every frame, one weight per part: a numeric factorisation per iteration.
+    #[default]
     Irls,
     /// Variable splitting ([`admm`]): least-squares solves with the pass-2 factor, per-edge
     /// gaps and duals carried from frame to frame. No factorisation while the assembly and
     /// the held vertices stay the same.
-    #[default]
     Admm,
 }
 
@@ -134,17 +135,17 @@ impl SolverConfig {
     pub fn from_params(params: &SolverParams) -> Self {
         Self {
             kind: SolverKind::Cholesky,
-            pass1: Pass1::Admm,
+            pass1: Pass1::Irls,
             admm_threshold: 0.05,
             admm_handle_factor: 0.9,
-            admm_iterations: 2,
+            admm_iterations: 20,
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
-            irls_iterations: 4,
-            l2_iterations: 2,
+            irls_iterations: 20,
+            l2_iterations: 20,
             handle_weight: 1e6,
-            rotation_cone_degrees: 20.0,
+            rotation_cone_degrees: 0.0,
             proximal_weight: 1e-8,
             tolerance: 1e-6,
             cg_tolerance: 1e-6,
@@ -176,8 +177,9 @@ pub struct FrameReport {
     pub energy: f64,
     /// Pass-2 objective: `energy` plus the handle terms.
     pub objective: f64,
-    /// The pass-2 objective of the warm start (the previous frame's positions, with this frame's
-    /// handle targets and final states); `objective <= warm_objective` always.
+    /// The pass-2 objective of the warm start (the previous frame's positions moved by rigid
+    /// following, with this frame's handle targets and final states); with pass-2
+    /// iterations, `objective <= warm_objective` (local and global steps never raise it).
     pub warm_objective: f64,
     /// Rest-state switches, in the order they happened.
     pub switches: Vec<StateSwitch>,
@@ -259,25 +261,13 @@ struct Work {
     scratch: Vec<f64>,
     cg: cg::CgWork,
     part_sums: Vec<DVec2>,
+    /// The displayed pose at the start of the frame (then moved by rigid following).
     warm: Vec<DVec2>,
-    /// Rotations and edge targets of the warm start with the final states (filled by the
-    /// first local step of pass 1 when no later one switches, else by pass 2), so pass 2 does
-    /// not recompute them.
-    warm_rotations: Vec<DVec2>,
-    warm_targets: Vec<DVec2>,
     /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged.
     kept_rotations: Vec<DVec2>,
     kept_targets: Vec<DVec2>,
-    warm_held: Vec<DVec2>,
-    /// The positions the last frame displayed (the splitting pass continues only from them).
+    /// The positions the last frame displayed (pass 1 continues only from them).
     shown: Vec<DVec2>,
-    /// The generation and active states for which `rotations` and `targets` are those of
-    /// `shown` (set by a frame that finished, taken by the next one): the first local step
-    /// then only judges the parts that have a state to switch to.
-    carried: Option<u64>,
-    carried_states: Vec<usize>,
-    /// Scratch: the parts whose edge targets a state switch changed.
-    touched: Vec<usize>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
 }
@@ -293,8 +283,14 @@ pub struct Solver {
     irls_factor: NumericFactor,
     l2_factor: NumericFactor,
     work: Work,
-    /// Pass-1 splitting variables ([`Pass1::Admm`]), carried between frames.
+    /// The pass-1 pose, and the splitting variables of [`Pass1::Admm`], carried between
+    /// frames.
     splitting: admm::Splitting,
+    /// The connected components of the vertex graph (rigid following).
+    components: follow::Components,
+    /// The mean rest edge length of the active states when the generation was prepared (the
+    /// splitting threshold's unit).
+    mean_rest_edge: f64,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
@@ -316,10 +312,18 @@ impl Solver {
             l2_factor: NumericFactor::default(),
             work: Work::default(),
             splitting: admm::Splitting::default(),
+            components: follow::Components::default(),
+            mean_rest_edge: 1.0,
             shifted: Vec::new(),
             factor_slot: Vec::new(),
             ordered: Vec::new(),
         }
+    }
+
+    /// The pass-1 (sub-quadratic) pose of the last frame, from which the active rest states
+    /// were decided; empty before the first frame.
+    pub fn pass1_pose(&self) -> &[DVec2] {
+        &self.splitting.pose
     }
 
     /// Number of stored entries of the normal matrix's lower triangle (after the first frame).
@@ -366,6 +370,8 @@ impl Solver {
         self.pattern = Pattern::build(n, &asm.data.parts);
         self.work.vertex_parts = local::VertexParts::build(&asm.data.parts, n);
         self.work.rest = local::RestCache::build(&asm.data.parts, &self.work.vertex_parts);
+        self.components = follow::Components::build(&asm.data.parts, n);
+        self.mean_rest_edge = mean_rest_edge(&asm.data.parts);
         self.symbolic = match self.config.kind {
             SolverKind::Cholesky if n > 0 => Some(
                 SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
@@ -416,12 +422,12 @@ impl Solver {
         deadline: Option<Instant>,
     ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
-        // Would another iteration that lasts as long as the last one overrun the deadline?
-        let out_of_time = |last: Duration| deadline.is_some_and(|d| Instant::now() + last > d);
         self.prepare(asm)?;
-        let mut report = FrameReport::default();
+        let mut report = FrameReport {
+            complete: true,
+            ..FrameReport::default()
+        };
         let n = asm.data.positions.len();
-        report.complete = true;
         if n == 0 || asm.data.parts.is_empty() {
             report.converged = true;
             report.ms = start.elapsed().as_secs_f64() * 1e3;
@@ -441,216 +447,40 @@ impl Solver {
         }
         let scale = bbox_diagonal(&warm).max(1e-9);
         let step_tolerance = cfg.tolerance * scale;
-        // Handle vertices start at their targets: the gap then opens where the handle meets the
-        // rest of the model, and the sub-quadratic norm keeps it there (paper 5.2: handles are
-        // the "outliers" and gaps first appear near them).
-        let mut warm_held = std::mem::take(&mut self.work.warm_held);
-        warm_held.clone_from(&warm);
-        for (v, p) in warm_held.iter_mut().enumerate() {
-            let count = self.work.handle_count[v];
-            if count > 0.0 {
-                *p = self.work.handle_sum[v] / count;
-            }
+        // IRLS starts from the displayed least-squares pose every frame: reweighting it
+        // gathers the deformation into the parts the least-squares pose already strains most
+        // (`docs/solver.md`). The splitting continues its own pose and variables while the
+        // assembly is the one this solver last displayed (its gaps carry the history).
+        let m = self.pattern.edges.len();
+        let mut split = std::mem::take(&mut self.splitting);
+        let carry = cfg.pass1 == Pass1::Admm && self.work.shown == warm;
+        if !(carry && split.is_valid(asm.generation(), m, n)) {
+            split.reset(asm.generation(), m, &warm);
         }
-        let mut f = std::mem::take(&mut self.work.f);
-        let mut next = std::mem::take(&mut self.work.next);
-        next.clear();
-        next.resize(n, DVec2::ZERO);
-        let mut pass1_converged = false;
-        // Set once `work.warm_*` hold the displayed pose's rotations and edge targets, with
-        // the states as they were after that many of this frame's switches.
-        let mut warm_cached: Option<usize> = None;
-
-        // Pass 1 by splitting: least-squares solves with the pass-2 factor.
-        let pass1_iterations = match cfg.pass1 {
-            Pass1::Irls => cfg.irls_iterations,
-            Pass1::Admm => cfg.admm_iterations,
-        };
-        let irls_iterations = match cfg.pass1 {
-            Pass1::Irls => cfg.irls_iterations,
-            Pass1::Admm => 0,
-        };
-        let carried = self.work.carried.take() == Some(asm.generation())
-            && self.work.carried_states.len() == asm.data.parts.len()
-            && self
-                .work
-                .carried_states
-                .iter()
-                .zip(&asm.data.parts)
-                .all(|(&s, p)| s == p.active)
-            && self.work.rotations.len() == asm.data.parts.len()
-            && self.work.targets.len() == self.pattern.edges.len();
-        if cfg.pass1 == Pass1::Admm && cfg.admm_iterations > 0 {
-            let carry = self.work.shown == warm;
-            pass1_converged = self.split_pass(
-                asm,
-                SplitStart {
-                    warm: &warm,
-                    carry,
-                    carried: carry && carried,
-                    step_tolerance,
-                    deadline,
-                },
-                &mut f,
-                &mut next,
-                &mut report,
-                &mut warm_cached,
-            )?;
-        } else {
-            f.clone_from(&warm_held);
-            // the splitting variables did not follow this frame
-            self.splitting.generation = None;
-        }
-
-        // Pass 1: IRLS with the sub-quadratic norm; local steps decide the active states.
-        let mut last_iteration = Duration::ZERO;
-        for it in 0..irls_iterations {
-            if it > 0 && out_of_time(last_iteration) {
-                report.complete = false;
-                break;
-            }
-            let iteration_start = Instant::now();
-            report.pass1_iterations += 1;
-            let t = Instant::now();
-            let switched_before = report.switches.len();
-            let pose = if it == 0 { &warm } else { &f };
-            self.judge_states(
-                &mut asm.data.parts,
-                pose,
-                it == 0,
-                &mut report,
-                &mut warm_cached,
-            );
-            report.phases.local += ms_since(t);
-            let t = Instant::now();
-            let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
-            let w = &mut self.work;
-            w.weights.clear();
-            for (e, &t) in self.pattern.edges.iter().zip(&w.targets) {
-                let r = (t - (f[e.x] - f[e.y])).length();
-                let weight = irls_weight(r + eps, p);
-                w.weights.push(if weight.is_finite() {
-                    weight
-                } else {
-                    eps.powf(p - 2.0)
-                });
-            }
-            let mean = mean_or_one(&w.weights);
-            report.phases.assembly += ms_since(t);
-            self.solve_global(&f, &mut next, mean, Pass::Irls, &mut report)?;
-            let delta = max_move(&f, &next);
-            std::mem::swap(&mut f, &mut next);
-            last_iteration = iteration_start.elapsed();
-            if delta <= step_tolerance && report.switches.len() == switched_before {
-                pass1_converged = true;
-                break;
-            }
-        }
-        if pass1_iterations == 0 {
-            pass1_converged = true;
-        }
-
-        // Pass 2: least squares, states fixed. Start from whichever of the pass-1 result and
-        // the warm start is better, and never accept an iterate that raises the objective, so
-        // the frame cannot end worse than it started.
-        let handles = asm.handles();
-        let t = Instant::now();
-        // Candidates: the pass-1 result, the warm start with the handles carried to their
-        // targets (continues last frame's least-squares pose), and the plain warm start. The
-        // handles-moved start is judged only when the pass-1 result does not beat the warm
-        // start (while dragging it nearly always does: one local step saved).
-        let parts = &asm.data.parts;
-        match warm_cached {
-            Some(k) if k == report.switches.len() => {}
-            // Later local steps switched a few parts: only theirs and their neighbours'
-            // rotations and targets at the warm start changed.
-            Some(k) if self.retarget_warm(parts, &warm, &report.switches[k..]) => {}
-            _ => {
-                self.objective(parts, handles, &warm);
-                self.work.warm_rotations.clone_from(&self.work.rotations);
-                self.work.warm_targets.clone_from(&self.work.targets);
-            }
-        }
-        let warm_terms = self.terms_at(&self.work.warm_targets, handles, &warm);
-        // objective() leaves f's rotations and edge targets in the work buffers
-        let mut terms = self.objective(parts, handles, &f);
-        report.warm_objective = warm_terms.total();
-        let mut chosen = 0;
-        let held_judged = report.pass1_iterations > 0 && terms.total() >= warm_terms.total();
-        if held_judged {
-            // keep f's rotations and edge targets aside while the held start is judged
-            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
-            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
-            let held_terms = self.objective(parts, handles, &warm_held);
-            if held_terms.total() < terms.total() {
-                (chosen, terms) = (1, held_terms);
-            }
-        }
-        if warm_terms.total() < terms.total() {
-            (chosen, terms) = (2, warm_terms);
-        }
-        if chosen != 0 {
-            f.copy_from_slice(if chosen == 1 { &warm_held } else { &warm });
-        }
-        // The first solve uses the rotations of its start, or for the handles-moved warm
-        // start those of the last displayed pose (see pass 1).
-        if chosen != 0 || report.pass1_iterations == 0 {
-            self.work.rotations.clone_from(&self.work.warm_rotations);
-            self.work.targets.clone_from(&self.work.warm_targets);
-        } else if held_judged {
-            // judging the handles-moved start overwrote f's rotations: take back the kept ones
-            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
-            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
-        }
-        // Whether the work buffers hold the rotations and edge targets of `f` itself (not
-        // so for the handles-moved start, which borrows the displayed pose's).
-        let mut exact = chosen == 2 || (chosen == 0 && report.pass1_iterations > 0);
-        report.phases.local += ms_since(t);
-        let mut pass2_converged = cfg.l2_iterations == 0;
-        let mut last_iteration = Duration::ZERO;
-        for it in 0..cfg.l2_iterations {
-            if it > 0 && out_of_time(last_iteration) {
-                report.complete = false;
-                break;
-            }
-            let iteration_start = Instant::now();
-            report.l2_iterations += 1;
-            // objective() left the rotations and edge targets of `f` in the work buffers.
-            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
-            let t = Instant::now();
-            // keep f's rotations aside instead of recomputing them if `next` is rejected
-            std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
-            std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
-            let new_terms = self.objective(&asm.data.parts, handles, &next);
-            let improved = new_terms
-                .total()
-                .partial_cmp(&terms.total())
-                .is_some_and(|o| o.is_le());
-            if !improved {
-                // restore rotations of the kept iterate
-                std::mem::swap(&mut self.work.rotations, &mut self.work.kept_rotations);
-                std::mem::swap(&mut self.work.targets, &mut self.work.kept_targets);
-                report.phases.local += ms_since(t);
-                pass2_converged = true;
-                break;
-            }
-            report.phases.local += ms_since(t);
-            let delta = max_move(&f, &next);
-            std::mem::swap(&mut f, &mut next);
-            terms = new_terms;
-            exact = true;
-            last_iteration = iteration_start.elapsed();
-            if delta <= step_tolerance {
-                pass2_converged = true;
-                break;
-            }
-        }
-
+        self.follow_handles(&mut warm, &mut split, step_tolerance);
+        let pass1 = self.pass1(
+            &mut asm.data.parts,
+            &mut split,
+            step_tolerance,
+            deadline,
+            &mut report,
+        );
+        self.splitting = split;
+        let pass1_converged = pass1?;
+        let (f, terms, pass2_converged) = self.pass2(
+            &asm.data.parts,
+            asm.handles(),
+            &warm,
+            step_tolerance,
+            deadline,
+            &mut report,
+        )?;
         if f.iter().any(|p| !p.is_finite()) {
             return Err(SolverError(
                 "the solve produced non-finite positions".into(),
             ));
         }
+        report.moved = max_move(&asm.data.positions, &f);
         asm.data.positions.copy_from_slice(&f);
         let rot = asm.rotations_mut();
         if rot.len() == self.work.rotations.len() {
@@ -659,69 +489,72 @@ impl Solver {
         sync_instance_states(asm);
         report.energy = terms.elastic;
         report.objective = terms.total();
-        report.moved = max_move(&warm, &f);
-        let settled = report.switches.is_empty() && report.moved <= cfg.settle_tolerance * scale;
-        report.converged = report.complete && (settled || (pass1_converged && pass2_converged));
+        let settled = report.moved <= cfg.settle_tolerance * scale;
+        report.converged = report.complete
+            && report.switches.is_empty()
+            && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
-        self.work.carried = exact.then_some(asm.generation());
-        self.work.carried_states.clear();
-        self.work
-            .carried_states
-            .extend(asm.data.parts.iter().map(|p| p.active));
         report.ms = start.elapsed().as_secs_f64() * 1e3;
-        (
-            self.work.warm,
-            self.work.warm_held,
-            self.work.f,
-            self.work.next,
-        ) = (warm, warm_held, f, next);
+        (self.work.warm, self.work.f) = (warm, f);
         Ok(report)
     }
 
-    /// Pass 1 by splitting ([`admm`]): up to `admm_iterations` iterations of local step,
-    /// least-squares solve with the edge targets shifted by `z - u` (pass 2's factor), shrink
-    /// and dual update. Continues the last frame's splitting variables and pass-1 pose when
-    /// the assembly is the same generation and shows what the solver last displayed; else
-    /// starts from the displayed pose with no gaps. Leaves the pass-1 pose in `f`; returns
-    /// whether it converged.
-    fn split_pass(
-        &mut self,
-        asm: &mut Assembly,
-        start: SplitStart<'_>,
-        f: &mut Vec<DVec2>,
-        next: &mut Vec<DVec2>,
-        report: &mut FrameReport,
-        warm_cached: &mut Option<usize>,
-    ) -> Result<bool, SolverError> {
-        let cfg = self.config;
-        let warm = start.warm;
-        let n = warm.len();
-        let m = self.pattern.edges.len();
-        let mut split = std::mem::take(&mut self.splitting);
-        if !(start.carry && split.is_valid(asm.generation(), m, n)) {
-            split.reset(asm.generation(), m, warm);
+    /// Moves every component whose held vertices all moved by one rigid motion by that
+    /// motion ([`follow`]): the displayed pose `warm`, the pass-1 pose and the splitting
+    /// variables (world-frame edge vectors: turned with it).
+    fn follow_handles(&mut self, warm: &mut [DVec2], split: &mut admm::Splitting, tolerance: f64) {
+        let w = &self.work;
+        let held: Vec<bool> = w.handle_count.iter().map(|&c| c > 0.0).collect();
+        if !held.iter().any(|&h| h) {
+            return;
         }
-        // The pass-1 pose continues; the handles' vertices jump to their targets.
-        f.clone_from(&split.pose);
-        for (v, p) in f.iter_mut().enumerate() {
-            let count = self.work.handle_count[v];
-            if count > 0.0 {
-                *p = self.work.handle_sum[v] / count;
+        let target: Vec<DVec2> = w
+            .handle_count
+            .iter()
+            .zip(&w.handle_sum)
+            .map(|(&c, &s)| if c > 0.0 { s / c } else { DVec2::ZERO })
+            .collect();
+        let motions = follow::motions(&self.components, warm, &held, &target, tolerance);
+        if motions.iter().all(Option::is_none) {
+            return;
+        }
+        follow::move_points(&self.components, &motions, warm);
+        follow::move_points(&self.components, &motions, &mut split.pose);
+        for (k, &[x, _]) in self.pattern.ends.iter().enumerate() {
+            if let Some(motion) = &motions[self.components.of(x as usize)] {
+                split.z[k] = motion.apply_direction(split.z[k]);
+                split.u[k] = motion.apply_direction(split.u[k]);
             }
         }
-        let p = cfg.norm;
-        let mut rho = 1.0;
-        let mut converged = false;
+    }
+
+    /// Pass 1 (paper 5.2): the sub-quadratic norm, by splitting or by IRLS, from the pass-1
+    /// pose in `split`; its local steps decide the active rest states. Iterates until no
+    /// vertex moves more than `tolerance` and no state switches, or the configured count, or
+    /// (after [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns
+    /// whether it converged.
+    fn pass1(
+        &mut self,
+        parts: &mut [Part],
+        split: &mut admm::Splitting,
+        tolerance: f64,
+        deadline: Option<Instant>,
+        report: &mut FrameReport,
+    ) -> Result<bool, SolverError> {
+        let cfg = self.config;
+        let iterations = match cfg.pass1 {
+            Pass1::Irls => cfg.irls_iterations,
+            Pass1::Admm => cfg.admm_iterations,
+        };
+        let mut f = std::mem::take(&mut split.pose);
+        let mut next = std::mem::take(&mut self.work.next);
+        next.clear();
+        next.resize(f.len(), DVec2::ZERO);
+        let mut converged = iterations == 0;
         let mut last_iteration = Duration::ZERO;
         let mut result = Ok(());
-        for it in 0..cfg.admm_iterations {
-            // Two iterations are the least that decides states: the first judges the
-            // displayed pose, the second the pass-1 pose, where the gaps are.
-            if it >= MIN_SPLIT_ITERATIONS
-                && start
-                    .deadline
-                    .is_some_and(|d| Instant::now() + last_iteration > d)
-            {
+        for it in 0..iterations {
+            if it >= MIN_PASS1_ITERATIONS && out_of_time(deadline, last_iteration) {
                 report.complete = false;
                 break;
             }
@@ -729,220 +562,228 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            if it == 0 && start.carried {
-                self.judge_carried(&mut asm.data.parts, warm, report, warm_cached);
-            } else {
-                let pose: &[DVec2] = if it == 0 { warm } else { f };
-                self.judge_states(&mut asm.data.parts, pose, it == 0, report, warm_cached);
-            }
-            // A part that switched state has new rest edges: its gaps and duals start over.
-            let edges = &self.pattern.edges;
-            for s in &report.switches[switched_before..] {
-                // edges are listed part by part
-                let first = edges.partition_point(|e| e.part < s.part);
-                let count = edges[first..]
-                    .iter()
-                    .take_while(|e| e.part == s.part)
-                    .count();
-                split.z[first..first + count].fill(DVec2::ZERO);
-                split.u[first..first + count].fill(DVec2::ZERO);
-            }
-            if it == 0 {
-                let lengths: f64 = self.work.targets.iter().map(|t| t.length()).sum();
-                let mean = if m > 0 { lengths / m as f64 } else { 1.0 };
-                let threshold = cfg.admm_threshold * if mean > 0.0 { mean } else { 1.0 };
-                rho = admm::penalty(threshold, p);
-            }
-            self.shifted.clear();
-            self.shifted.extend(
-                self.work
-                    .targets
-                    .iter()
-                    .zip(split.z.iter().zip(&split.u))
-                    .map(|(&t, (&z, &u))| t + z - u),
-            );
+            self.local_step_switching(parts, &f, cfg.hysteresis, &mut report.switches);
+            self.edge_targets(parts);
             report.phases.local += ms_since(t);
-            std::mem::swap(&mut self.work.targets, &mut self.shifted);
-            let solved = self.solve_global(f, next, 1.0, Pass::LeastSquares, report);
-            std::mem::swap(&mut self.work.targets, &mut self.shifted);
+            let solved = match cfg.pass1 {
+                Pass1::Admm => {
+                    let switched = report.switches[switched_before..].to_vec();
+                    self.split_iteration(split, &switched, &f, &mut next, report)
+                }
+                Pass1::Irls => self.irls_iteration(&f, &mut next, report),
+            };
             if let Err(e) = solved {
                 result = Err(e);
                 break;
             }
-            let t = Instant::now();
-            let shrink = admm::Shrink::new(rho, p);
-            // weight c = factor^(2 - p) in the norm: the penalty seen by the shrink is rho / c
-            let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
-            let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
-            let held = &self.work.handle_count;
-            for (k, &[x, y]) in self.pattern.ends.iter().enumerate() {
-                let (x, y) = (x as usize, y as usize);
-                let v = (next[x] - next[y]) - self.work.targets[k] + split.u[k];
-                let z = if held[x] > 0.0 || held[y] > 0.0 {
-                    at_handle.apply(v)
-                } else {
-                    shrink.apply(v)
-                };
-                split.z[k] = z;
-                split.u[k] = v - z;
-            }
-            report.phases.local += ms_since(t);
-            let delta = max_move(f, next);
-            std::mem::swap(f, next);
+            let delta = max_move(&f, &next);
+            std::mem::swap(&mut f, &mut next);
             last_iteration = iteration_start.elapsed();
-            if delta <= start.step_tolerance && report.switches.len() == switched_before {
+            if delta <= tolerance && report.switches.len() == switched_before {
                 converged = true;
                 break;
             }
         }
-        split.pose.clone_from(f);
-        self.splitting = split;
+        split.pose = f;
+        self.work.next = next;
         result.map(|()| converged)
     }
 
-    /// A pass-1 local step: rotations and state choice at `pose`, then the edge targets.
-    /// The first of a frame (`first`) judges the displayed pose, before the handles moved
-    /// (judged with only the handles moved, the parts next to a handle look rotated and the
-    /// first solve would bend a model that should just follow rigidly); its rotations and
-    /// targets are also pass 2's warm start, kept in `warm_*` until a later step switches a
-    /// state.
-    fn judge_states(
+    /// One splitting iteration ([`admm`]): a least-squares solve with the edge targets shifted
+    /// by `z - u` (pass 2's factor), the shrink, the dual update. The edges of parts that
+    /// just switched state have new rest edges: their gaps and duals start over.
+    fn split_iteration(
         &mut self,
-        parts: &mut [Part],
-        pose: &[DVec2],
-        first: bool,
+        split: &mut admm::Splitting,
+        switched: &[StateSwitch],
+        f: &[DVec2],
+        next: &mut [DVec2],
         report: &mut FrameReport,
-        warm_cached: &mut Option<usize>,
-    ) {
-        self.local_step_switching(parts, pose, self.config.hysteresis, &mut report.switches);
-        self.edge_targets(parts);
-        if first {
-            self.work.warm_rotations.clone_from(&self.work.rotations);
-            self.work.warm_targets.clone_from(&self.work.targets);
-            *warm_cached = Some(report.switches.len());
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let t = Instant::now();
+        let edges = &self.pattern.edges;
+        for s in switched {
+            // edges are listed part by part
+            let first = edges.partition_point(|e| e.part < s.part);
+            let count = edges[first..]
+                .iter()
+                .take_while(|e| e.part == s.part)
+                .count();
+            split.z[first..first + count].fill(DVec2::ZERO);
+            split.u[first..first + count].fill(DVec2::ZERO);
         }
+        self.shifted.clear();
+        self.shifted.extend(
+            self.work
+                .targets
+                .iter()
+                .zip(split.z.iter().zip(&split.u))
+                .map(|(&t, (&z, &u))| t + z - u),
+        );
+        report.phases.local += ms_since(t);
+        std::mem::swap(&mut self.work.targets, &mut self.shifted);
+        let solved = self.solve_global(f, next, 1.0, Pass::LeastSquares, report);
+        std::mem::swap(&mut self.work.targets, &mut self.shifted);
+        solved?;
+        let t = Instant::now();
+        let p = cfg.norm;
+        let rho = admm::penalty(cfg.admm_threshold * self.mean_rest_edge, p);
+        let shrink = admm::Shrink::new(rho, p);
+        // weight c = factor^(2 - p) in the norm: the penalty seen by the shrink is rho / c
+        let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
+        let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
+        let held = &self.work.handle_count;
+        let (edges, ends, targets) = (&self.pattern.edges, &self.pattern.ends, &self.work.targets);
+        // One group per part (paper Eq. 6: the shape distance is a part's): the part's
+        // stacked edge residuals shrink together, so the sparse norm gathers deformation into
+        // few parts and spreads it evenly within them (a bent segment, not a torn one).
+        let mut k = 0;
+        while k < ends.len() {
+            let part = edges[k].part;
+            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+            let (mut n2, mut at_held) = (0.0, false);
+            for j in k..end {
+                let [x, y] = ends[j].map(|i| i as usize);
+                let v = (next[x] - next[y]) - targets[j] + split.u[j];
+                split.z[j] = v;
+                n2 += v.length_squared();
+                at_held |= held[x] > 0.0 || held[y] > 0.0;
+            }
+            let scale = if at_held { &at_handle } else { &shrink }.factor(n2);
+            for j in k..end {
+                let v = split.z[j];
+                split.z[j] = v * scale;
+                split.u[j] = v - split.z[j];
+            }
+            k = end;
+        }
+        report.phases.local += ms_since(t);
+        Ok(())
     }
 
-    /// The first local step of a frame that starts where the last one ended, whose
-    /// rotations and edge targets are still in the work buffers: only parts with more than
-    /// one rest state are judged (a part keeping its state gets the same rotation, bit for
-    /// bit, since both come from the same sums), and the edge targets are recomputed only
-    /// when one switched. Otherwise as [`Solver::judge_states`] with `first`.
-    fn judge_carried(
+    /// One IRLS iteration (paper 5.2): weights `1 / (|r| + eps)^(2 - p)` from the residuals
+    /// at `f`, then the weighted global step.
+    fn irls_iteration(
         &mut self,
-        parts: &mut [Part],
-        pose: &[DVec2],
+        f: &[DVec2],
+        next: &mut [DVec2],
         report: &mut FrameReport,
-        warm_cached: &mut Option<usize>,
-    ) {
-        let switched_before = report.switches.len();
-        let hysteresis = self.config.hysteresis;
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let t = Instant::now();
+        let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
         let w = &mut self.work;
-        for (i, part) in parts.iter_mut().enumerate() {
-            if part.states.len() < 2 {
-                continue;
-            }
-            let (state, r) = match &mut w.rest {
-                Some(cache) => cache.choose_state(i, part, pose, hysteresis),
-                None => local::choose_state(part, pose, hysteresis),
+        let edges = &self.pattern.edges;
+        w.weights.clear();
+        w.weights.resize(edges.len(), 0.0);
+        // one weight per part, from its stacked residual (see the splitting's groups)
+        let mut k = 0;
+        while k < edges.len() {
+            let part = edges[k].part;
+            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+            let d2: f64 = (k..end)
+                .map(|j| (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared())
+                .sum();
+            let weight = irls_weight(d2.sqrt() + eps, p);
+            let weight = if weight.is_finite() {
+                weight
+            } else {
+                eps.powf(p - 2.0)
             };
-            if state != part.active {
-                report.switches.push(StateSwitch {
-                    part: i,
-                    from: part.active,
-                    to: state,
-                });
-                part.active = state;
-            }
-            w.rotations[i] = r;
+            w.weights[k..end].fill(weight);
+            k = end;
         }
-        if report.switches.len() > switched_before
-            && !self.retarget_switched(parts, &report.switches[switched_before..])
-        {
-            self.edge_targets(parts);
-        }
-        debug_assert!(self.carried_is_exact(parts, pose));
-        self.work.warm_rotations.clone_from(&self.work.rotations);
-        self.work.warm_targets.clone_from(&self.work.targets);
-        *warm_cached = Some(report.switches.len());
+        let mean = mean_or_one(&w.weights);
+        report.phases.assembly += ms_since(t);
+        self.solve_global(f, next, mean, Pass::Irls, report)
     }
 
-    /// Brings `work.rotations` and `work.targets`, which hold some pose's values with the
-    /// states before `switches`, up to date after them, given that the switched parts'
-    /// rotations already are: a switch changes the part's rest edges and rotation, hence its
-    /// own targets and those of every part sharing a vertex with it (their `R_xy`); no
-    /// other target. `false` (nothing done) without a rest cache that fits the parts.
-    fn retarget_switched(&mut self, parts: &[Part], switches: &[StateSwitch]) -> bool {
-        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+    /// Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose
+    /// `warm`, until no vertex moves more than `tolerance`, or the configured count, or (after
+    /// one iteration) the deadline. With no pass-2 iterations configured, shows the pass-1
+    /// pose. Returns the pose, its objective's terms (its rotations and edge targets left in
+    /// the work buffers) and whether it converged.
+    fn pass2(
+        &mut self,
+        parts: &[Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        tolerance: f64,
+        deadline: Option<Instant>,
+        report: &mut FrameReport,
+    ) -> Result<(Vec<DVec2>, Terms, bool), SolverError> {
+        let cfg = self.config;
+        let mut f = std::mem::take(&mut self.work.f);
+        f.clear();
+        f.extend_from_slice(if cfg.l2_iterations == 0 {
+            &self.splitting.pose
+        } else {
+            warm
+        });
+        let mut next = std::mem::take(&mut self.work.next);
+        next.clear();
+        next.resize(f.len(), DVec2::ZERO);
+        let t = Instant::now();
+        self.rotations_at(parts, &f);
+        self.edge_targets(parts);
+        let mut terms = self.terms_at(&self.work.targets, handles, &f);
+        report.warm_objective = terms.total();
+        report.phases.local += ms_since(t);
+        let mut converged = cfg.l2_iterations == 0;
+        let mut last_iteration = Duration::ZERO;
+        for it in 0..cfg.l2_iterations {
+            if it > 0 && out_of_time(deadline, last_iteration) {
+                report.complete = false;
+                break;
+            }
+            let iteration_start = Instant::now();
+            report.l2_iterations += 1;
+            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, report)?;
+            let t = Instant::now();
+            // f's rotations and targets aside while `next` is judged
+            let w = &mut self.work;
+            std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
+            std::mem::swap(&mut w.targets, &mut w.kept_targets);
+            self.rotations_at(parts, &next);
+            self.edge_targets(parts);
+            let next_terms = self.terms_at(&self.work.targets, handles, &next);
+            report.phases.local += ms_since(t);
+            // Only an iterate that lowers the objective is taken: a frame never ends worse
+            // than it started, and a model at rest stays exactly where it is (a solve of a
+            // pose at rest only adds rounding, and a free component's rounding drifts).
+            if next_terms.total() >= terms.total() || !next_terms.total().is_finite() {
+                let w = &mut self.work;
+                std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
+                std::mem::swap(&mut w.targets, &mut w.kept_targets);
+                converged = true;
+                break;
+            }
+            let delta = max_move(&f, &next);
+            std::mem::swap(&mut f, &mut next);
+            terms = next_terms;
+            last_iteration = iteration_start.elapsed();
+            if delta <= tolerance {
+                converged = true;
+                break;
+            }
+        }
+        self.work.next = next;
+        Ok((f, terms, converged))
+    }
+
+    /// Each part's rotation onto `f` with its active state (states fixed), into
+    /// `work.rotations`.
+    fn rotations_at(&mut self, parts: &[Part], f: &[DVec2]) {
         let w = &mut self.work;
         match &mut w.rest {
-            Some(cache) if cache.parts() == parts.len() && cache.edges() == w.targets.len() => {
-                w.touched.clear();
-                for s in switches {
-                    w.touched.push(s.part);
-                    for &v in &parts[s.part].vertices {
-                        w.touched.extend_from_slice(w.vertex_parts.of(v));
-                    }
-                }
-                w.touched.sort_unstable();
-                w.touched.dedup();
-                cache.edge_targets_of(parts, &w.touched, &w.rotations, cos_cone, &mut w.targets);
-                true
+            Some(cache) => cache.part_rotations(parts, f, &mut w.rotations),
+            None => {
+                w.rotations.clear();
+                w.rotations
+                    .extend(parts.iter().map(|part| local::part_rotation(part, f)));
             }
-            _ => false,
         }
-    }
-
-    /// Brings the warm start's rotations and edge targets (`work.warm_*`, computed at `warm`
-    /// before `switches`) up to date with the parts' states, recomputing only what the
-    /// switches changed: the same values, bit for bit, as a full local step at `warm`.
-    /// `work.rotations` and `work.targets` are left as they were. `false` when it could not
-    /// (the caller then redoes the local step at `warm`).
-    fn retarget_warm(&mut self, parts: &[Part], warm: &[DVec2], switches: &[StateSwitch]) -> bool {
-        let w = &mut self.work;
-        if w.warm_rotations.len() != parts.len() || switches.iter().any(|s| s.part >= parts.len()) {
-            return false;
-        }
-        let Some(cache) = &mut w.rest else {
-            return false;
-        };
-        std::mem::swap(&mut w.rotations, &mut w.warm_rotations);
-        std::mem::swap(&mut w.targets, &mut w.warm_targets);
-        for s in switches {
-            w.rotations[s.part] = cache.part_rotation(s.part, &parts[s.part], warm);
-        }
-        let done = self.retarget_switched(parts, switches);
-        debug_assert!(!done || self.carried_is_exact(parts, warm));
-        let w = &mut self.work;
-        std::mem::swap(&mut w.rotations, &mut w.warm_rotations);
-        std::mem::swap(&mut w.targets, &mut w.warm_targets);
-        done
-    }
-
-    /// Debug check of [`Solver::judge_carried`]: the carried rotations and edge targets
-    /// equal, bit for bit, those recomputed at `pose` (checked on models small enough to
-    /// afford it).
-    fn carried_is_exact(&mut self, parts: &[Part], pose: &[DVec2]) -> bool {
-        if parts.len() > 5000 {
-            return true;
-        }
-        let (rotations, targets) = (self.work.rotations.clone(), self.work.targets.clone());
-        let bits = |v: &[DVec2]| -> Vec<[u64; 2]> {
-            v.iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect()
-        };
-        self.work.rotations.clear();
-        for (i, part) in parts.iter().enumerate() {
-            let r = match &mut self.work.rest {
-                Some(cache) => cache.part_rotation(i, part, pose),
-                None => local::part_rotation(part, pose),
-            };
-            self.work.rotations.push(r);
-        }
-        self.edge_targets(parts);
-        let exact = bits(&rotations) == bits(&self.work.rotations)
-            && bits(&targets) == bits(&self.work.targets);
-        (self.work.rotations, self.work.targets) = (rotations, targets);
-        exact
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
@@ -1041,22 +882,6 @@ impl Solver {
                 k += 1;
             }
         }
-    }
-
-    /// Pass-2 objective at `f` with the states fixed; leaves `f`'s rotations and edge targets
-    /// in the work buffers.
-    fn objective(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
-        let w = &mut self.work;
-        match &mut w.rest {
-            Some(cache) => cache.part_rotations(parts, f, &mut w.rotations),
-            None => {
-                w.rotations.clear();
-                w.rotations
-                    .extend(parts.iter().map(|part| local::part_rotation(part, f)));
-            }
-        }
-        self.edge_targets(parts);
-        self.terms_at(&self.work.targets, handles, f)
     }
 
     /// The pass-2 objective's terms at `f` for the given edge targets.
@@ -1322,21 +1147,34 @@ fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFa
     factor.invalidate();
 }
 
-/// Splitting iterations a budgeted frame always runs (when configured to run that many).
-const MIN_SPLIT_ITERATIONS: usize = 2;
+/// Pass-1 iterations a budgeted frame always runs (when configured to run that many): the
+/// first judges the pose the last frame left, the second the pose with the handles moved.
+const MIN_PASS1_ITERATIONS: usize = 2;
 
-/// Where a splitting pass 1 starts from.
-struct SplitStart<'a> {
-    /// The displayed pose.
-    warm: &'a [DVec2],
-    /// Whether the displayed pose is the one this solver last produced (so the splitting
-    /// variables may continue).
-    carry: bool,
-    /// Whether, besides, the work buffers still hold that pose's rotations and edge targets
-    /// for the current states.
-    carried: bool,
-    step_tolerance: f64,
-    deadline: Option<Instant>,
+/// Would another iteration that lasts as long as the last one overrun the deadline?
+fn out_of_time(deadline: Option<Instant>, last: Duration) -> bool {
+    deadline.is_some_and(|d| Instant::now() + last > d)
+}
+
+/// The mean length of the parts' rest edges in their active states (1 when there are none).
+fn mean_rest_edge(parts: &[Part]) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for part in parts {
+        if let Some(rest) = part.states.get(part.active) {
+            for e in &part.edges {
+                if let (Some(a), Some(b)) = (rest.positions.get(e[0]), rest.positions.get(e[1])) {
+                    sum += (*a - *b).length();
+                    count += 1;
+                }
+            }
+        }
+    }
+    let mean = sum / count.max(1) as f64;
+    if mean.is_finite() && mean > 0.0 {
+        mean
+    } else {
+        1.0
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -1498,7 +1336,10 @@ fn cone_cosine(degrees: f64) -> f64 {
 /// Largest `|length / rest length - 1|` over the edges of every part's active state (edges
 /// of zero rest length are skipped).
 pub fn max_edge_strain(asm: &Assembly) -> f64 {
-    edge_strains(asm).into_iter().fold(0.0, f64::max)
+    edge_strains(asm)
+        .into_iter()
+        .map(f64::abs)
+        .fold(0.0, f64::max)
 }
 
 /// `length / rest length - 1` (signed) of every edge of every part's active state, part by
