@@ -226,19 +226,6 @@ fn fig8_monotonic_push_to_half_drops_bricks() {
     );
 }
 
-/// A wall pulled along its own line stays on it, even with least squares at 5x.
-#[test]
-fn fig8_least_squares_at_5x_stays_on_the_line() {
-    let s = wall_pull(2.0, 32.0, 240);
-    let [_, y0, _, y1] = s.bbox();
-    assert!(
-        ((y1 - y0) - 0.5).abs() <= 0.05,
-        "p = 2 pulled to 5x: bounding-box height {:.4} (rest 0.5), {}",
-        y1 - y0,
-        s.figures()
-    );
-}
-
 /// The path of `bend.clay`'s east end when only segment `k` (of six, 2 m each, along +x from
 /// the origin) bends evenly by `theta` radians and the segments after it stay straight: the
 /// centroid of the last segment (the handle).
