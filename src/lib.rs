@@ -2,6 +2,7 @@
 pub mod assembly;
 pub mod authoring;
 pub mod fit;
+pub mod gallery;
 pub mod render;
 pub mod rules;
 pub mod script;
