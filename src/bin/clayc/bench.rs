@@ -31,7 +31,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub json: bool,
     /// How pass 1 minimises the sub-quadratic energy.
-    #[arg(long, value_enum, default_value_t = Pass1Arg::Admm)]
+    #[arg(long, value_enum, default_value_t = Pass1Arg::Irls)]
     pub pass1: Pass1Arg,
     /// Most splitting (pass 1, `--pass1 admm`) iterations per frame (default: the solver's).
     #[arg(long)]
