@@ -100,6 +100,12 @@ impl Session {
         [lo.x, lo.y, hi.x, hi.y]
     }
 
+    /// Prints the figures (`cargo test --test paper_claims -- --nocapture` shows every
+    /// claim's measurements, passing or not).
+    fn report(&self, what: &str) {
+        eprintln!("{what}: {}", self.figures());
+    }
+
     /// The figures a failure prints.
     fn figures(&self) -> String {
         let fired: BTreeMap<&str, usize> = self
@@ -150,6 +156,7 @@ fn sec5_1_wall_round_trip_has_its_bricks_back() {
             .run(&drag(8.0, 0.0, frames))
             .run(&hold(60));
         let (bricks, strain) = (s.count("brick"), s.strain());
+        s.report(&format!("wall to 2x over {frames} frames"));
         assert!(
             (15..=17).contains(&bricks) && strain <= 0.05,
             "{frames} frames to 2x: {bricks} bricks (want 16 +- 1), {}",
@@ -157,6 +164,7 @@ fn sec5_1_wall_round_trip_has_its_bricks_back() {
         );
         s.run(&drag(-8.0, 0.0, frames)).run(&hold(60));
         let (bricks, strain, energy) = (s.count("brick"), s.strain(), s.energy());
+        s.report(&format!("wall to 2x and back over {frames} frames"));
         assert!(
             bricks == 8 && strain <= 0.02 && energy <= 1e-6,
             "{frames} frames to 2x and back: {bricks} bricks (want exactly 8), {}",
@@ -180,6 +188,7 @@ fn wall_pull(norm: f64, by: f64, frames: u64) -> Session {
 #[test]
 fn fig8_sub_l1_inserts_early() {
     let s = wall_pull(0.5, 0.8, 60);
+    s.report("p = 0.5 at 1.10x");
     assert!(
         s.count("brick") >= 9,
         "p = 0.5 at 1.10x: {} bricks (want >= 9), {}",
@@ -192,6 +201,7 @@ fn fig8_sub_l1_inserts_early() {
 #[test]
 fn fig8_least_squares_spreads_and_lags() {
     let s = wall_pull(2.0, 1.2, 60);
+    s.report("p = 2 at 1.15x");
     assert!(
         s.count("brick") == 8,
         "p = 2 at 1.15x: {} bricks (want 8), {}",
@@ -205,6 +215,7 @@ fn fig8_least_squares_spreads_and_lags() {
 #[test]
 fn fig8_monotonic_pull_to_3x_fills_the_length() {
     let s = wall_pull(0.5, 16.0, 240);
+    s.report("p = 0.5 pulled to 3x");
     let bricks = s.count("brick");
     assert!(
         (23..=25).contains(&bricks) && s.fired(RuleKind::Shrink) == 0,
@@ -218,6 +229,7 @@ fn fig8_monotonic_pull_to_3x_fills_the_length() {
 #[test]
 fn fig8_monotonic_push_to_half_drops_bricks() {
     let s = wall_pull(0.5, -4.0, 240);
+    s.report("p = 0.5 pushed to 0.5x");
     let bricks = s.count("brick");
     assert!(
         (3..=5).contains(&bricks) && s.fired(RuleKind::Stretch) == 0,
@@ -274,6 +286,7 @@ fn fig4_bend_snaps_to_a_quarter_turn() {
         .run(&bend_steps(3, segment_start(3)))
         .run(&hold(60));
     let states = s.states("road");
+    s.report(&format!("bend to 90 degrees, states {states:?}"));
     let left = states.iter().filter(|n| *n == "left").count();
     let right = states.iter().filter(|n| *n == "right").count();
     assert!(
@@ -299,6 +312,7 @@ fn fig4_u_turn_snaps_to_two_quarter_turns() {
         .run(&bend_steps(4, after_first))
         .run(&hold(60));
     let states = s.states("road");
+    s.report(&format!("U-turn, states {states:?}"));
     let left = states.iter().filter(|n| *n == "left").count();
     let right = states.iter().filter(|n| *n == "right").count();
     assert!(
@@ -362,6 +376,9 @@ fn sec4_1_free_rotation_is_rigid() {
             let (lo, hi) = bbox(&expected).unwrap();
             let size = (hi - lo).length();
             s.run(&rotate(degrees, 30)).run(&hold(60));
+            s.report(&format!(
+                "{name} turned {degrees} degrees (rigid bbox {lo:.4} {hi:.4})"
+            ));
             let got = s.bbox();
             let want = [lo.x, lo.y, hi.x, hi.y];
             let off = got
@@ -389,6 +406,7 @@ fn sec4_1_free_translation_is_exact() {
             .run(&drag(-5.0, 3.0, 30))
             .run(&hold(10));
         let components = vertex_components(&s.asm);
+        s.report(&format!("{name} moved by (-5, 3) from bbox {before:.4?}"));
         let got = s.bbox();
         if components.iter().all(|&c| c == components[0]) {
             let want = [
@@ -439,6 +457,10 @@ fn sec4_3_hysteresis_stops_oscillation() {
                 s
             };
             let (plain, jittered) = (session(false), session(true));
+            jittered.report(&format!(
+                "{pass1:?} jittered at {stretch}x ({} events plain)",
+                plain.events()
+            ));
             assert!(
                 jittered.events() <= plain.events() + 2,
                 "{pass1:?} at {stretch}x: {} events jittered, {} plain; jittered {}",
@@ -459,6 +481,7 @@ fn sec5_1_cut_connection_rewelds_only_after_parting() {
     s.run(r#"{"pin": {"extreme": "west"}}, {"pin": {"at": [15, 0]}}, {"grab": {"at": [9, 3]}}"#)
         .run(&drag(0.0, -1.3, 40))
         .run(&hold(10));
+    s.report("junction welded");
     assert_eq!(s.fired(RuleKind::Merge), 1, "{}", s.figures());
     // cut the weld and hold: it stays cut
     s.run(r#"{"cut": {"at": [9.5, 1.2]}}"#).run(&hold(30));
@@ -487,6 +510,7 @@ fn sec5_1_cut_connection_rewelds_only_after_parting() {
 fn max_edge_strain_counts_compression() {
     let mut s = Session::new("wall", |_| {});
     s.run(PIN_WEST_GRAB_EAST).run(&drag(-0.48, 0.0, 2));
+    s.report("a quick 6% squeeze");
     assert!(
         s.strain() >= 0.03,
         "a quick 6% squeeze: max |strain| {:.4}, {}",
