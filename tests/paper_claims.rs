@@ -11,6 +11,7 @@ use std::sync::Arc;
 use clay::assembly::Assembly;
 use clay::rules::{RuleKind, Rules};
 use clay::script::{Replay, Script};
+use clay::solver::follow::Components;
 use clay::solver::{Pass1, SolverConfig, bbox, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
@@ -58,13 +59,7 @@ impl Session {
     }
 
     fn count(&self, piece: &str) -> usize {
-        let g = &self.grammar;
-        self.asm
-            .data
-            .instances
-            .iter()
-            .filter(|i| g.pieces[i.piece].name == piece)
-            .count()
+        self.states(piece).len()
     }
 
     /// Instances of `piece` per active state name, in the model's order.
@@ -322,24 +317,11 @@ fn fig4_u_turn_snaps_to_two_quarter_turns() {
     );
 }
 
-/// Components of the vertex graph: for every vertex, a representative.
+/// Components of the vertex graph: for every vertex, its component.
 fn vertex_components(asm: &Assembly) -> Vec<usize> {
     let n = asm.data.positions.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for part in &asm.data.parts {
-        for w in part.vertices.windows(2) {
-            let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
-            parent[a] = b;
-        }
-    }
-    (0..n).map(|v| root(&mut parent, v)).collect()
+    let components = Components::build(&asm.data.parts, n);
+    (0..n).map(|v| components.of(v)).collect()
 }
 
 const GRAMMARS: [&str; 6] = ["wall", "bend", "castle", "streets", "centipede", "junction"];
