@@ -16,13 +16,13 @@ piece brick {
     site west: joint [nw, sw] out (-1, 0)
     site east: joint [se, ne] out (1, 0)
     polygon skinned fill #b5651d { (0.03, 0.03) (0.97, 0.03) (0.97, 0.47) (0.03, 0.47) hole { (0.4, 0.2) (0.6, 0.2) (0.5, 0.3) } }
-    state squat { sw (0, 0) se (1, 0) ne (1, 0.4) nw (0, 0.4) polyline width 0.1 fill #00000080 { (0, 0) (1, 0.4) } }
 }
 piece tower {
     vertex a (-1, -1) vertex b (1, -1) vertex c (1, 1) vertex d (-1, 1)
     vertex p (-0.25, 1) vertex q (0.25, 1)
     edges a-b-c-q-p-d-a, a-c
     site north: plug [q, p] out (0, 1)
+    state squat { a (-1, -1) b (1, -1) c (1, 0.5) d (-1, 0.5) p (-0.25, 0.5) q (0.25, 0.5) polyline width 0.1 fill #00000080 { (0, 0) (1, 0.4) } }
     axis north -> north
 }
 stretch brick from west to east { min 2 variants { brick 1 } }

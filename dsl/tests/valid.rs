@@ -79,6 +79,25 @@ piece seg {
     site west: end [d, a] out (-1, 0)
     site east: end [b, c] out (1, 0)
     polygon skinned fill #808080 { (0, 0) (2, 0) (2, 1) (0, 1) }
+}
+stretch seg from west to east { min 3 }
+model { road = chain seg x 4 at (10, 5) }
+"#;
+
+/// The segment outside any chain, with alternative states: a stretch piece may not have them
+/// (E047), so it gets its axis from `axis` instead.
+const POSED: &str = r#"
+site type end
+piece seg {
+    vertex a (0, 0)
+    vertex b (2, 0)
+    vertex c (2, 1)
+    vertex d (0, 1)
+    edges a-b-c-d-a, a-c
+    site west: end [d, a] out (-1, 0)
+    site east: end [b, c] out (1, 0)
+    axis west -> east
+    polygon skinned fill #808080 { (0, 0) (2, 0) (2, 1) (0, 1) }
     state leaning {
         a (0, 0) b (2, 0) c (2.5, 1) d (0.5, 1)
     }
@@ -87,13 +106,12 @@ piece seg {
         polygon rigid fill #ff000080 { (0, 0) (2, 0) (2, 1.5) }
     }
 }
-stretch seg from west to east { min 3 }
-model { road = chain seg x 4 at (10, 5) }
+model { post = seg at (10, 5) }
 "#;
 
 #[test]
 fn alternative_states_keep_vertex_order_and_frame_their_geometry() {
-    let g = ok(SEGMENT).grammar;
+    let g = ok(POSED).grammar;
     let p = &g.pieces[0];
     let names: Vec<&str> = p.states.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["base", "leaning", "bent"]);

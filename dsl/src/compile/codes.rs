@@ -53,6 +53,8 @@ pub const JUNCTION_SITES: &str = "E043";
 pub const TWO_STRETCH: &str = "E045";
 /// A chain with no `along` whose piece has no stretch rule.
 pub const CHAIN_SITES: &str = "E046";
+/// A stretch piece or variant that declares alternative rest states, which could never become active.
+pub const ELEMENT_STATES: &str = "E047";
 
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";

@@ -90,6 +90,8 @@ pub(crate) struct PieceSpans {
     pub sites: Vec<Span>,
     /// Where each of the piece's edges was written.
     pub edges: Vec<Span>,
+    /// `state NAME` of each alternative rest state that was compiled, in order.
+    pub states: Vec<Span>,
     /// False when the piece had errors: later passes skip geometric checks on it.
     pub sound: bool,
 }
@@ -586,6 +588,9 @@ impl Compiler {
                 let state = self.state(&piece, &spans, st, index, &geometry);
                 piece.states.push(state);
                 state_spans.push(st.name.span);
+                spans
+                    .states
+                    .push(Span::new(st.span.start, st.name.span.end));
             }
         }
         if let Some(a) = axis {

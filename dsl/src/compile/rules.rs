@@ -164,6 +164,8 @@ impl Compiler {
                 ok = false;
             } else {
                 claimed[v.piece] = Some(head);
+                // Checked at the first claim only, so a piece gets one E047 however it is named.
+                self.no_element_states(v.piece, head);
             }
         }
         let (Some(from), Some(to), Some(min)) = (from, to, min) else {
@@ -197,6 +199,23 @@ impl Compiler {
             part,
         });
         self.stretch_spans.push(s.span);
+    }
+
+    /// A chain element may not declare alternative rest states: the solver covers every chain
+    /// with two-element stretch parts, whose only states are `one`/`two`/`three`, so the piece's
+    /// own states could never become active. Reports the first of them (E047) against `rule`.
+    fn no_element_states(&mut self, piece: usize, rule: Span) {
+        let Some(&first) = self.piece_spans[piece].states.first() else {
+            return;
+        };
+        let p = &self.pieces[piece];
+        // `states[0]` is `base`; the first alternative is the one `first` points at.
+        let (name, state) = (p.name.clone(), p.states[1].name.clone());
+        self.error(
+            Diagnostic::error(codes::ELEMENT_STATES, format!("piece `{name}` is a chain element, so it cannot have alternative rest states"), first, format!("state `{state}` would never become active"))
+                .with_secondary(rule, format!("this rule makes `{name}` a chain element"))
+                .with_hint("alternative states on a stretch element would never become active: the chain's two-element parts only have the one/two/three states; move the states to a piece outside the chain, or drop the stretch rule"),
+        );
     }
 
     /// Site types compatible and vertex counts equal; reports otherwise.
