@@ -68,36 +68,31 @@ fn the_language_doc_example_compiles_to_a_wall_of_eight_bricks() {
     assert_eq!(g.pieces[0].axis, Some([0, 1]));
 }
 
-const SEGMENT: &str = r#"
-site type end
-piece seg {
-    vertex a (0, 0)
-    vertex b (2, 0)
-    vertex c (2, 1)
-    vertex d (0, 1)
-    edges a-b-c-d-a, a-c
-    site west: end [d, a] out (-1, 0)
-    site east: end [b, c] out (1, 0)
-    polygon skinned fill #808080 { (0, 0) (2, 0) (2, 1) (0, 1) }
+/// A 2 m segment piece: vertices, edges, sites, skinned geometry; `extra` goes inside it.
+macro_rules! segment {
+    ($extra:literal, $rest:literal) => {
+        concat!(
+            "site type end\npiece seg {\n",
+            "    vertex a (0, 0)\n    vertex b (2, 0)\n    vertex c (2, 1)\n    vertex d (0, 1)\n",
+            "    edges a-b-c-d-a, a-c\n",
+            "    site west: end [d, a] out (-1, 0)\n    site east: end [b, c] out (1, 0)\n",
+            "    polygon skinned fill #808080 { (0, 0) (2, 0) (2, 1) (0, 1) }\n",
+            $extra,
+            "}\n",
+            $rest
+        )
+    };
 }
-stretch seg from west to east { min 3 }
-model { road = chain seg x 4 at (10, 5) }
-"#;
+
+const SEGMENT: &str = segment!(
+    "",
+    "stretch seg from west to east { min 3 }\nmodel { road = chain seg x 4 at (10, 5) }\n"
+);
 
 /// The segment outside any chain, with alternative states: a stretch piece may not have them
 /// (E047), so it gets its axis from `axis` instead.
-const POSED: &str = r#"
-site type end
-piece seg {
-    vertex a (0, 0)
-    vertex b (2, 0)
-    vertex c (2, 1)
-    vertex d (0, 1)
-    edges a-b-c-d-a, a-c
-    site west: end [d, a] out (-1, 0)
-    site east: end [b, c] out (1, 0)
-    axis west -> east
-    polygon skinned fill #808080 { (0, 0) (2, 0) (2, 1) (0, 1) }
+const POSED: &str = segment!(
+    r#"    axis west -> east
     state leaning {
         a (0, 0) b (2, 0) c (2.5, 1) d (0.5, 1)
     }
@@ -105,9 +100,9 @@ piece seg {
         a (0, 0) b (2, 0) c (2, 1.5) d (0, 1)
         polygon rigid fill #ff000080 { (0, 0) (2, 0) (2, 1.5) }
     }
-}
-model { post = seg at (10, 5) }
-"#;
+"#,
+    "model { post = seg at (10, 5) }\n"
+);
 
 #[test]
 fn alternative_states_keep_vertex_order_and_frame_their_geometry() {
