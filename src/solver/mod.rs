@@ -67,19 +67,17 @@ pub struct SolverConfig {
     pub kind: SolverKind,
     /// The pass-1 method.
     pub pass1: Pass1,
-    /// [`Pass1::Admm`]: residuals shorter than this fraction of the mean rest edge length
-    /// close (the edge stays rigid); longer ones open as gaps.
+    /// [`Pass1::Admm`]: a part whose stacked residual is shorter than this fraction of the
+    /// mean rest edge length closes (stays rigid); a longer one opens as a gap.
     pub admm_threshold: f64,
-    /// [`Pass1::Admm`]: edges at a held vertex close below this fraction of the threshold,
-    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained edges the gaps
+    /// [`Pass1::Admm`]: parts with a held vertex close below this fraction of the threshold,
+    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained parts the gaps
     /// then open at the handles first (paper 5.2: the handles are the outliers); without it a
     /// chain pulled evenly stays evenly stretched, a stationary point the splitting cannot
-    /// leave by itself. Slightly below 1 breaks such ties without overriding real differences
-    /// (0.5 makes the streets next to a handle turn first and tears a bent street).
+    /// leave by itself.
     pub admm_handle_factor: f64,
     /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
-    /// the kept factor, a shrink and a dual update). The variables carry over between frames,
-    /// so fewer are needed than IRLS iterations.
+    /// the kept factor, a shrink and a dual update); the variables carry over between frames.
     pub admm_iterations: usize,
     /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
     pub hysteresis: f64,
@@ -87,8 +85,8 @@ pub struct SolverConfig {
     pub norm: f64,
     /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
     pub irls_epsilon: f64,
-    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local and a global step
-    /// with a fresh numeric factorisation.
+    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
+    /// per part, and a global step with a fresh numeric factorisation.
     pub irls_iterations: usize,
     /// Most least-squares (pass 2) iterations per frame.
     pub l2_iterations: usize,
@@ -99,7 +97,8 @@ pub struct SolverConfig {
     pub proximal_weight: f64,
     /// Parts whose rotations differ by more than this many degrees do not average into each
     /// other's `R_xy` (pieces at a corner sit in different frames even at rest). 180 gives the
-    /// paper's plain average, 0 each part's own rotation.
+    /// paper's plain average, 0 (the default) each part's own rotation: see `docs/solver.md`
+    /// for why (a cone makes the energy jump when a part crosses it).
     pub rotation_cone_degrees: f64,
     /// Pass 2 stops early once no vertex moved more than this fraction of the model's size.
     pub tolerance: f64,
