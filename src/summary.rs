@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::assembly::Assembly;
 use crate::rules::RuleKind;
+use crate::solver::follow::Components;
 use crate::solver::{FrameReport, SolverConfig, bbox, elastic_energy, max_edge_strain};
 
 /// Median and largest frame time in milliseconds (0 when no frame ran).
@@ -56,38 +57,21 @@ fn median(values: &[f64]) -> f64 {
     }
 }
 
-/// Connected components of the part graph.
+/// Connected components of the part graph (the solver's [`Components`], counted over the
+/// vertices that parts use).
 pub fn components(asm: &Assembly) -> usize {
     let n = asm.data.positions.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for part in &asm.data.parts {
-        let mut vs = part.vertices.iter().copied().filter(|&v| v < n);
-        if let Some(first) = vs.next() {
-            for v in vs {
-                let (a, b) = (root(&mut parent, first), root(&mut parent, v));
-                if a != b {
-                    parent[a] = b;
-                }
-            }
-        }
-    }
-    let mut roots: Vec<usize> = asm
+    let components = Components::build(&asm.data.parts, n);
+    let mut used: Vec<usize> = asm
         .data
         .parts
         .iter()
         .filter_map(|p| p.vertices.iter().copied().find(|&v| v < n))
-        .map(|v| root(&mut parent, v))
+        .map(|v| components.of(v))
         .collect();
-    roots.sort_unstable();
-    roots.dedup();
-    roots.len()
+    used.sort_unstable();
+    used.dedup();
+    used.len()
 }
 
 /// Summarises `asm` after a session with these frame times, rule counts and last frame.
