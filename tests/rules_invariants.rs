@@ -127,7 +127,7 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
     assert_eq!(events[0].instances, vec![d.instances[instance].id]);
     assert_eq!(d.instances[instance].state, 2);
     assert!(
-        events[0].detail.contains("base -> right"),
+        events[0].detail.contains("is now `right` (was `base`)"),
         "{}",
         events[0].detail
     );

@@ -14,7 +14,10 @@ use crate::author::{AuthorCommand, Authoring};
 use crate::author_canvas::{AuthorCanvas, Tool};
 use crate::author_panel::{self, AuthorForm};
 use crate::canvas::Canvas;
-use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Problem, Severity};
+use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem, Severity};
+use crate::files::{Desktop, NativeDialog, Recent};
+use crate::help;
+use crate::overlay::ViewOverlays;
 use crate::panels;
 use crate::sculpt::{Command, Sculpt};
 use crate::session::{self, Session};
@@ -33,6 +36,9 @@ pub const BACKGROUND_ABOVE: Duration = Duration::from_millis(4);
 /// Budget of one background solver frame: about one 60 Hz frame, so the model follows the
 /// mouse at up to 60 solver frames per second.
 pub const BACKGROUND_BUDGET: Duration = Duration::from_micros(16_667);
+
+/// The window title's last part: `castle.clay • Clay`.
+pub const TITLE: &str = "Clay";
 
 /// A file operation the user asked for.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,36 +69,14 @@ pub enum Mode {
     Author,
 }
 
-/// What a path asked for in the file dialog is for.
+pub use crate::files::FileKind;
+
+/// The unsaved-changes prompt's answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FileKind {
-    Grammar,
-    OpenSession,
-    SaveSession,
-    Png,
-    Json,
-}
-
-impl FileKind {
-    fn title(self) -> &'static str {
-        match self {
-            FileKind::Grammar => "Open grammar",
-            FileKind::OpenSession => "Open session",
-            FileKind::SaveSession => "Save session as",
-            FileKind::Png => "Export view as PNG",
-            FileKind::Json => "Export deformed assembly as JSON",
-        }
-    }
-
-    fn action(self, path: PathBuf) -> Action {
-        match self {
-            FileKind::Grammar => Action::OpenGrammar(path),
-            FileKind::OpenSession => Action::OpenSession(path),
-            FileKind::SaveSession => Action::SaveSession(path),
-            FileKind::Png => Action::ExportPng(path),
-            FileKind::Json => Action::ExportJson(path),
-        }
-    }
+enum Answer {
+    Save,
+    Discard,
+    Cancel,
 }
 
 struct PathDialog {
@@ -129,6 +113,70 @@ pub struct EditorApp {
     author_commands: Vec<AuthorCommand>,
     /// Tab was pressed (taken out of the input before egui moves keyboard focus with it).
     mode_key: bool,
+    desktop: Desktop,
+    pub recent: Recent,
+    /// A native file dialog waiting for the user.
+    native: Option<NativeDialog>,
+    /// What to do once the session is saved (the unsaved-changes prompt's Save).
+    after_save: Option<Action>,
+    /// The gestures-and-keys overlay is open.
+    pub help_open: bool,
+    pub overlays: ViewOverlays,
+    /// The window title last sent to the window.
+    title: String,
+    /// A file the user asked to open that was not opened, and its problems; the current model
+    /// stayed.
+    pub refused: Option<(String, Vec<Problem>)>,
+    /// The source line the user clicked in the diagnostics.
+    pub source_view: Option<panels::SourceView>,
+}
+
+/// The action a picked path is for.
+fn file_action(kind: FileKind, path: PathBuf) -> Action {
+    match kind {
+        FileKind::Grammar => Action::OpenGrammar(path),
+        FileKind::OpenSession => Action::OpenSession(path),
+        FileKind::SaveSession => Action::SaveSession(path),
+        FileKind::Png => Action::ExportPng(path),
+        FileKind::Json => Action::ExportJson(path),
+    }
+}
+
+/// A session read and checked against its grammar, not yet the editor's.
+struct LoadedSession {
+    sculpt: Sculpt,
+    warnings: Vec<Problem>,
+    /// The grammar's file (`None`: the bundled castle).
+    grammar_file: Option<PathBuf>,
+}
+
+/// Reads a session and rebuilds its sculpt, touching nothing of the editor's.
+fn load_session(path: &Path) -> Result<LoadedSession, String> {
+    let s = session::read(path).map_err(|e| e.to_string())?;
+    let grammar_path = PathBuf::from(&s.grammar);
+    let (source, file) = match std::fs::read_to_string(&grammar_path) {
+        Ok(text) => (text, Some(grammar_path.clone())),
+        Err(_) if s.grammar == CASTLE_PATH => (CASTLE_SOURCE.to_string(), None),
+        Err(e) => return Err(format!("the session's grammar {}: {e}", s.grammar)),
+    };
+    let compiled = compile::compile(&source, &s.grammar).map_err(|problems| {
+        let first = problems.first().map_or(String::new(), |p| p.to_string());
+        format!("the session's grammar does not compile: {first}")
+    })?;
+    let sculpt = Sculpt::from_saved(compiled.grammar, s.assembly, s.pins, s.settings, s.log)?;
+    Ok(LoadedSession {
+        sculpt,
+        warnings: compiled.warnings,
+        grammar_file: file,
+    })
+}
+
+/// Reads and compiles a grammar file without touching the editor's state.
+fn check_grammar(path: &Path) -> Result<Compiled, Vec<Problem>> {
+    let shown = path.display().to_string();
+    let source = std::fs::read_to_string(path)
+        .map_err(|e| vec![Problem::whole_file(&shown, format!("cannot read it: {e}"))])?;
+    compile::compile(&source, &shown)
 }
 
 /// A grammar with nothing in it: the model shown when the first compile fails.
@@ -157,7 +205,9 @@ impl EditorApp {
     /// The editor on a grammar file; problems reading or compiling it are shown, not fatal.
     pub fn open(path: &Path) -> Self {
         let mut app = Self::blank();
-        app.open_grammar(path);
+        if let Err(m) = app.open_grammar(path) {
+            app.message = Some(m);
+        }
         app
     }
 
@@ -183,6 +233,15 @@ impl EditorApp {
             author_form: AuthorForm::default(),
             author_commands: Vec::new(),
             mode_key: false,
+            desktop: Desktop::none(),
+            recent: Recent::default(),
+            native: None,
+            after_save: None,
+            help_open: false,
+            overlays: ViewOverlays::default(),
+            title: String::new(),
+            refused: None,
+            source_view: None,
         }
     }
 
@@ -192,6 +251,23 @@ impl EditorApp {
             self.author_canvas.request_fit();
         }
         self.mode = mode;
+    }
+
+    /// Uses the desktop's file dialogs and remembers recent files where it says (the binary
+    /// passes [`Desktop::detect`]; tests keep [`Desktop::none`]).
+    pub fn use_desktop(&mut self, desktop: Desktop) {
+        self.recent = Recent::load(desktop.recent_store.as_deref());
+        self.desktop = desktop;
+    }
+
+    /// The window title: the file's name, `*` when the sculpt has unsaved changes, and `Clay`.
+    pub fn title(&self) -> String {
+        let shown = self.display_path();
+        let name = Path::new(&shown)
+            .file_name()
+            .map_or(shown.clone(), |n| n.to_string_lossy().into_owned());
+        let dirty = if self.sculpt.dirty { "*" } else { "" };
+        format!("{name}{dirty} \u{2022} {TITLE}")
     }
 
     /// Lets the file watcher wake the UI when the grammar changes on disk.
@@ -216,45 +292,88 @@ impl EditorApp {
         }
     }
 
-    /// Opens a grammar file: a new sculpt on it (even if it does not compile, so that hot
-    /// reload picks up the fix), watched for changes.
-    fn open_grammar(&mut self, path: &Path) {
+    /// Opens a grammar file. A file that cannot be read or does not compile is not opened:
+    /// the current model stays and the file's problems are listed as the refused file's. Only
+    /// an editor with no model yet takes a broken file, and watches it, so that hot reload
+    /// picks up the fix.
+    fn open_grammar(&mut self, path: &Path) -> Result<String, String> {
         let shown = path.display().to_string();
-        let source = match std::fs::read_to_string(path) {
-            Ok(s) => Some(s),
-            Err(e) => {
-                self.problems = vec![Problem::whole_file(&shown, format!("cannot read: {e}"))];
-                None
+        match check_grammar(path) {
+            Ok(compiled) => {
+                self.refused = None;
+                self.grammar_path = Some(path.to_path_buf());
+                self.session_path = None;
+                self.adopt(compiled);
+                self.start_watch(path);
+                self.remember(path, false);
+                Ok(format!("opened {shown}"))
             }
-        };
-        self.grammar_path = Some(path.to_path_buf());
-        self.session_path = None;
-        match source {
-            Some(s) => self.load_grammar_text(Some(path), &s, &shown),
-            None => {
-                self.sculpt = Sculpt::new(empty_grammar(&shown));
+            Err(problems) if self.sculpt.data().parts.is_empty() => {
+                self.refused = None;
+                self.problems = problems;
                 self.stale = true;
+                self.grammar_path = Some(path.to_path_buf());
+                self.session_path = None;
+                self.sculpt = Sculpt::new(empty_grammar(&shown));
+                self.canvas.grammar_changed();
+                self.start_watch(path);
+                Err(format!(
+                    "{shown} has problems (see Diagnostics); it loads as soon as it compiles"
+                ))
+            }
+            Err(problems) => {
+                let why = problems
+                    .first()
+                    .map_or("it does not compile".to_string(), |p| p.message.clone());
+                let errors = problems
+                    .iter()
+                    .filter(|p| p.severity == Severity::Error)
+                    .count();
+                self.refused = Some((shown.clone(), problems));
+                Err(format!(
+                    "{shown} was not opened ({why}{}); the current model stays",
+                    if errors > 1 {
+                        format!(", and {} more errors", errors - 1)
+                    } else {
+                        String::new()
+                    }
+                ))
             }
         }
-        self.start_watch(path);
+    }
+
+    /// A good compile becomes the model: a new sculpt, the view fitted.
+    fn adopt(&mut self, compiled: Compiled) {
+        self.problems = compiled.warnings;
+        self.stale = false;
+        self.sculpt = Sculpt::new(compiled.grammar);
+        self.canvas.grammar_changed();
+        self.canvas.request_fit();
     }
 
     fn load_grammar_text(&mut self, path: Option<&Path>, source: &str, shown: &str) {
         self.grammar_path = path.map(Path::to_path_buf);
         match compile::compile(source, shown) {
-            Ok(c) => {
-                self.problems = c.warnings;
-                self.stale = false;
-                self.sculpt = Sculpt::new(c.grammar);
-            }
+            Ok(c) => self.adopt(c),
             Err(problems) => {
                 self.problems = problems;
                 self.stale = true;
                 self.sculpt = Sculpt::new(empty_grammar(shown));
+                self.canvas.grammar_changed();
+                self.canvas.request_fit();
             }
         }
-        self.canvas.grammar_changed();
-        self.canvas.request_fit();
+    }
+
+    /// Puts a file first in the recent files, kept in the user's config folder.
+    fn remember(&mut self, path: &Path, session: bool) {
+        self.recent.add(path, session);
+        if let Some(store) = self.desktop.recent_store.clone()
+            && let Err(e) = self.recent.save(&store)
+        {
+            self.sculpt
+                .note_outside_history(format!("could not remember recent files: {e}"));
+        }
     }
 
     fn start_watch(&mut self, path: &Path) {
@@ -282,10 +401,7 @@ impl EditorApp {
             return;
         };
         let shown = path.display().to_string();
-        let result = std::fs::read_to_string(&path)
-            .map_err(|e| vec![Problem::whole_file(&shown, format!("cannot read: {e}"))])
-            .and_then(|s| compile::compile(&s, &shown));
-        match result {
+        match check_grammar(&path) {
             Ok(c) => {
                 self.problems = c.warnings;
                 let first_good = self.stale && self.sculpt.data().parts.is_empty();
@@ -302,11 +418,20 @@ impl EditorApp {
                 });
             }
             Err(problems) => {
+                let first = problems.first().map_or(String::new(), |p| {
+                    format!(" (line {}: {})", p.line, p.message)
+                });
                 self.problems = problems;
                 self.stale = true;
-                self.message = Some(format!(
-                    "{shown} does not compile; keeping the last good model"
-                ));
+                let what = if self.sculpt.data().parts.is_empty() {
+                    "no model yet"
+                } else {
+                    "the last good model stays"
+                };
+                let m = format!("{shown} does not compile{first}; {what}");
+                self.sculpt
+                    .note_outside_history(format!("reload failed: {m}"));
+                self.message = Some(m);
             }
         }
     }
@@ -323,6 +448,12 @@ impl EditorApp {
         if ctx.input(|i| i.viewport().close_requested()) && !self.quitting && self.sculpt.dirty {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.confirm = Some(Action::Quit);
+        }
+        self.poll_native_dialog(ctx);
+        let title = self.title();
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
         }
         let heavy = self
             .sculpt
@@ -367,7 +498,10 @@ impl EditorApp {
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
             .show(ui, |ui| match self.mode {
-                Mode::Sculpt => self.canvas.show(ui, &self.sculpt, &mut self.commands),
+                Mode::Sculpt => {
+                    self.canvas
+                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands)
+                }
                 Mode::Author => {
                     self.author_canvas
                         .show(ui, &self.author, &mut self.author_commands)
@@ -382,22 +516,27 @@ impl EditorApp {
             return;
         }
         let mut toggle = std::mem::take(&mut self.mode_key);
+        let mut redo = None;
         ui.input_mut(|i| {
             let author = self.mode == Mode::Author;
             if i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
                 || i.consume_key(Modifiers::COMMAND, Key::Y)
             {
-                if author {
-                    self.author_commands.push(AuthorCommand::Redo);
-                } else {
-                    self.commands.push(Command::Redo);
-                }
+                redo = Some(true);
             } else if i.consume_key(Modifiers::COMMAND, Key::Z) {
-                if author {
-                    self.author_commands.push(AuthorCommand::Undo);
-                } else {
-                    self.commands.push(Command::Undo);
-                }
+                redo = Some(false);
+            }
+            if i.consume_key(Modifiers::NONE, Key::F1)
+                || i.consume_key(Modifiers::SHIFT, Key::Questionmark)
+                || i.consume_key(Modifiers::NONE, Key::Questionmark)
+            {
+                self.help_open = !self.help_open;
+            }
+            if self.help_open && i.consume_key(Modifiers::NONE, Key::Escape) {
+                self.help_open = false;
+            }
+            if i.consume_key(Modifiers::COMMAND, Key::Q) {
+                self.actions.push(Action::Quit);
             }
             toggle |= i.consume_key(Modifiers::NONE, Key::Tab);
             if author && i.consume_key(Modifiers::NONE, Key::D) {
@@ -419,6 +558,9 @@ impl EditorApp {
                 self.actions.push(Action::Ask(FileKind::Grammar));
             }
         });
+        if let Some(redo) = redo {
+            self.undo(self.mode == Mode::Author, redo);
+        }
         if toggle {
             self.set_mode(match self.mode {
                 Mode::Sculpt => Mode::Author,
@@ -429,76 +571,176 @@ impl EditorApp {
 
     fn menu(&mut self, ui: &mut egui::Ui) {
         egui::Panel::top("menu").show(ui, |ui| {
-            ui.horizontal_wrapped(|ui| {
+            egui::MenuBar::new().ui(ui, |ui| {
+                ui.menu_button("File", |ui| self.file_menu(ui));
+                ui.menu_button("Edit", |ui| self.edit_menu(ui));
+                ui.menu_button("View", |ui| self.view_menu(ui));
+                ui.menu_button("Help", |ui| {
+                    if ui.button("Gestures and keys (F1)").clicked() {
+                        self.help_open = true;
+                    }
+                });
+                ui.separator();
                 let mut mode = self.mode;
                 ui.selectable_value(&mut mode, Mode::Sculpt, "Sculpt")
-                    .on_hover_text("Tab switches mode");
+                    .on_hover_text("Sculpt the grammar's model (Tab switches mode)");
                 ui.selectable_value(&mut mode, Mode::Author, "Author")
-                    .on_hover_text("Tab switches mode");
+                    .on_hover_text("Make a grammar from a drawing (Tab switches mode)");
                 if mode != self.mode {
                     self.set_mode(mode);
                 }
                 ui.separator();
-                if ui.button("Open grammar…").clicked() {
-                    self.actions.push(Action::Ask(FileKind::Grammar));
-                }
-                if ui.button("Open session…").clicked() {
-                    self.actions.push(Action::Ask(FileKind::OpenSession));
-                }
-                if ui.button("Save session").clicked() {
-                    self.actions.push(match &self.session_path {
-                        Some(p) => Action::SaveSession(p.clone()),
-                        None => Action::Ask(FileKind::SaveSession),
-                    });
-                }
-                if ui.button("Save session as…").clicked() {
-                    self.actions.push(Action::Ask(FileKind::SaveSession));
-                }
-                if ui.button("Export PNG…").clicked() {
-                    self.actions.push(Action::Ask(FileKind::Png));
-                }
-                if ui.button("Export JSON…").clicked() {
-                    self.actions.push(Action::Ask(FileKind::Json));
-                }
-                ui.separator();
-                let author = self.mode == Mode::Author;
-                let (can_undo, can_redo) = if author {
-                    (self.author.can_undo(), self.author.can_redo())
-                } else {
-                    (self.sculpt.can_undo(), self.sculpt.can_redo())
-                };
+                self.undo_buttons(ui);
                 if ui
-                    .add_enabled(can_undo, egui::Button::new("Undo"))
+                    .button("Fit")
+                    .on_hover_text("Fit the model into the view (F)")
                     .clicked()
                 {
-                    if author {
-                        self.author_commands.push(AuthorCommand::Undo);
-                    } else {
-                        self.commands.push(Command::Undo);
-                    }
+                    self.fit();
                 }
                 if ui
-                    .add_enabled(can_redo, egui::Button::new("Redo"))
+                    .button("?")
+                    .on_hover_text("Every gesture and key (F1 or ?)")
                     .clicked()
                 {
-                    if author {
-                        self.author_commands.push(AuthorCommand::Redo);
-                    } else {
-                        self.commands.push(Command::Redo);
-                    }
-                }
-                if !author && ui.button("Reset").clicked() {
-                    self.commands.push(Command::Reset);
-                }
-                if ui.button("Fit (F)").clicked() {
-                    if author {
-                        self.author_canvas.request_fit();
-                    } else {
-                        self.canvas.request_fit();
-                    }
+                    self.help_open = !self.help_open;
                 }
             });
         });
+    }
+
+    fn file_menu(&mut self, ui: &mut egui::Ui) {
+        if ui
+            .button("Open grammar…")
+            .on_hover_text("Ctrl+O: a .clay file, or a compiled .json")
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::Grammar));
+        }
+        ui.menu_button("Open recent", |ui| {
+            if self.recent.files.is_empty() {
+                ui.label("Nothing opened yet.");
+            }
+            for f in self.recent.files.clone() {
+                let what = if f.session { "session" } else { "grammar" };
+                let button = egui::Button::new(format!("{} ({what})", f.path.display()));
+                if ui
+                    .add_enabled(f.path.exists(), button)
+                    .on_disabled_hover_text("no longer there")
+                    .clicked()
+                {
+                    self.actions.push(if f.session {
+                        Action::OpenSession(f.path)
+                    } else {
+                        Action::OpenGrammar(f.path)
+                    });
+                }
+            }
+        });
+        ui.separator();
+        if ui
+            .button("Open session…")
+            .on_hover_text("A saved sculpt")
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::OpenSession));
+        }
+        if ui.button("Save session").on_hover_text("Ctrl+S").clicked() {
+            self.actions.push(match &self.session_path {
+                Some(p) => Action::SaveSession(p.clone()),
+                None => Action::Ask(FileKind::SaveSession),
+            });
+        }
+        if ui.button("Save session as…").clicked() {
+            self.actions.push(Action::Ask(FileKind::SaveSession));
+        }
+        ui.separator();
+        if ui
+            .button("Export PNG…")
+            .on_hover_text("The view as `clayc render` draws it")
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::Png));
+        }
+        if ui
+            .button("Export JSON…")
+            .on_hover_text("The deformed assembly (the compiled format's `assembly`)")
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::Json));
+        }
+        ui.separator();
+        if ui.button("Quit").on_hover_text("Ctrl+Q").clicked() {
+            self.actions.push(Action::Quit);
+        }
+    }
+
+    fn edit_menu(&mut self, ui: &mut egui::Ui) {
+        self.undo_buttons(ui);
+        if self.mode == Mode::Sculpt
+            && ui
+                .button("Reset")
+                .on_hover_text("Back to the grammar's initial model (undoable)")
+                .clicked()
+        {
+            self.commands.push(Command::Reset);
+        }
+    }
+
+    fn view_menu(&mut self, ui: &mut egui::Ui) {
+        let o = &mut self.overlays;
+        ui.checkbox(&mut o.strain, "Strain")
+            .on_hover_text("Colour every part edge by how far it is stretched or squeezed");
+        ui.checkbox(&mut o.states, "Rest states")
+            .on_hover_text("Name the active rest state of every part that has alternatives");
+        ui.checkbox(&mut o.sites, "Docking sites")
+            .on_hover_text("Sites coloured by type; open sites point outwards");
+        ui.checkbox(&mut o.handles, "Handles and pins")
+            .on_hover_text("The grabbed part's vertices as rings, pinned ones as squares");
+        ui.checkbox(&mut o.part_graph, "Part outlines")
+            .on_hover_text("The edges and vertices the solver works on");
+        ui.separator();
+        if ui.button("Fit").on_hover_text("F").clicked() {
+            self.fit();
+        }
+    }
+
+    fn undo_buttons(&mut self, ui: &mut egui::Ui) {
+        let author = self.mode == Mode::Author;
+        let (can_undo, can_redo) = if author {
+            (self.author.can_undo(), self.author.can_redo())
+        } else {
+            (self.sculpt.can_undo(), self.sculpt.can_redo())
+        };
+        let undo = ui
+            .add_enabled(can_undo, egui::Button::new("Undo"))
+            .on_hover_text("Ctrl+Z: the last gesture, with the rules it fired");
+        if undo.clicked() {
+            self.undo(author, false);
+        }
+        let redo = ui
+            .add_enabled(can_redo, egui::Button::new("Redo"))
+            .on_hover_text("Ctrl+Shift+Z or Ctrl+Y");
+        if redo.clicked() {
+            self.undo(author, true);
+        }
+    }
+
+    fn undo(&mut self, author: bool, redo: bool) {
+        match (author, redo) {
+            (true, false) => self.author_commands.push(AuthorCommand::Undo),
+            (true, true) => self.author_commands.push(AuthorCommand::Redo),
+            (false, false) => self.commands.push(Command::Undo),
+            (false, true) => self.commands.push(Command::Redo),
+        }
+    }
+
+    fn fit(&mut self) {
+        if self.mode == Mode::Author {
+            self.author_canvas.request_fit();
+        } else {
+            self.canvas.request_fit();
+        }
     }
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
@@ -539,11 +781,35 @@ impl EditorApp {
             .iter()
             .filter(|p| p.severity == Severity::Error)
             .count();
-        egui::CollapsingHeader::new(format!("Diagnostics ({})", self.problems.len()))
+        let count = self.problems.len() + self.refused.as_ref().map_or(0, |r| r.1.len());
+        let mut clicked = None;
+        egui::CollapsingHeader::new(format!("Diagnostics ({count})"))
             .default_open(true)
             .show(ui, |ui| {
-                panels::diagnostics(ui, &self.problems, self.stale && errors > 0)
+                if let Some((file, problems)) = &self.refused {
+                    let banner = format!("{file} was not opened: the current model stays.");
+                    clicked = panels::diagnostics(ui, problems, Some(&banner)).cloned();
+                    ui.separator();
+                }
+                let banner = (self.stale && errors > 0).then(|| {
+                    if self.sculpt.data().parts.is_empty() {
+                        "The file does not compile: no model yet; it loads once it compiles."
+                    } else {
+                        "The file does not compile: the last good model stays live."
+                    }
+                });
+                if let Some(p) = panels::diagnostics(ui, &self.problems, banner) {
+                    clicked = Some(p.clone());
+                }
             });
+        if let Some(p) = clicked {
+            self.show_source(&p);
+        }
+        if let Some(view) = &self.source_view {
+            egui::CollapsingHeader::new("Source")
+                .default_open(true)
+                .show(ui, |ui| panels::source(ui, view));
+        }
         egui::CollapsingHeader::new("Inspector")
             .default_open(true)
             .show(ui, |ui| {
@@ -563,71 +829,161 @@ impl EditorApp {
     }
 
     fn dialogs(&mut self, ctx: &egui::Context) {
-        if let Some(d) = &mut self.dialog {
-            let mut done = None;
-            let r = egui::Modal::new(egui::Id::unique("path dialog")).show(ctx, |ui| {
-                ui.heading(d.kind.title());
-                ui.label("Path:");
-                let edit = ui.text_edit_singleline(&mut d.text);
-                let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(Key::Enter));
-                edit.request_focus();
-                ui.horizontal(|ui| {
-                    if ui.button("OK").clicked() || enter {
+        self.path_dialog(ctx);
+        self.unsaved_prompt(ctx);
+        help::show(ctx, &mut self.help_open);
+        if self.quitting && self.confirm.is_none() {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+
+    /// The typed-path dialog (where the desktop has no file dialog), with the recent files.
+    fn path_dialog(&mut self, ctx: &egui::Context) {
+        let Some(d) = &mut self.dialog else {
+            return;
+        };
+        let mut done = None;
+        let sessions = match d.kind {
+            FileKind::Grammar => Some(false),
+            FileKind::OpenSession => Some(true),
+            _ => None,
+        };
+        let recent: Vec<PathBuf> = self
+            .recent
+            .files
+            .iter()
+            .filter(|f| Some(f.session) == sessions)
+            .map(|f| f.path.clone())
+            .collect();
+        let r = egui::Modal::new(egui::Id::unique("path dialog")).show(ctx, |ui| {
+            ui.heading(d.kind.title());
+            ui.label("Path (relative to the folder the editor was started in):");
+            let edit = ui.add(egui::TextEdit::singleline(&mut d.text).desired_width(420.0));
+            let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(Key::Enter));
+            edit.request_focus();
+            if !recent.is_empty() {
+                ui.label("Recent:");
+                for p in &recent {
+                    let shown = p.display().to_string();
+                    if ui
+                        .add_enabled(p.exists(), egui::Button::new(&shown))
+                        .on_disabled_hover_text("no longer there")
+                        .clicked()
+                    {
+                        d.text = shown;
                         done = Some(true);
                     }
-                    if ui.button("Cancel").clicked() {
-                        done = Some(false);
-                    }
-                });
-            });
-            if r.should_close() && done.is_none() {
-                done = Some(false);
+                }
             }
-            match done {
-                Some(true) if !d.text.trim().is_empty() => {
-                    let action = d.kind.action(PathBuf::from(d.text.trim()));
-                    self.dialog = None;
+            ui.horizontal(|ui| {
+                if ui.button("OK").on_hover_text("Enter").clicked() || enter {
+                    done = Some(true);
+                }
+                if ui.button("Cancel").on_hover_text("Esc").clicked() {
+                    done = Some(false);
+                }
+            });
+        });
+        if r.should_close() && done.is_none() {
+            done = Some(false);
+        }
+        match done {
+            Some(true) if !d.text.trim().is_empty() => {
+                let action = file_action(d.kind, PathBuf::from(d.text.trim()));
+                self.dialog = None;
+                self.actions.push(action);
+            }
+            Some(_) => {
+                self.dialog = None;
+                self.after_save = None;
+            }
+            None => {}
+        }
+    }
+
+    /// Save, Discard or Cancel before an action that would lose the sculpt's changes.
+    fn unsaved_prompt(&mut self, ctx: &egui::Context) {
+        let Some(action) = self.confirm.clone() else {
+            return;
+        };
+        let mut answer = None;
+        egui::Modal::new(egui::Id::unique("unsaved prompt")).show(ctx, |ui| {
+            ui.heading("Unsaved changes");
+            let what = match &action {
+                Action::Quit => "quitting",
+                Action::TryAuthored => "sculpting the authored grammar",
+                _ => "opening another file",
+            };
+            ui.label(format!(
+                "The sculpt has unsaved changes. Save them before {what}?"
+            ));
+            ui.horizontal(|ui| {
+                let save = match &self.session_path {
+                    Some(p) => format!("saves the session to {}", p.display()),
+                    None => "asks where to save the session".to_string(),
+                };
+                if ui.button("Save").on_hover_text(save).clicked() {
+                    answer = Some(Answer::Save);
+                }
+                if ui
+                    .button("Discard")
+                    .on_hover_text("goes on without saving")
+                    .clicked()
+                {
+                    answer = Some(Answer::Discard);
+                }
+                if ui.button("Cancel").on_hover_text("Esc").clicked() {
+                    answer = Some(Answer::Cancel);
+                }
+            });
+            if ui.input(|i| i.key_pressed(Key::Escape)) {
+                answer = Some(Answer::Cancel);
+            }
+        });
+        let Some(answer) = answer else {
+            return;
+        };
+        self.confirm = None;
+        let quit = matches!(action, Action::Quit);
+        match answer {
+            Answer::Cancel => {}
+            Answer::Discard => {
+                self.sculpt.dirty = false;
+                if quit {
+                    self.quitting = true;
+                } else {
                     self.actions.push(action);
                 }
-                Some(_) => self.dialog = None,
-                None => {}
             }
-        }
-        if let Some(action) = self.confirm.clone() {
-            let mut answer = None;
-            egui::Modal::new(egui::Id::unique("confirm")).show(ctx, |ui| {
-                ui.heading("Unsaved changes");
-                let what = match &action {
-                    Action::Quit => "quitting",
-                    _ => "opening another file",
-                };
-                ui.label(format!(
-                    "The sculpt has unsaved changes. Discard them before {what}?"
-                ));
-                ui.horizontal(|ui| {
-                    if ui.button("Discard").clicked() {
-                        answer = Some(true);
-                    }
-                    if ui.button("Cancel").clicked() {
-                        answer = Some(false);
-                    }
+            Answer::Save => {
+                self.after_save = Some(action);
+                self.actions.push(match &self.session_path {
+                    Some(p) => Action::SaveSession(p.clone()),
+                    None => Action::Ask(FileKind::SaveSession),
                 });
-            });
-            match answer {
-                Some(true) => {
-                    self.confirm = None;
-                    self.sculpt.dirty = false;
-                    if action == Action::Quit {
-                        self.quitting = true;
-                        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                    } else {
-                        self.actions.push(action);
-                    }
-                }
-                Some(false) => self.confirm = None,
-                None => {}
             }
         }
+    }
+
+    /// Shows a problem's line in the source view (the file read again: the text is the one on
+    /// disk now, which is what the user will edit).
+    pub fn show_source(&mut self, p: &Problem) {
+        let text = match std::fs::read_to_string(&p.file) {
+            Ok(t) => t,
+            Err(_) if p.file == CASTLE_PATH => CASTLE_SOURCE.to_string(),
+            Err(e) => {
+                self.message = Some(format!("cannot show {}: {e}", p.file));
+                return;
+            }
+        };
+        self.source_view = Some(panels::SourceView {
+            file: p.file.clone(),
+            text,
+            line: p.line,
+            col: p.col,
+            end_col: p.end_col,
+        });
+        self.message = Some(format!("{}:{}:{}", p.file, p.line, p.col));
     }
 
     /// Applies the frame's commands and file actions.
@@ -653,42 +1009,39 @@ impl EditorApp {
         self.author_commands.push(c);
     }
 
-    /// Performs a file action now (tests and the UI's queue).
+    /// Performs a file action now (tests and the UI's queue). An action that would replace
+    /// the sculpt is checked first (the file read and compiled), so a mistyped path or a broken
+    /// file is reported without asking to discard anything; with unsaved changes it then asks
+    /// Save, Discard or Cancel.
     pub fn perform(&mut self, action: Action) {
         let discards = matches!(
             action,
             Action::OpenGrammar(_) | Action::OpenSession(_) | Action::TryAuthored
         );
         if discards && self.sculpt.dirty {
-            self.confirm = Some(action);
+            match self.precheck(&action) {
+                Ok(()) => self.confirm = Some(action),
+                Err(e) => self.fail(e),
+            }
             return;
         }
         let result = match action {
             Action::Ask(kind) => {
-                let text = match kind {
-                    FileKind::SaveSession | FileKind::OpenSession => self
-                        .session_path
-                        .as_ref()
-                        .map_or("sculpt.clay-session.json".to_string(), |p| {
-                            p.display().to_string()
-                        }),
-                    FileKind::Grammar => self.display_path(),
-                    FileKind::Png => "sculpt.png".to_string(),
-                    FileKind::Json => "sculpt.assembly.json".to_string(),
-                };
-                self.dialog = Some(PathDialog { kind, text });
+                self.ask(kind);
                 Ok(None)
             }
-            Action::OpenGrammar(p) => {
-                self.open_grammar(&p);
-                Ok(Some(format!("opened {}", p.display())))
-            }
-            Action::OpenSession(p) => self
-                .open_session(&p)
-                .map(|()| Some(format!("opened session {}", p.display()))),
-            Action::SaveSession(p) => self
-                .save_session(&p)
-                .map(|()| Some(format!("saved {}", p.display()))),
+            Action::OpenGrammar(p) => self.open_grammar(&p).map(Some),
+            Action::OpenSession(p) => self.open_session(&p).map(|()| {
+                self.remember(&p, true);
+                Some(format!("opened session {}", p.display()))
+            }),
+            Action::SaveSession(p) => self.save_session(&p).map(|()| {
+                self.remember(&p, true);
+                if let Some(next) = self.after_save.take() {
+                    self.actions.push(next);
+                }
+                Some(format!("saved {}", p.display()))
+            }),
             Action::ExportPng(p) => self
                 .export_png(&p)
                 .map(|()| Some(format!("exported {}", p.display()))),
@@ -696,7 +1049,11 @@ impl EditorApp {
                 .export_json(&p)
                 .map(|()| Some(format!("exported {}", p.display()))),
             Action::Quit => {
-                self.confirm = Some(Action::Quit);
+                if self.sculpt.dirty {
+                    self.confirm = Some(Action::Quit);
+                } else {
+                    self.quitting = true;
+                }
                 Ok(None)
             }
             Action::ImportSvg(p, scale) => self.author.import_svg(&p, scale).map(|()| {
@@ -717,7 +1074,71 @@ impl EditorApp {
         match result {
             Ok(Some(m)) => self.message = Some(m),
             Ok(None) => {}
-            Err(e) => self.message = Some(format!("error: {e}")),
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// A file action failed: said in the status bar and kept in the log.
+    fn fail(&mut self, e: String) {
+        // A Save from the unsaved-changes prompt that failed must not go on to discard.
+        self.after_save = None;
+        self.sculpt.note_outside_history(e.clone());
+        self.message = Some(format!("error: {e}"));
+    }
+
+    /// Whether an action that replaces the sculpt would succeed, without doing it.
+    fn precheck(&mut self, action: &Action) -> Result<(), String> {
+        match action {
+            Action::OpenGrammar(p) => check_grammar(p).map(drop).map_err(|problems| {
+                let shown = p.display().to_string();
+                let why = problems
+                    .first()
+                    .map_or(String::new(), |p| format!(" ({})", p.message));
+                self.refused = Some((shown.clone(), problems));
+                format!("{shown} was not opened{why}; the current model stays")
+            }),
+            Action::OpenSession(p) => load_session(p).map(drop),
+            Action::TryAuthored => self.authored().map(drop),
+            _ => Ok(()),
+        }
+    }
+
+    /// Asks for a path: the desktop's file dialog where there is one, else a typed path.
+    fn ask(&mut self, kind: FileKind) {
+        let text = match kind {
+            FileKind::SaveSession | FileKind::OpenSession => self
+                .session_path
+                .as_ref()
+                .map_or("sculpt.clay-session.json".to_string(), |p| {
+                    p.display().to_string()
+                }),
+            FileKind::Grammar => self.display_path(),
+            FileKind::Png => "sculpt.png".to_string(),
+            FileKind::Json => "sculpt.assembly.json".to_string(),
+        };
+        if self.desktop.native_dialogs {
+            self.native = Some(NativeDialog::open(kind, Path::new(&text)));
+        } else {
+            self.dialog = Some(PathDialog { kind, text });
+        }
+    }
+
+    /// Takes the native dialog's answer once it has one.
+    fn poll_native_dialog(&mut self, ctx: &egui::Context) {
+        let Some(d) = &self.native else {
+            return;
+        };
+        match d.poll() {
+            None => ctx.request_repaint_after(Duration::from_millis(100)),
+            Some(picked) => {
+                let kind = d.kind;
+                self.native = None;
+                match picked {
+                    Some(p) => self.actions.push(file_action(kind, p)),
+                    // Cancelled: a Save the prompt asked for is not made, so nothing goes on.
+                    None => self.after_save = None,
+                }
+            }
         }
     }
 
@@ -730,17 +1151,19 @@ impl EditorApp {
                 .to_string(),
             None => CASTLE_PATH.to_string(),
         };
-        Session::new(
+        let mut session = Session::new(
             grammar,
             self.sculpt.data().clone(),
             self.sculpt.pins(),
             Some(self.sculpt.settings()),
-        )
+        );
+        session.log = self.sculpt.log().to_vec();
+        session
     }
 
-    /// Compiles the authored grammar and sculpts it (switching to sculpt mode). The grammar
-    /// file is watched if the text was written to one; the authoring work stays.
-    pub fn try_authored(&mut self) -> Result<String, String> {
+    /// The authored grammar compiled, its name, and the file it was written to (if the text
+    /// there is the same).
+    fn authored(&self) -> Result<(Compiled, String, Option<PathBuf>), String> {
         let text = match &self.author.result {
             Ok(c) => c.text.clone(),
             Err(e) => return Err(format!("nothing to try: {e}")),
@@ -756,13 +1179,16 @@ impl EditorApp {
             .as_ref()
             .filter(|(_, t)| *t == text)
             .map(|(p, _)| p.clone());
-        self.problems = compiled.warnings;
-        self.stale = false;
-        self.sculpt = Sculpt::new(compiled.grammar);
+        Ok((compiled, name, written))
+    }
+
+    /// Compiles the authored grammar and sculpts it (switching to sculpt mode). The grammar
+    /// file is watched if the text was written to one; the authoring work stays.
+    pub fn try_authored(&mut self) -> Result<String, String> {
+        let (compiled, name, written) = self.authored()?;
+        self.adopt(compiled);
         self.grammar_path = written.clone();
         self.session_path = None;
-        self.canvas.grammar_changed();
-        self.canvas.request_fit();
         match written {
             Some(p) => self.start_watch(&p),
             None => self.watch = None,
@@ -785,29 +1211,19 @@ impl EditorApp {
         Ok(())
     }
 
-    /// Opens a session: compiles its grammar and restores the sculpt. On any error the current
-    /// sculpt stays.
+    /// Opens a session: compiles its grammar and restores the sculpt (and its rule log). On
+    /// any error the current sculpt stays.
     pub fn open_session(&mut self, path: &Path) -> Result<(), String> {
-        let s = session::read(path).map_err(|e| e.to_string())?;
-        let grammar_path = PathBuf::from(&s.grammar);
-        let (source, file) = match std::fs::read_to_string(&grammar_path) {
-            Ok(text) => (text, Some(grammar_path.clone())),
-            Err(_) if s.grammar == CASTLE_PATH => (CASTLE_SOURCE.to_string(), None),
-            Err(e) => return Err(format!("the session's grammar {}: {e}", s.grammar)),
-        };
-        let compiled = compile::compile(&source, &s.grammar).map_err(|problems| {
-            let first = problems.first().map_or(String::new(), |p| p.to_string());
-            format!("the session's grammar does not compile: {first}")
-        })?;
-        let sculpt = Sculpt::from_saved(compiled.grammar, s.assembly, s.pins, s.settings)?;
-        self.sculpt = sculpt;
-        self.problems = compiled.warnings;
+        let loaded = load_session(path)?;
+        self.sculpt = loaded.sculpt;
+        self.problems = loaded.warnings;
         self.stale = false;
-        self.grammar_path = file.clone();
+        self.refused = None;
+        self.grammar_path = loaded.grammar_file.clone();
         self.session_path = Some(path.to_path_buf());
         self.canvas.grammar_changed();
         self.canvas.request_fit();
-        match file {
+        match loaded.grammar_file {
             Some(f) => self.start_watch(&f),
             None => self.watch = None,
         }

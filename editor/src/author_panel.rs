@@ -638,7 +638,7 @@ fn grammar(
             RichText::new("The grammar does not compile.").color(Color32::from_rgb(200, 40, 40)),
         );
     }
-    panels::diagnostics(ui, &author.problems, false);
+    panels::diagnostics(ui, &author.problems, None);
     if let Some(text) = author.text() {
         egui::CollapsingHeader::new("Text")
             .default_open(false)

@@ -12,6 +12,7 @@ use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
 use crate::camera::{Camera, dv, pos};
+use crate::overlay::ViewOverlays;
 use crate::sculpt::{Command, Sculpt};
 
 /// Pointer distance (screen points) within which an edge or connection counts as under it.
@@ -95,7 +96,13 @@ impl Canvas {
     }
 
     /// Draws the sculpt and collects the user's commands.
-    pub fn show(&mut self, ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command>) {
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        sculpt: &Sculpt,
+        overlays: &ViewOverlays,
+        commands: &mut Vec<Command>,
+    ) {
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
         self.rect = response.rect;
         let data = sculpt.data();
@@ -231,6 +238,7 @@ impl Canvas {
         }
 
         self.paint(&painter, sculpt);
+        crate::overlay::paint(&painter, self.rect, &self.camera, sculpt, overlays);
         self.label_parts(ui, sculpt);
     }
 

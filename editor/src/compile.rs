@@ -27,7 +27,17 @@ pub struct Problem {
     pub file: String,
     pub line: usize,
     pub col: usize,
+    /// Where the underline ends on `line` (1-based, exclusive; at least `col + 1`).
+    pub end_col: usize,
     pub message: String,
+    /// What the primary span is (`no piece of this name`), or empty.
+    pub label: String,
+    /// The source line the problem is on, without its newline (empty if unknown).
+    pub snippet: String,
+    /// Other places that explain it: line, column and what is there.
+    pub related: Vec<(usize, usize, String)>,
+    /// `help:` notes.
+    pub hints: Vec<String>,
 }
 
 impl Problem {
@@ -39,8 +49,23 @@ impl Problem {
             file: file.to_string(),
             line: 1,
             col: 1,
+            end_col: 2,
             message: message.into(),
+            label: String::new(),
+            snippet: String::new(),
+            related: Vec::new(),
+            hints: Vec::new(),
         }
+    }
+
+    /// The underline under `snippet`: spaces up to the span, then `^` across it.
+    pub fn underline(&self) -> String {
+        let width = self.end_col.saturating_sub(self.col).max(1);
+        format!(
+            "{}{}",
+            " ".repeat(self.col.saturating_sub(1)),
+            "^".repeat(width)
+        )
     }
 }
 
@@ -83,13 +108,14 @@ pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
 
 fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     let grammar: CompiledGrammar = serde_json::from_str(source).map_err(|e| {
+        let line = e.line().max(1);
+        let col = e.column().max(1);
         vec![Problem {
-            severity: Severity::Error,
-            code: String::new(),
-            file: path.to_string(),
-            line: e.line().max(1),
-            col: e.column().max(1),
-            message: format!("not a compiled grammar: {e}"),
+            line,
+            col,
+            end_col: col + 1,
+            snippet: source.lines().nth(line - 1).unwrap_or("").to_string(),
+            ..Problem::whole_file(path, format!("not a compiled grammar: {e}"))
         }]
     })?;
     grammar.assembly.check(&grammar).map_err(|e| {
@@ -114,16 +140,30 @@ fn compile_clay(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     }
 }
 
-/// The compiler's diagnostics located by line and column of their primary span.
+/// The compiler's diagnostics located by line and column of their primary span, with the
+/// source line, the span's label, the secondary spans and the hints.
 fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Vec<Problem> {
     diagnostics
         .iter()
         .map(|d| {
-            let (line, col) = clay_dsl::line_col(source, d.primary.span.start);
-            let mut message = d.message.clone();
-            if !d.primary.message.is_empty() {
-                message = format!("{message} ({})", d.primary.message);
+            let span = d.primary.span;
+            let (line, col) = clay_dsl::line_col(source, span.start);
+            let (end_line, end) = clay_dsl::line_col(source, span.end);
+            let snippet = source.lines().nth(line - 1).unwrap_or("").to_string();
+            let end_col = if end_line == line {
+                end
+            } else {
+                snippet.chars().count() + 1
             }
+            .max(col + 1);
+            let related = d
+                .secondary
+                .iter()
+                .map(|l| {
+                    let (line, col) = clay_dsl::line_col(source, l.span.start);
+                    (line, col, l.message.clone())
+                })
+                .collect();
             Problem {
                 severity: if d.is_error() {
                     Severity::Error
@@ -134,7 +174,12 @@ fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Ve
                 file: path.to_string(),
                 line,
                 col,
-                message,
+                end_col,
+                message: d.message.clone(),
+                label: d.primary.message.clone(),
+                snippet,
+                related,
+                hints: d.hints.clone(),
             }
         })
         .collect()
@@ -162,6 +207,32 @@ mod tests {
             "error should point at the broken piece, got {p}"
         );
         assert!(p.to_string().starts_with("bad.clay:"));
+    }
+
+    #[test]
+    fn a_problem_carries_its_line_underline_label_and_hint() {
+        let source = CASTLE_SOURCE.replacen("chain wall x 4", "chain wal x 4", 1);
+        let problems = compile(&source, "castle.clay").unwrap_err();
+        let p = problems
+            .iter()
+            .find(|p| p.code == "E011")
+            .expect("unknown piece");
+        assert!(p.snippet.contains("wal x"), "{:?}", p.snippet);
+        let under = p.underline();
+        let start = under.find('^').unwrap();
+        let chars: Vec<char> = p.snippet.chars().collect();
+        let spanned: String = chars[start..start + under.len() - start].iter().collect();
+        assert_eq!(spanned, "wal", "the underline is under the name");
+        assert!(!p.label.is_empty());
+        assert!(
+            !p.message.contains(&p.label),
+            "the label is not repeated in the message"
+        );
+        assert!(
+            p.hints.iter().any(|h| h.contains("`wall`")),
+            "{:?}",
+            p.hints
+        );
     }
 
     #[test]

@@ -1,32 +1,59 @@
 //! The `clay-editor` binary: reads the arguments, opens the window and runs the editor.
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 
+use clap::Parser;
 use clay_editor::EditorApp;
 
-fn main() -> eframe::Result {
-    let mut args = std::env::args_os().skip(1);
-    let path = args.next().map(PathBuf::from);
-    if args.next().is_some() {
-        eprintln!("usage: clay-editor [GRAMMAR.clay]");
-        std::process::exit(2);
+/// Sculpt a Clay grammar's model live: drag, turn, pin and cut it while the mutable elastic
+/// solver keeps every part in its best rest state. Press F1 in the window for every gesture.
+#[derive(Parser, Debug)]
+#[command(name = "clay-editor", version, about, long_about = None)]
+struct Args {
+    /// The grammar to open (`.clay`, or a compiled `.json`); the bundled castle without one.
+    grammar: Option<PathBuf>,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    if let Some(missing) = clay_editor::files::no_display() {
+        eprintln!("clay-editor: {missing}");
+        return ExitCode::from(1);
     }
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
-            .with_title("Clay editor")
+            .with_title(clay_editor::app::TITLE)
             .with_inner_size([1280.0, 800.0]),
         ..Default::default()
     };
-    eframe::run_native(
+    let result = eframe::run_native(
         "Clay editor",
         options,
         Box::new(move |cc| {
-            let mut app = match &path {
+            let mut app = match &args.grammar {
                 Some(p) => EditorApp::open(p),
                 None => EditorApp::bundled(),
             };
             app.set_waker(cc.egui_ctx.clone());
+            app.use_desktop(clay_editor::files::Desktop::detect());
             Ok(Box::new(app))
         }),
-    )
+    );
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line, in words: winit's and glutin's errors are nested debug structures.
+            eprintln!("clay-editor: cannot open a window: {}", one_line(&e));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// An eframe error as a single line of text.
+fn one_line(e: &eframe::Error) -> String {
+    e.to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
 }

@@ -7,24 +7,112 @@ use egui::{Color32, RichText};
 use crate::compile::{Problem, Severity};
 use crate::sculpt::{Command, Sculpt};
 
-/// Diagnostics of the grammar file: `file:line:col: message`, errors in red.
-pub fn diagnostics(ui: &mut egui::Ui, problems: &[Problem], stale: bool) {
-    if stale {
-        ui.label(
-            RichText::new("The file does not compile: the last good model stays live.")
-                .color(Color32::from_rgb(200, 40, 40)),
-        );
+const ERROR: Color32 = Color32::from_rgb(200, 40, 40);
+const WARNING: Color32 = Color32::from_rgb(180, 120, 0);
+const NOTE: Color32 = Color32::from_rgb(40, 90, 170);
+
+/// Diagnostics as rustc shows them: `file:line:col: error[code]: message`, the source line
+/// with the span underlined and labelled, related places, and `help:` hints. `banner` says
+/// what became of the model. Returns the problem clicked (to show in the source view).
+pub fn diagnostics<'a>(
+    ui: &mut egui::Ui,
+    problems: &'a [Problem],
+    banner: Option<&str>,
+) -> Option<&'a Problem> {
+    if let Some(b) = banner {
+        ui.label(RichText::new(b).color(ERROR));
     }
     if problems.is_empty() {
         ui.label("No problems.");
-        return;
+        return None;
     }
+    let mut clicked = None;
     for p in problems {
-        let colour = match p.severity {
-            Severity::Error => Color32::from_rgb(200, 40, 40),
-            Severity::Warning => Color32::from_rgb(180, 120, 0),
-        };
-        ui.label(RichText::new(p.to_string()).color(colour).monospace());
+        if problem(ui, p) {
+            clicked = Some(p);
+        }
+    }
+    clicked
+}
+
+/// One problem; returns whether its headline was clicked.
+fn problem(ui: &mut egui::Ui, p: &Problem) -> bool {
+    let colour = match p.severity {
+        Severity::Error => ERROR,
+        Severity::Warning => WARNING,
+    };
+    let headline = ui
+        .add(
+            egui::Label::new(RichText::new(p.to_string()).color(colour).monospace())
+                .sense(egui::Sense::click()),
+        )
+        .on_hover_text("Click to show the line in the Source view");
+    if !p.snippet.is_empty() {
+        let gutter = p.line.to_string().len();
+        let text = format!(
+            "{:>gutter$} | {}\n{:>gutter$} | {} {}",
+            p.line,
+            p.snippet,
+            "",
+            p.underline(),
+            p.label
+        );
+        ui.label(RichText::new(text).monospace().size(11.0));
+    }
+    for (line, col, message) in &p.related {
+        ui.label(
+            RichText::new(format!("note: line {line}:{col}: {message}"))
+                .color(NOTE)
+                .monospace()
+                .size(11.0),
+        );
+    }
+    for h in &p.hints {
+        ui.label(RichText::new(format!("help: {h}")).monospace().size(11.0));
+    }
+    ui.add_space(4.0);
+    headline.clicked()
+}
+
+/// A read-only view of a grammar's text around one line, the span underlined.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SourceView {
+    pub file: String,
+    pub text: String,
+    /// The selected line (1-based) and the span on it (columns, 1-based, end exclusive).
+    pub line: usize,
+    pub col: usize,
+    pub end_col: usize,
+}
+
+/// Lines shown around the selected one.
+const CONTEXT_LINES: usize = 6;
+
+/// Shows the source view: the file's lines around the selected one, that line highlighted.
+pub fn source(ui: &mut egui::Ui, view: &SourceView) {
+    ui.label(RichText::new(format!("{}:{}:{}", view.file, view.line, view.col)).strong());
+    let lines: Vec<&str> = view.text.lines().collect();
+    let first = view.line.saturating_sub(CONTEXT_LINES + 1);
+    let last = (view.line + CONTEXT_LINES).min(lines.len());
+    let gutter = last.to_string().len();
+    for (i, line) in lines.iter().enumerate().take(last).skip(first) {
+        let n = i + 1;
+        let text = RichText::new(format!("{n:>gutter$} | {line}"))
+            .monospace()
+            .size(11.0);
+        if n == view.line {
+            ui.label(text.background_color(Color32::from_rgb(255, 236, 160)));
+            let width = view.end_col.saturating_sub(view.col).max(1);
+            let under = format!(
+                "{:>gutter$} | {}{}",
+                "",
+                " ".repeat(view.col.saturating_sub(1)),
+                "^".repeat(width)
+            );
+            ui.label(RichText::new(under).monospace().size(11.0).color(ERROR));
+        } else {
+            ui.label(text);
+        }
     }
 }
 
@@ -124,19 +212,24 @@ pub fn parameters(ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command
     }
 }
 
-/// The rule log, newest first.
+/// The rule log, newest first: what the rules did, in the words of the grammar's names. It
+/// follows undo and redo (an undone gesture's lines go with it).
 pub fn rule_log(ui: &mut egui::Ui, sculpt: &Sculpt) {
     if sculpt.log().is_empty() {
         ui.label("Nothing has fired yet.");
         return;
     }
     egui::ScrollArea::vertical()
+        .id_salt("rule log")
         .max_height(220.0)
         .show(ui, |ui| {
             for e in sculpt.log().iter().rev() {
-                let at =
-                    e.at.map_or(String::new(), |p| format!(" at ({:.2}, {:.2})", p.x, p.y));
-                ui.label(format!("frame {}: {}{at}", e.frame, e.message));
+                let text = format!("frame {}: {}", e.frame, e.message);
+                if e.outside {
+                    ui.colored_label(Color32::from_rgb(200, 40, 40), text);
+                } else {
+                    ui.label(text);
+                }
             }
         });
 }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use clay::assembly::{Assembly, HandleId, HandleKind};
-use clay::rules::{Rules, cut::CUT_REACH, site_centre};
+use clay::rules::{RuleKind, Rules, cut::CUT_REACH, site_centre};
 use clay::solver::local::align;
 use clay::solver::{FrameReport, Solver, SolverConfig, SolverError};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
@@ -50,15 +50,7 @@ pub enum Command {
     Settings(Settings),
 }
 
-/// An entry of the rule log.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LogEntry {
-    /// The solver frame it happened in.
-    pub frame: u64,
-    pub message: String,
-    /// Where it happened (world coordinates), if anywhere in particular.
-    pub at: Option<DVec2>,
-}
+pub use crate::session::LogEntry;
 
 /// The model as it was before a gesture.
 #[derive(Clone, Debug)]
@@ -66,6 +58,8 @@ struct Snapshot {
     grammar: Arc<CompiledGrammar>,
     data: AssemblyData,
     pins: Vec<Pin>,
+    /// The rule log as it was: undoing a gesture takes back what its rules logged too.
+    log: Vec<LogEntry>,
 }
 
 #[derive(Clone, Debug)]
@@ -123,6 +117,8 @@ pub struct Sculpt {
     pub frames_last_step: usize,
     error: Option<String>,
     log: Vec<LogEntry>,
+    /// The sequence number of the next log entry (entries keep their order across undo).
+    next_seq: u64,
     /// A solver frame running on another thread ([`Sculpt::step_in_background`]).
     job: Option<std::thread::JoinHandle<Job>>,
     /// The model the last background frame started from, reused for the next one.
@@ -152,6 +148,25 @@ struct FrameOutcome {
     rewrote: bool,
 }
 
+/// The names of the instances a part covers: "`t1`", or "`wall[3]` and `wall[4]`".
+fn instance_names(assembly: &Assembly, part: usize) -> String {
+    let data = &assembly.data;
+    let name = |i: usize| data.instances.get(i).map_or("?", |x| x.name.as_str());
+    match data.parts.get(part).map(|p| p.kind) {
+        Some(PartKind::Piece { instance }) => format!("`{}`", name(instance)),
+        Some(PartKind::Stretch { chain, first }) => {
+            let at = |k: usize| {
+                data.chains
+                    .get(chain)
+                    .and_then(|c| c.instances.get(k))
+                    .map_or("?", |&i| name(i))
+            };
+            format!("`{}` and `{}`", at(first), at(first + 1))
+        }
+        None => "?".to_string(),
+    }
+}
+
 /// One solver frame within `budget`, then the rules (paper 5.1), on whichever thread.
 fn solve_frame(
     assembly: &mut Assembly,
@@ -169,33 +184,65 @@ fn solve_frame(
             };
         }
     };
-    // Piece parts' switches come back from the rules as replacement events; stretch parts'
-    // switches are logged here, before the rules renumber the parts.
-    let mut notes = Vec::new();
+    // How much closer each switched piece part came to its new state, for the log; measured
+    // before the rules renumber the parts.
+    let mut closer = std::collections::HashMap::new();
+    let mut stretch_switches = Vec::new();
     for s in &report.switches {
         let Some(p) = assembly.data.parts.get(s.part) else {
             continue;
         };
-        if !matches!(p.kind, PartKind::Stretch { .. }) {
-            continue;
+        let d = |i: usize| {
+            p.states.get(i).map_or(f64::NAN, |st| {
+                align(&st.positions, &p.vertices, &assembly.data.positions).distance
+            })
+        };
+        match p.kind {
+            PartKind::Piece { instance } => {
+                if let Some(x) = assembly.data.instances.get(instance) {
+                    let (from, to) = (d(s.from), d(s.to));
+                    closer.insert(x.id, 1.0 - to / from);
+                }
+            }
+            PartKind::Stretch { .. } => {
+                let name = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str()).to_string();
+                let covers = instance_names(assembly, s.part);
+                let at = assembly.part_centroid(s.part);
+                stretch_switches.push((
+                    format!(
+                        "{covers} now rest as `{}` (was `{}`)",
+                        name(s.to),
+                        name(s.from)
+                    ),
+                    Some(at),
+                ));
+            }
         }
-        let name = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str()).to_string();
-        let (from, to) = (name(s.from), name(s.to));
-        let at = assembly.part_centroid(s.part);
-        notes.push((
-            format!("state switch: part {} {from} -> {to}", s.part),
-            Some(at),
-        ));
     }
     // Stretch, shrink, merge and replacement after every frame.
     let events = rules.after_frame(assembly, &report);
     rules.log.clear();
     let rewrote = !events.is_empty();
+    let mut notes = Vec::new();
+    // A stretch part's switch is worth a line only when no insertion or removal followed.
+    if !events
+        .iter()
+        .any(|e| matches!(e.kind, RuleKind::Stretch | RuleKind::Shrink))
+    {
+        notes.extend(stretch_switches);
+    }
     for e in events {
-        notes.push((
-            format!("{:?}: {}", e.kind, e.detail).to_lowercase(),
-            Some(e.at),
-        ));
+        let mut line = format!("{} at ({:.1}, {:.1})", e.detail, e.at.x, e.at.y);
+        if e.kind == RuleKind::Replace
+            && let Some(c) = e.instances.first().and_then(|id| closer.get(id))
+            && c.is_finite()
+        {
+            line.push_str(&format!(
+                ", {:.0}% closer to its shape than before",
+                100.0 * c
+            ));
+        }
+        notes.push((line, Some(e.at)));
     }
     FrameOutcome {
         report: Ok(report),
@@ -229,6 +276,7 @@ impl Sculpt {
             frames_last_step: 0,
             error: None,
             log: Vec::new(),
+            next_seq: 0,
             job: None,
             spare: None,
             moved_while_solving: false,
@@ -244,6 +292,7 @@ impl Sculpt {
         data: AssemblyData,
         pins: Vec<Pin>,
         settings: Option<Settings>,
+        log: Vec<LogEntry>,
     ) -> Result<Self, String> {
         data.check(&grammar)
             .map_err(|e| format!("the session does not fit the grammar: {e}"))?;
@@ -256,6 +305,7 @@ impl Sculpt {
             grammar,
             data,
             pins,
+            log,
         });
         sculpt
             .assembly
@@ -350,6 +400,19 @@ impl Sculpt {
             });
         }
         pins
+    }
+
+    /// The vertices the grab holds, and the pinned ones (the handles-and-pins overlay).
+    pub fn held_vertices(&self) -> (Vec<usize>, Vec<usize>) {
+        let mut grabbed = Vec::new();
+        let mut pinned = Vec::new();
+        for h in self.assembly.handles() {
+            match h.kind {
+                HandleKind::Grab => grabbed.extend(h.vertices.iter().copied()),
+                HandleKind::Pin => pinned.extend(h.vertices.iter().copied()),
+            }
+        }
+        (grabbed, pinned)
     }
 
     /// Whether an instance of `part` is held by a pin.
@@ -471,6 +534,7 @@ impl Sculpt {
                     data: grammar.assembly.clone(),
                     grammar,
                     pins: Vec::new(),
+                    log: self.log.clone(),
                 });
                 self.note("reset to the initial model".to_string(), None);
             }
@@ -528,12 +592,14 @@ impl Sculpt {
                 grammar,
                 data,
                 pins: self.pins(),
+                log: self.log.clone(),
             }
         } else {
             Snapshot {
                 data: grammar.assembly.clone(),
                 grammar,
                 pins: Vec::new(),
+                log: self.log.clone(),
             }
         };
         self.restore(snapshot);
@@ -816,11 +882,23 @@ impl Sculpt {
             grammar: self.grammar().clone(),
             data: self.assembly.data.clone(),
             pins: self.pins(),
+            log: self.log.clone(),
         }
     }
 
     fn restore(&mut self, s: Snapshot) {
         self.revision += 1;
+        // The log goes back with the model, except for what happened outside the gestures
+        // (failed reloads, file errors): those stay, in order.
+        let outside: Vec<LogEntry> = self
+            .log
+            .iter()
+            .filter(|e| e.outside && !s.log.contains(e))
+            .cloned()
+            .collect();
+        self.log = s.log;
+        self.log.extend(outside);
+        self.log.sort_by_key(|e| e.seq);
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
             // A pin on exactly one instance's vertices holds that instance, so it keeps
@@ -867,7 +945,10 @@ impl Sculpt {
             Ok(e) => {
                 self.rules.log.clear();
                 self.revision += 1;
-                self.note(format!("cut: {}", e.detail), Some(e.at));
+                self.note(
+                    format!("{} at ({:.1}, {:.1})", e.detail, e.at.x, e.at.y),
+                    Some(e.at),
+                );
                 self.unsettled = true;
             }
             Err(message) => {
@@ -908,11 +989,31 @@ impl Sculpt {
             .map(|(i, _)| i)
     }
 
+    /// Logs something that is not part of a gesture (a failed reload, a file error): undo
+    /// does not take it back.
+    pub fn note_outside_history(&mut self, message: String) {
+        self.push_log(message, None, true);
+    }
+
     fn note(&mut self, message: String, at: Option<DVec2>) {
+        self.push_log(message, at, false);
+    }
+
+    fn push_log(&mut self, message: String, at: Option<DVec2>, outside: bool) {
+        let seq = self
+            .log
+            .iter()
+            .map(|e| e.seq + 1)
+            .max()
+            .unwrap_or(0)
+            .max(self.next_seq);
+        self.next_seq = seq + 1;
         self.log.push(LogEntry {
             frame: self.frame,
             message,
             at,
+            outside,
+            seq,
         });
         if self.log.len() > LOG_LIMIT {
             let extra = self.log.len() - LOG_LIMIT;

@@ -30,6 +30,22 @@ pub struct Settings {
     pub merge_distance: f64,
 }
 
+/// An entry of the rule log.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LogEntry {
+    /// The solver frame it happened in.
+    pub frame: u64,
+    pub message: String,
+    /// Where it happened (world coordinates), if anywhere in particular.
+    pub at: Option<DVec2>,
+    /// Not part of a gesture (a failed reload, a file error): undo leaves it.
+    #[serde(default)]
+    pub outside: bool,
+    /// Order of entries, kept across undo and redo.
+    #[serde(default)]
+    pub seq: u64,
+}
+
 /// A saved sculpt.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Session {
@@ -42,6 +58,9 @@ pub struct Session {
     pub pins: Vec<Pin>,
     #[serde(default)]
     pub settings: Option<Settings>,
+    /// The rule log when it was saved, so an opened session shows its history.
+    #[serde(default)]
+    pub log: Vec<LogEntry>,
 }
 
 impl Session {
@@ -58,6 +77,7 @@ impl Session {
             assembly,
             pins,
             settings,
+            log: Vec::new(),
         }
     }
 }

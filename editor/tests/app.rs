@@ -236,21 +236,122 @@ fn closing_with_unsaved_changes_asks_first() {
 
 #[test]
 fn opening_another_file_with_unsaved_changes_asks_first() {
+    let dir = temp_dir("open-ask");
+    let other = dir.join("other.clay");
+    std::fs::write(&other, CASTLE_SOURCE).unwrap();
     let mut h = harness(EditorApp::bundled());
     h.state_mut().command(clay_editor::sculpt::Command::Reset);
     h.step();
     let kept = h.state().sculpt.data().clone();
-    h.state_mut().perform(clay_editor::app::Action::OpenGrammar(
-        "no/such/file.clay".into(),
-    ));
+    h.state_mut()
+        .perform(clay_editor::app::Action::OpenGrammar(other.clone()));
     assert!(h.state().confirming());
     // A new modal is laid out invisibly on its first frame.
     h.step();
     h.step();
+    h.get_by_label("Save");
+    h.get_by_label("Discard");
     h.get_by_label("Cancel").click();
     h.step();
     assert!(!h.state().confirming());
     assert!(h.state().sculpt.data() == &kept, "cancel keeps the sculpt");
+    assert_eq!(h.state().grammar_path(), None, "still the bundled castle");
+}
+
+#[test]
+fn a_failed_open_keeps_the_model_and_asks_nothing() {
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().command(clay_editor::sculpt::Command::Reset);
+    settle(&mut h);
+    let kept = h.state().sculpt.data().clone();
+    assert!(!kept.parts.is_empty());
+    h.state_mut().perform(clay_editor::app::Action::OpenGrammar(
+        "no/such/file.clay".into(),
+    ));
+    assert!(
+        !h.state().confirming(),
+        "a file that cannot be read is not worth discarding the sculpt for"
+    );
+    h.step();
+    let app = h.state();
+    assert!(app.sculpt.data() == &kept, "the model stays");
+    assert!(app.sculpt.dirty, "and so does its unsaved state");
+    assert_eq!(app.grammar_path(), None);
+    let m = app.message.clone().unwrap_or_default();
+    assert!(
+        m.contains("no/such/file.clay was not opened") && m.contains("the current model stays"),
+        "{m}"
+    );
+    assert!(
+        app.sculpt
+            .log()
+            .iter()
+            .any(|e| e.message.contains("was not opened")),
+        "the failure is in the log"
+    );
+
+    // A file that reads but does not compile: the same, with its problems listed.
+    let dir = temp_dir("open-broken");
+    let broken = dir.join("broken.clay");
+    std::fs::write(&broken, "piece broken {\n").unwrap();
+    h.state_mut()
+        .perform(clay_editor::app::Action::OpenGrammar(broken.clone()));
+    assert!(!h.state().confirming());
+    h.step();
+    h.step();
+    let app = h.state();
+    assert!(app.sculpt.data() == &kept);
+    let (file, problems) = app.refused.clone().expect("the refused file is shown");
+    assert_eq!(file, broken.display().to_string());
+    assert!(!problems.is_empty());
+    h.get_by_label(&format!(
+        "{} was not opened: the current model stays.",
+        broken.display()
+    ));
+}
+
+#[test]
+fn save_in_the_prompt_saves_the_session_then_opens() {
+    let dir = temp_dir("prompt-save");
+    let other = dir.join("other.clay");
+    std::fs::write(&other, CASTLE_SOURCE).unwrap();
+    let session = dir.join("castle.session.json");
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().command(clay_editor::sculpt::Command::Reset);
+    h.step();
+    h.state_mut()
+        .perform(clay_editor::app::Action::OpenGrammar(other.clone()));
+    h.step();
+    h.step();
+    h.get_by_label("Save").click();
+    h.step();
+    h.step();
+    // No session file yet: Save asks where (the typed path where no desktop dialog exists).
+    h.step();
+    h.get_by_label("Save session as");
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text(&session.display().to_string());
+    h.step();
+    h.key_press(egui::Key::Enter);
+    for _ in 0..4 {
+        h.step();
+    }
+    assert!(session.exists(), "the session was saved first");
+    assert_eq!(
+        h.state().grammar_path(),
+        Some(other.as_path()),
+        "then the other grammar opened"
+    );
+    assert!(!h.state().sculpt.dirty);
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-editor-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
 }
 
 fn request_close(h: &mut Harness<'_, EditorApp>) {

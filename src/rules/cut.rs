@@ -90,7 +90,7 @@ pub fn cut_dock(
                 (
                     vec![xid, yid, nid],
                     HashSet::from([xid, yid, nid]),
-                    format!("{yn} cut from {xn}; {xn} turned back into {nn}"),
+                    format!("`{yn}` cut from `{xn}`; `{xn}` turned back into `{nn}`"),
                 )
             }
             None => {
@@ -115,7 +115,7 @@ pub fn cut_dock(
                 (
                     vec![aid, bid],
                     HashSet::from([aid, bid]),
-                    format!("{} cut from {}", name(data, b), name(data, a)),
+                    format!("`{}` cut from `{}`", name(data, b), name(data, a)),
                 )
             }
         };

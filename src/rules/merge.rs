@@ -257,7 +257,7 @@ pub fn apply(
                 (
                     vec![mover_id, target_id],
                     HashSet::from([mover_id, target_id]),
-                    format!("{mover_name} welded to {target_name}"),
+                    format!("`{mover_name}` welded to `{target_name}`"),
                     at,
                 )
             }
@@ -286,7 +286,9 @@ pub fn apply(
                 (
                     vec![mover_id, target_id, junction_id],
                     HashSet::from([mover_id, target_id, junction_id]),
-                    format!("{mover_name} merged onto {target_name}, replaced by {junction_name}"),
+                    format!(
+                        "`{mover_name}` merged onto `{target_name}`, which became `{junction_name}`"
+                    ),
                     at,
                 )
             }

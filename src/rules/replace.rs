@@ -50,11 +50,11 @@ pub fn replacement_events(
             at,
             instances: vec![inst.id],
             detail: format!(
-                "{} ({}): {} -> {}",
+                "`{}` ({}) is now `{}` (was `{}`)",
                 inst.name,
                 piece.name,
-                name(from),
-                name(to)
+                name(to),
+                name(from)
             ),
         });
     }

@@ -363,12 +363,24 @@ pub fn stretch(
             at,
             instances: vec![ida, idb, id],
             detail: format!(
-                "chain {chain} at element {first}: 2 -> 3 elements, inserted {name} ({}); {count} elements",
-                grammar.pieces[piece].name
+                "`{}` and `{}` became three {}s: `{name}` inserted; {} has {count} now",
+                data.instances[ia].name,
+                data.instances[ib].name,
+                grammar.pieces[piece].name,
+                chain_name(&data.instances[ia].name, chain),
             ),
         };
         Ok(finish(grammar, data, &before, &touched, event))
     })
+}
+
+/// What the user calls a chain in messages: the model's name for it (`wall` of `wall[3]`), or
+/// "chain 2" for elements without one.
+fn chain_name(element: &str, chain: usize) -> String {
+    match element.split_once('[') {
+        Some((name, _)) if !name.is_empty() => format!("`{name}`"),
+        _ => format!("chain {chain}"),
+    }
 }
 
 /// Instance indices of elements `first` and `first + 1` of a chain: the stretch part that
@@ -480,7 +492,10 @@ pub fn shrink(
             at,
             instances: vec![kid, gid],
             detail: format!(
-                "chain {chain} at element {first}: 2 -> 1 elements, removed {gone_name}; {count} elements"
+                "`{}` and `{gone_name}` became one {}: `{gone_name}` removed; {} has {count} now",
+                data.instances[ki].name,
+                grammar.pieces[data.instances[ki].piece].name,
+                chain_name(&data.instances[ki].name, chain),
             ),
         };
         Ok(finish(grammar, data, &before, &touched, event))
