@@ -66,6 +66,7 @@ pub const GLOBAL: &[Row] = &[
     ("Ctrl + Shift + Z, Ctrl + Y", "redo"),
     ("Ctrl + O", "open a grammar"),
     ("Ctrl + S", "save the session"),
+    ("Ctrl + Q", "quit (asks first about unsaved changes)"),
     ("F1, ?", "show or hide this list"),
     ("Esc", "close this list or a dialog"),
 ];

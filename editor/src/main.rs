@@ -9,7 +9,7 @@ use clay_editor::EditorApp;
 /// Sculpt a Clay grammar's model live: drag, turn, pin and cut it while the mutable elastic
 /// solver keeps every part in its best rest state. Press F1 in the window for every gesture.
 #[derive(Parser, Debug)]
-#[command(name = "clay-editor", version, about, long_about = None)]
+#[command(name = "clay-editor", version)]
 struct Args {
     /// The grammar to open (`.clay`, or a compiled `.json`); the bundled castle without one.
     grammar: Option<PathBuf>,

@@ -123,26 +123,43 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         return;
     };
     ui.label(format!(
-        "part {}: {} ({}){}",
-        report.part,
-        report.piece,
+        "{} ({}){}",
         report.covers,
+        report.piece,
         if report.pinned { ", pinned" } else { "" }
-    ));
+    ))
+    .on_hover_text(format!("part {} of the solver", report.part));
     let active_name = report
         .states
         .get(report.active)
         .map_or("?", |s| s.0.as_str());
-    ui.label(format!("active state: {active_name}"));
+    ui.label(format!("rests as `{active_name}`"));
     if report.states.len() > 1 {
-        ui.label(format!(
-            "another state becomes active below distance {:.4} (hysteresis {:.2})",
-            report.switch_below, report.hysteresis
-        ));
+        let best_other = report
+            .states
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != report.active)
+            .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
+        if let Some((_, (name, d))) = best_other {
+            let d_active = report.states.get(report.active).map_or(0.0, |s| s.1);
+            let gap = if *d > 0.0 {
+                format!("{:.0}%", 100.0 * (1.0 - d_active / d))
+            } else {
+                "0%".to_string()
+            };
+            ui.label(format!(
+                "`{name}` would take over once it fits {:.0}% better than `{active_name}` \
+                 (now `{active_name}` fits {gap} better)",
+                100.0 * report.hysteresis
+            ));
+        }
     }
     egui::Grid::new("states").striped(true).show(ui, |ui| {
-        ui.label("state");
-        ui.label("distance");
+        ui.label("rest state");
+        ui.label("misfit (m²)").on_hover_text(
+            "shape-space distance from the current pose, squared, after the best rotation",
+        );
         ui.end_row();
         for (i, (name, d)) in report.states.iter().enumerate() {
             let text = if i == report.active {

@@ -76,7 +76,7 @@ pub struct PartReport {
     pub part: usize,
     /// `tower`, or `wall` for a stretch part.
     pub piece: String,
-    /// `t1`, or `wall[3] + wall[4]` for a stretch part.
+    /// "`t1`", or "`wall[3]` and `wall[4]`" for a stretch part.
     pub covers: String,
     pub active: usize,
     /// Every rest state with its shape-space distance (squared, after the best rotation) to the
@@ -771,7 +771,7 @@ impl Sculpt {
                     .get(instance)
                     .and_then(|x| grammar.pieces.get(x.piece))
                     .map_or("?".to_string(), |pc| pc.name.clone());
-                (piece, name(instance).to_string())
+                (piece, format!("`{}`", name(instance)))
             }
             PartKind::Stretch { chain, first } => {
                 let c = data.chains.get(chain)?;
@@ -782,7 +782,7 @@ impl Sculpt {
                     .map_or("?".to_string(), |pc| pc.name.clone());
                 let a = c.instances.get(first).copied().map_or("?", name);
                 let b = c.instances.get(first + 1).copied().map_or("?", name);
-                (piece, format!("{a} + {b}"))
+                (piece, format!("`{a}` and `{b}`"))
             }
         };
         let states: Vec<(String, f64)> = p

@@ -202,10 +202,15 @@ fn cutting_a_connection_is_one_undoable_step() {
     let centre = s.dock_centres()[0];
     assert_eq!(s.cut_target(centre), Some(0));
     s.apply(Command::Cut { point: centre });
-    assert!(s.log().iter().any(|e| e.message.starts_with("cut")));
+    // Logged in the grammar's names: "`a` cut from `b` at (x, y)".
+    assert!(s.log().iter().any(|e| e.message.contains("` cut from `")));
     assert_ne!(s.data(), &before, "the cut changed the assembly");
     s.apply(Command::Undo);
     assert!(s.data() == &before);
+    assert!(
+        !s.log().iter().any(|e| e.message.contains("` cut from `")),
+        "undo takes the cut's log line back"
+    );
     // Far from everything, a cut does nothing and leaves no undo step.
     let undo_before = s.can_undo();
     s.apply(Command::Cut {

@@ -1,0 +1,299 @@
+//! What the editor shows and tells, driven headless through egui_kittest: the window title
+//! with its unsaved marker, the View menu's overlays (drawn by the renderer's overlay code),
+//! the F1 help, the rule log following undo and kept in sessions and in the user's words,
+//! failed reloads in the log, and a click on a diagnostic showing its line.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use clay_editor::EditorApp;
+use clay_editor::compile::CASTLE_SOURCE;
+use clay_editor::sculpt::Command;
+use egui::{Shape, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+
+fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
+    Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .with_max_steps(8)
+        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
+}
+
+fn settle(h: &mut Harness<'_, EditorApp>) {
+    for _ in 0..300 {
+        h.step();
+        if !h.state().sculpt.needs_work() {
+            return;
+        }
+    }
+    panic!("the model did not settle");
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-editor-view-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn grammar(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../grammars")
+        .join(name)
+}
+
+/// The titles the app sent to the window in the last frame.
+fn titles(h: &Harness<'_, EditorApp>) -> Vec<String> {
+    h.output()
+        .viewport_output
+        .values()
+        .flat_map(|v| v.commands.iter())
+        .filter_map(|c| match c {
+            egui::ViewportCommand::Title(t) => Some(t.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every text the last frame painted.
+fn painted_texts(h: &Harness<'_, EditorApp>) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in &h.output().shapes {
+        collect_texts(&s.shape, &mut out);
+    }
+    out
+}
+
+fn collect_texts(shape: &Shape, out: &mut Vec<String>) {
+    match shape {
+        Shape::Text(t) => out.push(t.galley.text().to_string()),
+        Shape::Vec(v) => v.iter().for_each(|s| collect_texts(s, out)),
+        _ => {}
+    }
+}
+
+fn count_circles(h: &Harness<'_, EditorApp>) -> usize {
+    fn count(shape: &Shape) -> usize {
+        match shape {
+            Shape::Circle(_) => 1,
+            Shape::Vec(v) => v.iter().map(count).sum(),
+            _ => 0,
+        }
+    }
+    h.output().shapes.iter().map(|s| count(&s.shape)).sum()
+}
+
+#[test]
+fn the_title_names_the_file_and_marks_unsaved_changes() {
+    let mut h = harness(EditorApp::bundled());
+    h.step();
+    assert_eq!(h.state().title(), "castle.clay \u{2022} Clay");
+    h.state_mut().command(Command::Reset);
+    let mut sent = Vec::new();
+    for _ in 0..3 {
+        h.step();
+        sent.extend(titles(&h));
+    }
+    assert_eq!(h.state().title(), "castle.clay* \u{2022} Clay");
+    assert_eq!(
+        sent,
+        vec!["castle.clay* \u{2022} Clay".to_string()],
+        "the new title is sent to the window once"
+    );
+    let wall = grammar("wall.clay");
+    let mut h = harness(EditorApp::open(&wall));
+    h.step();
+    assert_eq!(h.state().title(), "wall.clay \u{2022} Clay");
+}
+
+#[test]
+fn view_menu_turns_on_the_renderers_overlays() {
+    let mut h = harness(EditorApp::open(&grammar("bend.clay")));
+    settle(&mut h);
+    let plain_texts = painted_texts(&h);
+    let plain_circles = count_circles(&h);
+    assert!(!plain_texts.iter().any(|t| t == "strain 0"));
+
+    h.get_by_label("View").click();
+    h.step();
+    h.step();
+    h.get_by_label("Strain").click();
+    h.step();
+    assert!(
+        h.state().overlays.strain,
+        "the menu's checkbox turns strain on"
+    );
+    h.step();
+    let texts = painted_texts(&h);
+    assert!(
+        texts.iter().any(|t| t == "strain 0"),
+        "the strain legend is drawn: {texts:?}"
+    );
+
+    let app = h.state_mut();
+    app.overlays.strain = false;
+    app.overlays.states = true;
+    app.overlays.sites = true;
+    h.step();
+    h.step();
+    let texts = painted_texts(&h);
+    // Every bend segment has alternatives (base, left, right): its state's name is shown.
+    let parts = h.state().sculpt.data().parts.len();
+    let names = texts.iter().filter(|t| *t == "base").count();
+    assert_eq!(names, parts, "one state label per part: {texts:?}");
+    assert!(
+        count_circles(&h) > plain_circles,
+        "site vertices are drawn as dots"
+    );
+    let _ = plain_texts;
+}
+
+#[test]
+fn f1_shows_every_gesture_and_the_docs_list_them_too() {
+    let mut h = harness(EditorApp::bundled());
+    h.step();
+    h.key_press(egui::Key::F1);
+    h.step();
+    h.step();
+    assert!(h.state().help_open);
+    h.get_by_label("Gestures and keys");
+    h.get_by_label("Ctrl + click");
+    h.key_press(egui::Key::F1);
+    h.step();
+    assert!(!h.state().help_open, "F1 again closes it");
+
+    let docs =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/editor.md"))
+            .unwrap();
+    for table in [
+        clay_editor::help::SCULPT,
+        clay_editor::help::AUTHOR,
+        clay_editor::help::GLOBAL,
+    ] {
+        for (keys, what) in table {
+            let row = format!("| {keys} | {what} |");
+            assert!(docs.contains(&row), "docs/editor.md lacks the row `{row}`");
+        }
+    }
+}
+
+/// Pulls the wall's last brick east by `by` metres and lets go.
+fn pull(h: &mut Harness<'_, EditorApp>, by: f64) {
+    let data = h.state().sculpt.data();
+    let last = data.parts.len() - 1;
+    let at = h.state().sculpt.assembly().part_centroid(last);
+    h.state_mut().command(Command::Grab { part: last, at });
+    for k in 1..=40 {
+        h.state_mut().command(Command::MoveGrab {
+            translation: DVec2::new(by * k as f64 / 40.0, 0.0),
+            angle: 0.0,
+        });
+        h.step();
+    }
+    h.state_mut().command(Command::Release);
+    settle(h);
+}
+
+#[test]
+fn undo_takes_back_the_rules_log_lines_and_a_session_keeps_the_log() {
+    let mut h = harness(EditorApp::open(&grammar("wall.clay")));
+    settle(&mut h);
+    let at = h.state().sculpt.assembly().part_centroid(0);
+    h.state_mut().command(Command::TogglePin { part: 0, at });
+    settle(&mut h);
+    let before = h.state().sculpt.log().to_vec();
+    pull(&mut h, 4.0);
+    let after = h.state().sculpt.log().to_vec();
+    let grew: Vec<_> = after
+        .iter()
+        .filter(|e| e.message.contains("became three bricks"))
+        .collect();
+    assert!(!grew.is_empty(), "the pull inserted bricks: {after:#?}");
+    let line = &grew[0].message;
+    assert!(
+        line.contains("`wall` has") && line.contains(" inserted") && line.contains(" at ("),
+        "in the grammar's names: {line}"
+    );
+
+    h.state_mut().command(Command::Undo);
+    h.step();
+    assert_eq!(
+        h.state().sculpt.log(),
+        &before[..],
+        "undo takes the gesture's lines back"
+    );
+    h.state_mut().command(Command::Redo);
+    h.step();
+    assert_eq!(h.state().sculpt.log(), &after[..], "redo brings them again");
+
+    let dir = scratch("session-log");
+    let session = dir.join("wall.session.json");
+    h.state_mut()
+        .perform(clay_editor::app::Action::SaveSession(session.clone()));
+    let mut again = EditorApp::bundled();
+    again.perform(clay_editor::app::Action::OpenSession(session));
+    assert_eq!(again.sculpt.log(), &after[..], "the session kept its log");
+}
+
+#[test]
+fn a_failed_reload_is_logged_and_undo_leaves_that_line() {
+    let dir = scratch("reload-log");
+    let path = dir.join("castle.clay");
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+    let mut app = EditorApp::open(&path);
+    app.command(Command::Reset);
+    app.apply();
+    std::fs::write(&path, format!("{CASTLE_SOURCE}\npiece broken {{\n")).unwrap();
+    app.reload();
+    let failed = |app: &EditorApp| {
+        app.sculpt
+            .log()
+            .iter()
+            .any(|e| e.message.starts_with("reload failed:") && e.message.contains("castle.clay"))
+    };
+    assert!(failed(&app), "{:#?}", app.sculpt.log());
+    app.command(Command::Undo);
+    app.apply();
+    assert!(
+        failed(&app),
+        "a failed reload is not part of the undone gesture"
+    );
+}
+
+#[test]
+fn clicking_a_diagnostic_shows_its_line_in_the_source_view() {
+    let dir = scratch("diagnostic-click");
+    let path = dir.join("broken.clay");
+    let source = CASTLE_SOURCE.replacen("chain wall x 4", "chain wal x 4", 1);
+    std::fs::write(&path, &source).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    h.step();
+    h.step();
+    let p = h
+        .state()
+        .problems
+        .iter()
+        .find(|p| p.code == "E011")
+        .cloned()
+        .expect("the unknown piece is reported");
+    assert_eq!(p.snippet.trim(), "wall_s1 = chain wal x 4");
+    // The snippet with its underline and the hint are in the panel.
+    h.get_by_label_contains("^^^ ");
+    h.get_by_label_contains("help: did you mean `wall`?");
+    h.get_by_label(&p.to_string()).click();
+    h.step();
+    h.step();
+    let view = h
+        .state()
+        .source_view
+        .clone()
+        .expect("the source view opened");
+    assert_eq!(
+        (view.line, view.col, view.end_col),
+        (p.line, p.col, p.end_col)
+    );
+    h.get_by_label(&format!("{} | {}", p.line, p.snippet));
+    let _ = Duration::ZERO;
+}
