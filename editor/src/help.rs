@@ -84,24 +84,24 @@ pub fn show(ctx: &egui::Context, open: &mut bool) {
         .open(&mut keep)
         .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
         .show(ctx, |ui| {
-            for (title, rows) in [
-                ("Sculpt", SCULPT),
-                ("Author", AUTHOR),
-                ("Everywhere", GLOBAL),
-            ] {
-                ui.heading(title);
-                egui::Grid::new(("help", title))
-                    .num_columns(2)
-                    .striped(true)
-                    .show(ui, |ui| {
+            egui::Grid::new("help rows")
+                .num_columns(2)
+                .striped(true)
+                .show(ui, |ui| {
+                    for (title, rows) in [
+                        ("Sculpt", SCULPT),
+                        ("Author", AUTHOR),
+                        ("Everywhere", GLOBAL),
+                    ] {
+                        ui.heading(title);
+                        ui.end_row();
                         for (keys, what) in rows {
                             ui.strong(*keys);
                             ui.label(*what);
                             ui.end_row();
                         }
-                    });
-                ui.add_space(6.0);
-            }
+                    }
+                });
             ui.label("F1 or ? closes this list.");
         });
     *open &= keep;

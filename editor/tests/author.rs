@@ -860,9 +860,5 @@ fn a_variant_with_a_rest_state_is_refused_with_e047() {
     assert_eq!(a.problems.len(), 1, "{:?}", a.problems);
     assert_eq!(a.problems[0].code, "E047");
     // The span's label names the state (the message no longer repeats the label).
-    assert!(
-        a.problems[0].label.contains("`lifted`"),
-        "{:?}",
-        a.problems
-    );
+    assert!(a.problems[0].label.contains("`lifted`"), "{:?}", a.problems);
 }

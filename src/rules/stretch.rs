@@ -374,10 +374,12 @@ pub fn stretch(
     })
 }
 
-/// What the user calls a chain in messages: the model's name for it (`wall` of `wall[3]`), or
+/// What the user calls a chain in messages: the model's name for it (`wall` of `wall[3]` or
+/// `wall#12`), or
 /// "chain 2" for elements without one.
 fn chain_name(element: &str, chain: usize) -> String {
-    match element.split_once('[') {
+    // `wall[3]` from the model, `wall#12` for an element a rule inserted.
+    match element.split_once(['[', '#']) {
         Some((name, _)) if !name.is_empty() => format!("`{name}`"),
         _ => format!("chain {chain}"),
     }
