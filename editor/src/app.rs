@@ -989,7 +989,17 @@ impl EditorApp {
     /// Applies the frame's commands and file actions.
     pub fn apply(&mut self) {
         for c in std::mem::take(&mut self.commands) {
+            let logged = self.sculpt.log().last().map(|e| e.seq);
+            let gesture = !matches!(c, Command::MoveGrab { .. } | Command::Settings(_));
             self.sculpt.apply(c);
+            // What a pin, a cut (or a cut that found nothing) did, also in the status bar, so
+            // that no click goes unanswered.
+            if gesture
+                && let Some(e) = self.sculpt.log().last()
+                && Some(e.seq) != logged
+            {
+                self.message = Some(e.message.clone());
+            }
         }
         for c in std::mem::take(&mut self.author_commands) {
             self.author.apply(c);

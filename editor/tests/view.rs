@@ -297,3 +297,48 @@ fn clicking_a_diagnostic_shows_its_line_in_the_source_view() {
     h.get_by_label(&format!("{} | {}", p.line, p.snippet));
     let _ = Duration::ZERO;
 }
+
+#[test]
+fn a_cut_click_that_finds_nothing_says_why_in_the_status_bar() {
+    let mut app = EditorApp::bundled();
+    app.command(Command::Cut {
+        point: DVec2::new(1e4, 1e4),
+    });
+    app.apply();
+    let m = app.message.clone().unwrap_or_default();
+    assert!(m.starts_with("cut failed: "), "{m}");
+}
+
+#[test]
+fn opened_files_are_remembered_and_offered_in_the_open_dialog() {
+    let dir = scratch("recent");
+    let store = dir.join("config").join("recent-files.json");
+    let desktop = clay_editor::files::Desktop {
+        native_dialogs: false,
+        recent_store: Some(store.clone()),
+    };
+    let wall = grammar("wall.clay");
+    let mut app = EditorApp::bundled();
+    app.use_desktop(desktop.clone());
+    app.perform(clay_editor::app::Action::OpenGrammar(wall.clone()));
+    assert!(store.exists(), "the list is kept in the config folder");
+
+    // A new editor reads the list; its typed Open dialog offers the file.
+    let mut app = EditorApp::bundled();
+    app.use_desktop(desktop);
+    let remembered = std::path::absolute(&wall).unwrap();
+    assert_eq!(app.recent.files[0].path, remembered);
+    let mut h = harness(app);
+    h.step();
+    h.state_mut().perform(clay_editor::app::Action::Ask(
+        clay_editor::app::FileKind::Grammar,
+    ));
+    for _ in 0..3 {
+        h.step();
+    }
+    h.get_by_label(&remembered.display().to_string()).click();
+    for _ in 0..3 {
+        h.step();
+    }
+    assert_eq!(h.state().grammar_path(), Some(remembered.as_path()));
+}
