@@ -217,13 +217,22 @@ pub fn statistics(ui: &mut egui::Ui, sculpt: &Sculpt) {
 pub fn parameters(ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command>) {
     let mut s = sculpt.settings();
     let before = s;
-    ui.add(egui::Slider::new(&mut s.hysteresis, 0.0..=0.9).text("hysteresis"));
-    ui.add(egui::Slider::new(&mut s.norm, 0.1..=2.0).text("p (norm)"));
+    ui.add(egui::Slider::new(&mut s.hysteresis, 0.0..=0.9).text("hysteresis"))
+        .on_hover_text(
+            "How much better another rest state must fit before a part switches to it \
+             (0.15: 15% better); higher stops parts flickering between states",
+        );
+    ui.add(egui::Slider::new(&mut s.norm, 0.1..=2.0).text("p (norm)"))
+        .on_hover_text(
+            "The sparsity of the deformation: below 1 one part bends and snaps to a new state \
+             while the others stay at rest; 2 spreads it over all (least squares)",
+        );
     ui.add(
         egui::Slider::new(&mut s.merge_distance, 0.0..=5.0)
             .text("merge distance (m)")
             .logarithmic(false),
-    );
+    )
+    .on_hover_text("Open sites closer than this weld (the grammar's merge rules)");
     if s != before {
         commands.push(Command::Settings(s));
     }
