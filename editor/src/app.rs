@@ -640,6 +640,9 @@ impl EditorApp {
         }
         for c in std::mem::take(&mut self.author_commands) {
             self.author.apply(c);
+            if let Some(m) = self.author.take_status() {
+                self.message = Some(m);
+            }
         }
         for a in std::mem::take(&mut self.actions) {
             self.perform(a);
