@@ -480,10 +480,13 @@ impl EditorApp {
         self.shortcuts(ui);
         self.menu(ui);
         self.status_bar(ui);
+        // A fixed width: a panel growing with its content would move the canvas.
         egui::Panel::right("panels")
-            .default_size(340.0)
+            .resizable(false)
+            .exact_size(340.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
+                // Both ways: content wider than the panel scrolls instead of pushing it over.
+                egui::ScrollArea::both().show(ui, |ui| match self.mode {
                     Mode::Sculpt => self.side_panels(ui),
                     Mode::Author => author_panel::show(
                         ui,
@@ -1003,6 +1006,9 @@ impl EditorApp {
         }
         for c in std::mem::take(&mut self.author_commands) {
             self.author.apply(c);
+            if let Some(m) = self.author.take_status() {
+                self.message = Some(m);
+            }
         }
         for a in std::mem::take(&mut self.actions) {
             self.perform(a);

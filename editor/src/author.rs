@@ -1,6 +1,7 @@
 //! Authoring mode's state: the drawing, its cut points and the author's rule declarations
-//! (site type names, site types, the stretchable piece and its variants, merge rules, posed
-//! rest states), the design recomputed from them through `clay::authoring` with the editor's
+//! (piece and site type names, site types, the stretchable piece and its variants, merge
+//! rules, posed rest states), the design recomputed from them through `clay::authoring` (with
+//! the editor's piece names from SVG ids and fills from the SVG or its palette) and the editor's
 //! additions to its syntax tree, and the grammar text with its diagnostics. Every change is an
 //! [`AuthorCommand`]; changes to the work are undoable as whole steps.
 
@@ -26,6 +27,10 @@ pub struct Work {
     /// Site type renames: generated name -> the author's name. Keyed by the generated name so
     /// a rename survives the design being recomputed after a new cut or stroke.
     pub site_names: BTreeMap<String, String>,
+    /// Piece renames: generated name (from the SVG ids, else `pieceN`) -> the author's name.
+    /// Keyed by the generated name like `site_names`; the other declarations name pieces by
+    /// their shown name.
+    pub piece_names: BTreeMap<String, String>,
     pub stretch: Option<StretchChoice>,
     /// Merge rules, by piece and site names (the library's design has none: the editor adds
     /// them to the syntax tree before printing).
@@ -48,6 +53,7 @@ impl Default for Work {
             drawing: Drawing::default(),
             cuts: Vec::new(),
             site_names: BTreeMap::new(),
+            piece_names: BTreeMap::new(),
             stretch: None,
             merges: Vec::new(),
             site_types: BTreeMap::new(),
@@ -139,6 +145,13 @@ pub enum AuthorCommand {
         from: String,
         to: String,
     },
+    /// Rename a piece: `from` is the generated name. The declarations naming the piece follow.
+    RenamePiece {
+        from: String,
+        to: String,
+    },
+    /// Say why a click did nothing (the canvas sends it): shown in the panel and status bar.
+    Report(String),
     /// Make a piece stretchable (or none).
     SetStretch(Option<StretchChoice>),
     /// Declare a merge rule (refused unless its sites exist).
@@ -176,6 +189,8 @@ pub struct Computed {
     pub design: Design,
     /// Generated site type names, parallel to `design.site_types` (which holds the shown ones).
     pub generated_site_types: Vec<String>,
+    /// Generated piece names, parallel to `design.pieces` (which holds the shown ones).
+    pub generated_piece_names: Vec<String>,
     pub text: String,
 }
 
@@ -194,6 +209,8 @@ pub struct Authoring {
     pub written: Option<(PathBuf, String)>,
     /// The outcome of the last command or file action, for the panel.
     pub message: Option<String>,
+    /// What the last command has to say, until the app moves it to its status bar.
+    status: Option<String>,
 }
 
 impl Default for Authoring {
@@ -202,12 +219,34 @@ impl Default for Authoring {
     }
 }
 
-fn valid_identifier(s: &str) -> bool {
+/// The grammar's keywords (docs/language.md). They are contextual, but a name that spells one
+/// reads badly (`piece piece {`), so the editor refuses them as names.
+pub const KEYWORDS: &[&str] = &[
+    "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
+    "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
+    "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
+    "at", "rotate", "dock", "last",
+];
+
+/// Why `s` cannot be a name in the grammar: an ASCII letter or `_`, then letters, digits and
+/// `_`, and not a keyword.
+pub fn check_name(s: &str) -> Result<(), String> {
     let mut chars = s.chars();
-    chars
+    let ok = chars
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !ok {
+        return Err(format!(
+            "`{s}` is not a name: use letters, digits and _, not starting with a digit"
+        ));
+    }
+    if KEYWORDS.contains(&s) {
+        return Err(format!(
+            "`{s}` is a keyword of the grammar: pick another name"
+        ));
+    }
+    Ok(())
 }
 
 /// Runs the library's steps on the work. A stretch choice that no longer fits the design (the
@@ -232,6 +271,8 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
     .map_err(|e| e.to_string())?;
     let mut design = authoring::pieces::find_pieces(&graph, &regions, &contacts, tol)
         .map_err(|e| e.to_string())?;
+    let generated_piece_names = name_pieces(&graph, &regions, work, &mut design);
+    colour_pieces(&graph, &regions, &mut design);
     if let Some(choice) = &work.stretch
         && let Err(e) = design.make_stretchable(choice)
     {
@@ -337,8 +378,157 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
         regions,
         design,
         generated_site_types,
+        generated_piece_names,
         text,
     })
+}
+
+/// Piece fills for pieces drawn without one (drawn on the canvas, or SVG paths with no fill):
+/// the canvas shows and the grammar writes the same colour.
+pub const PALETTE: [[u8; 3]; 8] = [
+    [232, 176, 120],
+    [150, 196, 230],
+    [170, 214, 150],
+    [226, 160, 200],
+    [236, 214, 120],
+    [180, 170, 230],
+    [140, 210, 200],
+    [220, 150, 140],
+];
+
+/// Where an instance came from in the drawing: its piece, and its region's fill and id.
+struct InstanceSource<'g> {
+    piece: usize,
+    fill: Option<[u8; 3]>,
+    id: Option<&'g str>,
+}
+
+/// The drawing's fill and id of each instance's region, by instance.
+fn instance_sources<'g>(
+    graph: &'g Graph,
+    regions: &[Region],
+    design: &Design,
+) -> Vec<InstanceSource<'g>> {
+    design
+        .instances
+        .iter()
+        .map(|inst| {
+            let source = regions
+                .get(inst.region)
+                .and_then(|r| r.source)
+                .and_then(|s| graph.sources.get(s));
+            InstanceSource {
+                piece: inst.piece,
+                fill: source.and_then(|s| s.0),
+                id: source.and_then(|s| s.1.as_deref()),
+            }
+        })
+        .collect()
+}
+
+/// Every piece's fill: the drawing's fill of one of its instances, else a palette colour (the
+/// library would write one brown for all of them).
+fn colour_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
+    let sources = instance_sources(graph, regions, design);
+    for (pi, piece) in design.pieces.iter_mut().enumerate() {
+        piece.fill = sources
+            .iter()
+            .find_map(|s| if s.piece == pi { s.fill } else { None })
+            .unwrap_or(PALETTE[pi % PALETTE.len()]);
+    }
+}
+
+/// An SVG id as a name: `brick3` -> `brick` (as the library does), if it then is a name.
+fn name_from_id(raw: &str) -> Option<String> {
+    let s: String = raw
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let s = s
+        .trim_end_matches(|c: char| c.is_ascii_digit() || c == '_')
+        .trim_start_matches(|c: char| c.is_ascii_digit() || c == '_');
+    check_name(s).is_ok().then(|| s.to_string())
+}
+
+/// Names the pieces and their instances; returns the generated names. A piece is named after
+/// the SVG id most of its instances have (any instance's, not just the first's); pieces with
+/// more instances choose first, so a one-off piece never takes a repeated piece's id. Pieces
+/// with no free id are `pieceN`. Then the author's renames apply (unless the name is taken).
+fn name_pieces(graph: &Graph, regions: &[Region], work: &Work, design: &mut Design) -> Vec<String> {
+    let n = design.pieces.len();
+    let sources = instance_sources(graph, regions, design);
+    let mut counts = vec![0usize; n];
+    for s in &sources {
+        counts[s.piece] += 1;
+    }
+    // Each piece's ids, most frequent first (ties: in instance order).
+    let ids: Vec<Vec<String>> = (0..n)
+        .map(|pi| {
+            let mut seen: Vec<(String, usize)> = Vec::new();
+            for name in sources
+                .iter()
+                .filter(|s| s.piece == pi)
+                .filter_map(|s| s.id.and_then(name_from_id))
+            {
+                match seen.iter_mut().find(|(s, _)| *s == name) {
+                    Some((_, k)) => *k += 1,
+                    None => seen.push((name, 1)),
+                }
+            }
+            seen.sort_by_key(|(_, k)| std::cmp::Reverse(*k));
+            seen.into_iter().map(|(s, _)| s).collect()
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&p| std::cmp::Reverse(counts[p]));
+    let mut taken: Vec<String> = vec!["base".into()];
+    let mut names: Vec<Option<String>> = vec![None; n];
+    for &p in &order {
+        if let Some(id) = ids[p].iter().find(|i| !taken.contains(i)) {
+            taken.push(id.clone());
+            names[p] = Some(id.clone());
+        }
+    }
+    let generated: Vec<String> = (0..n)
+        .map(|p| {
+            names[p].clone().unwrap_or_else(|| {
+                let name = (p + 1..)
+                    .map(|k| format!("piece{k}"))
+                    .find(|g| !taken.contains(g))
+                    .unwrap_or_default();
+                taken.push(name.clone());
+                name
+            })
+        })
+        .collect();
+    let mut shown = generated.clone();
+    for (p, g) in generated.iter().enumerate() {
+        let Some(to) = work.piece_names.get(g) else {
+            continue;
+        };
+        if shown.iter().enumerate().any(|(q, s)| q != p && s == to) {
+            design.notes.push(format!(
+                "the rename of `{g}` to `{to}` no longer applies: another piece is `{to}`"
+            ));
+        } else {
+            shown[p].clone_from(to);
+        }
+    }
+    for (piece, name) in design.pieces.iter_mut().zip(&shown) {
+        piece.name.clone_from(name);
+    }
+    let mut counts = vec![0usize; n];
+    for inst in &mut design.instances {
+        inst.name = format!("{}{}", shown[inst.piece], counts[inst.piece]);
+        counts[inst.piece] += 1;
+    }
+    generated
 }
 
 /// Piece and site index of `piece.site`.
@@ -741,6 +931,7 @@ impl Authoring {
             compiles: false,
             written: None,
             message: None,
+            status: None,
         };
         a.recompute();
         a
@@ -795,6 +986,19 @@ impl Authoring {
         }
     }
 
+    /// Says something about the last command: in the panel and, through the app, the status
+    /// bar.
+    fn say(&mut self, m: String) {
+        self.status = Some(m.clone());
+        self.message = Some(m);
+    }
+
+    /// What the last commands had to say for the status bar, once (the app takes it after
+    /// applying each command).
+    pub fn take_status(&mut self) -> Option<String> {
+        self.status.take()
+    }
+
     /// Replaces the work as one undoable step, if the new work has a design (or the old one
     /// had none either); otherwise keeps it and says why.
     fn change(&mut self, new: Work, what: &str) {
@@ -805,7 +1009,7 @@ impl Authoring {
         if let Err(e) = &result
             && self.result.is_ok()
         {
-            self.message = Some(format!("cannot {what}: {e}"));
+            self.say(format!("cannot {what}: {e}"));
             return;
         }
         let old = std::mem::replace(&mut self.work, new);
@@ -846,9 +1050,14 @@ impl Authoring {
             AuthorCommand::AddPolyline(p) => {
                 let n = if p.closed { 3 } else { 2 };
                 if p.points.len() < n || p.points.iter().any(|q| !q.is_finite()) {
-                    self.message = Some(format!("a stroke needs at least {n} points"));
+                    self.say(format!("a stroke needs at least {n} points"));
                     return;
                 }
+                self.status = Some(format!(
+                    "added a{} stroke of {} points",
+                    if p.closed { " closed" } else { "n open" },
+                    p.points.len()
+                ));
                 w.drawing.polylines.push(p);
                 let old = std::mem::replace(&mut self.work, w);
                 self.undo.push(old);
@@ -858,19 +1067,25 @@ impl Authoring {
             AuthorCommand::Cut { point } => {
                 w.cuts.push(point);
                 self.change(w, "cut there");
+                if self.message.is_none() {
+                    self.status = Some(format!("cut at ({}, {})", point.x, point.y));
+                }
             }
             AuthorCommand::RemoveCut { index } => {
                 if index < w.cuts.len() {
-                    w.cuts.remove(index);
+                    let at = w.cuts.remove(index);
                     self.change(w, "remove that cut");
+                    if self.message.is_none() {
+                        self.status = Some(format!("removed the cut at ({}, {})", at.x, at.y));
+                    }
                 }
             }
+            AuthorCommand::RenamePiece { from, to } => self.rename_piece(w, &from, to.trim()),
+            AuthorCommand::Report(m) => self.say(m),
             AuthorCommand::RenameSiteType { from, to } => {
                 let to = to.trim().to_string();
-                if !valid_identifier(&to) {
-                    self.message = Some(format!(
-                        "`{to}` is not a name: use letters, digits and _, not starting with a digit"
-                    ));
+                if let Err(e) = check_name(&to) {
+                    self.say(e);
                     return;
                 }
                 let shown = self
@@ -880,7 +1095,7 @@ impl Authoring {
                     .unwrap_or_default();
                 let current = w.site_names.get(&from).unwrap_or(&from);
                 if *current != to && shown.contains(&to) {
-                    self.message = Some(format!("there is already a site type `{to}`"));
+                    self.say(format!("there is already a site type `{to}`"));
                     return;
                 }
                 if to == from {
@@ -895,7 +1110,7 @@ impl Authoring {
                     // Check it here so a wrong pick is refused instead of becoming a note.
                     let mut d = computed.design.clone();
                     if let Err(e) = d.make_stretchable(c) {
-                        self.message = Some(e.to_string());
+                        self.say(e.to_string());
                         return;
                     }
                 }
@@ -906,11 +1121,11 @@ impl Authoring {
                 let names = self.design().map(site_names).unwrap_or_default();
                 let sites = [Some(&m.mover), Some(&m.target), m.junction.as_ref()];
                 if let Some(missing) = sites.into_iter().flatten().find(|s| !names.contains(s)) {
-                    self.message = Some(format!("there is no site {missing}"));
+                    self.say(format!("there is no site {missing}"));
                     return;
                 }
                 if m.mover == m.target {
-                    self.message = Some("a site cannot merge onto itself".into());
+                    self.say("a site cannot merge onto itself".into());
                     return;
                 }
                 if w.merges.contains(&m) {
@@ -927,17 +1142,15 @@ impl Authoring {
             }
             AuthorCommand::SetSiteType { site, site_type } => {
                 let site_type = site_type.trim().to_string();
-                if !valid_identifier(&site_type) {
-                    self.message = Some(format!(
-                        "`{site_type}` is not a name: use letters, digits and _, not starting with a digit"
-                    ));
+                if let Err(e) = check_name(&site_type) {
+                    self.say(e);
                     return;
                 }
                 let Some(design) = self.design() else {
                     return;
                 };
                 let Some(start) = find_site(design, &site) else {
-                    self.message = Some(format!("there is no site {site}"));
+                    self.say(format!("there is no site {site}"));
                     return;
                 };
                 let along: Vec<SiteName> = docked_sites(design, start)
@@ -954,7 +1167,7 @@ impl Authoring {
                 self.change(w, "set that site type");
                 if changed && along.len() > 1 && self.message.is_none() {
                     let others: Vec<String> = along[1..].iter().map(|s| s.to_string()).collect();
-                    self.message = Some(format!(
+                    self.say(format!(
                         "{} docks with {}: they get the type `{site_type}` too",
                         along[0],
                         others.join(", ")
@@ -971,20 +1184,19 @@ impl Authoring {
                     return;
                 };
                 let Some(sp) = design.pieces.iter().position(|p| p.stretch.is_some()) else {
-                    self.message =
-                        Some("variants need a stretchable piece: declare one first".into());
+                    self.say("variants need a stretchable piece: declare one first".into());
                     return;
                 };
                 for (k, v) in variants.iter().enumerate() {
                     if !(v.frequency.is_finite() && v.frequency > 0.0) {
-                        self.message = Some(format!(
+                        self.say(format!(
                             "the frequency of `{}` must be a positive number",
                             v.piece
                         ));
                         return;
                     }
                     if variants[..k].iter().any(|x| x.piece == v.piece) {
-                        self.message = Some(format!("`{}` is listed twice", v.piece));
+                        self.say(format!("`{}` is listed twice", v.piece));
                         return;
                     }
                     let problem = match design.pieces.iter().position(|p| p.name == v.piece) {
@@ -992,7 +1204,7 @@ impl Authoring {
                         Some(vi) => variant_map(design, sp, vi).err(),
                     };
                     if let Some(p) = problem {
-                        self.message = Some(format!("`{}` cannot be a variant: {p}", v.piece));
+                        self.say(format!("`{}` cannot be a variant: {p}", v.piece));
                         return;
                     }
                 }
@@ -1005,7 +1217,7 @@ impl Authoring {
             }
             AuthorCommand::AddState(st) => {
                 if let Err(e) = self.check_state(&st) {
-                    self.message = Some(e);
+                    self.say(e);
                     return;
                 }
                 w.states.push(st);
@@ -1019,7 +1231,7 @@ impl Authoring {
             }
             AuthorCommand::SetTolerance(t) => {
                 if !(t.is_finite() && t > 0.0) {
-                    self.message = Some("the tolerance must be a positive number".into());
+                    self.say("the tolerance must be a positive number".into());
                     return;
                 }
                 w.tolerance = t;
@@ -1042,14 +1254,76 @@ impl Authoring {
         }
     }
 
+    /// Renames a piece (`from` is its generated name) if `to` is a name no other piece has;
+    /// the declarations that name the piece follow it.
+    fn rename_piece(&mut self, mut w: Work, from: &str, to: &str) {
+        let Ok(c) = &self.result else {
+            return;
+        };
+        let Some(index) = c.generated_piece_names.iter().position(|g| g == from) else {
+            self.say(format!("there is no piece `{from}`"));
+            return;
+        };
+        let old = c.design.pieces[index].name.clone();
+        if let Err(e) = check_name(to) {
+            self.say(format!("cannot rename `{old}`: {e}"));
+            return;
+        }
+        if to == "base" {
+            self.say(format!(
+                "cannot rename `{old}`: `base` is the name of the drawn rest state"
+            ));
+            return;
+        }
+        if c.design
+            .pieces
+            .iter()
+            .any(|p| p.name == to && p.name != old)
+        {
+            self.say(format!(
+                "cannot rename `{old}`: there is already a piece `{to}`"
+            ));
+            return;
+        }
+        if to == from {
+            w.piece_names.remove(from);
+        } else {
+            w.piece_names.insert(from.to_string(), to.to_string());
+        }
+        let follow = |n: &mut String| {
+            if *n == old {
+                *n = to.to_string();
+            }
+        };
+        for m in &mut w.merges {
+            follow(&mut m.mover.piece);
+            follow(&mut m.target.piece);
+            if let Some(j) = &mut m.junction {
+                follow(&mut j.piece);
+            }
+        }
+        w.site_types = std::mem::take(&mut w.site_types)
+            .into_iter()
+            .map(|(mut k, v)| {
+                follow(&mut k.piece);
+                (k, v)
+            })
+            .collect();
+        for v in &mut w.variants {
+            follow(&mut v.piece);
+        }
+        for st in &mut w.states {
+            follow(&mut st.piece);
+        }
+        self.change(w, "rename that piece");
+        if self.message.is_none() && old != to {
+            self.status = Some(format!("renamed piece `{old}` to `{to}`"));
+        }
+    }
+
     /// Why a posed state cannot be added to its piece.
     fn check_state(&self, st: &StateChoice) -> Result<(), String> {
-        if !valid_identifier(&st.name) {
-            return Err(format!(
-                "`{}` is not a name: use letters, digits and _, not starting with a digit",
-                st.name
-            ));
-        }
+        check_name(&st.name)?;
         if st.name == "base" {
             return Err("`base` is the name of the drawn rest state: pick another".into());
         }

@@ -1,11 +1,13 @@
-//! Authoring mode's canvas: draws the drawing, the grid, the cut points and the design (regions
-//! filled by piece, instance outlines, docking sites coloured by site type), and turns clicks
-//! into [`AuthorCommand`]s: drawing strokes snapped to the grid or to drawn points in the draw
-//! tool, placing cut points on the drawing in the cut tool; it also picks sites (site tool)
-//! and lets the author drag the vertices of a posed copy of a piece (a rest state in the
-//! making). It never changes the work itself.
+//! Authoring mode's canvas: draws the drawing, the grid (and its step), the cut points and the
+//! design (regions filled in their piece's written colour, instance outlines, docking sites
+//! coloured by site type), and turns clicks into [`AuthorCommand`]s: drawing strokes snapped to
+//! the grid or to drawn points in the draw tool, placing cut points in the cut tool snapped to
+//! a drawn vertex or to where an edge crosses a grid line (an indicator shows the snap while
+//! hovering); it also picks sites (site tool) and lets the author drag the vertices of a posed
+//! copy of a piece (a rest state in the making). A click that does nothing says why. The view
+//! only fits the drawing on request, never after a stroke. It never changes the work itself.
 
-use clay::authoring::Polyline;
+use clay::authoring::{PieceDesign, Polyline};
 use clay::segment::nearest_on_segment;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
@@ -25,18 +27,6 @@ const CUT: Color32 = Color32::from_rgb(230, 40, 160);
 const POSE: Color32 = Color32::from_rgb(0, 150, 110);
 const LABELS: Color32 = Color32::from_rgb(50, 40, 30);
 
-/// Piece fills, by piece index.
-const PIECE_COLOURS: [Color32; 8] = [
-    Color32::from_rgb(232, 176, 120),
-    Color32::from_rgb(150, 196, 230),
-    Color32::from_rgb(170, 214, 150),
-    Color32::from_rgb(226, 160, 200),
-    Color32::from_rgb(236, 214, 120),
-    Color32::from_rgb(180, 170, 230),
-    Color32::from_rgb(140, 210, 200),
-    Color32::from_rgb(220, 150, 140),
-];
-
 /// Site type colours, by site type index.
 const SITE_COLOURS: [Color32; 6] = [
     Color32::from_rgb(200, 30, 30),
@@ -47,9 +37,11 @@ const SITE_COLOURS: [Color32; 6] = [
     Color32::from_rgb(0, 130, 140),
 ];
 
-/// The colour a piece is drawn in.
-pub fn piece_colour(piece: usize) -> Color32 {
-    PIECE_COLOURS[piece % PIECE_COLOURS.len()]
+/// The colour a piece is drawn in: its fill as the grammar writes it (the SVG's fill, or the
+/// editor's palette for pieces drawn without one), so "Try it" shows the same colours.
+pub fn piece_colour(piece: &PieceDesign) -> Color32 {
+    let [r, g, b] = piece.fill;
+    Color32::from_rgb(r, g, b)
 }
 
 /// The colour a site type is drawn in.
@@ -67,6 +59,27 @@ pub enum Tool {
     Cut,
     /// Click a docking site to pick it (the panel then sets its type).
     Site,
+}
+
+/// What a click's point snapped to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SnapKind {
+    /// A vertex of the drawing (or of the stroke being drawn).
+    Vertex,
+    /// A grid point (draw tool), or where the edge crosses a grid line (cut tool).
+    Grid,
+    /// The nearest point of an edge that crosses no grid line (cut tool).
+    Edge,
+}
+
+impl SnapKind {
+    fn label(self) -> &'static str {
+        match self {
+            SnapKind::Vertex => "vertex",
+            SnapKind::Grid => "grid",
+            SnapKind::Edge => "edge",
+        }
+    }
 }
 
 /// A posed copy of a piece: a new rest state in the making. Shown over one instance of the
@@ -92,15 +105,16 @@ pub struct AuthorCanvas {
     pub pending: Vec<DVec2>,
     /// Where a click would put a point or a cut, in the last frame.
     pub target: Option<DVec2>,
+    /// What `target` snapped to.
+    pub snap: Option<SnapKind>,
     /// The site picked with the site tool.
     pub selected_site: Option<SiteName>,
     /// The rest state being posed, if any.
     pub pose: Option<Pose>,
     panning: bool,
+    /// Fit the view to the drawing at the next frame: only on request (Fit, F, an import,
+    /// entering the mode), never after a stroke or cut.
     fit_pending: bool,
-    /// The canvas rectangle of the last fit, while the user has not moved the view since:
-    /// panels settle their width a frame after a change, so the fit follows the canvas.
-    fitted: Option<Rect>,
     pub rect: Rect,
 }
 
@@ -115,11 +129,11 @@ impl Default for AuthorCanvas {
             grid: 0.1,
             pending: Vec::new(),
             target: None,
+            snap: None,
             selected_site: None,
             pose: None,
             panning: false,
             fit_pending: true,
-            fitted: None,
             rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
         }
     }
@@ -134,6 +148,41 @@ fn segments(p: &Polyline) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
         n.saturating_sub(1)
     };
     (0..count).map(move |i| (p.points[i], p.points[(i + 1) % n]))
+}
+
+/// Where segment `a`-`b` crosses a grid line (`x = k step` or `y = k step`) nearest its
+/// point `p`, if it crosses one; the crossing's grid coordinate is exact.
+fn grid_crossing(a: DVec2, b: DVec2, p: DVec2, step: f64) -> Option<DVec2> {
+    if !(step.is_finite() && step > 0.0) {
+        return None;
+    }
+    let mut best: Option<DVec2> = None;
+    for axis in 0..2 {
+        let (from, to) = (a[axis], b[axis]);
+        if (to - from).abs() < 1e-12 {
+            // Along a grid line or parallel to one: no crossing on this axis.
+            continue;
+        }
+        for k in [(p[axis] / step).floor(), (p[axis] / step).ceil()] {
+            let t = (k * step - from) / (to - from);
+            if !(0.0..=1.0).contains(&t) {
+                continue;
+            }
+            let mut q = a + (b - a) * t;
+            q[axis] = k * step;
+            if best.is_none_or(|c| q.distance(p) < c.distance(p)) {
+                best = Some(q);
+            }
+        }
+    }
+    best
+}
+
+/// A coordinate for messages and labels: at most four decimals, no trailing zeros.
+fn short(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
 }
 
 impl AuthorCanvas {
@@ -168,7 +217,7 @@ impl AuthorCanvas {
 
     /// Where a click in the draw tool puts a point: a drawn or pending point under the
     /// pointer, else the nearest grid point.
-    fn draw_target(&self, author: &Authoring, w: DVec2) -> DVec2 {
+    fn draw_target(&self, author: &Authoring, w: DVec2) -> (DVec2, SnapKind) {
         let radius = PICK_RADIUS / self.camera.scale;
         let near = author
             .work()
@@ -179,27 +228,44 @@ impl AuthorCanvas {
             .chain(self.pending.iter().copied())
             .filter(|p| p.distance(w) <= radius)
             .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)));
-        near.unwrap_or_else(|| {
-            if self.grid.is_finite() && self.grid > 0.0 {
-                (w / self.grid).round() * self.grid
-            } else {
-                w
+        match near {
+            Some(p) => (p, SnapKind::Vertex),
+            None if self.grid.is_finite() && self.grid > 0.0 => {
+                ((w / self.grid).round() * self.grid, SnapKind::Grid)
             }
-        })
+            None => (w, SnapKind::Edge),
+        }
     }
 
-    /// Where a click in the cut tool cuts: the nearest point on the drawing within reach.
-    fn cut_target(&self, author: &Authoring, w: DVec2) -> Option<DVec2> {
+    /// Where a click in the cut tool cuts: a vertex of the drawing under the pointer, else
+    /// where the nearest edge in reach crosses the grid line nearest the pointer, else the
+    /// nearest point of that edge. So two clicks a few millimetres apart cut at one place.
+    /// `Err` says why there is no cut: the distance (screen points) to the nearest edge.
+    fn cut_target(&self, author: &Authoring, w: DVec2) -> Result<(DVec2, SnapKind), f64> {
         let radius = PICK_RADIUS / self.camera.scale;
-        author
-            .work()
-            .drawing
-            .polylines
+        let polylines = &author.work().drawing.polylines;
+        let vertex = polylines
+            .iter()
+            .flat_map(|p| p.points.iter().copied())
+            .filter(|p| p.distance(w) <= radius)
+            .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)));
+        if let Some(v) = vertex {
+            return Ok((v, SnapKind::Vertex));
+        }
+        let (a, b, p) = polylines
             .iter()
             .flat_map(segments)
-            .map(|(a, b)| nearest_on_segment(w, a, b).0)
-            .filter(|p| p.distance(w) <= radius)
-            .min_by(|a, b| a.distance(w).total_cmp(&b.distance(w)))
+            .map(|(a, b)| (a, b, nearest_on_segment(w, a, b).0))
+            .min_by(|x, y| x.2.distance(w).total_cmp(&y.2.distance(w)))
+            .ok_or(f64::INFINITY)?;
+        let d = p.distance(w);
+        if d > radius {
+            return Err(d * self.camera.scale);
+        }
+        Ok(match grid_crossing(a, b, p, self.grid) {
+            Some(q) => (q, SnapKind::Grid),
+            None => (p, SnapKind::Edge),
+        })
     }
 
     /// Starts posing a copy of piece `piece` over its first instance.
@@ -289,6 +355,7 @@ impl AuthorCanvas {
         best.map(|(_, s)| s)
     }
 
+    /// Ends the pending stroke; too few points are dropped with a message saying so.
     fn finish(&mut self, closed: bool, commands: &mut Vec<AuthorCommand>) {
         let points = std::mem::take(&mut self.pending);
         let needed = if closed { 3 } else { 2 };
@@ -299,6 +366,11 @@ impl AuthorCanvas {
                 fill: None,
                 name: None,
             }));
+        } else if !points.is_empty() {
+            commands.push(AuthorCommand::Report(format!(
+                "a stroke needs at least {needed} points, this one has {}: it was dropped",
+                points.len()
+            )));
         }
     }
 
@@ -311,30 +383,77 @@ impl AuthorCanvas {
     ) {
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
         self.rect = response.rect;
-        if self.fitted.is_some_and(|r| r != self.rect) {
-            self.fit_pending = true;
-        }
         if self.fit_pending {
             if !author.work().drawing.polylines.is_empty() {
                 self.fit(author);
-                self.fitted = Some(self.rect);
                 ui.ctx().request_repaint();
             }
             self.fit_pending = false;
         }
-        let mid = dv(self.rect.center());
         let pointer = ui
             .input(|i| i.pointer.hover_pos())
             .filter(|p| self.rect.contains(*p));
-        let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
+        self.view_input(ui, &response, author, pointer);
+        let world = pointer.map(|p| self.to_world(p));
+        let (target, snap) = match (world, self.tool) {
+            (Some(w), Tool::Draw) => {
+                let (t, k) = self.draw_target(author, w);
+                (Some(t), Some(k))
+            }
+            (Some(w), Tool::Cut) => match self.cut_target(author, w) {
+                Ok((t, k)) => (Some(t), Some(k)),
+                Err(_) => (None, None),
+            },
+            _ => (None, None),
+        };
+        (self.target, self.snap) = (target, snap);
+        match self.tool {
+            Tool::Draw => self.draw_input(ui, &response, commands),
+            Tool::Cut => self.cut_input(&response, author, world, commands),
+            Tool::Site => {
+                if response.clicked_by(PointerButton::Primary)
+                    && let Some(w) = world
+                {
+                    self.selected_site = self.site_at(author, w);
+                    if self.selected_site.is_none() {
+                        commands.push(AuthorCommand::Report(match author.design() {
+                            Some(_) => format!(
+                                "no docking site within {PICK_RADIUS} px of the click: click \
+                                 just inside an instance, next to a site's coloured line"
+                            ),
+                            None => "no sites yet: the drawing has no design".into(),
+                        }));
+                    }
+                }
+                if response.clicked_by(PointerButton::Secondary) {
+                    commands.push(AuthorCommand::Report(
+                        "right-click does nothing in the Pick site tool (in the Cut tool it \
+                         removes a cut)"
+                            .into(),
+                    ));
+                }
+            }
+        }
+        self.paint(&painter, author);
+    }
+
+    /// Zoom (wheel, pinch), fit (F), dragging a posed vertex, and panning (any other drag).
+    fn view_input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        author: &Authoring,
+        pointer: Option<Pos2>,
+    ) {
+        let mid = dv(self.rect.center());
         if let Some(p) = pointer {
             let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
             let factor = zoom as f64 * (scroll as f64 * 0.0025).exp();
             if (factor - 1.0).abs() > 1e-6 {
                 self.camera.zoom_at(factor, dv(p), mid);
-                self.fitted = None;
             }
         }
+        let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
         if keyboard_free && ui.input(|i| i.key_pressed(Key::F)) {
             self.fit(author);
         }
@@ -354,10 +473,7 @@ impl AuthorCanvas {
             });
             match (grabbed, self.pose.as_mut()) {
                 (Some(k), Some(pose)) => pose.dragging = Some(k),
-                _ => {
-                    self.panning = true;
-                    self.fitted = None;
-                }
+                _ => self.panning = true,
             }
         }
         if let Some(k) = self.pose.as_ref().and_then(|p| p.dragging) {
@@ -378,66 +494,97 @@ impl AuthorCanvas {
                 self.panning = false;
             }
         }
+    }
 
-        let world = pointer.map(|p| self.camera.to_world(dv(p), mid));
-        self.target = world.and_then(|w| match self.tool {
-            Tool::Draw => Some(self.draw_target(author, w)),
-            Tool::Cut => self.cut_target(author, w),
-            Tool::Site => None,
-        });
+    /// The draw tool: clicks add snapped points, the first point closes, double-click or
+    /// Enter ends an open stroke, Backspace drops a point, Esc the stroke.
+    fn draw_input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        commands: &mut Vec<AuthorCommand>,
+    ) {
         let radius = PICK_RADIUS / self.camera.scale;
-        match self.tool {
-            Tool::Draw => {
-                if response.clicked_by(PointerButton::Primary)
-                    && let Some(t) = self.target
-                {
-                    let closes = self.pending.len() >= 3 && self.pending[0].distance(t) <= radius;
-                    if closes {
-                        self.finish(true, commands);
-                    } else if self.pending.last() != Some(&t) {
-                        self.pending.push(t);
-                    }
-                }
-                let enter = keyboard_free && ui.input(|i| i.key_pressed(Key::Enter));
-                if response.double_clicked() || enter {
-                    self.finish(false, commands);
-                }
-                if keyboard_free && ui.input(|i| i.key_pressed(Key::Escape)) {
-                    self.pending.clear();
-                }
-                if keyboard_free && ui.input(|i| i.key_pressed(Key::Backspace)) {
-                    self.pending.pop();
-                }
-            }
-            Tool::Cut => {
-                if response.clicked_by(PointerButton::Primary)
-                    && let Some(t) = self.target
-                {
-                    commands.push(AuthorCommand::Cut { point: t });
-                }
-                if response.clicked_by(PointerButton::Secondary)
-                    && let Some(w) = world
-                    && let Some((index, _)) = author
-                        .work()
-                        .cuts
-                        .iter()
-                        .enumerate()
-                        .map(|(i, c)| (i, c.distance(w)))
-                        .filter(|(_, d)| *d <= radius)
-                        .min_by(|a, b| a.1.total_cmp(&b.1))
-                {
-                    commands.push(AuthorCommand::RemoveCut { index });
-                }
-            }
-            Tool::Site => {
-                if response.clicked_by(PointerButton::Primary)
-                    && let Some(w) = world
-                {
-                    self.selected_site = self.site_at(author, w);
-                }
+        let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
+        let finishing =
+            response.double_clicked() || (keyboard_free && ui.input(|i| i.key_pressed(Key::Enter)));
+        if response.clicked_by(PointerButton::Primary)
+            && let Some(t) = self.target
+        {
+            let closes = self.pending.len() >= 3 && self.pending[0].distance(t) <= radius;
+            if closes {
+                self.finish(true, commands);
+                return;
+            } else if self.pending.last() != Some(&t) {
+                self.pending.push(t);
+            } else if !finishing {
+                commands.push(AuthorCommand::Report(
+                    "that point is already the stroke's last one: click elsewhere, or \
+                     double-click or press Enter to end the stroke"
+                        .into(),
+                ));
             }
         }
-        self.paint(&painter, author);
+        if response.clicked_by(PointerButton::Secondary) {
+            commands.push(AuthorCommand::Report(
+                "right-click does nothing in the Draw tool (Backspace drops the last point, \
+                 Esc the stroke)"
+                    .into(),
+            ));
+        }
+        if finishing {
+            self.finish(false, commands);
+        }
+        if keyboard_free && ui.input(|i| i.key_pressed(Key::Escape)) {
+            self.pending.clear();
+        }
+        if keyboard_free && ui.input(|i| i.key_pressed(Key::Backspace)) {
+            self.pending.pop();
+        }
+    }
+
+    /// The cut tool: a click cuts at the snapped point, a right-click removes the cut under it;
+    /// a click that does neither says why.
+    fn cut_input(
+        &self,
+        response: &egui::Response,
+        author: &Authoring,
+        world: Option<DVec2>,
+        commands: &mut Vec<AuthorCommand>,
+    ) {
+        let Some(w) = world else {
+            return;
+        };
+        if response.clicked_by(PointerButton::Primary) {
+            commands.push(match self.cut_target(author, w) {
+                Ok((t, _)) => AuthorCommand::Cut { point: t },
+                Err(d) if d.is_finite() => AuthorCommand::Report(format!(
+                    "no edge within {PICK_RADIUS} px of the click (the nearest is {d:.0} px \
+                     away); cuts go across an edge: click on or next to one"
+                )),
+                Err(_) => {
+                    AuthorCommand::Report("nothing to cut yet: import an SVG or draw first".into())
+                }
+            });
+        }
+        if response.clicked_by(PointerButton::Secondary) {
+            let radius = PICK_RADIUS / self.camera.scale;
+            let near = author
+                .work()
+                .cuts
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (i, c.distance(w)))
+                .filter(|(_, d)| *d <= radius)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            commands.push(match near {
+                Some((index, _)) => AuthorCommand::RemoveCut { index },
+                None => AuthorCommand::Report(format!(
+                    "no cut within {PICK_RADIUS} px of the right-click: right-click a \
+                     magenta X to remove that cut"
+                )),
+            });
+        }
     }
 
     fn paint(&self, painter: &egui::Painter, author: &Authoring) {
@@ -470,23 +617,61 @@ impl AuthorCanvas {
             painter.circle_filled(screen(p), 3.0, PENDING);
         }
         if let Some(t) = self.target {
-            match self.tool {
-                Tool::Draw => {
-                    if let Some(&last) = self.pending.last() {
-                        painter.line_segment(
-                            [screen(last), screen(t)],
-                            Stroke::new(1.0, PENDING.gamma_multiply(0.6)),
-                        );
-                    }
-                    painter.circle_stroke(screen(t), 5.0, Stroke::new(1.5, PENDING));
-                }
-                Tool::Cut => {
-                    painter.circle_stroke(screen(t), 6.0, Stroke::new(2.0, CUT));
-                }
-                Tool::Site => {}
+            if let (Tool::Draw, Some(&last)) = (self.tool, self.pending.last()) {
+                painter.line_segment(
+                    [screen(last), screen(t)],
+                    Stroke::new(1.0, PENDING.gamma_multiply(0.6)),
+                );
+            }
+            self.paint_snap(painter, t);
+        }
+        self.paint_grid_step(painter);
+        self.paint_pose(painter, author);
+    }
+
+    /// The snap indicator under the pointer: a square on a vertex, a ring with a cross on the
+    /// grid, a plain ring on an edge off the grid, with what it snapped to and where.
+    fn paint_snap(&self, painter: &egui::Painter, t: DVec2) {
+        let colour = if self.tool == Tool::Cut { CUT } else { PENDING };
+        let s = self.to_screen(t);
+        let stroke = Stroke::new(2.0, colour);
+        match self.snap {
+            Some(SnapKind::Vertex) => {
+                let r = Rect::from_center_size(s, Vec2::splat(12.0));
+                painter.rect_stroke(r, 0.0, stroke, egui::StrokeKind::Middle);
+            }
+            Some(SnapKind::Grid) => {
+                painter.circle_stroke(s, 6.0, stroke);
+                let d = 9.0;
+                let thin = Stroke::new(1.0, colour);
+                painter.line_segment([s - Vec2::new(d, 0.0), s + Vec2::new(d, 0.0)], thin);
+                painter.line_segment([s - Vec2::new(0.0, d), s + Vec2::new(0.0, d)], thin);
+            }
+            _ => {
+                painter.circle_stroke(s, 6.0, stroke);
             }
         }
-        self.paint_pose(painter, author);
+        if let Some(k) = self.snap {
+            painter.text(
+                s + Vec2::new(10.0, -10.0),
+                Align2::LEFT_BOTTOM,
+                format!("{} ({}, {})", k.label(), short(t.x), short(t.y)),
+                FontId::proportional(11.0),
+                colour,
+            );
+        }
+    }
+
+    /// The snap grid's step, in the canvas's lower-left corner (the lines are not drawn when
+    /// they would be too dense, but points still snap to it).
+    fn paint_grid_step(&self, painter: &egui::Painter) {
+        painter.text(
+            self.rect.left_bottom() + Vec2::new(8.0, -6.0),
+            Align2::LEFT_BOTTOM,
+            format!("grid {} m", short(self.grid)),
+            FontId::proportional(11.0),
+            LABELS,
+        );
     }
 
     /// The posed copy: its edges and its vertices as handles.
@@ -550,7 +735,7 @@ impl AuthorCanvas {
             let Some(piece) = design.pieces.get(inst.piece) else {
                 continue;
             };
-            let fill = piece_colour(inst.piece);
+            let fill = piece_colour(piece);
             let edge = Stroke::new(1.5, fill.gamma_multiply(0.5).to_opaque());
             let world_of = |k: usize| inst.vertices.get(k).and_then(|&v| at(v));
             match &piece.outline {

@@ -1,8 +1,8 @@
-//! Authoring mode's side panel: the tool and grid, SVG import, the pieces with their instance
-//! counts and sites, site type names and the picked site's type, the stretch declaration and
-//! its variants, merge rules, posed rest states, and writing and trying the grammar with its
-//! diagnostics. It reads state and emits commands and actions only (besides the canvas's
-//! pose and picked site, which are view state).
+//! Authoring mode's side panel: the tool and snap grid, SVG import, the pieces (names
+//! editable) with their instance counts and sites, site type names and the picked site's type,
+//! the stretch declaration and its variants, merge rules, posed rest states, and writing and
+//! trying the grammar with its diagnostics. It reads state and emits commands and actions only
+//! (besides the canvas's pose and picked site, which are view state).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -25,6 +25,8 @@ pub struct AuthorForm {
     pub tolerance: String,
     /// Site type name being edited, by generated name.
     names: BTreeMap<String, String>,
+    /// Piece name being edited, by generated name.
+    piece_names: BTreeMap<String, String>,
     /// Stretch sites being picked, by piece.
     picks: BTreeMap<usize, (usize, usize)>,
     /// Merge rule being put together: mover, target, junction (indices into the design's
@@ -46,6 +48,7 @@ impl Default for AuthorForm {
             write_path: "authored.clay".into(),
             tolerance: "0.001".into(),
             names: BTreeMap::new(),
+            piece_names: BTreeMap::new(),
             picks: BTreeMap::new(),
             merge: (0, 1, None),
             site_type: String::new(),
@@ -139,7 +142,11 @@ fn drawing(
                 .speed(0.01)
                 .range(0.001..=100.0),
         )
-        .labelled_by(l.id);
+        .labelled_by(l.id)
+        .on_hover_text(
+            "snap grid step: drawn points snap to grid points, cuts to where an edge crosses \
+             a grid line (a drawn vertex under the pointer wins)",
+        );
         let l = ui.label("Tolerance (m):");
         let r = ui
             .add(egui::TextEdit::singleline(&mut form.tolerance).desired_width(60.0))
@@ -208,10 +215,19 @@ fn pieces(
             *c += 1;
         }
     }
+    let generated = author
+        .result
+        .as_ref()
+        .map(|c| c.generated_piece_names.clone())
+        .unwrap_or_default();
     for (pi, piece) in design.pieces.iter().enumerate() {
-        ui.horizontal(|ui| {
-            swatch(ui, piece_colour(pi));
-            ui.strong(&piece.name);
+        ui.horizontal_wrapped(|ui| {
+            swatch(ui, piece_colour(piece));
+            if let Some(g) = generated.get(pi) {
+                piece_name(ui, g, &piece.name, form, commands);
+            } else {
+                ui.strong(&piece.name);
+            }
             ui.label(format!(
                 "× {} instance{}",
                 counts[pi],
@@ -290,6 +306,39 @@ fn pieces(
             commands.push(AuthorCommand::SetStretch(None));
         }
     });
+}
+
+/// A piece's name as an editable field: Enter (or leaving the field) renames it; a refused
+/// name reverts, and the panel and status bar say why.
+fn piece_name(
+    ui: &mut egui::Ui,
+    generated: &str,
+    shown: &str,
+    form: &mut AuthorForm,
+    commands: &mut Vec<AuthorCommand>,
+) {
+    let buffer = form
+        .piece_names
+        .entry(generated.to_string())
+        .or_insert_with(|| shown.to_string());
+    let r = ui
+        .add(egui::TextEdit::singleline(buffer).desired_width(110.0))
+        .on_hover_text("piece name, written into the grammar: edit, then Enter");
+    r.widget_info(|| {
+        egui::WidgetInfo::labeled(egui::Role::TextInput, true, format!("piece {generated}"))
+    });
+    if r.lost_focus() {
+        if *buffer != shown {
+            commands.push(AuthorCommand::RenamePiece {
+                from: generated.to_string(),
+                to: buffer.clone(),
+            });
+        }
+        form.piece_names.remove(generated);
+    } else if !r.has_focus() && *buffer != shown {
+        // Undo or redo changed the name under the field.
+        *buffer = shown.to_string();
+    }
 }
 
 fn merges(
@@ -444,10 +493,14 @@ fn site_type_of_site(
         let l = ui.label("new type:");
         ui.add(egui::TextEdit::singleline(&mut form.site_type).desired_width(100.0))
             .labelled_by(l.id);
-        if ui.button("Set type").clicked() && !form.site_type.trim().is_empty() {
-            commands.push(AuthorCommand::SetSiteType {
-                site: site.clone(),
-                site_type: form.site_type.trim().to_string(),
+        if ui.button("Set type").clicked() {
+            commands.push(if form.site_type.trim().is_empty() {
+                AuthorCommand::Report("type the new site type's name first".into())
+            } else {
+                AuthorCommand::SetSiteType {
+                    site: site.clone(),
+                    site_type: form.site_type.trim().to_string(),
+                }
             });
         }
     });
@@ -614,12 +667,17 @@ fn grammar(
             .labelled_by(l.id);
     });
     ui.horizontal(|ui| {
-        if ui.button("Write grammar").clicked() && !form.write_path.trim().is_empty() {
-            actions.push(Action::WriteGrammar(PathBuf::from(form.write_path.trim())));
+        if ui.button("Write grammar").clicked() {
+            actions.push(if form.write_path.trim().is_empty() {
+                Action::Report("type the file to write the grammar to first".into())
+            } else {
+                Action::WriteGrammar(PathBuf::from(form.write_path.trim()))
+            });
         }
         if ui
             .add_enabled(author.compiles, egui::Button::new("Try it"))
             .on_hover_text("compile and sculpt the grammar")
+            .on_disabled_hover_text("the grammar does not compile yet: see its diagnostics")
             .clicked()
         {
             actions.push(Action::TryAuthored);

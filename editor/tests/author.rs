@@ -8,7 +8,7 @@ use clay::authoring::{Drawing, Polyline, StretchChoice};
 use clay_editor::EditorApp;
 use clay_editor::app::{Action, Mode};
 use clay_editor::author::{AuthorCommand, Authoring, Work};
-use clay_editor::author_canvas::Tool;
+use clay_editor::author_canvas::{SnapKind, Tool};
 use egui::{Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -861,4 +861,416 @@ fn a_variant_with_a_rest_state_is_refused_with_e047() {
     assert_eq!(a.problems[0].code, "E047");
     // The span's label names the state (the message no longer repeats the label).
     assert!(a.problems[0].label.contains("`lifted`"), "{:?}", a.problems);
+}
+
+/// The app in authoring mode on `author`, with `tool`, after its first frames (the view is
+/// fitted to the drawing).
+fn authoring(author: Authoring, tool: Tool) -> Harness<'static, EditorApp> {
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.author = author;
+    app.author_canvas.tool = tool;
+    let mut h = harness(app);
+    h.run();
+    h
+}
+
+fn rect(x: f64, y: f64, w: f64, h: f64) -> Polyline {
+    Polyline::polygon(vec![
+        DVec2::new(x, y),
+        DVec2::new(x + w, y),
+        DVec2::new(x + w, y + h),
+        DVec2::new(x, y + h),
+    ])
+}
+
+fn drawing(polylines: Vec<Polyline>) -> Authoring {
+    Authoring::new(Work {
+        drawing: Drawing { polylines },
+        ..Work::default()
+    })
+}
+
+#[test]
+fn two_hand_placed_cuts_millimetres_apart_snap_to_one_grid_line_and_make_one_piece() {
+    // Two separate 2 m x 0.5 m strips, each cut by hand near x = 1 (the 0.9985 m and
+    // 1.0021 m): unsnapped, the halves differ by 3 to 4 mm, more than the 1 mm tolerance.
+    let mut h = authoring(
+        drawing(vec![rect(0.0, 0.0, 2.0, 0.5), rect(0.0, 1.0, 2.0, 0.5)]),
+        Tool::Cut,
+    );
+    assert_eq!(h.state().author_canvas.grid, 0.1);
+    let first = h.state().author_canvas.to_screen(DVec2::new(0.9985, -0.01));
+    h.hover_at(first);
+    h.run();
+    // The indicator shows the grid snap before the click.
+    let canvas = &h.state().author_canvas;
+    assert_eq!(canvas.snap, Some(SnapKind::Grid));
+    assert_eq!(canvas.target, Some(DVec2::new(1.0, 0.0)));
+    click(&mut h, first);
+    let second = h.state().author_canvas.to_screen(DVec2::new(1.0021, 1.51));
+    click(&mut h, second);
+    let a = &h.state().author;
+    assert!(a.message.is_none(), "{:?}", a.message);
+    assert_eq!(
+        a.work().cuts,
+        vec![DVec2::new(1.0, 0.0), DVec2::new(1.0, 1.5)]
+    );
+    assert_eq!(
+        instances_of_each_piece(a),
+        vec![4],
+        "four identical 1 m halves"
+    );
+}
+
+#[test]
+fn the_grid_step_set_in_the_panel_is_where_cuts_snap() {
+    let mut h = authoring(drawing(vec![rect(0.0, 0.0, 2.0, 0.5)]), Tool::Cut);
+    assert!(h.query_by_label("Grid (m):").is_some());
+    h.state_mut().author_canvas.grid = 0.25;
+    h.run();
+    let at = h.state().author_canvas.to_screen(DVec2::new(0.71, -0.01));
+    click(&mut h, at);
+    assert_eq!(h.state().author.work().cuts, vec![DVec2::new(0.75, 0.0)]);
+}
+
+#[test]
+fn a_cut_near_a_drawn_vertex_snaps_to_the_vertex_before_the_grid() {
+    // The bottom edge has a vertex at x = 0.97, off the 0.1 m grid.
+    let mut h = authoring(
+        drawing(vec![Polyline::polygon(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(0.97, 0.0),
+            DVec2::new(2.0, 0.0),
+            DVec2::new(2.0, 0.5),
+            DVec2::new(0.0, 0.5),
+        ])]),
+        Tool::Cut,
+    );
+    let at = h.state().author_canvas.to_screen(DVec2::new(0.975, -0.005));
+    h.hover_at(at);
+    h.run();
+    let canvas = &h.state().author_canvas;
+    assert_eq!(canvas.snap, Some(SnapKind::Vertex));
+    assert_eq!(canvas.target, Some(DVec2::new(0.97, 0.0)));
+    click(&mut h, at);
+    let a = &h.state().author;
+    assert_eq!(a.work().cuts, vec![DVec2::new(0.97, 0.0)]);
+    assert_eq!(instances_of_each_piece(a).iter().sum::<usize>(), 2);
+}
+
+/// Clicks the corners of a rectangle (a little off the grid points) and its first corner
+/// again to close it.
+fn draw_rect(h: &mut Harness<'_, EditorApp>, x: f64, y: f64, w: f64, ht: f64) {
+    let corners = [(x, y), (x + w, y), (x + w, y + ht), (x, y + ht), (x, y)];
+    for (cx, cy) in corners {
+        let at = h
+            .state()
+            .author_canvas
+            .to_screen(DVec2::new(cx + 0.02, cy - 0.01));
+        click(h, at);
+    }
+}
+
+#[test]
+fn drawing_strokes_never_moves_the_view_only_fit_does() {
+    let mut app = EditorApp::bundled();
+    app.set_mode(Mode::Author);
+    app.perform(Action::ImportSvg(wall_svg(), 0.01));
+    let mut h = harness(app);
+    h.run();
+    let fitted = h.state().author_canvas.camera;
+    let canvas = h.state().author_canvas.rect;
+    draw_rect(&mut h, 1.0, 1.0, 1.0, 0.5);
+    assert_eq!(h.state().author.work().drawing.polylines.len(), 8);
+    assert_eq!(h.state().author_canvas.camera, fitted);
+    assert_eq!(h.state().author_canvas.rect, canvas);
+    // The second rectangle lands where it is clicked, beside the first, not inside it.
+    draw_rect(&mut h, 2.5, 1.0, 1.0, 0.5);
+    h.run();
+    let a = &h.state().author;
+    assert_eq!(a.work().drawing.polylines.len(), 9);
+    assert_eq!(
+        a.work().drawing.polylines[8].points,
+        vec![
+            DVec2::new(2.5, 1.0),
+            DVec2::new(3.5, 1.0),
+            DVec2::new(3.5, 1.5),
+            DVec2::new(2.5, 1.5)
+        ]
+    );
+    assert_eq!(h.state().author_canvas.camera, fitted);
+    // F fits on request: the drawing is taller now, so the view changes.
+    h.key_press(egui::Key::F);
+    h.run();
+    assert_ne!(h.state().author_canvas.camera, fitted);
+}
+
+#[test]
+fn the_side_panel_keeps_its_width_whatever_it_shows() {
+    let mut h = authoring(Authoring::default(), Tool::Draw);
+    let empty = h.state().author_canvas.rect;
+    let clear = h.get_by_label("Clear drawing").rect();
+    h.state_mut().author_form.svg_path = wall_svg().display().to_string();
+    h.get_by_label("Import SVG").click();
+    h.run();
+    assert_eq!(instances_of_each_piece(&h.state().author), vec![6]);
+    assert_eq!(h.state().author_canvas.rect, empty);
+    // A long piece name and every section open: still the same canvas.
+    let long = "a_very_long_piece_name_that_would_widen_any_panel_sized_by_its_content";
+    h.state_mut().author_command(AuthorCommand::RenamePiece {
+        from: "brick".into(),
+        to: long.into(),
+    });
+    h.state_mut()
+        .author_command(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    h.run();
+    assert_eq!(h.state().author.design().unwrap().pieces[0].name, long);
+    // Commands apply at the end of a frame: two more frames show their outcome.
+    h.step();
+    h.step();
+    for header in ["Variants (0)", "Rest states (0)", "Merge rules (0)", "Text"] {
+        h.get_by_label(header).click();
+        h.run();
+        h.step();
+    }
+    assert_eq!(h.state().author_canvas.rect, empty);
+    assert_eq!(
+        h.get_by_label("Clear drawing").rect(),
+        clear,
+        "the panel stays put"
+    );
+}
+
+#[test]
+fn a_click_that_does_nothing_says_why_in_the_status_bar() {
+    let mut h = authoring(strip(), Tool::Cut);
+    // 36 px below the bottom edge: out of the 10 px reach.
+    let edge = h.state().author_canvas.to_screen(DVec2::new(2.0, 0.0));
+    click(&mut h, edge + Vec2::new(0.0, 36.0));
+    h.run();
+    assert!(h.state().author.work().cuts.is_empty());
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("no edge within 10 px"), "{m}");
+    assert!(m.contains("36 px away"), "{m}");
+    assert!(m.contains("cuts go across an edge"), "{m}");
+    assert_eq!(
+        h.query_all_by_label_contains("no edge within 10 px")
+            .count(),
+        2,
+        "the status bar shows it, and the panel"
+    );
+    // A right-click with no cut under it, and the site tool on no site, say so too.
+    let away = h.state().author_canvas.to_screen(DVec2::new(2.0, 0.5));
+    h.hover_at(away);
+    h.event(egui::Event::PointerButton {
+        pos: away,
+        button: egui::PointerButton::Secondary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: away,
+        button: egui::PointerButton::Secondary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    h.run();
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("no cut within 10 px"), "{m}");
+    h.state_mut().author_canvas.tool = Tool::Site;
+    click(&mut h, away);
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("no docking site within 10 px"), "{m}");
+    // A click that does something replaces the explanation.
+    h.state_mut().author_canvas.tool = Tool::Cut;
+    let on = h.state().author_canvas.to_screen(DVec2::new(2.0, -0.01));
+    click(&mut h, on);
+    assert_eq!(h.state().author.work().cuts.len(), 1);
+    assert_eq!(h.state().message.as_deref(), Some("cut at (2, 0)"));
+}
+
+/// Each piece's fill as compiled from the written text, by piece name.
+fn written_fills(a: &Authoring) -> Vec<(String, [u8; 4])> {
+    let compiled = clay_editor::compile::compile(a.text().unwrap(), "t.clay").expect("compiles");
+    compiled
+        .grammar
+        .pieces
+        .iter()
+        .map(|p| (p.name.clone(), p.states[0].geometry[0].fill.0))
+        .collect()
+}
+
+#[test]
+fn the_canvas_fills_each_piece_with_the_colour_the_grammar_writes() {
+    use clay_editor::author_canvas::piece_colour;
+    // SVG fills: a blue and a green region.
+    let mut blue = rect(0.0, 0.0, 1.0, 1.0);
+    blue.fill = Some([0x33, 0x66, 0xcc]);
+    let mut green = rect(2.0, 0.0, 2.0, 1.0);
+    green.fill = Some([0x22, 0xaa, 0x44]);
+    // Drawn without a fill: the palette, written into the grammar too.
+    let plain = rect(5.0, 0.0, 1.0, 3.0);
+    let a = drawing(vec![blue, green, plain]);
+    let d = a.design().unwrap();
+    let fills = written_fills(&a);
+    assert_eq!(fills.len(), 3);
+    for piece in &d.pieces {
+        let c = piece_colour(piece);
+        let (_, written) = fills.iter().find(|(n, _)| *n == piece.name).unwrap();
+        assert_eq!([c.r(), c.g(), c.b(), 255], *written, "{}", piece.name);
+    }
+    let colours: Vec<[u8; 3]> = d.pieces.iter().map(|p| p.fill).collect();
+    assert!(colours.contains(&[0x33, 0x66, 0xcc]));
+    assert!(colours.contains(&[0x22, 0xaa, 0x44]));
+    // Drawn pieces get distinct palette colours, not one colour for all.
+    let drawn = squares_and_a_long_one();
+    let d = drawn.design().unwrap();
+    assert_ne!(d.pieces[0].fill, d.pieces[1].fill);
+    for (piece, (name, written)) in d.pieces.iter().zip(written_fills(&drawn)) {
+        assert_eq!(piece.name, name);
+        let c = piece_colour(piece);
+        assert_eq!([c.r(), c.g(), c.b(), 255], written);
+    }
+}
+
+fn named(mut p: Polyline, id: Option<&str>) -> Polyline {
+    p.name = id.map(str::to_string);
+    p
+}
+
+#[test]
+fn a_repeated_piece_takes_the_svg_id_of_any_of_its_instances() {
+    // Three separate squares, the first without an id; a one-off slab.
+    let squares = |first: Option<&str>| {
+        vec![
+            named(rect(0.0, 0.0, 1.0, 1.0), first),
+            named(rect(2.0, 0.0, 1.0, 1.0), Some("tile2")),
+            named(rect(4.0, 0.0, 1.0, 1.0), Some("tile3")),
+        ]
+    };
+    let mut lines = squares(None);
+    lines.push(named(rect(6.0, 0.0, 2.0, 1.0), Some("slab1")));
+    let a = drawing(lines);
+    let d = a.design().unwrap();
+    let name_of = |n: usize| {
+        d.pieces
+            .iter()
+            .enumerate()
+            .find(|(p, _)| d.instances.iter().filter(|i| i.piece == *p).count() == n)
+            .map(|(_, p)| p.name.clone())
+            .unwrap()
+    };
+    assert_eq!(name_of(3), "tile");
+    assert_eq!(name_of(1), "slab");
+    assert!(a.text().unwrap().contains("piece tile {"));
+    assert!(a.compiles, "{:?}", a.problems);
+    // A one-off piece with the same id does not take it from the repeated piece.
+    let mut lines = squares(Some("tile1"));
+    lines.insert(0, named(rect(6.0, 0.0, 2.0, 1.0), Some("tile4")));
+    let a = drawing(lines);
+    let d = a.design().unwrap();
+    let long = d
+        .pieces
+        .iter()
+        .position(|p| p.positions.iter().any(|q| q.x.max(q.y) > 1.5))
+        .expect("the slab's piece");
+    let square = 1 - long;
+    assert_eq!(d.pieces[square].name, "tile");
+    assert!(
+        d.pieces[long].name.starts_with("piece"),
+        "{}",
+        d.pieces[long].name
+    );
+    assert!(a.compiles, "{:?}", a.problems);
+}
+
+#[test]
+fn a_renamed_piece_is_written_and_its_declarations_follow() {
+    let mut a = wall();
+    a.apply(AuthorCommand::SetSiteType {
+        site: site("brick", "west"),
+        site_type: "mortar".into(),
+    });
+    a.apply(AuthorCommand::RenamePiece {
+        from: "brick".into(),
+        to: "stone".into(),
+    });
+    assert!(a.message.is_none(), "{:?}", a.message);
+    let d = a.design().unwrap();
+    assert_eq!(d.pieces[0].name, "stone");
+    assert_eq!(d.instances[0].name, "stone0");
+    assert!(d.notes.is_empty(), "{:?}", d.notes);
+    let text = a.text().unwrap();
+    assert!(text.contains("piece stone {"), "{text}");
+    assert!(!text.contains("brick"), "{text}");
+    assert!(
+        text.contains("mortar"),
+        "the site type followed the rename: {text}"
+    );
+    assert!(a.compiles, "{:?}", a.problems);
+    // The rename survives a recomputation and undoes.
+    a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    assert!(a.text().unwrap().contains("stretch stone from"));
+    a.apply(AuthorCommand::Undo);
+    a.apply(AuthorCommand::Undo);
+    assert_eq!(a.design().unwrap().pieces[0].name, "brick");
+}
+
+#[test]
+fn an_invalid_piece_name_is_refused_with_the_reason() {
+    let mut a = squares_and_a_long_one();
+    let before = a.design().unwrap().clone();
+    let names: Vec<String> = before.pieces.iter().map(|p| p.name.clone()).collect();
+    assert_eq!(names, vec!["piece1", "piece2"]);
+    for (to, why) in [
+        ("2bad", "is not a name"),
+        ("has space", "is not a name"),
+        ("chain", "is a keyword"),
+        ("piece1", "there is already a piece `piece1`"),
+    ] {
+        a.apply(AuthorCommand::RenamePiece {
+            from: "piece2".into(),
+            to: to.into(),
+        });
+        let m = a.message.clone().unwrap_or_default();
+        assert!(m.contains(why), "{to}: {m}");
+        assert_eq!(a.design().unwrap(), &before);
+        assert!(!a.can_undo() || a.work().piece_names.is_empty());
+    }
+    assert!(a.work().piece_names.is_empty());
+}
+
+#[test]
+fn the_panel_renames_a_piece_and_shows_why_a_name_is_refused() {
+    let mut h = authoring(wall(), Tool::Draw);
+    let field = h.get_by_label("piece brick");
+    field.focus();
+    field.type_text("_wall");
+    h.run();
+    h.key_press(egui::Key::Enter);
+    h.run();
+    let a = &h.state().author;
+    assert_eq!(a.design().unwrap().pieces[0].name, "brick_wall");
+    assert!(a.text().unwrap().contains("piece brick_wall {"));
+    // A name that is no identifier is refused, the field reverts and the status bar says
+    // why.
+    h.get_by_label("piece brick").focus();
+    h.run();
+    h.get_by_label("piece brick").type_text("-2");
+    h.run();
+    h.key_press(egui::Key::Enter);
+    h.run();
+    assert_eq!(
+        h.state().author.design().unwrap().pieces[0].name,
+        "brick_wall"
+    );
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("`brick_wall-2` is not a name"), "{m}");
+    assert_eq!(h.query_all_by_label_contains("is not a name").count(), 2);
+    assert_eq!(
+        h.get_by_label("piece brick").value().as_deref(),
+        Some("brick_wall")
+    );
 }
