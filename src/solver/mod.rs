@@ -7,236 +7,26 @@
 pub mod admm;
 pub mod cg;
 pub mod cholesky;
+mod config;
 pub mod follow;
 pub mod global;
 pub mod local;
+mod measure;
+mod report;
+
+use config::cone_cosine;
+pub use config::{Pass1, SolverConfig, SolverKind};
+pub use measure::{bbox, bbox_diagonal, edge_strains, elastic_energy, max_edge_strain};
+pub use report::{FrameReport, PhaseTimes, SolverError, StateSwitch};
 
 use std::time::{Duration, Instant};
 
-use clay_dsl::compiled::{Part, PartKind, SolverParams};
+use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
 use crate::assembly::{Assembly, Handle};
 use cholesky::{NumericFactor, SymbolicFactor};
 use global::Pattern;
-
-/// Which linear solver the global step uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum SolverKind {
-    /// Sparse supernodal Cholesky, symbolic analysis reused per assembly generation.
-    #[default]
-    Cholesky,
-    /// Unpreconditioned conjugate gradients warm-started from the previous positions (the
-    /// paper's own solver; the baseline).
-    Cg,
-}
-
-/// How pass 1 minimises the sub-quadratic energy (both decide the active rest states).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Pass1 {
-    /// Iteratively reweighted least squares (the paper's 5.2), restarted from the displayed
-    /// pose every frame, one weight per part: a numeric factorisation per iteration.
-    #[default]
-    Irls,
-    /// Variable splitting ([`admm`]): least-squares solves with the pass-2 factor, per-edge
-    /// gaps and duals carried from frame to frame. No factorisation while the assembly and
-    /// the held vertices stay the same.
-    Admm,
-}
-
-impl Pass1 {
-    pub fn name(self) -> &'static str {
-        match self {
-            Pass1::Irls => "irls",
-            Pass1::Admm => "admm",
-        }
-    }
-
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "irls" => Some(Pass1::Irls),
-            "admm" => Some(Pass1::Admm),
-            _ => None,
-        }
-    }
-}
-
-/// Solver parameters. The first four mirror the grammar's [`SolverParams`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SolverConfig {
-    pub kind: SolverKind,
-    /// The pass-1 method.
-    pub pass1: Pass1,
-    /// [`Pass1::Admm`]: a part whose stacked residual is shorter than this fraction of the
-    /// mean rest edge length closes (stays rigid); a longer one opens as a gap.
-    pub admm_threshold: f64,
-    /// [`Pass1::Admm`]: parts with a held vertex close below this fraction of the threshold,
-    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained parts the gaps
-    /// then open at the handles first (paper 5.2: the handles are the outliers); without it a
-    /// chain pulled evenly stays evenly stretched, a stationary point the splitting cannot
-    /// leave by itself.
-    pub admm_handle_factor: f64,
-    /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
-    /// the kept factor, a shrink and a dual update); the variables carry over between frames.
-    pub admm_iterations: usize,
-    /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
-    pub hysteresis: f64,
-    /// Exponent p of the IRLS pass (2 = least squares).
-    pub norm: f64,
-    /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
-    pub irls_epsilon: f64,
-    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
-    /// per part, and a global step with a fresh numeric factorisation.
-    pub irls_iterations: usize,
-    /// Most least-squares (pass 2) iterations per frame.
-    pub l2_iterations: usize,
-    /// Handle weight relative to the mean edge weight (Eq. 3): large, so handles are hard.
-    pub handle_weight: f64,
-    /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
-    /// current iterate; keeps components without handles well-posed.
-    pub proximal_weight: f64,
-    /// Parts whose rotations differ by more than this many degrees do not average into each
-    /// other's `R_xy` (pieces at a corner sit in different frames even at rest). 180 gives the
-    /// paper's plain average, 0 (the default) each part's own rotation: see `docs/solver.md`
-    /// for why (a cone makes the energy jump when a part crosses it).
-    pub rotation_cone_degrees: f64,
-    /// Pass 2 stops early once no vertex moved more than this fraction of the model's size.
-    pub tolerance: f64,
-    /// Pass 1 stops early once no vertex moved more than this fraction of the model's size
-    /// and no state switched. Pass 1 only decides the rest states, so its pose need not be as
-    /// exact as the displayed one: 1e-3 decides the same states on every claim of
-    /// `tests/paper_claims.rs` as 1e-6, in a sixth of the iterations on a brisk drag.
-    pub pass1_tolerance: f64,
-    /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
-    /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
-    pub cg_tolerance: f64,
-    /// Cap on CG iterations per solve.
-    pub cg_max_iterations: usize,
-    /// Cholesky path, pass 1: most iterations of CG preconditioned by the last IRLS factor
-    /// before the reweighted system is factorised afresh (0: factorise every IRLS iteration).
-    /// The factor is kept across iterations and frames; only the weights change in between.
-    pub pcg_max_iterations: usize,
-    /// Relative residual (against the right-hand side's edge terms, as `cg_tolerance`) the
-    /// preconditioned pass-1 solves reach. Pass 2 is always solved directly.
-    pub pcg_tolerance: f64,
-    /// A frame counts as converged ([`FrameReport::converged`]) when no state switched and the
-    /// displayed positions moved less than this fraction of the model's size.
-    pub settle_tolerance: f64,
-    /// Compute the relative residual of every linear solve into the report (one extra matrix
-    /// product per solve).
-    pub measure_residual: bool,
-}
-
-impl Default for SolverConfig {
-    fn default() -> Self {
-        Self::from_params(&SolverParams::default())
-    }
-}
-
-impl SolverConfig {
-    /// The defaults with the grammar's parameters.
-    pub fn from_params(params: &SolverParams) -> Self {
-        Self {
-            kind: SolverKind::Cholesky,
-            pass1: Pass1::Irls,
-            admm_threshold: 0.05,
-            admm_handle_factor: 0.9,
-            admm_iterations: 20,
-            hysteresis: params.hysteresis,
-            norm: params.norm,
-            irls_epsilon: params.irls_epsilon,
-            irls_iterations: 20,
-            l2_iterations: 8,
-            handle_weight: 1e6,
-            rotation_cone_degrees: 0.0,
-            proximal_weight: 1e-8,
-            tolerance: 1e-6,
-            pass1_tolerance: 1e-3,
-            cg_tolerance: 1e-6,
-            cg_max_iterations: 20_000,
-            pcg_max_iterations: 0,
-            pcg_tolerance: 1e-6,
-            settle_tolerance: 1e-6,
-            measure_residual: false,
-        }
-    }
-}
-
-/// A part's active rest state changed during a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StateSwitch {
-    pub part: usize,
-    pub from: usize,
-    pub to: usize,
-}
-
-/// What one frame did.
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct FrameReport {
-    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`]).
-    pub pass1_iterations: usize,
-    /// Least-squares (pass 2) iterations run.
-    pub l2_iterations: usize,
-    /// Pass-2 elastic energy (Eq. 4 with the final states and rotations), handles excluded.
-    pub energy: f64,
-    /// Pass-2 objective: `energy` plus the handle terms.
-    pub objective: f64,
-    /// The pass-2 objective of the warm start (the previous frame's positions moved by rigid
-    /// following, with this frame's handle targets and final states); with pass-2
-    /// iterations, `objective <= warm_objective` (local and global steps never raise it).
-    pub warm_objective: f64,
-    /// Rest-state switches, in the order they happened.
-    pub switches: Vec<StateSwitch>,
-    /// Wall time of the frame in milliseconds.
-    pub ms: f64,
-    /// The frame left the model at rest: the frame was complete, no rest state switched, and
-    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`] times the
-    /// model's size (or both passes stopped on their step tolerance). Running another frame
-    /// with the same handles would change nothing visible, so a caller can stop solving.
-    pub converged: bool,
-    /// The frame ran the iterations its passes asked for; `false` when
-    /// [`Solver::frame_budgeted`] cut it short to meet its time budget (the displayed
-    /// positions are still a least-squares pose; the next call continues from them).
-    pub complete: bool,
-    /// Largest distance a displayed vertex moved this frame.
-    pub moved: f64,
-    /// Numeric Cholesky factorisations done this frame.
-    pub factorizations: usize,
-    /// CG iterations summed over all solves this frame (unpreconditioned, `SolverKind::Cg`).
-    pub cg_iterations: usize,
-    /// Iterations of CG preconditioned by a kept Cholesky factor (pass 1 of the Cholesky path).
-    pub pcg_iterations: usize,
-    /// Where the frame's time went.
-    pub phases: PhaseTimes,
-    /// Largest relative residual `|b - A x| / |b|` of the frame's linear solves, when
-    /// [`SolverConfig::measure_residual`] is set.
-    pub linear_residual: Option<f64>,
-}
-
-/// Wall time of a frame by phase, in milliseconds.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub struct PhaseTimes {
-    /// Local steps: rest-state choice, rotations, edge targets, objective evaluations.
-    pub local: f64,
-    /// IRLS weights, right-hand side and matrix values.
-    pub assembly: f64,
-    /// Numeric Cholesky factorisations.
-    pub factorization: f64,
-    /// Triangular solves and (preconditioned) CG.
-    pub solve: f64,
-}
-
-/// Why a frame could not be solved (left the positions unchanged).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SolverError(pub String);
-
-impl std::fmt::Display for SolverError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for SolverError {}
 
 /// Buffers sized once per generation and reused every frame.
 #[derive(Debug, Default)]
@@ -1320,24 +1110,6 @@ fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
         .sqrt()
 }
 
-/// Length of the diagonal of the positions' bounding box (0 for no or non-finite positions).
-pub fn bbox_diagonal(positions: &[DVec2]) -> f64 {
-    match bbox(positions) {
-        Some((lo, hi)) => (hi - lo).length(),
-        None => 0.0,
-    }
-}
-
-/// Bounding box `(min, max)` of the positions, `None` when there are none.
-pub fn bbox(positions: &[DVec2]) -> Option<(DVec2, DVec2)> {
-    let first = *positions.first()?;
-    Some(
-        positions
-            .iter()
-            .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
-    )
-}
-
 /// Piece parts carry their active state to their instance (that is the replacement rule).
 fn sync_instance_states(asm: &mut Assembly) {
     let data = &mut asm.data;
@@ -1348,64 +1120,4 @@ fn sync_instance_states(asm: &mut Assembly) {
             inst.state = part.active;
         }
     }
-}
-
-/// Elastic energy (Eq. 4, unit weights) of the assembly's current positions and active states,
-/// with each part's rotation fitted to the current pose.
-pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
-    let parts = &asm.data.parts;
-    let f = &asm.data.positions;
-    let rotations: Vec<DVec2> = parts.iter().map(|p| local::part_rotation(p, f)).collect();
-    let vertex_parts = local::VertexParts::build(parts, f.len());
-    let cos_cone = cone_cosine(config.rotation_cone_degrees);
-    let mut energy = 0.0;
-    for (pi, part) in parts.iter().enumerate() {
-        let Some(rest) = part.states.get(part.active) else {
-            continue;
-        };
-        for e in &part.edges {
-            let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
-            let d0 = rest.positions[e[0]] - rest.positions[e[1]];
-            let r = local::edge_rotation(&vertex_parts, &rotations, x, y, pi, cos_cone);
-            energy += (r.rotate(d0) - (f[x] - f[y])).length_squared();
-        }
-    }
-    energy
-}
-
-fn cone_cosine(degrees: f64) -> f64 {
-    if degrees >= 180.0 {
-        -1.0
-    } else {
-        degrees.max(0.0).to_radians().cos()
-    }
-}
-
-/// Largest `|length / rest length - 1|` over the edges of every part's active state (edges
-/// of zero rest length are skipped).
-pub fn max_edge_strain(asm: &Assembly) -> f64 {
-    edge_strains(asm)
-        .into_iter()
-        .map(f64::abs)
-        .fold(0.0, f64::max)
-}
-
-/// `length / rest length - 1` (signed) of every edge of every part's active state, part by
-/// part; edges of zero rest length are skipped.
-pub fn edge_strains(asm: &Assembly) -> Vec<f64> {
-    let f = &asm.data.positions;
-    let mut out = Vec::new();
-    for part in &asm.data.parts {
-        let Some(rest) = part.states.get(part.active) else {
-            continue;
-        };
-        for e in &part.edges {
-            let rest_len = (rest.positions[e[0]] - rest.positions[e[1]]).length();
-            if rest_len > 1e-12 {
-                let len = (f[part.vertices[e[0]]] - f[part.vertices[e[1]]]).length();
-                out.push(len / rest_len - 1.0);
-            }
-        }
-    }
-    out
 }

@@ -1,0 +1,155 @@
+//! The solver's settings: which linear solver, which pass-1 method, iteration counts and
+//! tolerances, hysteresis and the norm exponent, taken from a grammar's `solver` block.
+
+use clay_dsl::compiled::SolverParams;
+
+/// Which linear solver the global step uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Sparse supernodal Cholesky, symbolic analysis reused per assembly generation.
+    #[default]
+    Cholesky,
+    /// Unpreconditioned conjugate gradients warm-started from the previous positions (the
+    /// paper's own solver; the baseline).
+    Cg,
+}
+
+/// How pass 1 minimises the sub-quadratic energy (both decide the active rest states).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Pass1 {
+    /// Iteratively reweighted least squares (the paper's 5.2), restarted from the displayed
+    /// pose every frame, one weight per part: a numeric factorisation per iteration.
+    #[default]
+    Irls,
+    /// Variable splitting ([`admm`]): least-squares solves with the pass-2 factor, per-edge
+    /// gaps and duals carried from frame to frame. No factorisation while the assembly and
+    /// the held vertices stay the same.
+    Admm,
+}
+
+impl Pass1 {
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass1::Irls => "irls",
+            Pass1::Admm => "admm",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "irls" => Some(Pass1::Irls),
+            "admm" => Some(Pass1::Admm),
+            _ => None,
+        }
+    }
+}
+
+/// Solver parameters. The first four mirror the grammar's [`SolverParams`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverConfig {
+    pub kind: SolverKind,
+    /// The pass-1 method.
+    pub pass1: Pass1,
+    /// [`Pass1::Admm`]: a part whose stacked residual is shorter than this fraction of the
+    /// mean rest edge length closes (stays rigid); a longer one opens as a gap.
+    pub admm_threshold: f64,
+    /// [`Pass1::Admm`]: parts with a held vertex close below this fraction of the threshold,
+    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained parts the gaps
+    /// then open at the handles first (paper 5.2: the handles are the outliers); without it a
+    /// chain pulled evenly stays evenly stretched, a stationary point the splitting cannot
+    /// leave by itself.
+    pub admm_handle_factor: f64,
+    /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
+    /// the kept factor, a shrink and a dual update); the variables carry over between frames.
+    pub admm_iterations: usize,
+    /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
+    pub hysteresis: f64,
+    /// Exponent p of the IRLS pass (2 = least squares).
+    pub norm: f64,
+    /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
+    pub irls_epsilon: f64,
+    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
+    /// per part, and a global step with a fresh numeric factorisation.
+    pub irls_iterations: usize,
+    /// Most least-squares (pass 2) iterations per frame.
+    pub l2_iterations: usize,
+    /// Handle weight relative to the mean edge weight (Eq. 3): large, so handles are hard.
+    pub handle_weight: f64,
+    /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
+    /// current iterate; keeps components without handles well-posed.
+    pub proximal_weight: f64,
+    /// Parts whose rotations differ by more than this many degrees do not average into each
+    /// other's `R_xy` (pieces at a corner sit in different frames even at rest). 180 gives the
+    /// paper's plain average, 0 (the default) each part's own rotation: see `docs/solver.md`
+    /// for why (a cone makes the energy jump when a part crosses it).
+    pub rotation_cone_degrees: f64,
+    /// Pass 2 stops early once no vertex moved more than this fraction of the model's size.
+    pub tolerance: f64,
+    /// Pass 1 stops early once no vertex moved more than this fraction of the model's size
+    /// and no state switched. Pass 1 only decides the rest states, so its pose need not be as
+    /// exact as the displayed one: 1e-3 decides the same states on every claim of
+    /// `tests/paper_claims.rs` as 1e-6, in a sixth of the iterations on a brisk drag.
+    pub pass1_tolerance: f64,
+    /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
+    /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
+    pub cg_tolerance: f64,
+    /// Cap on CG iterations per solve.
+    pub cg_max_iterations: usize,
+    /// Cholesky path, pass 1: most iterations of CG preconditioned by the last IRLS factor
+    /// before the reweighted system is factorised afresh (0: factorise every IRLS iteration).
+    /// The factor is kept across iterations and frames; only the weights change in between.
+    pub pcg_max_iterations: usize,
+    /// Relative residual (against the right-hand side's edge terms, as `cg_tolerance`) the
+    /// preconditioned pass-1 solves reach. Pass 2 is always solved directly.
+    pub pcg_tolerance: f64,
+    /// A frame counts as converged ([`FrameReport::converged`]) when no state switched and the
+    /// displayed positions moved less than this fraction of the model's size.
+    pub settle_tolerance: f64,
+    /// Compute the relative residual of every linear solve into the report (one extra matrix
+    /// product per solve).
+    pub measure_residual: bool,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        Self::from_params(&SolverParams::default())
+    }
+}
+
+impl SolverConfig {
+    /// The defaults with the grammar's parameters.
+    pub fn from_params(params: &SolverParams) -> Self {
+        Self {
+            kind: SolverKind::Cholesky,
+            pass1: Pass1::Irls,
+            admm_threshold: 0.05,
+            admm_handle_factor: 0.9,
+            admm_iterations: 20,
+            hysteresis: params.hysteresis,
+            norm: params.norm,
+            irls_epsilon: params.irls_epsilon,
+            irls_iterations: 20,
+            l2_iterations: 8,
+            handle_weight: 1e6,
+            rotation_cone_degrees: 0.0,
+            proximal_weight: 1e-8,
+            tolerance: 1e-6,
+            pass1_tolerance: 1e-3,
+            cg_tolerance: 1e-6,
+            cg_max_iterations: 20_000,
+            pcg_max_iterations: 0,
+            pcg_tolerance: 1e-6,
+            settle_tolerance: 1e-6,
+            measure_residual: false,
+        }
+    }
+}
+
+/// The cosine of a cone half-angle in degrees (180 and above: every direction).
+pub(crate) fn cone_cosine(degrees: f64) -> f64 {
+    if degrees >= 180.0 {
+        -1.0
+    } else {
+        degrees.max(0.0).to_radians().cos()
+    }
+}

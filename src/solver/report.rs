@@ -1,0 +1,78 @@
+//! What one solver frame reports: iterations, energies, state switches, convergence and the
+//! time spent per phase; and the solver's error.
+
+/// A part's active rest state changed during a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StateSwitch {
+    pub part: usize,
+    pub from: usize,
+    pub to: usize,
+}
+
+/// What one frame did.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct FrameReport {
+    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`]).
+    pub pass1_iterations: usize,
+    /// Least-squares (pass 2) iterations run.
+    pub l2_iterations: usize,
+    /// Pass-2 elastic energy (Eq. 4 with the final states and rotations), handles excluded.
+    pub energy: f64,
+    /// Pass-2 objective: `energy` plus the handle terms.
+    pub objective: f64,
+    /// The pass-2 objective of the warm start (the previous frame's positions moved by rigid
+    /// following, with this frame's handle targets and final states); with pass-2
+    /// iterations, `objective <= warm_objective` (local and global steps never raise it).
+    pub warm_objective: f64,
+    /// Rest-state switches, in the order they happened.
+    pub switches: Vec<StateSwitch>,
+    /// Wall time of the frame in milliseconds.
+    pub ms: f64,
+    /// The frame left the model at rest: the frame was complete, no rest state switched, and
+    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`] times the
+    /// model's size (or both passes stopped on their step tolerance). Running another frame
+    /// with the same handles would change nothing visible, so a caller can stop solving.
+    pub converged: bool,
+    /// The frame ran the iterations its passes asked for; `false` when
+    /// [`Solver::frame_budgeted`] cut it short to meet its time budget (the displayed
+    /// positions are still a least-squares pose; the next call continues from them).
+    pub complete: bool,
+    /// Largest distance a displayed vertex moved this frame.
+    pub moved: f64,
+    /// Numeric Cholesky factorisations done this frame.
+    pub factorizations: usize,
+    /// CG iterations summed over all solves this frame (unpreconditioned, `SolverKind::Cg`).
+    pub cg_iterations: usize,
+    /// Iterations of CG preconditioned by a kept Cholesky factor (pass 1 of the Cholesky path).
+    pub pcg_iterations: usize,
+    /// Where the frame's time went.
+    pub phases: PhaseTimes,
+    /// Largest relative residual `|b - A x| / |b|` of the frame's linear solves, when
+    /// [`SolverConfig::measure_residual`] is set.
+    pub linear_residual: Option<f64>,
+}
+
+/// Wall time of a frame by phase, in milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct PhaseTimes {
+    /// Local steps: rest-state choice, rotations, edge targets, objective evaluations.
+    pub local: f64,
+    /// IRLS weights, right-hand side and matrix values.
+    pub assembly: f64,
+    /// Numeric Cholesky factorisations.
+    pub factorization: f64,
+    /// Triangular solves and (preconditioned) CG.
+    pub solve: f64,
+}
+
+/// Why a frame could not be solved (left the positions unchanged).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverError(pub String);
+
+impl std::fmt::Display for SolverError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SolverError {}
