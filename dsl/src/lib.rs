@@ -10,6 +10,7 @@ pub mod compile;
 pub mod diagnostic;
 pub mod format;
 pub mod parse;
+mod suggest;
 pub mod syntax;
 
 pub use compile::{Compiled, compile, compile_bytes};

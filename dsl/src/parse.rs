@@ -320,7 +320,7 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
                 .flat_map(|w| w.split('`').skip(1).step_by(2))
                 .filter_map(|k| k.split_whitespace().next())
                 .filter(|k| k.chars().all(|c| c.is_ascii_alphabetic()));
-            if let Some(k) = crate::compile::closest(text, keywords) {
+            if let Some(k) = crate::suggest::closest(text, keywords) {
                 d = d.with_hint(format!("did you mean `{k}`?"));
             }
             if span.start >= source.len()

@@ -10,12 +10,13 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, SolverPa
 use egui::{Key, Modifiers};
 use glam::DVec2;
 
+use crate::action::Action;
 use crate::author::{AuthorCommand, Authoring};
 use crate::author_canvas::{AuthorCanvas, Tool};
 use crate::author_panel::{self, AuthorForm};
 use crate::canvas::Canvas;
 use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem, Severity};
-use crate::files::{Desktop, NativeDialog, Recent};
+use crate::files::{Desktop, FileKind, NativeDialog, Recent};
 use crate::help;
 use crate::overlay::ViewOverlays;
 use crate::panels;
@@ -40,27 +41,6 @@ pub const BACKGROUND_BUDGET: Duration = Duration::from_micros(16_667);
 /// The window title's last part: `castle.clay • Clay`.
 pub const TITLE: &str = "Clay";
 
-/// A file operation the user asked for.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Action {
-    OpenGrammar(PathBuf),
-    OpenSession(PathBuf),
-    SaveSession(PathBuf),
-    ExportPng(PathBuf),
-    ExportJson(PathBuf),
-    /// Ask for a path first.
-    Ask(FileKind),
-    Quit,
-    /// Authoring: make an SVG file (metres per SVG unit) the drawing.
-    ImportSvg(PathBuf, f64),
-    /// Authoring: write the grammar text to a file.
-    WriteGrammar(PathBuf),
-    /// Authoring: compile the grammar and sculpt it.
-    TryAuthored,
-    /// Show a message in the status bar.
-    Report(String),
-}
-
 /// What the editor is doing: sculpting a grammar's model, or authoring a grammar from a
 /// drawing. Switching keeps both.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,8 +48,6 @@ pub enum Mode {
     Sculpt,
     Author,
 }
-
-pub use crate::files::FileKind;
 
 /// The unsaved-changes prompt's answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -27,15 +27,6 @@ const CUT: Color32 = Color32::from_rgb(230, 40, 160);
 const POSE: Color32 = Color32::from_rgb(0, 150, 110);
 const LABELS: Color32 = Color32::from_rgb(50, 40, 30);
 
-/// Site type colours, by site type index.
-const SITE_COLOURS: [Color32; 6] = [
-    Color32::from_rgb(200, 30, 30),
-    Color32::from_rgb(20, 120, 40),
-    Color32::from_rgb(30, 60, 200),
-    Color32::from_rgb(190, 110, 0),
-    Color32::from_rgb(130, 30, 160),
-    Color32::from_rgb(0, 130, 140),
-];
 
 /// The colour a piece is drawn in: its fill as the grammar writes it (the SVG's fill, or the
 /// editor's palette for pieces drawn without one), so "Try it" shows the same colours.
@@ -44,9 +35,11 @@ pub fn piece_colour(piece: &PieceDesign) -> Color32 {
     Color32::from_rgb(r, g, b)
 }
 
-/// The colour a site type is drawn in.
+/// The colour a site type is drawn in: the renderer's, so a site type has one colour in the
+/// author canvas, the sculpt overlays and `clayc render --overlay sites`.
 pub fn site_colour(site_type: usize) -> Color32 {
-    SITE_COLOURS[site_type % SITE_COLOURS.len()]
+    let [r, g, b, a] = clay::render::site_type_colour(site_type).0;
+    Color32::from_rgba_unmultiplied(r, g, b, a)
 }
 
 /// What a click on the canvas does.

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use clay::authoring::StretchChoice;
 use egui::{Color32, RichText};
 
-use crate::app::Action;
+use crate::action::Action;
 use crate::author::{
     AuthorCommand, Authoring, MergeChoice, StateChoice, VariantChoice, find_site, site_names,
 };

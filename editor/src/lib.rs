@@ -1,5 +1,6 @@
 //! The Clay editor: sculpt a grammar's model live with the mouse. The state (sculpt, sessions,
 //! camera) is separate from the drawing so it is tested without a window.
+pub mod action;
 pub mod app;
 pub mod author;
 pub mod author_canvas;

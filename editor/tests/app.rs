@@ -244,7 +244,7 @@ fn opening_another_file_with_unsaved_changes_asks_first() {
     h.step();
     let kept = h.state().sculpt.data().clone();
     h.state_mut()
-        .perform(clay_editor::app::Action::OpenGrammar(other.clone()));
+        .perform(clay_editor::action::Action::OpenGrammar(other.clone()));
     assert!(h.state().confirming());
     // A new modal is laid out invisibly on its first frame.
     h.step();
@@ -265,9 +265,10 @@ fn a_failed_open_keeps_the_model_and_asks_nothing() {
     settle(&mut h);
     let kept = h.state().sculpt.data().clone();
     assert!(!kept.parts.is_empty());
-    h.state_mut().perform(clay_editor::app::Action::OpenGrammar(
-        "no/such/file.clay".into(),
-    ));
+    h.state_mut()
+        .perform(clay_editor::action::Action::OpenGrammar(
+            "no/such/file.clay".into(),
+        ));
     assert!(
         !h.state().confirming(),
         "a file that cannot be read is not worth discarding the sculpt for"
@@ -295,7 +296,7 @@ fn a_failed_open_keeps_the_model_and_asks_nothing() {
     let broken = dir.join("broken.clay");
     std::fs::write(&broken, "piece broken {\n").unwrap();
     h.state_mut()
-        .perform(clay_editor::app::Action::OpenGrammar(broken.clone()));
+        .perform(clay_editor::action::Action::OpenGrammar(broken.clone()));
     assert!(!h.state().confirming());
     h.step();
     h.step();
@@ -320,7 +321,7 @@ fn save_in_the_prompt_saves_the_session_then_opens() {
     h.state_mut().command(clay_editor::sculpt::Command::Reset);
     h.step();
     h.state_mut()
-        .perform(clay_editor::app::Action::OpenGrammar(other.clone()));
+        .perform(clay_editor::action::Action::OpenGrammar(other.clone()));
     h.step();
     h.step();
     h.get_by_label("Save").click();

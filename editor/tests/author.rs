@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use clay::authoring::{Drawing, Polyline, StretchChoice};
 use clay_editor::EditorApp;
-use clay_editor::app::{Action, Mode};
+use clay_editor::action::Action;
+use clay_editor::app::Mode;
 use clay_editor::author::{AuthorCommand, Authoring, Work};
 use clay_editor::author_canvas::{SnapKind, Tool};
 use egui::{Pos2, Vec2};

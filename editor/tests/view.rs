@@ -231,9 +231,9 @@ fn undo_takes_back_the_rules_log_lines_and_a_session_keeps_the_log() {
     let dir = scratch("session-log");
     let session = dir.join("wall.session.json");
     h.state_mut()
-        .perform(clay_editor::app::Action::SaveSession(session.clone()));
+        .perform(clay_editor::action::Action::SaveSession(session.clone()));
     let mut again = EditorApp::bundled();
-    again.perform(clay_editor::app::Action::OpenSession(session));
+    again.perform(clay_editor::action::Action::OpenSession(session));
     assert_eq!(again.sculpt.log(), &after[..], "the session kept its log");
 }
 
@@ -320,7 +320,7 @@ fn opened_files_are_remembered_and_offered_in_the_open_dialog() {
     let wall = grammar("wall.clay");
     let mut app = EditorApp::bundled();
     app.use_desktop(desktop.clone());
-    app.perform(clay_editor::app::Action::OpenGrammar(wall.clone()));
+    app.perform(clay_editor::action::Action::OpenGrammar(wall.clone()));
     assert!(store.exists(), "the list is kept in the config folder");
 
     // A new editor reads the list; its typed Open dialog offers the file.
@@ -330,8 +330,8 @@ fn opened_files_are_remembered_and_offered_in_the_open_dialog() {
     assert_eq!(app.recent.files[0].path, remembered);
     let mut h = harness(app);
     h.step();
-    h.state_mut().perform(clay_editor::app::Action::Ask(
-        clay_editor::app::FileKind::Grammar,
+    h.state_mut().perform(clay_editor::action::Action::Ask(
+        clay_editor::files::FileKind::Grammar,
     ));
     for _ in 0..3 {
         h.step();

@@ -14,6 +14,7 @@ use glam::DVec2;
 
 use crate::compiled::*;
 use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::suggest::closest;
 use crate::syntax::{self, Ident, Item, Number, PieceStmt, Point, Span};
 
 /// The result of a successful compilation: the grammar, and the warnings found on the way.
@@ -65,21 +66,6 @@ pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> 
             .into())
         }
     }
-}
-
-/// The closest candidate by edit distance, if it is close enough to be a likely typo.
-pub(crate) fn closest<'a>(
-    name: &str,
-    candidates: impl IntoIterator<Item = &'a str>,
-) -> Option<&'a str> {
-    let limit = (name.chars().count() / 3).max(1) + usize::from(name.len() > 5);
-    candidates
-        .into_iter()
-        .filter(|c| *c != name)
-        .map(|c| (strsim::levenshtein(name, c), c))
-        .filter(|(d, _)| *d <= limit)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
 }
 
 /// Where things were declared, for secondary labels.

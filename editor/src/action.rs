@@ -1,0 +1,27 @@
+//! What the user asks of the editor's files: open, save, export, import, write, quit. Panels
+//! emit these during a frame; the app performs them after it.
+
+use std::path::PathBuf;
+
+use crate::files::FileKind;
+
+/// A file operation the user asked for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    OpenGrammar(PathBuf),
+    OpenSession(PathBuf),
+    SaveSession(PathBuf),
+    ExportPng(PathBuf),
+    ExportJson(PathBuf),
+    /// Ask for a path first.
+    Ask(FileKind),
+    Quit,
+    /// Authoring: make an SVG file (metres per SVG unit) the drawing.
+    ImportSvg(PathBuf, f64),
+    /// Authoring: write the grammar text to a file.
+    WriteGrammar(PathBuf),
+    /// Authoring: compile the grammar and sculpt it.
+    TryAuthored,
+    /// Show a message in the status bar.
+    Report(String),
+}
