@@ -8,7 +8,7 @@
 //! only fits the drawing on request, never after a stroke. It never changes the work itself.
 
 use clay::authoring::{PieceDesign, Polyline};
-use clay::segment::nearest_on_segment;
+use clay::plane::nearest_on_segment;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
@@ -26,7 +26,6 @@ const PENDING: Color32 = Color32::from_rgb(30, 80, 220);
 const CUT: Color32 = Color32::from_rgb(230, 40, 160);
 const POSE: Color32 = Color32::from_rgb(0, 150, 110);
 const LABELS: Color32 = Color32::from_rgb(50, 40, 30);
-
 
 /// The colour a piece is drawn in: its fill as the grammar writes it (the SVG's fill, or the
 /// editor's palette for pieces drawn without one), so "Try it" shows the same colours.

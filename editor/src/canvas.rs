@@ -2,12 +2,10 @@
 //! hovered, grabbed and pinned parts marked, finds the part or connection under the cursor, and
 //! turns pointer and key input into [`Command`]s. It never changes the model itself.
 
-use std::collections::HashSet;
-
+use clay::render::pick::{instances_of, part_at};
 use clay::render::pose::pose_assembly_into;
 use clay::render::{TessellationCache, WorldMesh};
-use clay::segment::nearest_on_segment;
-use clay_dsl::compiled::{AssemblyData, PartKind};
+use clay_dsl::compiled::AssemblyData;
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
@@ -395,91 +393,4 @@ fn append(mesh: &mut egui::Mesh, m: &WorldMesh, screen: impl Fn(DVec2) -> Pos2, 
             mesh.add_triangle(base + a, base + b, base + c);
         }
     }
-}
-
-/// The instances a part covers.
-fn instances_of(data: &AssemblyData, part: usize) -> HashSet<usize> {
-    match data.parts.get(part).map(|p| p.kind) {
-        Some(PartKind::Piece { instance }) => HashSet::from([instance]),
-        Some(PartKind::Stretch { chain, first }) => data
-            .chains
-            .get(chain)
-            .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
-            .unwrap_or_default(),
-        None => HashSet::new(),
-    }
-}
-
-/// The part under world point `w`: the part covering the top-most instance whose geometry
-/// contains `w` (of several, the one whose centre is nearest), else the part with an edge
-/// within `tolerance`.
-pub fn part_at(
-    w: DVec2,
-    meshes: &[WorldMesh],
-    data: &AssemblyData,
-    tolerance: f64,
-) -> Option<usize> {
-    let centre = |part: &clay_dsl::compiled::Part| {
-        let pts: Vec<DVec2> = part
-            .vertices
-            .iter()
-            .filter_map(|&v| data.positions.get(v).copied())
-            .collect();
-        pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64
-    };
-    let hit = meshes.iter().rev().find(|m| mesh_contains(m, w));
-    if let Some(m) = hit {
-        let best = data
-            .parts
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| instances_of(data, *i).contains(&m.instance))
-            .min_by(|a, b| {
-                centre(a.1)
-                    .distance_squared(w)
-                    .total_cmp(&centre(b.1).distance_squared(w))
-            });
-        if let Some((i, _)) = best {
-            return Some(i);
-        }
-    }
-    let mut best: Option<(usize, f64)> = None;
-    for (i, part) in data.parts.iter().enumerate() {
-        for &[a, b] in &part.edges {
-            let (Some(&va), Some(&vb)) = (part.vertices.get(a), part.vertices.get(b)) else {
-                continue;
-            };
-            let (Some(&pa), Some(&pb)) = (data.positions.get(va), data.positions.get(vb)) else {
-                continue;
-            };
-            let d = segment_distance(w, pa, pb);
-            if d <= tolerance && best.is_none_or(|(_, bd)| d < bd) {
-                best = Some((i, d));
-            }
-        }
-    }
-    best.map(|(i, _)| i)
-}
-
-fn mesh_contains(m: &WorldMesh, w: DVec2) -> bool {
-    m.triangles.iter().any(|t| {
-        let [a, b, c] = t.map(|i| m.positions.get(i as usize).map(|&p| world_of(p)));
-        match (a, b, c) {
-            (Some(a), Some(b), Some(c)) => triangle_contains(a, b, c, w),
-            _ => false,
-        }
-    })
-}
-
-fn triangle_contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
-    let d1 = (b - a).perp_dot(p - a);
-    let d2 = (c - b).perp_dot(p - b);
-    let d3 = (a - c).perp_dot(p - c);
-    let neg = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
-    let pos = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
-    !(neg && pos)
-}
-
-fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    p.distance(nearest_on_segment(p, a, b).0)
 }

@@ -68,7 +68,7 @@ fn key(a: usize, b: usize) -> [usize; 2] {
 
 /// Distance from `p` to the segment `a-b` and the parameter of the nearest point.
 fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
-    let (q, t) = crate::segment::nearest_on_segment(p, a, b);
+    let (q, t) = crate::plane::nearest_on_segment(p, a, b);
     ((q - p).length(), t)
 }
 
@@ -514,12 +514,9 @@ impl Graph {
     }
 }
 
-/// Twice the signed area of a polygon of graph vertices (positive when counter-clockwise).
+/// The signed area of a polygon of graph vertices (positive when counter-clockwise).
 pub fn signed_area(positions: &[DVec2], cycle: &[usize]) -> f64 {
-    let n = cycle.len();
-    (0..n)
-        .map(|i| positions[cycle[i]].perp_dot(positions[cycle[(i + 1) % n]]))
-        .sum()
+    crate::plane::polygon_area(cycle.iter().map(|&i| positions[i]))
 }
 
 fn most_common(xs: &[usize]) -> Option<usize> {

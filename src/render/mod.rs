@@ -6,6 +6,7 @@
 //! a [`Canvas`] ([`raster`] or [`svg`]). The editor draws the same [`WorldMesh`]es with egui.
 
 pub mod draw;
+pub mod pick;
 pub mod pose;
 pub mod raster;
 pub mod sheet;

@@ -62,8 +62,5 @@ pub fn replacement_events(
 }
 
 fn centroid(positions: &[DVec2], vertices: &[usize]) -> DVec2 {
-    if vertices.is_empty() {
-        return DVec2::ZERO;
-    }
-    vertices.iter().map(|&v| positions[v]).sum::<DVec2>() / vertices.len() as f64
+    crate::plane::centroid(vertices.iter().map(|&v| positions[v])).unwrap_or(DVec2::ZERO)
 }
