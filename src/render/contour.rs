@@ -3,8 +3,6 @@
 //! path across every scanline it spans; the interior edges of a big tessellation (long chords
 //! of a 200,000-point ring) cost far more than the boundary, though they cancel out.
 
-use std::collections::HashMap;
-
 use glam::DVec2;
 
 use super::draw::finite;
@@ -26,9 +24,8 @@ pub const CONTOUR_MIN_TRIANGLES: usize = 256;
 /// way, the winding number this chain gives a point is the number of triangles over it.
 pub fn contours(points: &[[f32; 2]], triangles: &[[u32; 3]]) -> Option<Vec<Vec<[f32; 2]>>> {
     let (mut ccw, mut cw) = (false, false);
-    // Net count of each undirected edge (lower index first): +1 per triangle running low to
-    // high along it, -1 per triangle running the other way.
-    let mut net: HashMap<(u32, u32), i64> = HashMap::with_capacity(triangles.len() * 2);
+    // Every directed edge as (lower index, higher index, +1 low to high or -1 high to low).
+    let mut edges: Vec<(u32, u32, i64)> = Vec::with_capacity(triangles.len() * 3);
     for t in triangles {
         let mut c = [DVec2::ZERO; 3];
         for (k, &i) in t.iter().enumerate() {
@@ -48,36 +45,67 @@ pub fn contours(points: &[[f32; 2]], triangles: &[[u32; 3]]) -> Option<Vec<Vec<[
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if a != b {
-                *net.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+                edges.push((a.min(b), a.max(b), if a < b { 1 } else { -1 }));
             }
         }
     }
     if ccw && cw {
         return None;
     }
-    // Out-going boundary edges per vertex, each as often as its net count says.
-    let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
-    for (&(lo, hi), &n) in &net {
-        let (from, to) = if n > 0 { (lo, hi) } else { (hi, lo) };
-        for _ in 0..n.unsigned_abs() {
-            out.entry(from).or_default().push(to);
-        }
+    Some(walk(points, &boundary(edges)))
+}
+
+/// The boundary chain: the directed edges whose net count is not zero, each as often as its
+/// count says, sorted by their start.
+fn boundary(mut edges: Vec<(u32, u32, i64)>) -> Vec<(u32, u32)> {
+    edges.sort_unstable_by_key(|&(lo, hi, _)| (lo, hi));
+    let mut chain = Vec::new();
+    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let (lo, hi) = (run[0].0, run[0].1);
+        let net: i64 = run.iter().map(|e| e.2).sum();
+        let edge = if net > 0 { (lo, hi) } else { (hi, lo) };
+        chain.extend(std::iter::repeat_n(edge, net.unsigned_abs() as usize));
     }
-    let mut starts: Vec<u32> = out.keys().copied().collect();
-    starts.sort_unstable();
+    chain.sort_unstable();
+    chain
+}
+
+/// Splits a chain (sorted by start; as many edges into every vertex as out of it) into closed
+/// contours of points.
+fn walk(points: &[[f32; 2]], chain: &[(u32, u32)]) -> Vec<Vec<[f32; 2]>> {
+    // The next unused out-going edge of each vertex, and where its edges end.
+    let mut next = vec![0usize; points.len()];
+    let mut end = vec![0usize; points.len()];
+    let mut i = 0;
+    while i < chain.len() {
+        let v = chain[i].0;
+        let j = i + chain[i..].partition_point(|e| e.0 == v);
+        (next[v as usize], end[v as usize]) = (i, j);
+        i = j;
+    }
+    let mut take = |v: u32| {
+        let v = v as usize;
+        (next[v] < end[v]).then(|| {
+            next[v] += 1;
+            chain[next[v] - 1].1
+        })
+    };
     let mut result = Vec::new();
-    for start in starts {
+    for &(start, _) in chain {
         // Every vertex has as many edges in as out, so a walk from `start` can only stop there.
-        while let Some(mut at) = out.get_mut(&start).and_then(Vec::pop) {
+        while let Some(mut at) = take(start) {
             let mut contour = vec![points[start as usize]];
             while at != start {
                 contour.push(points[at as usize]);
-                at = out.get_mut(&at).and_then(Vec::pop)?;
+                match take(at) {
+                    Some(to) => at = to,
+                    None => break,
+                }
             }
             result.push(contour);
         }
     }
-    Some(result)
+    result
 }
 
 #[cfg(test)]

@@ -91,7 +91,8 @@ pub fn tessellate_polygon(
             .collect(),
     };
 
-    let mut index_of: HashMap<usize, u32> = HashMap::new();
+    // The mesh index of each triangulation vertex, once it is used (u32::MAX before).
+    let mut index_of = vec![u32::MAX; cdt.num_vertices()];
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     for (face, inside) in cdt.inner_faces().zip(inside) {
@@ -108,10 +109,11 @@ pub fn tessellate_polygon(
             continue;
         }
         let mut tri = corners.map(|(handle, p)| {
-            *index_of.entry(handle).or_insert_with(|| {
+            if index_of[handle] == u32::MAX {
+                index_of[handle] = vertices.len() as u32;
                 vertices.push(p);
-                (vertices.len() - 1) as u32
-            })
+            }
+            index_of[handle]
         });
         if area < 0.0 {
             tri.swap(1, 2);
@@ -392,21 +394,27 @@ fn inside_even_odd(p: DVec2, rings: &[Vec<DVec2>]) -> bool {
     inside
 }
 
-/// Edges that belong to exactly one triangle, oriented as in that triangle.
+/// Edges that belong to exactly one triangle, oriented as in that triangle, in the order the
+/// triangles give them. Sorting the undirected edges counts them in O(n log n).
 fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut count: HashMap<[u32; 2], usize> = HashMap::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
-        }
-    }
+    let undirected = |t: &[u32; 3], k: usize| {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        [a.min(b), a.max(b)]
+    };
+    let mut sorted: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| undirected(t, k)))
+        .collect();
+    sorted.sort_unstable();
+    let once = |e: [u32; 2]| {
+        let first = sorted.partition_point(|x| *x < e);
+        sorted.get(first + 1) != Some(&e)
+    };
     let mut out = Vec::new();
     for t in triangles {
         for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if count[&[a.min(b), a.max(b)]] == 1 {
-                out.push([a, b]);
+            if once(undirected(t, k)) {
+                out.push([t[k], t[(k + 1) % 3]]);
             }
         }
     }
