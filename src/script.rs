@@ -1,6 +1,7 @@
 //! Scripted sculpting sessions (issue 3): the JSON script format, its validation with messages
-//! that name the offending step, and headless replay of a script on a live assembly through the
-//! solver, with a hook where rules run after every frame.
+//! that name the offending step (its index, kind and line/column in the file), and headless replay
+//! of a script on a live assembly through the solver, with a hook where rules run after every
+//! frame.
 
 use std::collections::BTreeMap;
 
@@ -11,6 +12,7 @@ use crate::assembly::{Assembly, Compass, HandleId, HandleKind};
 use crate::rules::{RuleEvent, RuleKind};
 use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
 use crate::summary::{Summary, summarize};
+use clay_dsl::compile::MAX_COORDINATE;
 use clay_dsl::compiled::PartKind;
 
 /// Largest frame count a single step may ask for (keeps a typo from running for hours).
@@ -60,12 +62,16 @@ pub struct Script {
     pub steps: Vec<Step>,
 }
 
-/// A malformed script: which step (if any) and what is wrong.
+/// A malformed script: which step (if any), where it is and what is wrong.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScriptError {
     /// Index of the offending step in `steps`, `None` for the document as a whole.
     pub step: Option<usize>,
     pub message: String,
+    /// 1-based line and column of the offending step (of the JSON syntax error), when known.
+    pub position: Option<(usize, usize)>,
+    /// What to do about it, when there is more to say than the message.
+    pub hint: Option<String>,
 }
 
 impl std::fmt::Display for ScriptError {
@@ -79,6 +85,27 @@ impl std::fmt::Display for ScriptError {
 
 impl std::error::Error for ScriptError {}
 
+/// What is wrong with one step, before it is tied to its index and position.
+struct Fault {
+    message: String,
+    hint: Option<String>,
+}
+
+impl From<String> for Fault {
+    fn from(message: String) -> Self {
+        Self {
+            message,
+            hint: None,
+        }
+    }
+}
+
+impl From<&str> for Fault {
+    fn from(message: &str) -> Self {
+        message.to_string().into()
+    }
+}
+
 fn number(v: &Value, what: &str) -> Result<f64, String> {
     match v.as_f64() {
         Some(x) if x.is_finite() => Ok(x),
@@ -86,12 +113,25 @@ fn number(v: &Value, what: &str) -> Result<f64, String> {
     }
 }
 
-fn point(v: &Value, what: &str) -> Result<DVec2, String> {
+/// A coordinate: a finite number within +/-[`MAX_COORDINATE`] metres, like grammar coordinates
+/// (E013), so that no later computation can overflow.
+fn coordinate(v: &Value, what: &str) -> Result<f64, Fault> {
+    let x = number(v, what)?;
+    if x.abs() > MAX_COORDINATE {
+        return Err(Fault {
+            message: format!("{what}: coordinate {x:e} is outside +/-{MAX_COORDINATE:e} m"),
+            hint: Some(format!(
+                "script coordinates are metres and must lie within +/-{MAX_COORDINATE:e}, as in grammars (E013)"
+            )),
+        });
+    }
+    Ok(x)
+}
+
+fn point(v: &Value, what: &str) -> Result<DVec2, Fault> {
     match v.as_array().map(Vec::as_slice) {
-        Some([x, y]) => Ok(DVec2::new(number(x, what)?, number(y, what)?)),
-        _ => Err(format!(
-            "{what} must be an array of two numbers [x, y], found {v}"
-        )),
+        Some([x, y]) => Ok(DVec2::new(coordinate(x, what)?, coordinate(y, what)?)),
+        _ => Err(format!("{what} must be an array of two numbers [x, y], found {v}").into()),
     }
 }
 
@@ -128,7 +168,7 @@ fn only_keys(
     Ok(())
 }
 
-fn selector(v: &Value, kind: &str) -> Result<Selector, String> {
+fn selector(v: &Value, kind: &str) -> Result<Selector, Fault> {
     let obj = object(v, kind)?;
     match (obj.get("at"), obj.get("extreme"), obj.len()) {
         (Some(at), None, 1) => Ok(Selector::At(point(at, &format!("{kind}: \"at\""))?)),
@@ -139,15 +179,17 @@ fn selector(v: &Value, kind: &str) -> Result<Selector, String> {
             Some("south") => Ok(Selector::Extreme(Compass::South)),
             _ => Err(format!(
                 "{kind}: \"extreme\" must be \"east\", \"west\", \"north\" or \"south\", found {dir}"
-            )),
+            )
+            .into()),
         },
         _ => Err(format!(
             "{kind} takes {{\"at\": [x, y]}} or {{\"extreme\": \"east\"|\"west\"|\"north\"|\"south\"}}"
-        )),
+        )
+        .into()),
     }
 }
 
-fn step(v: &Value) -> Result<Step, String> {
+fn step(v: &Value) -> Result<Step, Fault> {
     let obj = v
         .as_object()
         .ok_or_else(|| format!("a step must be an object, found {v}"))?;
@@ -159,7 +201,8 @@ fn step(v: &Value) -> Result<Step, String> {
             } else {
                 obj.keys().cloned().collect::<Vec<_>>().join(", ")
             }
-        ));
+        )
+        .into());
     }
     let (kind, body) = obj.iter().next().ok_or("empty step")?;
     match kind.as_str() {
@@ -211,20 +254,26 @@ fn step(v: &Value) -> Result<Step, String> {
         }
         other => Err(format!(
             "unknown step \"{other}\" (expected grab, pin, drag, rotate, release, hold or cut)"
-        )),
+        )
+        .into()),
     }
 }
 
 impl Script {
-    /// Parses and validates a script; every error names the step index and what is wrong.
+    /// Parses and validates a script; every error names the step index, its line and column
+    /// and what is wrong.
     pub fn parse(json: &str) -> Result<Self, ScriptError> {
         let doc: Value = serde_json::from_str(json).map_err(|e| ScriptError {
             step: None,
             message: format!("the script is not valid JSON: {e}"),
+            position: (e.line() > 0).then(|| (e.line(), e.column())),
+            hint: None,
         })?;
         let whole = |message: String| ScriptError {
             step: None,
             message,
+            position: None,
+            hint: None,
         };
         let obj = doc
             .as_object()
@@ -243,9 +292,13 @@ impl Script {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                step(v).map_err(|message| ScriptError {
+                step(v).map_err(|fault| ScriptError {
                     step: Some(i),
-                    message,
+                    message: fault.message,
+                    position: step_offsets(json)
+                        .get(i)
+                        .map(|&at| clay_dsl::line_col(json, at)),
+                    hint: fault.hint,
                 })
             })
             .collect::<Result<_, _>>()?;
@@ -264,6 +317,59 @@ impl Script {
             })
             .sum()
     }
+}
+
+/// Byte offsets where the elements of the top-level `"steps"` array of valid JSON start (of the
+/// last such array, as serde_json keeps the last of repeated keys).
+fn step_offsets(json: &str) -> Vec<usize> {
+    let bytes = json.as_bytes();
+    let (mut offsets, mut depth, mut i) = (Vec::new(), 0usize, 0usize);
+    let mut last_string: (usize, usize) = (0, 0);
+    // Depth inside the steps array while scanning it; an element starts at the next token.
+    let mut in_steps: Option<usize> = None;
+    let mut element_next = false;
+    while i < bytes.len() {
+        let b = bytes[i];
+        if b.is_ascii_whitespace() {
+            i += 1;
+            continue;
+        }
+        if element_next && b != b']' {
+            offsets.push(i);
+        }
+        element_next = false;
+        match b {
+            b'"' => {
+                let start = i + 1;
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                if depth == 1 {
+                    last_string = (start, i.min(bytes.len()));
+                }
+            }
+            b'[' | b'{' => {
+                depth += 1;
+                let key = &bytes[last_string.0..last_string.1];
+                if b == b'[' && depth == 2 && in_steps.is_none() && key == b"steps" {
+                    offsets.clear();
+                    in_steps = Some(depth);
+                    element_next = true;
+                }
+            }
+            b']' | b'}' => {
+                if in_steps == Some(depth) {
+                    in_steps = None;
+                }
+                depth = depth.saturating_sub(1);
+            }
+            b',' if in_steps == Some(depth) => element_next = true,
+            _ => {}
+        }
+        i += 1;
+    }
+    offsets
 }
 
 /// Where rules plug into a session: called after every solver frame, and for cut requests.
@@ -416,9 +522,13 @@ impl Replay {
         match *step {
             Step::Grab(sel) | Step::Pin(sel) => {
                 let Some(instance) = self.select(asm, sel) else {
-                    self.notes.push(format!(
-                        "step {index}: nothing to select (the model is empty)"
-                    ));
+                    let why = if asm.data.instances.is_empty() {
+                        "the model is empty"
+                    } else {
+                        "no instance is a finite distance away"
+                    };
+                    self.notes
+                        .push(format!("step {index}: nothing to select ({why})"));
                     return Ok(());
                 };
                 if let Step::Grab(_) = step {

@@ -1,9 +1,11 @@
 //! The summary of a session (issue 3's `clayc run --json` object): counts of pieces, states and
 //! rules, connectivity, extent, strain, energy and frame times, all finite or reported as not.
+//! JSON never holds `null` for a number: a figure that is not finite is written as the largest
+//! finite number of its sign (NaN as 0), `finite` is false and `not_finite` names it.
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 use crate::assembly::Assembly;
 use crate::rules::RuleKind;
@@ -13,8 +15,30 @@ use crate::solver::{FrameReport, SolverConfig, bbox, elastic_energy, max_edge_st
 /// Median and largest frame time in milliseconds (0 when no frame ran).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct FrameMs {
+    #[serde(serialize_with = "finite_number")]
     pub median: f64,
+    #[serde(serialize_with = "finite_number")]
     pub max: f64,
+}
+
+/// The JSON number for `x`: `x` when finite, else the largest finite number of its sign, or 0
+/// for NaN (serde_json would write `null`). The summary's `finite` flag says when this applies.
+pub fn json_number(x: f64) -> f64 {
+    if x.is_finite() {
+        x
+    } else if x.is_nan() {
+        0.0
+    } else {
+        f64::MAX.copysign(x)
+    }
+}
+
+fn finite_number<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(json_number(*x))
+}
+
+fn finite_numbers<S: Serializer>(xs: &[f64; 4], s: S) -> Result<S::Ok, S::Error> {
+    xs.map(json_number).serialize(s)
 }
 
 /// The state of an assembly at the end of a session.
@@ -33,14 +57,20 @@ pub struct Summary {
     /// Connected components of the part graph (parts sharing a vertex are connected).
     pub components: usize,
     /// `[min x, min y, max x, max y]` of all vertices (zeros for an empty assembly).
+    #[serde(serialize_with = "finite_numbers")]
     pub bbox: [f64; 4],
     /// Largest `|length / rest length - 1|` over all edges of the active states.
+    #[serde(serialize_with = "finite_number")]
     pub max_edge_strain: f64,
     /// Pass-2 elastic energy of the last frame (of the initial assembly when no frame ran).
+    #[serde(serialize_with = "finite_number")]
     pub energy: f64,
     pub frame_ms: FrameMs,
-    /// Every coordinate is finite.
+    /// Every coordinate and every figure above is finite.
     pub finite: bool,
+    /// The fields that are not finite (`positions` for the coordinates), when any.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_finite: Vec<&'static str>,
 }
 
 fn median(values: &[f64]) -> f64 {
@@ -109,6 +139,26 @@ pub fn summarize(
         Some(r) => r.energy,
         None => elastic_energy(asm, config),
     };
+    let times = FrameMs {
+        median: median(frame_ms),
+        max: frame_ms.iter().copied().fold(0.0, f64::max),
+    };
+    let max_edge_strain = max_edge_strain(asm);
+    let figures = [
+        ("positions", finite),
+        ("bbox", bbox.iter().all(|x| x.is_finite())),
+        ("max_edge_strain", max_edge_strain.is_finite()),
+        ("energy", energy.is_finite()),
+        (
+            "frame_ms",
+            times.median.is_finite() && times.max.is_finite(),
+        ),
+    ];
+    let not_finite: Vec<&'static str> = figures
+        .iter()
+        .filter(|(_, ok)| !ok)
+        .map(|(name, _)| *name)
+        .collect();
     Summary {
         frames: frame_ms.len(),
         vertices: asm.data.positions.len(),
@@ -126,13 +176,11 @@ pub fn summarize(
             .collect(),
         components: components(asm),
         bbox,
-        max_edge_strain: max_edge_strain(asm),
+        max_edge_strain,
         energy,
-        frame_ms: FrameMs {
-            median: median(frame_ms),
-            max: frame_ms.iter().copied().fold(0.0, f64::max),
-        },
-        finite,
+        frame_ms: times,
+        finite: not_finite.is_empty(),
+        not_finite,
     }
 }
 
@@ -151,8 +199,14 @@ impl Summary {
             .map(|(p, s)| format!("{p}: {}", list(s)))
             .collect::<Vec<_>>()
             .join("; ");
+        let f = figure;
+        let warning = if self.finite {
+            String::new()
+        } else {
+            format!("\nWARNING: not finite: {}", self.not_finite.join(", "))
+        };
         format!(
-            "{} frames, {} vertices, {} parts, {} component(s)\npieces: {}\nstates: {}\nrules fired: {}\nbbox [{:.3}, {:.3}, {:.3}, {:.3}], max edge strain {:.4}, energy {:.6}\nframe time median {:.2} ms, max {:.2} ms{}\n",
+            "{} frames, {} vertices, {} parts, {} component(s)\npieces: {}\nstates: {}\nrules fired: {}\nbbox [{}, {}, {}, {}], max edge strain {}, energy {}\nframe time median {} ms, max {} ms{warning}\n",
             self.frames,
             self.vertices,
             self.parts,
@@ -160,19 +214,24 @@ impl Summary {
             list(&self.pieces),
             states,
             list(&self.rules_fired),
-            self.bbox[0],
-            self.bbox[1],
-            self.bbox[2],
-            self.bbox[3],
-            self.max_edge_strain,
-            self.energy,
-            self.frame_ms.median,
-            self.frame_ms.max,
-            if self.finite {
-                ""
-            } else {
-                "\nWARNING: some coordinates are not finite"
-            }
+            f(self.bbox[0], 3),
+            f(self.bbox[1], 3),
+            f(self.bbox[2], 3),
+            f(self.bbox[3], 3),
+            f(self.max_edge_strain, 4),
+            f(self.energy, 6),
+            f(self.frame_ms.median, 2),
+            f(self.frame_ms.max, 2),
         )
+    }
+}
+
+/// A figure for people: `decimals` places below a million, three significant decimals in
+/// scientific notation above (never a 300-digit number), `inf` / `NaN` as such.
+pub fn figure(x: f64, decimals: usize) -> String {
+    if x.is_finite() && x.abs() >= 1e6 {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.decimals$}")
     }
 }

@@ -369,3 +369,49 @@ fn svg_has_one_filled_path_per_mesh() {
     let meshes = pose_assembly(&g, &a, &mut TessellationCache::new());
     assert_eq!(svg.matches("<path").count(), meshes.len());
 }
+
+#[test]
+fn a_large_mesh_filled_by_its_contours_looks_as_filled_by_its_triangles() {
+    use clay::render::Canvas;
+    use clay::render::raster::PixmapCanvas;
+    // A 20,000-point star with a hole, about 300 px across: far above the contour threshold.
+    let ring = |n: usize, centre: DVec2, scale: f64| -> Vec<DVec2> {
+        (0..n)
+            .map(|k| {
+                let r = if k % 2 == 0 { 1.0 } else { 0.8 };
+                centre + DVec2::from_angle(k as f64 * std::f64::consts::TAU / n as f64) * r * scale
+            })
+            .collect()
+    };
+    let outer = ring(20_000, DVec2::splat(160.0), 150.0);
+    let hole = ring(600, DVec2::new(120.0, 170.0), 40.0);
+    let (v, t) = clay::render::tessellate_polygon(&outer, &[hole]).unwrap();
+    assert!(t.len() > clay::render::contour::CONTOUR_MIN_TRIANGLES);
+    let points: Vec<[f32; 2]> = v.iter().map(|p| [p.x as f32, p.y as f32]).collect();
+    let contours = clay::render::contour::contours(&points, &t).unwrap();
+    assert_eq!(contours.len(), 2, "the outer ring and the hole");
+    let mut by_triangles = PixmapCanvas::new(320, 320, BG).unwrap();
+    by_triangles.fill_triangles(&points, &t, RED);
+    let mut by_contours = PixmapCanvas::new(320, 320, BG).unwrap();
+    by_contours.fill_contours(&contours, RED);
+    let (a, b) = (by_triangles.pixmap, by_contours.pixmap);
+    let mut differing = 0;
+    for (p, q) in a.pixels().iter().zip(b.pixels()) {
+        let (p, q) = (p.demultiply(), q.demultiply());
+        let gap = [
+            p.red().abs_diff(q.red()),
+            p.green().abs_diff(q.green()),
+            p.blue().abs_diff(q.blue()),
+        ];
+        // Anti-aliasing may round an edge pixel differently, never more than a few levels.
+        assert!(gap.iter().all(|&g| g <= 8), "{p:?} vs {q:?}");
+        differing += usize::from(gap.iter().any(|&g| g > 0));
+    }
+    // Only edge pixels may differ, a few of the star's rim of about 2,000.
+    assert!(differing < 100, "{differing} pixels differ");
+    // The inside is filled (the centre) and the hole is not.
+    let centre = pixel(&a, 200, 160);
+    assert_eq!(pixel(&b, 200, 160), centre);
+    assert_eq!(centre, RED.0);
+    assert_eq!(pixel(&b, 120, 170), BG.0);
+}

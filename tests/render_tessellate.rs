@@ -106,6 +106,56 @@ fn self_touching_polygon_does_not_panic() {
     let _ = tessellate_polygon(&bow, &duplicate_hole);
 }
 
+/// A star of `n` points (radii alternating 1 and 0.8) around `centre`, counter-clockwise.
+fn star(n: usize, centre: DVec2, scale: f64) -> Vec<DVec2> {
+    (0..n)
+        .map(|k| {
+            let r = if k % 2 == 0 { 1.0 } else { 0.8 };
+            centre + DVec2::from_angle(k as f64 * std::f64::consts::TAU / n as f64) * r * scale
+        })
+        .collect()
+}
+
+#[test]
+fn a_20k_point_star_with_holes_covers_its_exact_area() {
+    let outer = star(20_000, DVec2::ZERO, 10.0);
+    // Three holes: two small stars and a 4,000-point circle, clockwise as authors often draw them.
+    let mut circle: Vec<DVec2> = (0..4000)
+        .map(|k| {
+            DVec2::new(-3.0, 2.0)
+                + DVec2::from_angle(k as f64 * std::f64::consts::TAU / 4000.0) * 1.5
+        })
+        .collect();
+    circle.reverse();
+    let holes = vec![
+        star(1000, DVec2::new(3.0, 3.0), 1.0),
+        star(2000, DVec2::new(2.0, -4.0), 2.0),
+        circle,
+    ];
+    let expected =
+        shoelace_area(&outer) - holes.iter().map(|h| shoelace_area(h).abs()).sum::<f64>();
+    let (v, t) = tessellate_polygon(&outer, &holes).unwrap();
+    let area = triangles_area(&v, &t);
+    assert!(
+        ((area - expected) / expected).abs() < 1e-9,
+        "triangles {area} vs shoelace {expected}"
+    );
+    for tri in &t {
+        let [a, b, c] = tri.map(|i| v[i as usize]);
+        assert!((b - a).perp_dot(c - a) > 0.0);
+    }
+}
+
+#[test]
+fn a_hole_sharing_the_outer_edges_is_cut_out() {
+    // The hole's corner square shares two half edges with the outer square: the ring segments
+    // over them count twice, so the region inside both is outside by the even-odd rule.
+    let outer = pts(&[(0.0, 0.0), (3.0, 0.0), (3.0, 3.0), (0.0, 3.0)]);
+    let hole = pts(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+    let (v, t) = tessellate_polygon(&outer, &[hole]).unwrap();
+    assert!((triangles_area(&v, &t) - 8.0).abs() < 1e-12);
+}
+
 fn proxy(shape: ProxyShape) -> Proxy {
     Proxy {
         shape,
@@ -128,6 +178,31 @@ proptest! {
             prop_assert!(mesh.triangles.iter().flatten().all(|&i| (i as usize) < mesh.vertices.len()));
             prop_assert!(mesh.area() > 0.0);
         }
+    }
+
+    #[test]
+    fn star_shaped_polygons_with_a_hole_have_the_shoelace_area(
+        radii in prop::collection::vec(0.5f64..2.0, 3..200),
+        hole_share in 0.1f64..0.9,
+        hole_points in 3usize..40,
+    ) {
+        // Points at increasing angles with any radius make a simple polygon. It holds the disk
+        // of radius 0.5 cos(pi / n) (the smallest radius times the cosine of half the angle
+        // between neighbours); the hole is a regular polygon inside that disk.
+        let n = radii.len();
+        let hole_radius = hole_share * 0.5 * (std::f64::consts::PI / n as f64).cos();
+        let outer: Vec<DVec2> = radii
+            .iter()
+            .enumerate()
+            .map(|(k, &r)| DVec2::from_angle(k as f64 * std::f64::consts::TAU / n as f64) * r)
+            .collect();
+        let hole: Vec<DVec2> = (0..hole_points)
+            .map(|k| DVec2::from_angle(k as f64 * std::f64::consts::TAU / hole_points as f64) * hole_radius)
+            .collect();
+        let expected = shoelace_area(&outer) - shoelace_area(&hole);
+        let (v, t) = tessellate_polygon(&outer, &[hole]).unwrap();
+        let area = triangles_area(&v, &t);
+        prop_assert!(((area - expected) / expected).abs() < 1e-9, "{} vs {}", area, expected);
     }
 
     #[test]

@@ -222,3 +222,78 @@ fn the_human_summary_names_frames_and_pieces() {
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("0 frames") && out.contains("tower"), "{out}");
 }
+
+/// Every JSON number of `v`, with the path to it; fails on `null` anywhere.
+fn numbers(v: &Value, at: &str, out: &mut Vec<(String, f64)>) {
+    match v {
+        Value::Null => panic!("{at} is null"),
+        Value::Number(n) => out.push((at.to_string(), n.as_f64().unwrap())),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| numbers(x, &format!("{at}[{i}]"), out)),
+        Value::Object(o) => o
+            .iter()
+            .for_each(|(k, x)| numbers(x, &format!("{at}.{k}"), out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn figures_that_are_not_finite_are_flagged_and_never_null() {
+    let grammar = Arc::new(synthetic::wall(4));
+    let config = SolverConfig::default();
+    let summarize = |asm: &Assembly| {
+        let (summary, _) =
+            replay(&mut asm.clone(), &Script::default(), &config, &mut NoRules).unwrap();
+        summary
+    };
+    // Huge but finite coordinates: lengths and the energy overflow, the extent does not.
+    let mut huge = Assembly::new(grammar.clone());
+    for p in &mut huge.data.positions {
+        *p *= 1e300;
+    }
+    let s = summarize(&huge);
+    assert!(!s.finite, "{s:?}");
+    assert!(s.not_finite.contains(&"energy"), "{:?}", s.not_finite);
+    assert!(!s.not_finite.contains(&"positions"), "{:?}", s.not_finite);
+    let json = serde_json::to_value(&s).unwrap();
+    let mut all = Vec::new();
+    numbers(&json, "summary", &mut all);
+    assert!(all.iter().all(|(_, x)| x.is_finite()), "{all:?}");
+    assert_eq!(json["finite"], false);
+    assert_eq!(
+        json["not_finite"],
+        serde_json::json!(["max_edge_strain", "energy"])
+    );
+    assert_eq!(json["energy"].as_f64(), Some(f64::MAX));
+    // The text form writes the extent as 1.000e300, never as a 300-digit number.
+    let text = s.human();
+    let longest_digits = text
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(longest_digits < 20, "{text}");
+    assert!(
+        text.contains("e300") && text.contains("WARNING: not finite: max_edge_strain, energy"),
+        "{text}"
+    );
+    // A coordinate that is not a number: every figure it touches is named, none is null.
+    let mut nan = Assembly::new(grammar);
+    nan.data.positions[0].x = f64::NAN;
+    let s = summarize(&nan);
+    assert!(!s.finite);
+    assert_eq!(
+        s.not_finite.first(),
+        Some(&"positions"),
+        "{:?}",
+        s.not_finite
+    );
+    let json = serde_json::to_value(&s).unwrap();
+    numbers(&json, "summary", &mut Vec::new());
+    assert!(!serde_json::to_string(&s).unwrap().contains("null"));
+    // A finite session has no `not_finite` key at all.
+    let v = run_json("wall.clay", r#"{"steps": []}"#, &[]);
+    assert!(v.get("not_finite").is_none(), "{v}");
+}

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind, Rgba};
 use glam::DVec2;
 
+use super::contour::{CONTOUR_MIN_TRIANGLES, contours};
 use super::pose::{WorldMesh, site_out};
 use super::text;
 
@@ -40,6 +41,8 @@ pub trait Canvas {
     /// Fills the union of the triangles (each one's winding is normalised, so overlaps do not
     /// cancel or double-blend).
     fn fill_triangles(&mut self, points: &[[f32; 2]], triangles: &[[u32; 3]], colour: Rgba);
+    /// Fills what the closed contours wind around (the nonzero rule).
+    fn fill_contours(&mut self, contours: &[Vec<[f32; 2]>], colour: Rgba);
     /// Strokes each segment with round caps.
     fn stroke_segments(&mut self, segments: &[[[f32; 2]; 2]], width: f32, colour: Rgba);
     fn fill_circle(&mut self, centre: [f32; 2], radius: f32, colour: Rgba);
@@ -287,7 +290,15 @@ pub fn draw_meshes(canvas: &mut dyn Canvas, meshes: &[WorldMesh], view: &View, o
             .collect()
     };
     for m in meshes {
-        canvas.fill_triangles(&px(m), &m.triangles, m.fill);
+        let points = px(m);
+        // A large mesh is filled by its boundary: the same pixels without every interior edge.
+        match (m.triangles.len() >= CONTOUR_MIN_TRIANGLES)
+            .then(|| contours(&points, &m.triangles))
+            .flatten()
+        {
+            Some(c) => canvas.fill_contours(&c, m.fill),
+            None => canvas.fill_triangles(&points, &m.triangles, m.fill),
+        }
     }
     if outlines {
         for m in meshes {

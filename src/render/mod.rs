@@ -3,8 +3,10 @@
 //!
 //! Data flows one way: [`tessellate`] (once per piece and rest state, cached) -> [`pose`]
 //! (every frame: plain world-space triangles, [`WorldMesh`]) -> [`draw`] (overlays, labels) onto
-//! a [`Canvas`] ([`raster`] or [`svg`]). The editor draws the same [`WorldMesh`]es with egui.
+//! a [`Canvas`] ([`raster`] or [`svg`]); large meshes are filled by their [`contour`]s. The
+//! editor draws the same [`WorldMesh`]es with egui.
 
+pub mod contour;
 pub mod draw;
 pub mod pick;
 pub mod pose;

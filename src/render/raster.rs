@@ -85,6 +85,26 @@ impl Canvas for PixmapCanvas {
         }
     }
 
+    fn fill_contours(&mut self, contours: &[Vec<[f32; 2]>], colour: Rgba) {
+        let mut pb = PathBuilder::new();
+        for c in contours.iter().filter(|c| c.len() >= 3) {
+            pb.move_to(c[0][0], c[0][1]);
+            for p in &c[1..] {
+                pb.line_to(p[0], p[1]);
+            }
+            pb.close();
+        }
+        if let Some(path) = pb.finish() {
+            self.pixmap.fill_path(
+                &path,
+                &paint(colour),
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
+        }
+    }
+
     fn stroke_segments(&mut self, segments: &[[[f32; 2]; 2]], width: f32, colour: Rgba) {
         let mut pb = PathBuilder::new();
         for [a, b] in segments.iter().filter(|s| finite(&s[0]) && finite(&s[1])) {

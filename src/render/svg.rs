@@ -78,6 +78,20 @@ impl Canvas for SvgCanvas {
         }
     }
 
+    fn fill_contours(&mut self, contours: &[Vec<[f32; 2]>], colour: Rgba) {
+        let mut d = String::new();
+        for c in contours.iter().filter(|c| c.len() >= 3) {
+            let _ = write!(d, "M{} {}", num(c[0][0]), num(c[0][1]));
+            for p in &c[1..] {
+                let _ = write!(d, "L{} {}", num(p[0]), num(p[1]));
+            }
+            d.push('Z');
+        }
+        if !d.is_empty() {
+            let _ = writeln!(self.body, "<path d=\"{d}\" {}/>", fill_attrs(colour));
+        }
+    }
+
     fn stroke_segments(&mut self, segments: &[[[f32; 2]; 2]], width: f32, colour: Rgba) {
         let mut d = String::new();
         for [a, b] in segments.iter().filter(|s| finite(&s[0]) && finite(&s[1])) {

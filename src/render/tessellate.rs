@@ -2,8 +2,11 @@
 //! geometry-frame coordinates, computed once per piece and rest state.
 //!
 //! Polygons (concave, with holes) go through spade's constrained Delaunay triangulation: every
-//! ring is inserted as constraint edges and the triangles whose centroid lies inside by the
-//! even-odd rule are kept. Thick polylines become a strip of quads with miter joins (bevel joins
+//! ring is inserted as constraint edges and the triangles inside by the even-odd rule are kept.
+//! Which triangles are inside is found in one walk over the triangulation from its outside, the
+//! parity flipping across every edge that an odd number of ring segments cover: O(n) after the
+//! O(n log n) triangulation, for 200,000-point rings too. Only when a self-crossing ring had a
+//! constraint left out does each triangle's centroid get the even-odd ray test (O(n) each). Thick polylines become a strip of quads with miter joins (bevel joins
 //! past the miter limit). Degenerate shapes are skipped, never a panic: a picture with one
 //! missing shape beats a crashed editor.
 
@@ -12,6 +15,7 @@ use std::sync::Arc;
 
 use clay_dsl::compiled::{Binding, CompiledGrammar, Proxy, ProxyShape, Rgba};
 use glam::DVec2;
+use spade::handles::FixedUndirectedEdgeHandle;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 /// Rings whose shoelace area is below this (square metres) have no inside worth drawing.
@@ -75,26 +79,26 @@ pub fn tessellate_polygon(
         .chain(holes.iter().filter_map(|h| clean_ring(h)))
         .collect();
 
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-    for ring in &rings {
-        let mut handles = Vec::with_capacity(ring.len());
-        for p in ring {
-            // Coordinates spade cannot represent (e.g. 1e-300) make the whole shape unusable.
-            handles.push(cdt.insert(Point2::new(p.x, p.y)).ok()?);
-        }
-        for i in 0..handles.len() {
-            let (a, b) = (handles[i], handles[(i + 1) % handles.len()]);
-            if a != b {
-                // try_add_constraint leaves crossing constraints out instead of panicking.
-                let _ = cdt.try_add_constraint(a, b);
-            }
-        }
-    }
+    let (cdt, cover) = constrained(&rings)?;
+    let inside = match cover {
+        Some(cover) => inside_by_walk(&cdt, &cover),
+        None => cdt
+            .inner_faces()
+            .map(|face| {
+                let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
+                inside_even_odd((a + b + c) / 3.0, &rings)
+            })
+            .collect(),
+    };
 
-    let mut index_of: HashMap<usize, u32> = HashMap::new();
+    // The mesh index of each triangulation vertex, once it is used (u32::MAX before).
+    let mut index_of = vec![u32::MAX; cdt.num_vertices()];
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
-    for face in cdt.inner_faces() {
+    for (face, inside) in cdt.inner_faces().zip(inside) {
+        if !inside {
+            continue;
+        }
         let corners = face.vertices().map(|v| {
             let p = v.position();
             (v.fix().index(), DVec2::new(p.x, p.y))
@@ -104,15 +108,12 @@ pub fn tessellate_polygon(
         if area.abs() <= f64::EPSILON * scale_of(pts) {
             continue;
         }
-        let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
-        if !inside_even_odd(centroid, &rings) {
-            continue;
-        }
         let mut tri = corners.map(|(handle, p)| {
-            *index_of.entry(handle).or_insert_with(|| {
+            if index_of[handle] == u32::MAX {
+                index_of[handle] = vertices.len() as u32;
                 vertices.push(p);
-                (vertices.len() - 1) as u32
-            })
+            }
+            index_of[handle]
         });
         if area < 0.0 {
             tri.swap(1, 2);
@@ -120,6 +121,85 @@ pub fn tessellate_polygon(
         triangles.push(tri);
     }
     (!triangles.is_empty()).then_some((vertices, triangles))
+}
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// The constrained triangulation of the rings, and how many ring segments cover each of its
+/// undirected edges (indexed by edge), or `None` for the cover when a constraint that crosses
+/// another had to be left out. `None` when spade cannot represent a coordinate.
+fn constrained(rings: &[Vec<DVec2>]) -> Option<(Cdt, Option<Vec<u32>>)> {
+    let mut cdt = Cdt::new();
+    // Every point first, then every constraint: a point inserted later could split a constraint
+    // edge already counted.
+    let mut handles = Vec::with_capacity(rings.len());
+    for ring in rings {
+        let mut ring_handles = Vec::with_capacity(ring.len());
+        for p in ring {
+            // Coordinates spade cannot represent (e.g. 1e-300) make the whole shape unusable.
+            ring_handles.push(cdt.insert(Point2::new(p.x, p.y)).ok()?);
+        }
+        handles.push(ring_handles);
+    }
+    let mut covered: Vec<FixedUndirectedEdgeHandle> = Vec::new();
+    let mut complete = true;
+    for ring in &handles {
+        for i in 0..ring.len() {
+            let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+            if a == b {
+                continue;
+            }
+            // try_add_constraint leaves crossing constraints out instead of panicking; it gives
+            // every edge the segment now consists of (also edges that were constraints before).
+            let edges = cdt.try_add_constraint(a, b);
+            complete &= !edges.is_empty();
+            covered.extend(edges.iter().map(|e| e.as_undirected()));
+        }
+    }
+    if !complete {
+        return Some((cdt, None));
+    }
+    // Constraint edges are never flipped, so the handles taken above still name them.
+    let mut cover = vec![0u32; cdt.num_undirected_edges()];
+    for e in covered {
+        cover[e.index()] += 1;
+    }
+    Some((cdt, Some(cover)))
+}
+
+/// Which inner faces (in `inner_faces` order) are inside by the even-odd rule: a walk from the
+/// outer face across the triangulation's edges, the parity flipping across an edge covered by
+/// an odd number of ring segments. Every path from outside crosses the rings that often.
+fn inside_by_walk(cdt: &Cdt, cover: &[u32]) -> Vec<bool> {
+    let odd = |e: spade::handles::DirectedEdgeHandle<_, _, _, _>| {
+        cover[e.as_undirected().fix().index()] % 2 == 1
+    };
+    // Parity per face index; the faces next to the outer face (which is outside) start the walk.
+    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for face in cdt.inner_faces() {
+        for e in face.adjacent_edges() {
+            if e.rev().face().is_outer() && parity[face.fix().index()].is_none() {
+                parity[face.fix().index()] = Some(odd(e));
+                stack.push(face.fix());
+            }
+        }
+    }
+    while let Some(face) = stack.pop() {
+        let here = parity[face.index()].unwrap_or(false);
+        for e in cdt.face(face).adjacent_edges() {
+            let Some(next) = e.rev().face().as_inner() else {
+                continue;
+            };
+            if parity[next.fix().index()].is_none() {
+                parity[next.fix().index()] = Some(here != odd(e));
+                stack.push(next.fix());
+            }
+        }
+    }
+    cdt.inner_faces()
+        .map(|f| parity[f.fix().index()].unwrap_or(false))
+        .collect()
 }
 
 /// A thick open polyline as a strip of quads, counter-clockwise triangles. Consecutive duplicate
@@ -314,21 +394,27 @@ fn inside_even_odd(p: DVec2, rings: &[Vec<DVec2>]) -> bool {
     inside
 }
 
-/// Edges that belong to exactly one triangle, oriented as in that triangle.
+/// Edges that belong to exactly one triangle, oriented as in that triangle, in the order the
+/// triangles give them. Sorting the undirected edges counts them in O(n log n).
 fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut count: HashMap<[u32; 2], usize> = HashMap::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
-        }
-    }
+    let undirected = |t: &[u32; 3], k: usize| {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        [a.min(b), a.max(b)]
+    };
+    let mut sorted: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| undirected(t, k)))
+        .collect();
+    sorted.sort_unstable();
+    let once = |e: [u32; 2]| {
+        let first = sorted.partition_point(|x| *x < e);
+        sorted.get(first + 1) != Some(&e)
+    };
     let mut out = Vec::new();
     for t in triangles {
         for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if count[&[a.min(b), a.max(b)]] == 1 {
-                out.push([a, b]);
+            if once(undirected(t, k)) {
+                out.push([t[k], t[(k + 1) % 3]]);
             }
         }
     }
@@ -361,6 +447,45 @@ mod tests {
         assert!(tessellate_polygon(&nan, &[]).is_none());
         assert!(tessellate_polyline(&[DVec2::ZERO, DVec2::ZERO], 1.0).is_none());
         assert!(tessellate_polyline(&[DVec2::ZERO, DVec2::X], 0.0).is_none());
+    }
+
+    /// The walk keeps exactly the triangles whose centroid the even-odd ray test puts inside, on
+    /// small integer rings full of duplicates, collinear runs, shared edges and touching corners.
+    #[test]
+    fn the_walk_agrees_with_the_even_odd_test() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n) as f64
+        };
+        let (mut walked, mut compared) = (0, 0);
+        for _ in 0..12_000 {
+            let mut ring = |len: u64, scale: f64| -> Vec<DVec2> {
+                let n = 3 + next(len) as usize;
+                (0..n)
+                    .map(|_| DVec2::new(next(7) - 3.0, next(7) - 3.0) * scale)
+                    .collect()
+            };
+            let rings: Vec<Vec<DVec2>> = [ring(6, 1.0), ring(4, 0.5)]
+                .iter()
+                .filter_map(|r| clean_ring(r))
+                .collect();
+            let Some((cdt, Some(cover))) = constrained(&rings) else {
+                continue;
+            };
+            walked += 1;
+            for (face, inside) in cdt.inner_faces().zip(inside_by_walk(&cdt, &cover)) {
+                let pts = face.positions().map(|p| DVec2::new(p.x, p.y));
+                if signed_area(pts).abs() > 1e-9 {
+                    let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
+                    assert_eq!(inside, inside_even_odd(centroid, &rings), "{rings:?}");
+                    compared += 1;
+                }
+            }
+        }
+        assert!(walked > 1500 && compared > 8000, "{walked} {compared}");
     }
 
     #[test]

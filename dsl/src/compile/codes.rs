@@ -5,6 +5,9 @@ pub use crate::parse::codes::{NON_FINITE, SYNTAX, TOO_DEEP};
 
 /// The file is not valid UTF-8.
 pub const NOT_UTF8: &str = "E003";
+/// The file cannot be read at all (missing, not readable, a directory): `clayc` reports it;
+/// docs/language.md describes it below the table, as no fixture can show it.
+pub const UNREADABLE: &str = "E004";
 /// A name declared twice in the same scope.
 pub const DUPLICATE: &str = "E010";
 /// A name that refers to nothing (piece, site type, site, vertex, instance, parameter).

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use crate::out;
 use clay::authoring::{AuthorOptions, StretchChoice, author, svg::drawing_from_svg};
 use glam::DVec2;
 
@@ -45,27 +46,27 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
         match parse_point(c) {
             Ok(p) => cuts.push(p),
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!("error: {e}");
                 return 2;
             }
         }
     }
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        eprintln!("error: --tolerance must be a positive number of metres");
+        errln!("error: --tolerance must be a positive number of metres");
         return 2;
     }
     let path = args.drawing.display().to_string();
     let text = match std::fs::read_to_string(&args.drawing) {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("error: cannot read `{path}`: {e}");
+            errln!("error: cannot read `{path}`: {e}");
             return 2;
         }
     };
     let drawing = match drawing_from_svg(&text, args.scale) {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("error: {path}: {e}");
+            errln!("error: {path}: {e}");
             return 1;
         }
     };
@@ -82,25 +83,19 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
     let authored = match author(&drawing, &options) {
         Ok(a) => a,
         Err(e) => {
-            eprintln!("error: {path}: {e}");
+            errln!("error: {path}: {e}");
             return 1;
         }
     };
     for note in &authored.design.notes {
-        eprintln!("note: {note}");
+        errln!("note: {note}");
     }
-    let result = if args.output.as_os_str() == "-" {
-        print!("{}", authored.text);
-        Ok(())
-    } else {
-        std::fs::write(&args.output, &authored.text)
-    };
-    if let Err(e) = result {
-        eprintln!("error: cannot write `{}`: {e}", args.output.display());
-        return 2;
+    let code = out::write_output(&args.output, authored.text.as_bytes());
+    if code != 0 {
+        return code;
     }
     let d = &authored.design;
-    eprintln!(
+    errln!(
         "authored {} piece(s), {} instance(s), {} dock(s)",
         d.pieces.len(),
         d.instances.len(),

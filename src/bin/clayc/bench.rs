@@ -6,6 +6,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use crate::out;
 use clay::assembly::{Assembly, HandleKind};
 use clay::rules::Rules;
 use clay::solver::{FrameReport, Pass1, Solver, SolverConfig, SolverKind};
@@ -110,7 +111,7 @@ fn stats(values: &[f64]) -> Ms {
 
 pub fn bench(args: BenchArgs) -> u8 {
     if args.frames == 0 || args.frames > 100_000 {
-        eprintln!("error: --frames must be from 1 to 100000");
+        errln!("error: --frames must be from 1 to 100000");
         return 2;
     }
     let kind = match args.solver {
@@ -137,7 +138,7 @@ pub fn bench(args: BenchArgs) -> u8 {
     let (model, mut asm, drag) = match args.arap_grid {
         Some(k) => {
             if !(2..=2000).contains(&k) {
-                eprintln!("error: --arap-grid must be from 2 to 2000");
+                errln!("error: --arap-grid must be from 2 to 2000");
                 return 2;
             }
             // classic ARAP: least squares only, one local + global iteration per frame
@@ -158,7 +159,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         }
         None => {
             if !(10..=10_000_000).contains(&args.parts) {
-                eprintln!("error: --parts must be from 10 to 10000000");
+                errln!("error: --parts must be from 10 to 10000000");
                 return 2;
             }
             let mut asm = Assembly::new(Arc::new(synthetic::city(args.parts)));
@@ -198,7 +199,7 @@ pub fn bench(args: BenchArgs) -> u8 {
                 reports.push(r);
             }
             Err(e) => {
-                eprintln!("error: frame {k}: {e}");
+                errln!("error: frame {k}: {e}");
                 return 1;
             }
         }
@@ -246,16 +247,16 @@ pub fn bench(args: BenchArgs) -> u8 {
         energy: reports.last().map_or(0.0, |r| r.energy),
         checksum: asm.data.positions.iter().map(|p| p.x + p.y).sum(),
     };
-    if args.json {
+    let text = if args.json {
         match serde_json::to_string_pretty(&result) {
-            Ok(s) => println!("{s}"),
+            Ok(s) => s,
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!("error: {e}");
                 return 2;
             }
         }
     } else {
-        println!(
+        format!(
             "{}: {} parts, {} vertices, solver {}, pass 1 {}, {} frames\niterations per frame: {:.2} pass-1 + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
             result.model,
             result.parts,
@@ -280,9 +281,9 @@ pub fn bench(args: BenchArgs) -> u8 {
                     "\niteration_ms median {:.2}, max {:.2}",
                     m.median, m.max
                 )),
-        );
-    }
-    0
+        )
+    };
+    out::stdout_line(&text).err().map_or(0, |stop| stop.exit(0))
 }
 
 /// South-west and north-east corners of the street grid (the parts above the wall).

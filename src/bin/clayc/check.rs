@@ -1,10 +1,13 @@
 //! `clayc check` (print diagnostics for grammar files) and `clayc build` (compile one grammar to
 //! JSON). Exit codes: 0 no errors (warnings allowed), 1 the input has errors, 2 usage or I/O.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use clay_dsl::{Diagnostics, compile_bytes};
+use crate::out;
+use clay_dsl::compile::codes::UNREADABLE;
+use clay_dsl::diagnostic::{JsonDiagnostic, JsonLabel, JsonPos};
+use clay_dsl::{Diagnostics, Severity, compile_bytes};
 
 /// How diagnostics are printed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -40,15 +43,72 @@ fn stderr_color() -> bool {
     std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty())
 }
 
-/// The file's bytes, or a message naming it.
-fn read(path: &Path) -> Result<Vec<u8>, String> {
+/// A file that could not be read: what went wrong, in words, and what to do about it.
+pub struct Unreadable {
+    pub path: String,
+    pub why: String,
+    pub hint: String,
+}
+
+impl Unreadable {
+    /// The human form: a rustc-style error line with the code and a help line.
+    pub fn human(&self) -> String {
+        format!(
+            "error[{UNREADABLE}]: cannot read `{}`: {}\n  = help: {}",
+            self.path, self.why, self.hint
+        )
+    }
+
+    /// The JSON form: one diagnostic object at the start of the file, as `to_json` writes them.
+    pub fn json(&self) -> JsonDiagnostic {
+        let start = JsonPos { line: 1, column: 1 };
+        JsonDiagnostic {
+            code: UNREADABLE,
+            severity: Severity::Error,
+            message: format!("cannot read `{}`: {}", self.path, self.why),
+            file: self.path.clone(),
+            line: 1,
+            column: 1,
+            end: start,
+            labels: vec![JsonLabel {
+                message: "the file cannot be read".into(),
+                primary: true,
+                start,
+                end: start,
+                byte_start: 0,
+                byte_end: 0,
+            }],
+            hints: vec![self.hint.clone()],
+        }
+    }
+}
+
+/// The file's bytes, or why they cannot be had.
+pub fn read(path: &Path) -> Result<Vec<u8>, Unreadable> {
     std::fs::read(path).map_err(|e| {
-        let why = match e.kind() {
-            std::io::ErrorKind::NotFound => "no such file".to_string(),
-            std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
-            _ => e.to_string(),
+        let (why, hint) = match e.kind() {
+            std::io::ErrorKind::NotFound => (
+                "no such file".to_string(),
+                "check the spelling; a relative path starts in the current directory".to_string(),
+            ),
+            std::io::ErrorKind::PermissionDenied => (
+                "permission denied".to_string(),
+                "the file's permissions must allow reading it".to_string(),
+            ),
+            std::io::ErrorKind::IsADirectory => (
+                "it is a directory".to_string(),
+                "name a grammar file (.clay), not a directory".to_string(),
+            ),
+            _ => (
+                e.to_string(),
+                "name a readable grammar file (.clay)".to_string(),
+            ),
         };
-        format!("error: cannot read `{}`: {why}", path.display())
+        Unreadable {
+            path: path.display().to_string(),
+            why,
+            hint,
+        }
     })
 }
 
@@ -60,12 +120,19 @@ fn print_human(diags: &Diagnostics, bytes: &[u8], path: &str) {
 pub fn check(args: CheckArgs) -> u8 {
     let mut worst = 0u8;
     let mut json = Vec::new();
-    let (mut errors, mut warnings) = (0, 0);
+    let mut counts = Counts {
+        files: args.files.len(),
+        ..Counts::default()
+    };
     for file in &args.files {
         let bytes = match read(file) {
             Ok(b) => b,
-            Err(msg) => {
-                eprintln!("{msg}");
+            Err(unreadable) => {
+                match args.format {
+                    Format::Human => errln!("{}", unreadable.human()),
+                    Format::Json => json.push(unreadable.json()),
+                }
+                counts.unreadable += 1;
                 worst = 2;
                 continue;
             }
@@ -75,8 +142,8 @@ pub fn check(args: CheckArgs) -> u8 {
             Ok(c) => c.warnings,
             Err(d) => d,
         };
-        errors += diags.error_count();
-        warnings += diags.warning_count();
+        counts.errors += diags.error_count();
+        counts.warnings += diags.warning_count();
         if diags.has_errors() && worst == 0 {
             worst = 1;
         }
@@ -91,40 +158,67 @@ pub fn check(args: CheckArgs) -> u8 {
     }
     match args.format {
         Format::Json => match serde_json::to_string_pretty(&json) {
-            Ok(text) => println!("{text}"),
+            Ok(text) => {
+                if let Err(stop) = out::stdout_line(&text) {
+                    return stop.exit(worst);
+                }
+            }
             Err(e) => {
-                eprintln!("error: cannot write JSON: {e}");
+                errln!("error: cannot write JSON: {e}");
                 return 2;
             }
         },
         // A clean check says so: silence would leave an author unsure anything was read.
-        Format::Human => eprintln!("{}", summary(args.files.len(), errors, warnings)),
+        Format::Human => errln!("{}", counts.summary()),
     }
     worst
 }
 
-fn summary(files: usize, errors: usize, warnings: usize) -> String {
-    let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
-    match (errors, warnings) {
-        (0, 0) => format!(
-            "check passed: {}, no errors or warnings",
-            plural(files, "file")
-        ),
-        (0, w) => format!("check passed with {}", plural(w, "warning")),
-        (e, 0) => format!("check failed: {}", plural(e, "error")),
-        (e, w) => format!(
-            "check failed: {}, {}",
-            plural(e, "error"),
-            plural(w, "warning")
-        ),
+/// What a check found, for its last line.
+#[derive(Default)]
+struct Counts {
+    files: usize,
+    /// Files that could not be read: the check cannot have passed.
+    unreadable: usize,
+    errors: usize,
+    warnings: usize,
+}
+
+impl Counts {
+    fn summary(&self) -> String {
+        let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+        let mut problems = Vec::new();
+        if self.unreadable > 0 {
+            problems.push(format!(
+                "{} of {} could not be read",
+                self.unreadable,
+                plural(self.files, "file")
+            ));
+        }
+        if self.errors > 0 {
+            problems.push(plural(self.errors, "error"));
+        }
+        match (problems.is_empty(), self.warnings) {
+            (true, 0) => format!(
+                "check passed: {}, no errors or warnings",
+                plural(self.files, "file")
+            ),
+            (true, w) => format!("check passed with {}", plural(w, "warning")),
+            (false, 0) => format!("check failed: {}", problems.join(", ")),
+            (false, w) => format!(
+                "check failed: {}, {}",
+                problems.join(", "),
+                plural(w, "warning")
+            ),
+        }
     }
 }
 
 pub fn build(args: BuildArgs) -> u8 {
     let bytes = match read(&args.file) {
         Ok(b) => b,
-        Err(msg) => {
-            eprintln!("{msg}");
+        Err(unreadable) => {
+            errln!("{}", unreadable.human());
             return 2;
         }
     };
@@ -133,7 +227,13 @@ pub fn build(args: BuildArgs) -> u8 {
         Ok(c) => c,
         Err(diags) => {
             print_human(&diags, &bytes, &path);
-            eprintln!("{}", summary(1, diags.error_count(), diags.warning_count()));
+            let counts = Counts {
+                files: 1,
+                errors: diags.error_count(),
+                warnings: diags.warning_count(),
+                ..Counts::default()
+            };
+            errln!("{}", counts.summary());
             return 1;
         }
     };
@@ -141,18 +241,9 @@ pub fn build(args: BuildArgs) -> u8 {
     let text = match serde_json::to_string_pretty(&compiled.grammar) {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("error: cannot serialise the grammar: {e}");
+            errln!("error: cannot serialise the grammar: {e}");
             return 2;
         }
     };
-    if args.output.as_os_str() == "-" {
-        let mut out = std::io::stdout().lock();
-        if writeln!(out, "{text}").is_err() {
-            return 2;
-        }
-    } else if let Err(e) = std::fs::write(&args.output, text + "\n") {
-        eprintln!("error: cannot write `{}`: {e}", args.output.display());
-        return 2;
-    }
-    0
+    out::write_output(&args.output, (text + "\n").as_bytes())
 }

@@ -5,6 +5,8 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
+use crate::out;
+
 #[derive(clap::Args)]
 pub struct FmtArgs {
     /// Grammar files to format (`-` reads standard input).
@@ -56,18 +58,17 @@ fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
 
 pub fn fmt(args: FmtArgs) -> u8 {
     let mut worst = 0u8;
-    let mut out = std::io::stdout().lock();
     for file in &args.files {
         let path = file.display().to_string();
         if args.write && file.as_os_str() == "-" {
-            eprintln!("error: --write needs files, not standard input");
+            errln!("error: --write needs files, not standard input");
             worst = 2;
             continue;
         }
         let bytes = match read(file) {
             Ok(b) => b,
             Err(e) => {
-                eprintln!("error: cannot read `{path}`: {e}");
+                errln!("error: cannot read `{path}`: {e}");
                 worst = 2;
                 continue;
             }
@@ -83,8 +84,8 @@ pub fn fmt(args: FmtArgs) -> u8 {
         let formatted = match formatted {
             Ok(f) => f,
             Err(diags) => {
-                eprint!("{}", clay_dsl::render(&diags, &source, &path, false));
-                eprintln!("error: `{path}` was not formatted: it does not parse");
+                err!("{}", clay_dsl::render(&diags, &source, &path, false));
+                errln!("error: `{path}` was not formatted: it does not parse");
                 worst = worst.max(1);
                 continue;
             }
@@ -92,16 +93,18 @@ pub fn fmt(args: FmtArgs) -> u8 {
         let changed = formatted.as_bytes() != bytes.as_slice();
         if args.check {
             if changed {
-                let _ = writeln!(out, "{path}");
                 worst = worst.max(1);
+                if let Err(stop) = out::stdout_line(&path) {
+                    return stop.exit(worst);
+                }
             }
         } else if args.write {
             if changed && let Err(e) = write_atomically(file, &formatted) {
-                eprintln!("error: cannot write `{path}`: {e}");
+                errln!("error: cannot write `{path}`: {e}");
                 worst = 2;
             }
-        } else if out.write_all(formatted.as_bytes()).is_err() {
-            return 2;
+        } else if let Err(stop) = out::stdout(formatted.as_bytes()) {
+            return stop.exit(worst);
         }
     }
     worst

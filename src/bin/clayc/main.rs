@@ -1,10 +1,14 @@
 //! `clayc`: the command-line edge of Clay. Each subcommand lives in its own module; this file
 //! only parses arguments and maps results to exit codes (0 ok, 1 the input has errors, 2 usage
-//! or I/O errors).
+//! or I/O errors). Output goes through [`out`], so a closed pipe never panics.
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+// First: its `errln!` / `err!` macros are used by the modules below.
+#[macro_use]
+mod out;
 
 mod author;
 mod bench;

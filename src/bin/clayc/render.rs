@@ -1,9 +1,11 @@
 //! `clayc render` and `clayc sheet`: load a grammar, draw its assembly (or every piece and rest
-//! state) with the renderer, and write a PNG or SVG file.
+//! state) with the renderer, and write a PNG or SVG file (`-o -`: standard output).
 
 use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
+
+use crate::out;
 
 use clay::assembly::{Assembly, HandleKind};
 use clay::render::{Overlays, RenderOptions, render_png, render_svg, sheet_png, sheet_svg};
@@ -31,7 +33,8 @@ pub enum OverlayKind {
 pub struct RenderArgs {
     /// A grammar (.clay) or a compiled grammar (.json from `clayc build`).
     pub file: PathBuf,
-    /// The picture to write (.png, or .svg for SVG).
+    /// The picture to write (.png, or .svg for SVG; `-` writes PNG, or SVG with --svg, to
+    /// standard output).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Replay this sculpting script first and render the assembly it ends with.
@@ -52,7 +55,8 @@ pub struct RenderArgs {
 pub struct SheetArgs {
     /// A grammar (.clay) or a compiled grammar (.json from `clayc build`).
     pub file: PathBuf,
-    /// The picture to write (.png, or .svg for SVG).
+    /// The picture to write (.png, or .svg for SVG; `-` writes PNG, or SVG with --svg, to
+    /// standard output).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Write SVG whatever the output's extension.
@@ -83,12 +87,12 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 /// Exit codes: 1 the input has errors, 2 usage or I/O.
 const INPUT_ERROR: u8 = 1;
-const IO_ERROR: u8 = 2;
+use crate::out::IO_ERROR;
 
 /// Loads and compiles a grammar; on failure prints why and gives the exit code.
 fn load(path: &Path) -> Result<CompiledGrammar, u8> {
     let source = std::fs::read_to_string(path).map_err(|e| {
-        eprintln!("error: cannot read {}: {e}", path.display());
+        errln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
     })?;
     if path
@@ -96,7 +100,7 @@ fn load(path: &Path) -> Result<CompiledGrammar, u8> {
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     {
         return serde_json::from_str(&source).map_err(|e| {
-            eprintln!("error: {} is not a compiled grammar: {e}", path.display());
+            errln!("error: {} is not a compiled grammar: {e}", path.display());
             INPUT_ERROR
         });
     }
@@ -110,14 +114,14 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
         && std::env::var_os("NO_COLOR").is_none();
     match clay_dsl::compile(source, &name) {
         Ok(compiled) => {
-            eprint!(
+            err!(
                 "{}",
                 clay_dsl::render(&compiled.warnings, source, &name, color)
             );
             Ok(compiled.grammar)
         }
         Err(diagnostics) => {
-            eprint!("{}", clay_dsl::render(&diagnostics, source, &name, color));
+            err!("{}", clay_dsl::render(&diagnostics, source, &name, color));
             Err(INPUT_ERROR)
         }
     }
@@ -131,17 +135,17 @@ fn replay(
     path: &Path,
 ) -> Result<(AssemblyData, Vec<usize>, Vec<usize>), u8> {
     let text = std::fs::read_to_string(path).map_err(|e| {
-        eprintln!("error: cannot read {}: {e}", path.display());
+        errln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
     })?;
     let script = Script::parse(&text).map_err(|e| {
-        eprintln!("error: {}: {e}", path.display());
+        errln!("{}", crate::run::script_error(path, &e));
         INPUT_ERROR
     })?;
     let config = SolverConfig::from_params(&grammar.solver);
     let mut assembly = Assembly::new(Arc::new(grammar));
     if let Err(e) = clay::script::replay(&mut assembly, &script, &config, &mut Rules::new()) {
-        eprintln!("error: {}: {e}", path.display());
+        errln!("error: {}: {e}", path.display());
         return Err(INPUT_ERROR);
     }
     let vertices = |kind: HandleKind| -> Vec<usize> {
@@ -160,16 +164,6 @@ fn wants_svg(output: &Path, flag: bool) -> bool {
     flag || output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
-}
-
-fn write(output: &Path, bytes: &[u8]) -> u8 {
-    match std::fs::write(output, bytes) {
-        Ok(()) => 0,
-        Err(e) => {
-            eprintln!("error: cannot write {}: {e}", output.display());
-            IO_ERROR
-        }
-    }
 }
 
 pub fn render(args: RenderArgs) -> u8 {
@@ -208,15 +202,15 @@ pub fn render(args: RenderArgs) -> u8 {
         ..RenderOptions::default()
     };
     if wants_svg(&args.output, args.svg) {
-        return write(
+        return out::write_output(
             &args.output,
             render_svg(&grammar, &assembly, &options).as_bytes(),
         );
     }
     match render_png(&grammar, &assembly, &options) {
-        Ok(png) => write(&args.output, &png),
+        Ok(png) => out::write_output(&args.output, &png),
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             IO_ERROR
         }
     }
@@ -228,12 +222,12 @@ pub fn sheet(args: SheetArgs) -> u8 {
         Err(code) => return code,
     };
     if wants_svg(&args.output, args.svg) {
-        return write(&args.output, sheet_svg(&grammar).as_bytes());
+        return out::write_output(&args.output, sheet_svg(&grammar).as_bytes());
     }
     match sheet_png(&grammar) {
-        Ok(png) => write(&args.output, &png),
+        Ok(png) => out::write_output(&args.output, &png),
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             IO_ERROR
         }
     }

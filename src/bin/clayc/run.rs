@@ -1,12 +1,13 @@
 //! `clayc run FILE [--script SCRIPT.json] [--json] [--set NAME=VALUE]...`: compiles a grammar,
 //! replays a scripted sculpting session headlessly and prints its summary.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::out;
 use clay::assembly::Assembly;
 use clay::rules::Rules;
-use clay::script::{Script, replay};
+use clay::script::{Script, ScriptError, replay};
 use clay::solver::{Pass1, SolverConfig, SolverKind};
 
 #[derive(clap::Args)]
@@ -24,6 +25,18 @@ pub struct RunArgs {
     /// solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+}
+
+/// The message for a malformed script: `error: FILE:LINE:COLUMN: step N: ...` and its hint.
+pub fn script_error(path: &Path, e: &ScriptError) -> String {
+    let at = match e.position {
+        Some((line, column)) => format!("{}:{line}:{column}", path.display()),
+        None => path.display().to_string(),
+    };
+    match &e.hint {
+        Some(hint) => format!("error: {at}: {e}\n  = help: {hint}"),
+        None => format!("error: {at}: {e}"),
+    }
 }
 
 /// Applies one `NAME=VALUE` override, checking the name and the range.
@@ -109,7 +122,7 @@ pub fn run(args: RunArgs) -> u8 {
     let source = match std::fs::read(&args.file) {
         Ok(bytes) => bytes,
         Err(e) => {
-            eprintln!("error: cannot read {path}: {e}");
+            errln!("error: cannot read {path}: {e}");
             return 2;
         }
     };
@@ -117,13 +130,13 @@ pub fn run(args: RunArgs) -> u8 {
         None => Script::default(),
         Some(p) => match std::fs::read_to_string(p) {
             Err(e) => {
-                eprintln!("error: cannot read script {}: {e}", p.display());
+                errln!("error: cannot read script {}: {e}", p.display());
                 return 2;
             }
             Ok(text) => match Script::parse(&text) {
                 Ok(s) => s,
                 Err(e) => {
-                    eprintln!("error: {}: {e}", p.display());
+                    errln!("{}", script_error(p, &e));
                     return 1;
                 }
             },
@@ -133,12 +146,12 @@ pub fn run(args: RunArgs) -> u8 {
     let compiled = match clay_dsl::compile_bytes(&source, &path) {
         Ok(c) => c,
         Err(diagnostics) => {
-            eprint!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
+            err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
             return 1;
         }
     };
     if !compiled.warnings.items.is_empty() {
-        eprint!(
+        err!(
             "{}",
             clay_dsl::render(&compiled.warnings, &text, &path, false)
         );
@@ -148,7 +161,7 @@ pub fn run(args: RunArgs) -> u8 {
     let mut merge_distance = grammar.solver.merge_distance;
     for s in &args.set {
         if let Err(e) = apply_setting(&mut config, &mut merge_distance, s) {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return 2;
         }
     }
@@ -158,7 +171,7 @@ pub fn run(args: RunArgs) -> u8 {
     grammar.solver.merge_distance = merge_distance;
     let mut assembly = Assembly::new(Arc::new(grammar));
     if let Err(problems) = assembly.validate() {
-        eprintln!(
+        errln!(
             "error: the compiled assembly is inconsistent:\n  {}",
             problems.join("\n  ")
         );
@@ -168,23 +181,25 @@ pub fn run(args: RunArgs) -> u8 {
     let (summary, session) = match replay(&mut assembly, &script, &config, &mut rules) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return 1;
         }
     };
     for note in session.notes.iter().chain(&rules.notes) {
-        eprintln!("note: {note}");
+        errln!("note: {note}");
     }
-    if args.json {
+    let text = if args.json {
         match serde_json::to_string_pretty(&summary) {
-            Ok(s) => println!("{s}"),
+            Ok(s) => s + "\n",
             Err(e) => {
-                eprintln!("error: cannot write the summary: {e}");
+                errln!("error: cannot write the summary: {e}");
                 return 2;
             }
         }
     } else {
-        print!("{}", summary.human());
-    }
-    0
+        summary.human()
+    };
+    out::stdout(text.as_bytes())
+        .err()
+        .map_or(0, |stop| stop.exit(0))
 }
