@@ -113,6 +113,24 @@ impl clay::render::Canvas for PainterCanvas {
         self.painter.add(Shape::mesh(mesh));
     }
 
+    /// The renderer fills big meshes by their outlines; overlays never do. The contours are
+    /// triangulated as an outline with holes (the case the renderer produces) and filled.
+    fn fill_contours(&mut self, contours: &[Vec<[f32; 2]>], c: Rgba) {
+        let ring = |r: &Vec<[f32; 2]>| -> Vec<glam::DVec2> {
+            r.iter()
+                .map(|p| glam::DVec2::new(p[0] as f64, p[1] as f64))
+                .collect()
+        };
+        let Some((outer, holes)) = contours.split_first() else {
+            return;
+        };
+        let holes: Vec<_> = holes.iter().map(ring).collect();
+        if let Some((points, triangles)) = clay::render::tessellate_polygon(&ring(outer), &holes) {
+            let points: Vec<[f32; 2]> = points.iter().map(|p| [p.x as f32, p.y as f32]).collect();
+            self.fill_triangles(&points, &triangles, c);
+        }
+    }
+
     fn stroke_segments(&mut self, segments: &[[[f32; 2]; 2]], width: f32, c: Rgba) {
         let stroke = Stroke::new(width, colour(c));
         for [a, b] in segments {
