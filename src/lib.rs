@@ -1,6 +1,7 @@
 //! Clay: live assemblies, the mutable elastic solver, rules and rendering.
 pub mod assembly;
 pub mod authoring;
+pub mod files;
 pub mod fit;
 pub mod gallery;
 pub mod plane;

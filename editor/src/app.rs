@@ -1250,13 +1250,14 @@ impl EditorApp {
         };
         let png = clay::render::render_png(self.sculpt.grammar(), self.sculpt.data(), &options)
             .map_err(|e| e.to_string())?;
-        session::write_atomic(path, &png).map_err(|e| format!("{}: {e}", path.display()))
+        clay::files::write_atomic(path, &png).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Writes the deformed assembly as JSON (the contract's `AssemblyData`).
     pub fn export_json(&self, path: &Path) -> Result<(), String> {
         let text = serde_json::to_string_pretty(self.sculpt.data()).map_err(|e| e.to_string())?;
-        session::write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+        clay::files::write_atomic(path, text.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Whether a confirmation is waiting.

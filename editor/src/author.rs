@@ -13,7 +13,6 @@ use clay::authoring::{self, Design, Drawing, Polyline, StretchChoice};
 use glam::DVec2;
 
 use crate::compile::{self, Problem};
-use crate::session;
 
 /// Name the authored grammar is compiled under before it has been written to a file.
 pub const UNSAVED_NAME: &str = "authored.clay";
@@ -1390,7 +1389,7 @@ impl Authoring {
             Ok(c) => c.text.clone(),
             Err(e) => return Err(format!("no grammar to write: {e}")),
         };
-        session::write_atomic(path, text.as_bytes())
+        clay::files::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))?;
         self.written = Some((path.to_path_buf(), text));
         self.recompute();

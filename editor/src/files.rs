@@ -7,8 +7,6 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 
 use serde::{Deserialize, Serialize};
 
-use crate::session;
-
 /// Most recent files remembered.
 pub const RECENT_LIMIT: usize = 10;
 
@@ -193,7 +191,7 @@ impl Recent {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         let text = serde_json::to_string_pretty(self).map_err(|e| e.to_string())?;
-        session::write_atomic(store, text.as_bytes())
+        clay::files::write_atomic(store, text.as_bytes())
             .map_err(|e| format!("{}: {e}", store.display()))
     }
 }

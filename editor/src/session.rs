@@ -3,7 +3,7 @@
 
 use std::fmt;
 use std::fs;
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 use clay_dsl::compiled::AssemblyData;
@@ -148,43 +148,8 @@ pub fn read(path: &Path) -> Result<Session, SessionError> {
 pub fn write(path: &Path, session: &Session) -> Result<(), SessionError> {
     let text = serde_json::to_string_pretty(session)
         .map_err(|e| SessionError::Malformed(format!("cannot encode the session: {e}")))?;
-    write_atomic(path, text.as_bytes()).map_err(|error| SessionError::Io {
+    clay::files::write_atomic(path, text.as_bytes()).map_err(|error| SessionError::Io {
         path: path.to_path_buf(),
         error,
     })
-}
-
-/// Writes `bytes` to `path` so that readers see the old file or the new one, never a torn one:
-/// a temporary file in the same folder (so the rename stays on one file system), flushed to
-/// disk, then renamed over the target. On failure the target is untouched and the temporary
-/// file removed.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut file = fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)?;
-        // Make the rename itself durable; not every platform lets a folder be opened.
-        if let Ok(d) = fs::File::open(&dir) {
-            let _ = d.sync_all();
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
 }

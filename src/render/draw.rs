@@ -209,9 +209,12 @@ pub fn edge_strains(
             else {
                 continue;
             };
-            let rest = ra.distance(*rb);
-            let strain = (pa.distance(*pb) / rest - 1.0).abs();
-            if !(rest > 1e-12 && strain.is_finite()) {
+            let Some(strain) = crate::solver::edge_strain(ra.distance(*rb), pa.distance(*pb))
+            else {
+                continue;
+            };
+            let strain = strain.abs();
+            if !strain.is_finite() {
                 continue;
             }
             let key = (a.min(b), a.max(b));

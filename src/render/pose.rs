@@ -67,11 +67,11 @@ impl Skin {
 
 /// The centroid of a site's vertices; `None` when the site is empty or out of range.
 fn centroid(positions: &[DVec2], site: &[usize]) -> Option<DVec2> {
-    let mut sum = DVec2::ZERO;
-    for &v in site {
-        sum += *positions.get(v)?;
-    }
-    (!site.is_empty()).then(|| sum / site.len() as f64)
+    let points = site
+        .iter()
+        .map(|&v| positions.get(v).copied())
+        .collect::<Option<Vec<DVec2>>>()?;
+    crate::plane::centroid(points)
 }
 
 /// One axis site at rest: its vertices, centroid, unit tangent (first to last vertex; `None`

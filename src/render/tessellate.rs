@@ -335,21 +335,12 @@ pub fn shown_geometry(
     Some((&rest.geometry, frame))
 }
 
-/// Signed area of a closed ring (positive when counter-clockwise).
-pub fn shoelace_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
-    (0..n)
-        .map(|i| ring[i].perp_dot(ring[(i + 1) % n]))
-        .sum::<f64>()
-        / 2.0
-}
-
 fn triangle_area(p: [DVec2; 3]) -> f64 {
     signed_area(p).abs()
 }
 
 fn signed_area(p: [DVec2; 3]) -> f64 {
-    (p[1] - p[0]).perp_dot(p[2] - p[0]) / 2.0
+    crate::plane::triangle_area(p[0], p[1], p[2])
 }
 
 fn scale_of(p: [DVec2; 3]) -> f64 {
@@ -376,7 +367,8 @@ fn clean_ring(ring: &[DVec2]) -> Option<Vec<DVec2>> {
     while out.len() > 1 && out.first() == out.last() {
         out.pop();
     }
-    (out.len() >= 3 && shoelace_area(&out).abs() > MIN_RING_AREA).then_some(out)
+    (out.len() >= 3 && crate::plane::polygon_area(out.iter().copied()).abs() > MIN_RING_AREA)
+        .then_some(out)
 }
 
 /// Even-odd rule over all rings: inside the outer ring and outside every hole.

@@ -48,6 +48,14 @@ pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
     energy
 }
 
+/// The strain of an edge: `length / rest - 1` (positive stretched, negative squeezed); `None`
+/// for an edge of (near) zero rest length. The one definition the summaries, the claims suite
+/// and the renderer's strain overlay share (a non-finite length gives a non-finite strain,
+/// which summaries report and pictures skip).
+pub fn edge_strain(rest: f64, length: f64) -> Option<f64> {
+    (rest > 1e-12).then(|| length / rest - 1.0)
+}
+
 /// Largest `|length / rest length - 1|` over the edges of every part's active state (edges
 /// of zero rest length are skipped).
 pub fn max_edge_strain(asm: &Assembly) -> f64 {
@@ -68,10 +76,8 @@ pub fn edge_strains(asm: &Assembly) -> Vec<f64> {
         };
         for e in &part.edges {
             let rest_len = (rest.positions[e[0]] - rest.positions[e[1]]).length();
-            if rest_len > 1e-12 {
-                let len = (f[part.vertices[e[0]]] - f[part.vertices[e[1]]]).length();
-                out.push(len / rest_len - 1.0);
-            }
+            let len = (f[part.vertices[e[0]]] - f[part.vertices[e[1]]]).length();
+            out.extend(edge_strain(rest_len, len));
         }
     }
     out

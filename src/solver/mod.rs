@@ -16,7 +16,9 @@ mod report;
 
 use config::cone_cosine;
 pub use config::{Pass1, SolverConfig, SolverKind};
-pub use measure::{bbox, bbox_diagonal, edge_strains, elastic_energy, max_edge_strain};
+pub use measure::{
+    bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
+};
 pub use report::{FrameReport, PhaseTimes, SolverError, StateSwitch};
 
 use std::time::{Duration, Instant};

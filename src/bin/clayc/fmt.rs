@@ -2,7 +2,7 @@
 //! `--write` rewrites them in place (temp file, then rename), or with `--check` lists the files
 //! that would change. Exit codes: 0 fine, 1 a file would change or does not parse, 2 I/O.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::out;
@@ -28,32 +28,6 @@ fn read(path: &Path) -> std::io::Result<Vec<u8>> {
     } else {
         std::fs::read(path)
     }
-}
-
-/// Writes `text` next to `path` and renames it over `path`, so a crash never leaves half a file.
-fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.clayfmt-{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.sync_all()?;
-        if let Ok(meta) = std::fs::metadata(path) {
-            std::fs::set_permissions(&tmp, meta.permissions())?;
-        }
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 pub fn fmt(args: FmtArgs) -> u8 {
@@ -99,7 +73,7 @@ pub fn fmt(args: FmtArgs) -> u8 {
                 }
             }
         } else if args.write {
-            if changed && let Err(e) = write_atomically(file, &formatted) {
+            if changed && let Err(e) = clay::files::write_atomic(file, formatted.as_bytes()) {
                 errln!("error: cannot write `{path}`: {e}");
                 worst = 2;
             }
