@@ -10,8 +10,8 @@ use clay_dsl::compiled::CompiledGrammar;
 
 use crate::assembly::Assembly;
 use crate::render::{Overlays, RenderOptions, render_png, sheet_png};
-use crate::rules::Rules;
-use crate::script::{Script, replay};
+use crate::script::Script;
+use crate::session::{Session, replay};
 use crate::solver::SolverConfig;
 
 /// One picture: its file name in `docs/pictures/` and its PNG bytes.
@@ -54,7 +54,7 @@ pub fn pictures(
     if let Some(script) = script {
         let config = SolverConfig::from_params(&grammar.solver);
         let mut assembly = Assembly::new(Arc::new(grammar.clone()));
-        replay(&mut assembly, script, &config, &mut Rules::new()).map_err(|e| e.to_string())?;
+        replay(&mut assembly, script, &mut Session::new(config)).map_err(|e| e.to_string())?;
         out.push(Picture {
             file: format!("{name}-after.png"),
             png: render_png(grammar, &assembly.data, &options).map_err(|e| e.to_string())?,

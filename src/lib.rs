@@ -8,6 +8,7 @@ pub mod plane;
 pub mod render;
 pub mod rules;
 pub mod script;
+pub mod session;
 pub mod solver;
 pub mod summary;
 pub mod synthetic;

@@ -9,8 +9,8 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use clay::assembly::Assembly;
-use clay::rules::{RuleKind, Rules};
-use clay::script::{Replay, Script};
+use clay::rules::RuleKind;
+use clay::script::Script;
 use clay::solver::follow::Components;
 use clay::solver::{Pass1, SolverConfig, bbox, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
@@ -20,8 +20,7 @@ use glam::DVec2;
 struct Session {
     grammar: CompiledGrammar,
     asm: Assembly,
-    replay: Replay,
-    rules: Rules,
+    replay: clay::session::Session,
     steps: usize,
 }
 
@@ -40,8 +39,7 @@ impl Session {
         Self {
             asm: Assembly::new(Arc::new(g.clone())),
             grammar: g,
-            replay: Replay::new(config),
-            rules: Rules::new(),
+            replay: clay::session::Session::new(config),
             steps: 0,
         }
     }
@@ -50,9 +48,7 @@ impl Session {
     fn run(&mut self, steps: &str) -> &mut Self {
         let script = Script::parse(&format!(r#"{{"steps": [{steps}]}}"#)).unwrap();
         for s in &script.steps {
-            self.replay
-                .step(&mut self.asm, self.steps, s, &mut self.rules)
-                .unwrap();
+            self.replay.step(&mut self.asm, self.steps, s).unwrap();
             self.steps += 1;
         }
         self
@@ -83,11 +79,11 @@ impl Session {
     }
 
     fn fired(&self, kind: RuleKind) -> usize {
-        self.replay.rules_fired.get(&kind).copied().unwrap_or(0)
+        self.replay.rules_fired().get(&kind).copied().unwrap_or(0)
     }
 
     fn events(&self) -> usize {
-        self.replay.rules_fired.values().sum()
+        self.replay.rules_fired().values().sum()
     }
 
     fn strain(&self) -> f64 {
@@ -113,7 +109,7 @@ impl Session {
     fn figures(&self) -> String {
         let fired: BTreeMap<&str, usize> = self
             .replay
-            .rules_fired
+            .rules_fired()
             .iter()
             .map(|(k, &n)| (k.name(), n))
             .collect();
@@ -328,7 +324,7 @@ const GRAMMARS: [&str; 6] = ["wall", "bend", "castle", "streets", "centipede", "
 /// components stay where they are.
 fn grab_north(s: &mut Session, motion: impl Fn(DVec2, DVec2) -> DVec2) -> [f64; 4] {
     s.run(r#"{"grab": {"extreme": "north"}}"#);
-    let handle = s.asm.handle(s.replay.current.unwrap()).unwrap();
+    let handle = s.asm.handle(s.replay.grabbed().unwrap()).unwrap();
     let (centre, held) = (handle.target_centre(), handle.vertices[0]);
     let n = s.asm.data.positions.len();
     let components = Components::build(&s.asm.data.parts, n);

@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use clay::assembly::Assembly;
-use clay::rules::{RuleKind, Rules, cut};
-use clay::script::{Replay, Script};
+use clay::rules::{RuleKind, cut};
+use clay::script::Script;
 use clay::solver::SolverConfig;
 
 struct Outcome {
@@ -23,15 +23,14 @@ fn replay(name: &str) -> Outcome {
     let json = std::fs::read_to_string(format!("{dir}/grammars/{name}.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));
-    let mut session = Replay::new(SolverConfig::from_params(&g.solver));
-    let mut rules = Rules::new();
+    let mut session = clay::session::Session::new(SolverConfig::from_params(&g.solver));
     for (i, s) in script.steps.iter().enumerate() {
-        session.step(&mut asm, i, s, &mut rules).unwrap();
+        session.step(&mut asm, i, s).unwrap();
         asm.data.check(&g).unwrap();
         assert!(asm.validate().is_ok(), "{:?}", asm.validate());
     }
     let mut fired = BTreeMap::new();
-    for e in &rules.log {
+    for e in session.rule_log() {
         let k = match e.kind {
             RuleKind::Replace => "replace",
             RuleKind::Stretch => "stretch",
@@ -47,13 +46,13 @@ fn replay(name: &str) -> Outcome {
     }
     eprintln!(
         "{name}: fired {fired:?}, pieces {pieces:?}, notes {:?}",
-        rules.notes
+        session.notes()
     );
     Outcome {
         fired,
         pieces,
         components: cut::components(&asm.data),
-        notes: rules.notes,
+        notes: session.notes().to_vec(),
     }
 }
 

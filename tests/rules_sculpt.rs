@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use clay::assembly::{Assembly, Compass, HandleKind};
-use clay::rules::{Rules, cut};
-use clay::script::{Replay, Script};
+use clay::rules::cut;
+use clay::script::Script;
 use clay::solver::{SolverConfig, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 
@@ -24,8 +24,7 @@ fn grammar(name: &str) -> CompiledGrammar {
 /// A live session: the assembly, the replay (solver) and the rules.
 struct Session {
     asm: Assembly,
-    replay: Replay,
-    rules: Rules,
+    replay: clay::session::Session,
 }
 
 impl Session {
@@ -36,17 +35,14 @@ impl Session {
         }
         Self {
             asm: Assembly::new(Arc::new(g)),
-            replay: Replay::new(config),
-            rules: Rules::new(),
+            replay: clay::session::Session::new(config),
         }
     }
 
     fn run(&mut self, json: &str) {
         let script = Script::parse(json).unwrap();
         for (i, s) in script.steps.iter().enumerate() {
-            self.replay
-                .step(&mut self.asm, i, s, &mut self.rules)
-                .unwrap();
+            self.replay.step(&mut self.asm, i, s).unwrap();
             self.asm.data.check(self.asm.grammar()).unwrap();
         }
     }
@@ -62,7 +58,11 @@ impl Session {
     }
 
     fn fired(&self, kind: clay::rules::RuleKind) -> usize {
-        self.rules.log.iter().filter(|e| e.kind == kind).count()
+        self.replay
+            .rule_log()
+            .iter()
+            .filter(|e| e.kind == kind)
+            .count()
     }
 }
 
@@ -118,8 +118,8 @@ fn stretch_wall(n: usize, fraction: f64, frames: u64, norm: Option<f64>) -> (usi
         r#"{{"steps": [{PIN_WEST_GRAB_EAST}, {{"drag": {{"by": [{by}, 0], "frames": {frames}}}}}, {{"hold": {{"frames": 30}}}}]}}"#
     ));
     let first = s
-        .rules
-        .log
+        .replay
+        .rule_log()
         .iter()
         .find(|e| e.kind == clay::rules::RuleKind::Stretch)
         .map(|e| e.frame);
@@ -268,7 +268,9 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
     let k = stretch_part(&s.asm, 0);
     s.asm.data.parts[k].active = clay::rules::stretch::THREE;
     let events = s
-        .rules
+        .replay
+        .rules_mut()
+        .unwrap()
         .after_frame(&mut s.asm, &clay::solver::FrameReport::default());
     assert!(
         events
@@ -308,7 +310,9 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
     let k = stretch_part(&s.asm, n - 2);
     s.asm.data.parts[k].active = clay::rules::stretch::ONE;
     let events = s
-        .rules
+        .replay
+        .rules_mut()
+        .unwrap()
         .after_frame(&mut s.asm, &clay::solver::FrameReport::default());
     let shrink = events
         .iter()
@@ -395,7 +399,7 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
         s.fired(clay::rules::RuleKind::Cut),
         1,
         "{:?}",
-        s.rules.notes
+        s.replay.notes()
     );
     assert_eq!(s.count("tee"), 0);
     assert_eq!(cut::components(&s.asm.data), 2);
@@ -440,8 +444,8 @@ fn the_generation_changes_only_when_a_rule_rewrites_the_structure() {
     assert_eq!(s.asm.generation(), 0, "holding still rewrote something");
     s.run(r#"{"steps": [{"drag": {"by": [3, 0], "frames": 60}}, {"hold": {"frames": 10}}]}"#);
     let structural = s
-        .rules
-        .log
+        .replay
+        .rule_log()
         .iter()
         .filter(|e| e.kind != clay::rules::RuleKind::Replace)
         .count();

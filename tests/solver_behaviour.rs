@@ -5,7 +5,8 @@
 use std::sync::Arc;
 
 use clay::assembly::{Assembly, Compass, HandleKind};
-use clay::script::{NoRules, Script, replay};
+use clay::script::Script;
+use clay::session::{Session, replay};
 use clay::solver::{Pass1, Solver, SolverConfig, SolverKind};
 use clay::synthetic;
 use glam::DVec2;
@@ -53,7 +54,7 @@ fn dragging_one_part_with_nothing_pinned_moves_the_model_rigidly() {
 }
 
 /// Pins the west end of bend.clay and carries the east end round a left turn.
-fn bend_session(frames: u64) -> (Assembly, clay::script::Replay) {
+fn bend_session(frames: u64) -> (Assembly, Session) {
     let mut asm = assembly(grammar("bend.clay"));
     let config = SolverConfig::from_params(&asm.grammar().solver);
     // the end is carried round the turn: each frame turns it a little and moves it a little
@@ -75,7 +76,8 @@ fn bend_session(frames: u64) -> (Assembly, clay::script::Replay) {
     }
     steps.push(r#"{"hold": {"frames": 10}}"#.to_string());
     let script = Script::parse(&format!(r#"{{"steps": [{}]}}"#, steps.join(", "))).unwrap();
-    let (summary, session) = replay(&mut asm, &script, &config, &mut NoRules).unwrap();
+    let mut session = Session::without_rules(config);
+    let summary = replay(&mut asm, &script, &mut session).unwrap();
     assert!(summary.finite);
     (asm, session)
 }
@@ -95,7 +97,7 @@ fn a_street_bent_round_a_pinned_end_switches_segments_to_turns() {
         "{names:?}"
     );
     assert!(names.contains(&"left"), "no segment turned left: {names:?}");
-    assert!(session.rules_fired[&clay::rules::RuleKind::Replace] >= 1);
+    assert!(session.rules_fired()[&clay::rules::RuleKind::Replace] >= 1);
     // the turned street is not torn: every edge is within 35% of its rest length
     assert!(
         clay::solver::max_edge_strain(&asm) < 0.35,
@@ -165,7 +167,7 @@ fn top_tenth_share(asm: &mut Assembly, norm: f64) -> f64 {
         0.15 * length
     ))
     .unwrap();
-    let (summary, _) = replay(asm, &script, &config, &mut NoRules).unwrap();
+    let summary = replay(asm, &script, &mut Session::without_rules(config)).unwrap();
     assert!(summary.finite);
     let mut s: Vec<f64> = brick_stretch(asm).into_iter().map(|x| x.max(0.0)).collect();
     let total: f64 = s.iter().sum();
@@ -210,7 +212,7 @@ fn cg_and_cholesky_agree_within_the_cg_tolerance() {
                     {"drag": {"by": [0.5, 0.8], "frames": 3}}]}"#,
             )
             .unwrap();
-            replay(&mut asm, &script, &config, &mut NoRules).unwrap();
+            replay(&mut asm, &script, &mut Session::without_rules(config)).unwrap();
             positions.push(asm.data.positions.clone());
         }
         let size = clay::solver::bbox_diagonal(&positions[0]);

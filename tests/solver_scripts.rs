@@ -7,7 +7,8 @@ use std::process::Command;
 use std::sync::Arc;
 
 use clay::assembly::Assembly;
-use clay::script::{NoRules, Script, replay};
+use clay::script::Script;
+use clay::session::{Session, replay};
 use clay::solver::SolverConfig;
 use clay::synthetic;
 use serde_json::Value;
@@ -106,16 +107,16 @@ fn grabbing_on_an_empty_model_does_nothing_and_stays_finite() {
         r#"{"steps": [{"grab": {"at": [0, 0]}}, {"pin": {"extreme": "west"}}, {"drag": {"by": [1, 0], "frames": 3}}, {"rotate": {"degrees": 30, "frames": 2}}]}"#,
     )
     .unwrap();
-    let (summary, session) =
-        replay(&mut asm, &script, &SolverConfig::default(), &mut NoRules).unwrap();
+    let mut session = Session::without_rules(SolverConfig::default());
+    let summary = replay(&mut asm, &script, &mut session).unwrap();
     assert!(summary.finite);
     assert_eq!(summary.frames, 5);
     assert_eq!(summary.parts, 0);
     assert_eq!(summary.components, 0);
     assert!(
-        session.notes.iter().any(|n| n.starts_with("step 0")),
+        session.notes().iter().any(|n| n.starts_with("step 0")),
         "{:?}",
-        session.notes
+        session.notes()
     );
 }
 
@@ -244,9 +245,12 @@ fn figures_that_are_not_finite_are_flagged_and_never_null() {
     let grammar = Arc::new(synthetic::wall(4));
     let config = SolverConfig::default();
     let summarize = |asm: &Assembly| {
-        let (summary, _) =
-            replay(&mut asm.clone(), &Script::default(), &config, &mut NoRules).unwrap();
-        summary
+        replay(
+            &mut asm.clone(),
+            &Script::default(),
+            &mut Session::without_rules(config),
+        )
+        .unwrap()
     };
     // Huge but finite coordinates: lengths and the energy overflow, the extent does not.
     let mut huge = Assembly::new(grammar.clone());

@@ -6,9 +6,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use clay::assembly::{Assembly, HandleId, HandleKind};
-use clay::rules::{RuleKind, Rules, cut::CUT_REACH, site_centre};
-use clay::solver::local::align;
-use clay::solver::{FrameReport, Solver, SolverConfig, SolverError};
+use clay::session::Session;
+use clay::solver::{FrameReport, SolverConfig, SolverError};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
@@ -98,8 +97,8 @@ const UNDO_LIMIT: usize = 200;
 /// The live sculpt.
 pub struct Sculpt {
     assembly: Assembly,
-    solver: Solver,
-    rules: Rules,
+    /// The solver and the rules (what a frame is).
+    session: Session,
     settings: Settings,
     grab: Option<Grab>,
     undo: Vec<Snapshot>,
@@ -134,8 +133,7 @@ struct Job {
     model: Assembly,
     /// A copy of `model`, made when a rule rewrote it (the next frame starts from it).
     spare: Option<Assembly>,
-    solver: Solver,
-    rules: Rules,
+    session: Session,
     outcome: FrameOutcome,
 }
 
@@ -148,34 +146,11 @@ struct FrameOutcome {
     rewrote: bool,
 }
 
-/// The names of the instances a part covers: "`t1`", or "`wall[3]` and `wall[4]`".
-fn instance_names(assembly: &Assembly, part: usize) -> String {
-    let data = &assembly.data;
-    let name = |i: usize| data.instances.get(i).map_or("?", |x| x.name.as_str());
-    match data.parts.get(part).map(|p| p.kind) {
-        Some(PartKind::Piece { instance }) => format!("`{}`", name(instance)),
-        Some(PartKind::Stretch { chain, first }) => {
-            let at = |k: usize| {
-                data.chains
-                    .get(chain)
-                    .and_then(|c| c.instances.get(k))
-                    .map_or("?", |&i| name(i))
-            };
-            format!("`{}` and `{}`", at(first), at(first + 1))
-        }
-        None => "?".to_string(),
-    }
-}
-
-/// One solver frame within `budget`, then the rules (paper 5.1), on whichever thread.
-fn solve_frame(
-    assembly: &mut Assembly,
-    solver: &mut Solver,
-    rules: &mut Rules,
-    budget: Duration,
-) -> FrameOutcome {
-    let report = match solver.frame_budgeted(assembly, budget) {
-        Ok(report) => report,
+/// One sculpting frame within `budget` (the session's: a solver frame, then the rules), on
+/// whichever thread, with its log lines in the grammar's names.
+fn solve_frame(assembly: &mut Assembly, session: &mut Session, budget: Duration) -> FrameOutcome {
+    let frame = match session.frame_within(assembly, budget) {
+        Ok(frame) => frame,
         Err(e) => {
             return FrameOutcome {
                 report: Err(e),
@@ -184,68 +159,22 @@ fn solve_frame(
             };
         }
     };
-    // How much closer each switched piece part came to its new state, for the log; measured
-    // before the rules renumber the parts.
-    let mut closer = std::collections::HashMap::new();
-    let mut stretch_switches = Vec::new();
-    for s in &report.switches {
-        let Some(p) = assembly.data.parts.get(s.part) else {
-            continue;
-        };
-        let d = |i: usize| {
-            p.states.get(i).map_or(f64::NAN, |st| {
-                align(&st.positions, &p.vertices, &assembly.data.positions).distance
-            })
-        };
-        match p.kind {
-            PartKind::Piece { instance } => {
-                if let Some(x) = assembly.data.instances.get(instance) {
-                    let (from, to) = (d(s.from), d(s.to));
-                    closer.insert(x.id, 1.0 - to / from);
-                }
-            }
-            PartKind::Stretch { .. } => {
-                let name = |i: usize| p.states.get(i).map_or("?", |s| s.name.as_str()).to_string();
-                let covers = instance_names(assembly, s.part);
-                let at = assembly.part_centroid(s.part);
-                stretch_switches.push((
-                    format!(
-                        "{covers} now rest as `{}` (was `{}`)",
-                        name(s.to),
-                        name(s.from)
-                    ),
-                    Some(at),
-                ));
-            }
-        }
-    }
-    // Stretch, shrink, merge and replacement after every frame.
-    let events = rules.after_frame(assembly, &report);
-    rules.log.clear();
-    let rewrote = !events.is_empty();
-    let mut notes = Vec::new();
-    // A stretch part's switch is worth a line only when no insertion or removal followed.
-    if !events
+    // The editor keeps its own bounded log.
+    session.clear_rule_log();
+    // Any event, a replacement too, means the model may move on: not settled yet.
+    let rewrote = !frame.events.is_empty();
+    let notes = frame
+        .events
         .iter()
-        .any(|e| matches!(e.kind, RuleKind::Stretch | RuleKind::Shrink))
-    {
-        notes.extend(stretch_switches);
-    }
-    for e in events {
-        let mut line = format!("{} at ({:.1}, {:.1})", e.detail, e.at.x, e.at.y);
-        if e.kind == RuleKind::Replace
-            && let Some(c) = e.instances.first().and_then(|id| closer.get(id))
-            && c.is_finite()
-        {
-            line.push_str(&format!(
-                ", {:.0}% closer to its shape than before",
-                100.0 * c
-            ));
-        }
-        notes.push((line, Some(e.at)));
-    }
+        .map(|e| {
+            (
+                format!("{} at ({:.1}, {:.1})", e.detail, e.at.x, e.at.y),
+                Some(e.at),
+            )
+        })
+        .collect();
     FrameOutcome {
-        report: Ok(report),
+        report: Ok(frame.report),
         notes,
         rewrote,
     }
@@ -261,8 +190,7 @@ impl Sculpt {
         };
         let assembly = Assembly::new(grammar);
         let mut sculpt = Self {
-            solver: Solver::new(SolverConfig::default()),
-            rules: Rules::new(),
+            session: Session::new(SolverConfig::default()),
             assembly,
             settings,
             grab: None,
@@ -455,12 +383,7 @@ impl Sculpt {
     /// The pin holding `instance`, found by the instance's stable id (its vertices change when
     /// rules rewrite the chain around it).
     fn pin_of(&self, instance: usize) -> Option<HandleId> {
-        let id = self.assembly.data.instances.get(instance)?.id;
-        self.assembly
-            .handles()
-            .iter()
-            .find(|h| h.kind == HandleKind::Pin && h.held.as_ref().is_some_and(|x| x.id == id))
-            .map(|h| h.id)
+        Session::pin_of(&self.assembly, instance)
     }
 
     /// Applies one command.
@@ -625,7 +548,7 @@ impl Sculpt {
             // finish in time stops early with a proper least-squares pose and continues on the
             // next call, so a large model never blocks the window.
             let left = budget.saturating_sub(start.elapsed());
-            let outcome = solve_frame(&mut self.assembly, &mut self.solver, &mut self.rules, left);
+            let outcome = solve_frame(&mut self.assembly, &mut self.session, left);
             self.integrate(outcome);
             if start.elapsed() >= budget {
                 break;
@@ -658,24 +581,22 @@ impl Sculpt {
                 }
                 None => self.assembly.clone(),
             };
-            let placeholder = Solver::new(self.solver.config);
-            let mut solver = std::mem::replace(&mut self.solver, placeholder);
-            let mut rules = std::mem::take(&mut self.rules);
+            let placeholder = Session::new(self.session.config());
+            let mut session = std::mem::replace(&mut self.session, placeholder);
             let stale = self.stale.take();
             self.moved_while_solving = false;
             self.job = Some(std::thread::spawn(move || {
                 // freeing a whole model costs milliseconds at 10k parts: not on the UI thread
                 drop(stale);
                 let generation = model.generation();
-                let outcome = solve_frame(&mut model, &mut solver, &mut rules, budget);
+                let outcome = solve_frame(&mut model, &mut session, budget);
                 // After a rewrite the model shown now can no longer be brought up to date in
                 // place for the next frame: copy the result here, off the UI thread.
                 let spare = (model.generation() != generation).then(|| model.clone());
                 Job {
                     model,
                     spare,
-                    solver,
-                    rules,
+                    session,
                     outcome,
                 }
             }));
@@ -717,8 +638,7 @@ impl Sculpt {
                     }
                     None => self.spare = Some(shown),
                 }
-                self.solver = job.solver;
-                self.rules = job.rules;
+                self.session = job.session;
                 self.integrate(job.outcome);
                 if self.moved_while_solving {
                     self.unsettled = true;
@@ -785,36 +705,23 @@ impl Sculpt {
                 (piece, format!("`{a}` and `{b}`"))
             }
         };
-        let states: Vec<(String, f64)> = p
-            .states
-            .iter()
-            .map(|s| {
-                let d = align(&s.positions, &p.vertices, &data.positions).distance;
-                (s.name.clone(), d)
-            })
-            .collect();
-        let active = p.active.min(states.len().saturating_sub(1));
-        let d_active = states.get(active).map_or(0.0, |s| s.1);
+        // The distances and the switch threshold are the session's (the solver's own rule).
+        let why = self.session.inspect(&self.assembly, part)?;
         Some(PartReport {
             part,
             piece,
             covers,
-            active,
-            hysteresis: self.settings.hysteresis,
-            switch_below: (1.0 - self.settings.hysteresis) * d_active,
-            states,
+            active: why.active,
+            hysteresis: why.hysteresis,
+            switch_below: why.switch_below,
+            states: why.states,
             pinned: self.is_pinned(part),
         })
     }
 
     /// Where each dock (connection) is: the centre of its docked site.
     pub fn dock_centres(&self) -> Vec<DVec2> {
-        let data = &self.assembly.data;
-        let grammar = self.assembly.grammar();
-        data.docks
-            .iter()
-            .map(|d| site_centre(grammar, data, d.a).unwrap_or(DVec2::NAN))
-            .collect()
+        Session::dock_centres(&self.assembly)
     }
 
     fn grab(&mut self, part: usize, at: DVec2) {
@@ -845,12 +752,7 @@ impl Sculpt {
             // The last moves came while a background frame ran: solve once more here, so the
             // part is dropped where the pointer let go, not a frame behind it.
             self.moved_while_solving = false;
-            let outcome = solve_frame(
-                &mut self.assembly,
-                &mut self.solver,
-                &mut self.rules,
-                Duration::MAX,
-            );
+            let outcome = solve_frame(&mut self.assembly, &mut self.session, Duration::MAX);
             self.integrate(outcome);
         }
         let Some(g) = self.grab.take() else {
@@ -926,7 +828,7 @@ impl Sculpt {
         }
         // A fresh solver: the old one's pattern belongs to another topology. The spare copy
         // belongs to it too (and a restored model counts its generations from 0 again).
-        self.solver = Solver::new(self.solver.config);
+        self.session.reset_solver();
         self.spare = None;
         self.error = None;
         self.unsettled = true;
@@ -936,14 +838,14 @@ impl Sculpt {
         let mut config = SolverConfig::from_params(&self.grammar().solver);
         config.hysteresis = self.settings.hysteresis;
         config.norm = self.settings.norm;
-        self.solver.config = config;
+        self.session.set_config(config);
     }
 
     fn cut(&mut self, point: DVec2) {
         self.checkpoint();
-        match self.rules.cut(&mut self.assembly, point) {
+        match self.session.cut(&mut self.assembly, point) {
             Ok(e) => {
-                self.rules.log.clear();
+                self.session.clear_rule_log();
                 self.revision += 1;
                 self.note(
                     format!("{} at ({:.1}, {:.1})", e.detail, e.at.x, e.at.y),
@@ -982,11 +884,7 @@ impl Sculpt {
 
     /// The connection a cut at `point` would cut, if any is within the cut's reach.
     pub fn cut_target(&self, point: DVec2) -> Option<usize> {
-        let grammar = self.assembly.grammar();
-        let reach = CUT_REACH.max(2.0 * grammar.solver.merge_distance);
-        clay::rules::cut::nearest_dock(grammar, &self.assembly.data, point)
-            .filter(|(_, d)| *d <= reach)
-            .map(|(i, _)| i)
+        Session::cut_target(&self.assembly, point)
     }
 
     /// Logs something that is not part of a gesture (a failed reload, a file error): undo

@@ -377,8 +377,6 @@ pub struct Rules {
     pub frame: u64,
     /// Every event so far, in order.
     pub log: Vec<RuleEvent>,
-    /// Why requested operations did nothing (a cut with nothing near), in order.
-    pub notes: Vec<String>,
     /// Pairs of instances (stable ids, smaller first) a cut separated: they do not weld
     /// again until their sites have moved beyond the merge distance (paper 5.1: a
     /// connection is fixed until cut, and a cut is the user's explicit wish to part them).
@@ -477,26 +475,6 @@ impl Rules {
                 && let Some(slot) = rot.get_mut(*new)
             {
                 *slot = q;
-            }
-        }
-    }
-}
-
-/// The replay hook (`clayc run`, the editor). The replay counts `replace` itself from the
-/// solver's state switches, so replacement events are not passed on (no double counting).
-impl crate::script::FrameHook for Rules {
-    fn after_frame(&mut self, assembly: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent> {
-        let mut events = Rules::after_frame(self, assembly, report);
-        events.retain(|e| e.kind != RuleKind::Replace);
-        events
-    }
-
-    fn cut(&mut self, assembly: &mut Assembly, at: DVec2) -> Option<Vec<RuleEvent>> {
-        match Rules::cut(self, assembly, at) {
-            Ok(e) => Some(vec![e]),
-            Err(message) => {
-                self.notes.push(message);
-                Some(Vec::new())
             }
         }
     }

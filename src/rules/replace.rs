@@ -10,6 +10,7 @@ use glam::DVec2;
 
 use super::{RuleEvent, RuleKind};
 use crate::solver::StateSwitch;
+use crate::solver::local::align;
 
 /// Sets each piece part's instance to the part's active state and returns one event per
 /// instance that ends the frame in a different state than it started. `switches` are the
@@ -44,13 +45,26 @@ pub fn replacement_events(
         let name = |s: usize| piece.states.get(s).map_or("?", |st| st.name.as_str());
         let at = centroid(&data.positions, &data.instances[instance].vertices);
         let inst = &data.instances[instance];
+        // How much better the new state fits the pose than the old one (the hysteresis makes
+        // this at least its share), so the log can say why.
+        let misfit = |s: usize| {
+            part.states.get(s).map_or(f64::NAN, |st| {
+                align(&st.positions, &part.vertices, &data.positions).distance
+            })
+        };
+        let better = 1.0 - misfit(to) / misfit(from);
+        let why = if better.is_finite() {
+            format!(", {:.0}% closer to its shape", 100.0 * better)
+        } else {
+            String::new()
+        };
         events.push(RuleEvent {
             kind: RuleKind::Replace,
             frame: 0,
             at,
             instances: vec![inst.id],
             detail: format!(
-                "`{}` ({}) is now `{}` (was `{}`)",
+                "`{}` ({}) is now `{}` (was `{}`){why}",
                 inst.name,
                 piece.name,
                 name(to),

@@ -9,8 +9,8 @@ use crate::out;
 
 use clay::assembly::{Assembly, HandleKind};
 use clay::render::{Overlays, RenderOptions, render_png, render_svg, sheet_png, sheet_svg};
-use clay::rules::Rules;
 use clay::script::Script;
+use clay::session::Session;
 use clay::solver::SolverConfig;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
@@ -144,7 +144,7 @@ fn replay(
     })?;
     let config = SolverConfig::from_params(&grammar.solver);
     let mut assembly = Assembly::new(Arc::new(grammar));
-    if let Err(e) = clay::script::replay(&mut assembly, &script, &config, &mut Rules::new()) {
+    if let Err(e) = clay::session::replay(&mut assembly, &script, &mut Session::new(config)) {
         errln!("error: {}: {e}", path.display());
         return Err(INPUT_ERROR);
     }

@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use crate::out;
 use clay::assembly::Assembly;
-use clay::rules::Rules;
-use clay::script::{Script, ScriptError, replay};
+use clay::script::{Script, ScriptError};
+use clay::session::{Session, replay};
 use clay::solver::{Pass1, SolverConfig, SolverKind};
 
 #[derive(clap::Args)]
@@ -177,15 +177,15 @@ pub fn run(args: RunArgs) -> u8 {
         );
         return 1;
     }
-    let mut rules = Rules::new();
-    let (summary, session) = match replay(&mut assembly, &script, &config, &mut rules) {
+    let mut session = Session::new(config);
+    let summary = match replay(&mut assembly, &script, &mut session) {
         Ok(r) => r,
         Err(e) => {
             errln!("error: {e}");
             return 1;
         }
     };
-    for note in session.notes.iter().chain(&rules.notes) {
+    for note in session.notes() {
         errln!("note: {note}");
     }
     let text = if args.json {

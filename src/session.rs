@@ -1,0 +1,462 @@
+//! A sculpting session: the solver, the rules, the grab and what the session has done so far.
+//! [`Session::frame`] is the one definition of a sculpting frame (a solver frame, then the
+//! rules, paper 5.1) and of what counts as a rule event; `clayc run` (through [`replay`] and
+//! [`Session::step`]), `clayc bench` and the editor all sculpt through it.
+//!
+//! The assembly is passed in rather than owned: the editor solves a spare copy of its model
+//! on another thread while it draws the one on screen, and swaps them when the frame is done.
+//!
+//! Architecture Invariant: nothing outside this module runs the rules after a solver frame
+//! (checked by `tests/session.rs`: `clayc run`'s counts equal the session's events).
+
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+use glam::DVec2;
+
+use crate::assembly::{Assembly, HandleId, HandleKind};
+use crate::rules::cut::CUT_REACH;
+use crate::rules::{RuleEvent, RuleKind, Rules, replace};
+use crate::script::{Motion, Script, Selector, Step};
+use crate::solver::local::align;
+use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
+use crate::summary::{Summary, summarize};
+
+/// What one sculpting frame did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub report: FrameReport,
+    /// The rules that fired after it, in order: one `replace` per instance whose rest state
+    /// changed in the frame, then stretches and shrinks, then at most one merge.
+    pub events: Vec<RuleEvent>,
+}
+
+/// Why a part is in the rest state it is in (the editor's inspector shows this).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartReport {
+    pub part: usize,
+    /// The active state's index in `states`.
+    pub active: usize,
+    /// Every rest state's name with its shape-space distance (squared, after the best
+    /// rotation) to the current pose.
+    pub states: Vec<(String, f64)>,
+    pub hysteresis: f64,
+    /// Another state becomes active once its distance drops below this (paper 4.2's
+    /// hysteresis: `(1 - hysteresis)` times the active state's distance).
+    pub switch_below: f64,
+}
+
+/// A sculpting session over an assembly.
+#[derive(Debug)]
+pub struct Session {
+    solver: Solver,
+    /// `None`: a solver-only session (tests, benchmarks of the solver alone). Replacement
+    /// still happens (it is the solver's state choice shown on the instances).
+    rules: Option<Rules>,
+    /// The handle `drag`, `rotate` and `release` act on.
+    grab: Option<HandleId>,
+    rules_fired: BTreeMap<RuleKind, usize>,
+    /// Wall time of every frame so far (solver and rules), in milliseconds.
+    frame_ms: Vec<f64>,
+    /// Remarks about steps and requests that did nothing, in order.
+    notes: Vec<String>,
+    last_report: Option<FrameReport>,
+}
+
+impl Session {
+    /// A session with the grammar's rules.
+    pub fn new(config: SolverConfig) -> Self {
+        Self::with(config, Some(Rules::new()))
+    }
+
+    /// A session without stretch, shrink, merge and cut rules.
+    pub fn without_rules(config: SolverConfig) -> Self {
+        Self::with(config, None)
+    }
+
+    fn with(config: SolverConfig, rules: Option<Rules>) -> Self {
+        Self {
+            solver: Solver::new(config),
+            rules,
+            grab: None,
+            rules_fired: RuleKind::ALL.iter().map(|&k| (k, 0)).collect(),
+            frame_ms: Vec::new(),
+            notes: Vec::new(),
+            last_report: None,
+        }
+    }
+
+    pub fn config(&self) -> SolverConfig {
+        self.solver.config
+    }
+
+    /// New solver settings, from the next frame on.
+    pub fn set_config(&mut self, config: SolverConfig) {
+        self.solver.config = config;
+    }
+
+    /// A fresh solver (after the model was replaced by one of another topology).
+    pub fn reset_solver(&mut self) {
+        self.solver = Solver::new(self.solver.config);
+    }
+
+    pub fn solver(&self) -> &Solver {
+        &self.solver
+    }
+
+    pub fn has_rules(&self) -> bool {
+        self.rules.is_some()
+    }
+
+    /// The rules, for tests that drive them directly between frames.
+    pub fn rules_mut(&mut self) -> Option<&mut Rules> {
+        self.rules.as_mut()
+    }
+
+    /// Rules fired so far, per kind (every kind present).
+    pub fn rules_fired(&self) -> &BTreeMap<RuleKind, usize> {
+        &self.rules_fired
+    }
+
+    pub fn frame_ms(&self) -> &[f64] {
+        &self.frame_ms
+    }
+
+    /// Why requests did nothing (a grab that found no instance, a cut with nothing near).
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
+    pub fn last_report(&self) -> Option<&FrameReport> {
+        self.last_report.as_ref()
+    }
+
+    /// Every rule event so far, in order (empty without rules).
+    pub fn rule_log(&self) -> &[RuleEvent] {
+        self.rules.as_ref().map_or(&[], |r| &r.log)
+    }
+
+    /// Forgets the rule log (a long live session keeps its own, bounded one).
+    pub fn clear_rule_log(&mut self) {
+        if let Some(r) = &mut self.rules {
+            r.log.clear();
+        }
+    }
+
+    /// The grabbed handle.
+    pub fn grabbed(&self) -> Option<HandleId> {
+        self.grab
+    }
+
+    /// One sculpting frame: a solver frame, then the rules.
+    pub fn frame(&mut self, asm: &mut Assembly) -> Result<Frame, SolverError> {
+        self.run_frame(asm, None)
+    }
+
+    /// One sculpting frame whose solver part stops within `budget` (it continues next frame;
+    /// see [`Solver::frame_budgeted`]).
+    pub fn frame_within(
+        &mut self,
+        asm: &mut Assembly,
+        budget: Duration,
+    ) -> Result<Frame, SolverError> {
+        self.run_frame(asm, Some(budget))
+    }
+
+    fn run_frame(
+        &mut self,
+        asm: &mut Assembly,
+        budget: Option<Duration>,
+    ) -> Result<Frame, SolverError> {
+        let start = Instant::now();
+        let report = match budget {
+            Some(b) => self.solver.frame_budgeted(asm, b)?,
+            None => self.solver.frame(asm)?,
+        };
+        let events = match &mut self.rules {
+            Some(rules) => rules.after_frame(asm, &report),
+            None => {
+                let grammar = asm.grammar_arc().clone();
+                replace::replacement_events(&grammar, &mut asm.data, &report.switches)
+            }
+        };
+        for e in &events {
+            *self.rules_fired.entry(e.kind).or_default() += 1;
+        }
+        self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        self.last_report = Some(report.clone());
+        Ok(Frame { report, events })
+    }
+
+    /// Grabs `instance` (releasing the previous grab; pins stay). `None` if it has no vertices.
+    pub fn grab(&mut self, asm: &mut Assembly, instance: usize) -> Option<HandleId> {
+        self.release(asm);
+        self.grab = asm.hold_instance(instance, HandleKind::Grab);
+        self.grab
+    }
+
+    /// Moves the grab's target: its start pose moved by `translation` and turned by `angle`
+    /// radians about its centre. Returns whether anything changed.
+    pub fn move_grab(&mut self, asm: &mut Assembly, translation: DVec2, angle: f64) -> bool {
+        if !(translation.is_finite() && angle.is_finite()) {
+            return false;
+        }
+        match self.grab.and_then(|id| asm.handle_mut(id)) {
+            Some(h) if h.translation != translation || h.angle != angle => {
+                h.translation = translation;
+                h.angle = angle;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Lets go of the grab. Returns whether there was one.
+    pub fn release(&mut self, asm: &mut Assembly) -> bool {
+        match self.grab.take() {
+            Some(id) => asm.release(id),
+            None => false,
+        }
+    }
+
+    /// Forgets the grab without touching the assembly (the assembly was replaced, e.g. by
+    /// undo, and its handles with it).
+    pub fn forget_grab(&mut self) {
+        self.grab = None;
+    }
+
+    /// Pins `instance` where it is.
+    pub fn pin(&mut self, asm: &mut Assembly, instance: usize) -> Option<HandleId> {
+        asm.hold_instance(instance, HandleKind::Pin)
+    }
+
+    /// The pin holding `instance`, found by its stable id (its vertices change when rules
+    /// rewrite the chain around it).
+    pub fn pin_of(asm: &Assembly, instance: usize) -> Option<HandleId> {
+        let id = asm.data.instances.get(instance)?.id;
+        asm.handles()
+            .iter()
+            .find(|h| h.kind == HandleKind::Pin && h.held.as_ref().is_some_and(|x| x.id == id))
+            .map(|h| h.id)
+    }
+
+    /// Unpins `instance`. Returns whether it was pinned.
+    pub fn unpin(&mut self, asm: &mut Assembly, instance: usize) -> bool {
+        match Self::pin_of(asm, instance) {
+            Some(id) => asm.release(id),
+            None => false,
+        }
+    }
+
+    /// Cuts the connection nearest `point` (paper 5.1's cut rule).
+    pub fn cut(&mut self, asm: &mut Assembly, point: DVec2) -> Result<RuleEvent, String> {
+        let Some(rules) = &mut self.rules else {
+            let why = "this session runs without rules".to_string();
+            self.notes.push(why.clone());
+            return Err(why);
+        };
+        match rules.cut(asm, point) {
+            Ok(e) => {
+                *self.rules_fired.entry(e.kind).or_default() += 1;
+                Ok(e)
+            }
+            Err(why) => {
+                self.notes.push(why.clone());
+                Err(why)
+            }
+        }
+    }
+
+    /// The connection (dock index) a cut at `point` would cut, if one is within reach.
+    pub fn cut_target(asm: &Assembly, point: DVec2) -> Option<usize> {
+        let grammar = asm.grammar();
+        let reach = CUT_REACH.max(2.0 * grammar.solver.merge_distance);
+        crate::rules::cut::nearest_dock(grammar, &asm.data, point)
+            .filter(|(_, d)| *d <= reach)
+            .map(|(i, _)| i)
+    }
+
+    /// Where each connection (dock) is: the centre of its docked site (NaN if it has none).
+    pub fn dock_centres(asm: &Assembly) -> Vec<DVec2> {
+        let (grammar, data) = (asm.grammar(), &asm.data);
+        data.docks
+            .iter()
+            .map(|d| crate::rules::site_centre(grammar, data, d.a).unwrap_or(DVec2::NAN))
+            .collect()
+    }
+
+    /// Why `part` is in the state it is in, under the solver's hysteresis.
+    pub fn inspect(&self, asm: &Assembly, part: usize) -> Option<PartReport> {
+        let data = &asm.data;
+        let p = data.parts.get(part)?;
+        let states: Vec<(String, f64)> = p
+            .states
+            .iter()
+            .map(|s| {
+                let d = align(&s.positions, &p.vertices, &data.positions).distance;
+                (s.name.clone(), d)
+            })
+            .collect();
+        let active = p.active.min(states.len().saturating_sub(1));
+        let d_active = states.get(active).map_or(0.0, |s| s.1);
+        let hysteresis = self.solver.config.hysteresis;
+        Some(PartReport {
+            part,
+            active,
+            hysteresis,
+            switch_below: (1.0 - hysteresis) * d_active,
+            states,
+        })
+    }
+
+    /// The summary of the session so far.
+    pub fn summary(&self, asm: &Assembly) -> Summary {
+        summarize(
+            asm,
+            &self.frame_ms,
+            &self.rules_fired,
+            self.last_report.as_ref(),
+            &self.solver.config,
+        )
+    }
+}
+
+/// A frame failed to solve during replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReplayError {
+    pub step: Option<usize>,
+    pub error: SolverError,
+}
+
+impl std::fmt::Display for ReplayError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.step {
+            Some(i) => write!(f, "step {i}: {}", self.error),
+            None => write!(f, "{}", self.error),
+        }
+    }
+}
+
+impl std::error::Error for ReplayError {}
+
+/// Replays a whole script on `asm` and summarises the result.
+pub fn replay(
+    asm: &mut Assembly,
+    script: &Script,
+    session: &mut Session,
+) -> Result<Summary, ReplayError> {
+    for (i, s) in script.steps.iter().enumerate() {
+        session.step(asm, i, s).map_err(|error| ReplayError {
+            step: Some(i),
+            error,
+        })?;
+    }
+    Ok(session.summary(asm))
+}
+
+/// Script steps (`clayc run`): each one a call of the session's own operations.
+impl Session {
+    /// Runs one script step (its index is only used in notes).
+    pub fn step(
+        &mut self,
+        asm: &mut Assembly,
+        index: usize,
+        step: &Step,
+    ) -> Result<(), SolverError> {
+        match *step {
+            Step::Grab(sel) | Step::Pin(sel) => {
+                let Some(instance) = select(asm, sel) else {
+                    let why = if asm.data.instances.is_empty() {
+                        "the model is empty"
+                    } else {
+                        "no instance is a finite distance away"
+                    };
+                    self.notes
+                        .push(format!("step {index}: nothing to select ({why})"));
+                    return Ok(());
+                };
+                if let Step::Grab(_) = step {
+                    self.grab(asm, instance);
+                } else {
+                    self.pin(asm, instance);
+                }
+            }
+            Step::Drag { motion, frames } => {
+                if self.grab.is_none() {
+                    self.notes.push(format!(
+                        "step {index}: drag without a grabbed part only holds"
+                    ));
+                }
+                let offset = match (motion, self.grab.and_then(|id| asm.handle(id))) {
+                    (Motion::By(d), _) => d,
+                    (Motion::To(p), Some(h)) => p - h.target_centre(),
+                    (Motion::To(_), None) => DVec2::ZERO,
+                };
+                self.move_handle(asm, offset, 0.0, frames)?;
+            }
+            Step::Rotate { degrees, frames } => {
+                if self.grab.is_none() {
+                    self.notes.push(format!(
+                        "step {index}: rotate without a grabbed part only holds"
+                    ));
+                }
+                self.move_handle(asm, DVec2::ZERO, degrees.to_radians(), frames)?;
+            }
+            Step::Release => {
+                if !self.release(asm) {
+                    self.notes
+                        .push(format!("step {index}: release without a grabbed part"));
+                }
+            }
+            Step::Hold { frames } => {
+                for _ in 0..frames {
+                    self.frame(asm)?;
+                }
+            }
+            Step::Cut { at } => {
+                if let Err(why) = self.cut(asm, at) {
+                    let last = self.notes.len() - 1;
+                    self.notes[last] = format!(
+                        "step {index}: cut at [{}, {}] does nothing: {why}",
+                        at.x, at.y
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves the grab by `offset` and turns it by `angle` over `frames` frames.
+    fn move_handle(
+        &mut self,
+        asm: &mut Assembly,
+        offset: DVec2,
+        angle: f64,
+        frames: u64,
+    ) -> Result<(), SolverError> {
+        let Some(h) = self.grab.and_then(|id| asm.handle(id)) else {
+            self.grab = None;
+            return (0..frames).try_for_each(|_| self.frame(asm).map(drop));
+        };
+        let (t0, a0) = (h.translation, h.angle);
+        if frames == 0 {
+            self.move_grab(asm, t0 + offset, a0 + angle);
+            return Ok(());
+        }
+        for k in 1..=frames {
+            let s = k as f64 / frames as f64;
+            // The handle may vanish when rules drop its vertices; the drag then just holds.
+            self.move_grab(asm, t0 + offset * s, a0 + angle * s);
+            self.frame(asm)?;
+        }
+        Ok(())
+    }
+}
+
+/// The instance a selector picks (see [`Selector`]).
+fn select(asm: &Assembly, sel: Selector) -> Option<usize> {
+    match sel {
+        Selector::At(p) => asm.instance_nearest(p),
+        Selector::Extreme(dir) => asm.instance_extreme(dir),
+    }
+}

@@ -1,0 +1,110 @@
+//! The sculpting session is the one definition of a frame and of a rule event: `clayc run`
+//! reports what a library session counts, and a session's counts are its events.
+
+use std::collections::BTreeMap;
+use std::process::Command;
+use std::sync::Arc;
+
+use clay::assembly::Assembly;
+use clay::rules::RuleKind;
+use clay::script::Script;
+use clay::session::{Session, replay};
+use clay::solver::SolverConfig;
+
+fn grammar(name: &str) -> clay_dsl::compiled::CompiledGrammar {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let src = std::fs::read_to_string(format!("{dir}/grammars/{name}.clay")).unwrap();
+    clay_dsl::compile(&src, &format!("grammars/{name}.clay"))
+        .unwrap()
+        .grammar
+}
+
+fn script(name: &str) -> Script {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    Script::parse(&std::fs::read_to_string(format!("{dir}/grammars/{name}.script.json")).unwrap())
+        .unwrap()
+}
+
+#[test]
+fn clayc_run_counts_what_the_session_counts() {
+    for name in ["wall", "castle", "junction"] {
+        let g = grammar(name);
+        let mut asm = Assembly::new(Arc::new(g.clone()));
+        let mut session = Session::new(SolverConfig::from_params(&g.solver));
+        let summary = replay(&mut asm, &script(name), &mut session).unwrap();
+        let dir = env!("CARGO_MANIFEST_DIR");
+        let out = Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .current_dir(dir)
+            .args([
+                "run",
+                &format!("grammars/{name}.clay"),
+                "--json",
+                "--script",
+            ])
+            .arg(format!("grammars/{name}.script.json"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let cli: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        for kind in RuleKind::ALL {
+            assert_eq!(
+                cli["rules_fired"][kind.name()].as_u64(),
+                Some(session.rules_fired()[&kind] as u64),
+                "{name}: {}",
+                kind.name()
+            );
+        }
+        assert_eq!(cli["parts"].as_u64(), Some(summary.parts as u64));
+        assert_eq!(
+            cli["pieces"],
+            serde_json::to_value(&summary.pieces).unwrap()
+        );
+    }
+}
+
+#[test]
+fn a_sessions_counts_are_its_events_one_replace_per_instance_and_frame() {
+    let g = grammar("wall");
+    let mut asm = Assembly::new(Arc::new(g.clone()));
+    let mut session = Session::new(SolverConfig::from_params(&g.solver));
+    replay(&mut asm, &script("wall"), &mut session).unwrap();
+    let mut logged: BTreeMap<RuleKind, usize> = RuleKind::ALL.iter().map(|&k| (k, 0)).collect();
+    for e in session.rule_log() {
+        *logged.entry(e.kind).or_default() += 1;
+    }
+    assert_eq!(&logged, session.rules_fired());
+    assert!(logged[&RuleKind::Stretch] >= 8, "{logged:?}");
+
+    // Without rules the replacement rule still reports, once per instance whose state changed.
+    let g = grammar("bend");
+    let mut asm = Assembly::new(Arc::new(g.clone()));
+    let mut s = Session::without_rules(SolverConfig::from_params(&g.solver));
+    let steps = Script::parse(
+        r#"{"steps": [{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}},
+            {"rotate": {"degrees": 90, "frames": 30}}, {"drag": {"by": [-3, 3], "frames": 30}},
+            {"hold": {"frames": 30}}]}"#,
+    )
+    .unwrap();
+    let mut replaced = 0;
+    for (i, step) in steps.steps.iter().enumerate() {
+        s.step(&mut asm, i, step).unwrap();
+    }
+    for _ in 0..5 {
+        let f = s.frame(&mut asm).unwrap();
+        let mut ids: Vec<u64> = f.events.iter().flat_map(|e| e.instances.clone()).collect();
+        let n = ids.len();
+        ids.dedup();
+        assert_eq!(ids.len(), n, "one event per instance in a frame");
+        replaced += f.events.len();
+    }
+    assert!(s.rules_fired()[&RuleKind::Replace] >= replaced);
+    assert!(
+        s.rules_fired()[&RuleKind::Replace] >= 1,
+        "the bend switched a segment"
+    );
+    assert_eq!(s.rules_fired()[&RuleKind::Stretch], 0);
+}
