@@ -6,7 +6,7 @@ use glam::DVec2;
 use serde_json::Value;
 
 use crate::assembly::Compass;
-use clay_dsl::compile::MAX_COORDINATE;
+use clay_dsl::MAX_COORDINATE;
 
 /// Largest frame count a single step may ask for (keeps a typo from running for hours).
 pub const MAX_FRAMES: u64 = 100_000;

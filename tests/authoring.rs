@@ -59,10 +59,7 @@ fn six_identical_bricks_become_one_piece_with_six_instances() {
     };
     assert!((span(&xs) - 6.0).abs() < 1e-9 && (span(&ys) - 0.5).abs() < 1e-9);
     // The output is already canonical.
-    assert_eq!(
-        clay_dsl::format::format(&authored.text).unwrap(),
-        authored.text
-    );
+    assert_eq!(clay_dsl::format(&authored.text).unwrap(), authored.text);
 }
 
 #[test]
@@ -293,7 +290,7 @@ fn fmt_prints_checks_and_writes_with_the_documented_exit_codes() {
     let o = clayc(&["fmt", f]);
     assert_eq!(o.status.code(), Some(0));
     let printed = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(printed, clay_dsl::format::format(messy).unwrap());
+    assert_eq!(printed, clay_dsl::format(messy).unwrap());
     assert!(printed.contains("    vertex b (1, 0) // b\n"));
     assert_eq!(std::fs::read_to_string(&file).unwrap(), messy);
     // --check: 1 and the file listed while it would change; 0 after --write.

@@ -2,8 +2,8 @@
 //! formatted text equals the original's), it is idempotent, it keeps every comment, and it does
 //! not care how the input was spaced.
 
-use clay_dsl::format::{comment_spans, format, format_number, print_file};
 use clay_dsl::{CompiledGrammar, Diagnostics, compile};
+use clay_dsl::{comment_spans, format, format_number, print_file};
 use proptest::prelude::*;
 
 fn grammar_files() -> Vec<(String, String)> {
@@ -214,7 +214,7 @@ fn text_that_does_not_parse_is_reported_not_formatted() {
 fn printing_the_parsed_tree_without_source_keeps_the_meaning() {
     // `print_file` is what code-built trees go through: no comments, numbers by value.
     for (path, source) in all_sources() {
-        let tree = clay_dsl::parse::parse(&source).unwrap();
+        let tree = clay_dsl::parse(&source).unwrap();
         let printed = print_file(&tree);
         assert_eq!(
             meaning(&source),
@@ -224,7 +224,7 @@ fn printing_the_parsed_tree_without_source_keeps_the_meaning() {
         assert!(comment_spans(&printed).is_empty());
         // Idempotent in the sense that matters: printing the re-parsed tree gives the same text.
         assert_eq!(
-            print_file(&clay_dsl::parse::parse(&printed).unwrap()),
+            print_file(&clay_dsl::parse(&printed).unwrap()),
             printed,
             "{path}"
         );
@@ -249,7 +249,7 @@ fn numbers_print_as_the_shortest_text_that_reads_back() {
     ] {
         let t = format_number(x);
         assert_eq!(t.parse::<f64>().unwrap(), x, "{t}");
-        let tree = clay_dsl::parse::parse(&format!("solver {{ norm = {t} }}"));
+        let tree = clay_dsl::parse(&format!("solver {{ norm = {t} }}"));
         assert!(tree.is_ok(), "{t} is not a clay number");
     }
     assert_eq!(format_number(0.5), "0.5");

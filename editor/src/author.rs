@@ -371,7 +371,7 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
         }
     }
     tree.items.splice(at..at, merges);
-    let text = clay_dsl::format::print_file(&tree);
+    let text = clay_dsl::print_file(&tree);
     Ok(Computed {
         graph,
         regions,

@@ -11,7 +11,7 @@
 //! 5. [`pieces::find_pieces`]: regions equal up to a rigid motion become one piece with several
 //!    instances; contacts become typed docking sites;
 //! 6. [`pieces::Design::to_syntax`]: the grammar as a syntax tree, printed by
-//!    [`clay_dsl::format::print_file`].
+//!    [`clay_dsl::print_file`].
 //!
 //! [`author`] runs them all.
 
@@ -135,6 +135,6 @@ pub fn author(drawing: &Drawing, options: &AuthorOptions) -> Result<Authored, Au
             text += &format!("// {line}\n");
         }
     }
-    text += &clay_dsl::format::print_file(&tree);
+    text += &clay_dsl::print_file(&tree);
     Ok(Authored { design, text })
 }

@@ -606,7 +606,7 @@ impl Design {
     }
 
     /// The design as a `.clay` syntax tree (default spans); print it with
-    /// [`clay_dsl::format::print_file`].
+    /// [`clay_dsl::print_file`].
     pub fn to_syntax(&self) -> File {
         let mut items = Vec::new();
         for t in &self.site_types {

@@ -5,9 +5,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::out;
-use clay_dsl::compile::codes::UNREADABLE;
-use clay_dsl::diagnostic::{JsonDiagnostic, JsonLabel, JsonPos};
+use clay_dsl::codes::UNREADABLE;
 use clay_dsl::{Diagnostics, Severity, compile_bytes};
+use clay_dsl::{JsonDiagnostic, JsonLabel, JsonPos};
 
 /// How diagnostics are printed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -114,7 +114,7 @@ pub fn read(path: &Path) -> Result<Vec<u8>, Unreadable> {
 
 fn print_human(diags: &Diagnostics, bytes: &[u8], path: &str) {
     let source = String::from_utf8_lossy(bytes);
-    clay_dsl::diagnostic::emit_to_stderr(diags, &source, path, stderr_color());
+    clay_dsl::emit_to_stderr(diags, &source, path, stderr_color());
 }
 
 pub fn check(args: CheckArgs) -> u8 {

@@ -49,7 +49,7 @@ pub fn fmt(args: FmtArgs) -> u8 {
         };
         let source = String::from_utf8_lossy(&bytes);
         let formatted = match std::str::from_utf8(&bytes) {
-            Ok(text) => clay_dsl::format::format(text),
+            Ok(text) => clay_dsl::format(text),
             // compile_bytes words the not-UTF-8 diagnostic; reuse it.
             Err(_) => Err(clay_dsl::compile_bytes(&bytes, &path)
                 .err()
