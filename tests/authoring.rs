@@ -335,3 +335,53 @@ fn fmt_prints_checks_and_writes_with_the_documented_exit_codes() {
         );
     }
 }
+
+#[test]
+fn clayc_author_writes_merges_and_posed_states_as_the_editor_does() {
+    let wall = fixture("wall.svg");
+    let o = clayc(&[
+        "author",
+        wall.to_str().unwrap(),
+        "-o",
+        "-",
+        "--merge",
+        "brick.east:brick.west",
+        "--state",
+        "brick:lean:0,0;1,0;1.2,0.5;0.2,0.5",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("merge brick.east onto brick.west"), "{text}");
+    assert!(text.contains("state lean {"), "{text}");
+    let g = compiles_clean(&text);
+    assert_eq!(g.merge_rules.len(), 1);
+    let brick = g.pieces.iter().find(|p| p.name == "brick").unwrap();
+    let lean = brick.states.iter().find(|s| s.name == "lean").unwrap();
+    assert_eq!(lean.positions[2], glam::DVec2::new(1.2, 0.5));
+
+    // A declaration the drawing cannot take is an error naming it, and nothing is written.
+    let out = scratch("refused.clay");
+    let _ = std::fs::remove_file(&out);
+    let o = clayc(&[
+        "author",
+        wall.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--state",
+        "tower:tall:0,0",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("state `tall` does not apply"), "{err}");
+    assert!(!out.exists());
+    // Variants belong to the stretch rule.
+    let o = clayc(&[
+        "author",
+        wall.to_str().unwrap(),
+        "-o",
+        "-",
+        "--variant",
+        "brick=1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}

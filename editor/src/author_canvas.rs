@@ -12,7 +12,9 @@ use clay::plane::nearest_on_segment;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
-use crate::author::{AuthorCommand, Authoring, Computed, SiteName};
+use clay::authoring::work::{Computed, SiteName};
+
+use crate::author::{AuthorCommand, Authoring};
 use crate::camera::{Camera, dv, pos};
 
 /// Pointer distance (screen points) within which a point or edge counts as under it.

@@ -18,6 +18,7 @@
 pub mod graph;
 pub mod pieces;
 pub mod svg;
+pub mod work;
 
 use glam::DVec2;
 

@@ -1,11 +1,14 @@
-//! `clayc author DRAWING.svg -o OUT.clay [--cut x,y]... [--stretch] [--tolerance T] [--scale S]`:
-//! turns an SVG drawing into a grammar through `clay::authoring`. Exit codes: 0 written, 1 the
-//! drawing cannot become a grammar, 2 usage or I/O.
+//! `clayc author DRAWING.svg -o OUT.clay [--cut x,y]... [--stretch] [--variant P=F]...
+//! [--merge A.s:B.t[:J.u]]... [--state P:NAME:x,y;x,y;...]... [--tolerance T] [--scale S]`:
+//! turns an SVG drawing into a grammar through `clay::authoring::work::compute`, the same
+//! steps as the editor's author mode. Exit codes: 0 written, 1 the drawing or a declaration
+//! cannot become a grammar, 2 usage or I/O.
 
 use std::path::PathBuf;
 
 use crate::out;
-use clay::authoring::{AuthorOptions, StretchChoice, author, svg::drawing_from_svg};
+use clay::authoring::work::{MergeChoice, SiteName, StateChoice, VariantChoice, Work, compute};
+use clay::authoring::{StretchChoice, svg::drawing_from_svg};
 use glam::DVec2;
 
 #[derive(clap::Args)]
@@ -21,6 +24,17 @@ pub struct AuthorArgs {
     /// Make the most repeated piece stretchable between its two opposite docked sites.
     #[arg(long)]
     pub stretch: bool,
+    /// A variant of the stretch piece and its target frequency, e.g. `long_brick=0.25`;
+    /// repeatable (the stretch piece itself may be listed too).
+    #[arg(long = "variant", value_name = "PIECE=FREQ")]
+    pub variants: Vec<String>,
+    /// A merge rule `MOVER.SITE:TARGET.SITE`, or with a junction `...:JUNCTION.SITE`.
+    #[arg(long = "merge", value_name = "A.s:B.t[:J.u]")]
+    pub merges: Vec<String>,
+    /// An alternative rest state: `PIECE:NAME:x,y;x,y;...`, one position per vertex of the
+    /// piece in the piece's own coordinates and vertex order (`v0`, `v1`, ...).
+    #[arg(long = "state", value_name = "PIECE:NAME:XY;...")]
+    pub states: Vec<String>,
     /// Snap and congruence tolerance in metres.
     #[arg(long, default_value_t = 0.001)]
     pub tolerance: f64,
@@ -40,21 +54,108 @@ fn parse_point(s: &str) -> Result<DVec2, String> {
     }
 }
 
-pub fn author_cmd(args: AuthorArgs) -> u8 {
-    let mut cuts = Vec::new();
-    for c in &args.cuts {
-        match parse_point(c) {
-            Ok(p) => cuts.push(p),
-            Err(e) => {
-                errln!("error: {e}");
-                return 2;
-            }
-        }
+fn parse_site(s: &str, flag: &str) -> Result<SiteName, String> {
+    match s.split_once('.') {
+        Some((piece, site)) if !piece.is_empty() && !site.is_empty() => Ok(SiteName {
+            piece: piece.to_string(),
+            site: site.to_string(),
+        }),
+        _ => Err(format!("{flag} {s}: expected PIECE.SITE")),
     }
+}
+
+fn parse_merge(s: &str) -> Result<MergeChoice, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(format!(
+            "--merge {s}: expected MOVER.SITE:TARGET.SITE[:JUNCTION.SITE]"
+        ));
+    }
+    Ok(MergeChoice {
+        mover: parse_site(parts[0], "--merge")?,
+        target: parse_site(parts[1], "--merge")?,
+        junction: parts.get(2).map(|j| parse_site(j, "--merge")).transpose()?,
+    })
+}
+
+fn parse_variant(s: &str) -> Result<VariantChoice, String> {
+    let (piece, f) = s
+        .split_once('=')
+        .ok_or_else(|| format!("--variant {s}: expected PIECE=FREQ"))?;
+    match f.trim().parse::<f64>() {
+        Ok(frequency) if frequency.is_finite() && frequency > 0.0 => Ok(VariantChoice {
+            piece: piece.trim().to_string(),
+            frequency,
+        }),
+        _ => Err(format!(
+            "--variant {s}: the frequency must be a positive number"
+        )),
+    }
+}
+
+fn parse_state(s: &str) -> Result<StateChoice, String> {
+    let mut parts = s.splitn(3, ':');
+    let (Some(piece), Some(name), Some(points)) = (parts.next(), parts.next(), parts.next()) else {
+        return Err(format!("--state {s}: expected PIECE:NAME:x,y;x,y;..."));
+    };
+    let positions = points
+        .split(';')
+        .filter(|p| !p.trim().is_empty())
+        .map(|p| {
+            parse_point(p).map_err(|e| format!("--state {s}: {}", e.trim_start_matches("--cut ")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(StateChoice {
+        piece: piece.to_string(),
+        name: name.to_string(),
+        positions,
+    })
+}
+
+/// The work the arguments describe (the drawing filled in by the caller).
+fn work_from(args: &AuthorArgs) -> Result<Work, String> {
+    let cuts = args
+        .cuts
+        .iter()
+        .map(|c| parse_point(c))
+        .collect::<Result<Vec<_>, _>>()?;
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        errln!("error: --tolerance must be a positive number of metres");
-        return 2;
+        return Err("--tolerance must be a positive number of metres".into());
     }
+    if !args.variants.is_empty() && !args.stretch {
+        return Err("--variant needs --stretch: variants belong to the stretch rule".into());
+    }
+    Ok(Work {
+        cuts,
+        stretch: args.stretch.then_some(StretchChoice::Auto),
+        merges: args
+            .merges
+            .iter()
+            .map(|m| parse_merge(m))
+            .collect::<Result<_, _>>()?,
+        variants: args
+            .variants
+            .iter()
+            .map(|v| parse_variant(v))
+            .collect::<Result<_, _>>()?,
+        states: args
+            .states
+            .iter()
+            .map(|s| parse_state(s))
+            .collect::<Result<_, _>>()?,
+        tolerance: args.tolerance,
+        ..Work::default()
+    })
+}
+
+pub fn author_cmd(args: AuthorArgs) -> u8 {
+    let mut work = match work_from(&args) {
+        Ok(w) => w,
+        Err(e) => {
+            errln!("error: {e}");
+            return 2;
+        }
+    };
     let path = args.drawing.display().to_string();
     let text = match std::fs::read_to_string(&args.drawing) {
         Ok(t) => t,
@@ -70,27 +171,41 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
             return 1;
         }
     };
-    let options = AuthorOptions {
-        snap: args.tolerance,
-        congruence: args.tolerance,
-        cuts,
-        stretch: args.stretch.then_some(StretchChoice::Auto),
-        header: Some(format!(
-            "Authored by `clayc author` from {} (1 SVG unit = {} m, y up).",
-            path, args.scale
-        )),
-    };
-    let authored = match author(&drawing, &options) {
-        Ok(a) => a,
+    work.drawing = drawing;
+    let computed = match compute(&work) {
+        Ok(c) => c,
         Err(e) => {
             errln!("error: {path}: {e}");
             return 1;
         }
     };
-    for note in &authored.design.notes {
+    // A declaration the drawing cannot take is an error here (the editor keeps it as a note
+    // while the author is still drawing).
+    let refused: Vec<&String> = computed
+        .design
+        .notes
+        .iter()
+        .filter(|n| n.contains("no longer applies"))
+        .collect();
+    if !refused.is_empty() {
+        for n in refused {
+            errln!(
+                "error: {path}: {}",
+                n.replace("no longer applies", "does not apply")
+            );
+        }
+        return 1;
+    }
+    for note in &computed.design.notes {
         errln!("note: {note}");
     }
-    let code = out::write_output(&args.output, authored.text.as_bytes());
+    let mut text = format!(
+        "// Authored by `clayc author` from {} (1 SVG unit = {} m, y up).\n",
+        path, args.scale
+    );
+    text += &computed.text;
+    let authored = computed;
+    let code = out::write_output(&args.output, text.as_bytes());
     if code != 0 {
         return code;
     }
