@@ -17,7 +17,7 @@ use glam::DVec2;
 fn setup(parts: usize) -> (Assembly, u64) {
     let mut asm = Assembly::new(Arc::new(synthetic::city(parts)));
     let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
-    for p in asm.data.positions.iter().filter(|p| p.y >= 0.0) {
+    for p in asm.data().positions.iter().filter(|p| p.y >= 0.0) {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
@@ -63,7 +63,7 @@ fn frames(c: &mut Criterion) {
 /// Per-phase breakdown of the `clayc bench --parts N` drag (same model, handles and drag).
 fn phases(parts: usize) {
     let (mut asm, h) = setup(parts);
-    let (lo, hi) = asm.data.positions.iter().filter(|p| p.y >= 0.0).fold(
+    let (lo, hi) = asm.data().positions.iter().filter(|p| p.y >= 0.0).fold(
         (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
@@ -106,7 +106,7 @@ fn phases(parts: usize) {
         "parts {} | frame median {:.1} ms max {:.1} | mean: local {:.1} assembly {:.1} \
          factorisation {:.1} solve {:.1} | irls {:.2} l2 {:.2} factorisations {:.2} pcg {:.1} \
          | converged frames {}",
-        asm.data.parts.len(),
+        asm.data().parts.len(),
         ms[ms.len() / 2],
         ms[ms.len() - 1],
         mean(&|r| r.phases.local),

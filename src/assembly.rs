@@ -94,8 +94,10 @@ impl Compass {
 #[derive(Clone, Debug)]
 pub struct Assembly {
     grammar: Arc<CompiledGrammar>,
-    /// The contract data; rules rewrite it and then call [`Assembly::topology_changed`].
-    pub data: AssemblyData,
+    /// The contract data. Private: a change of topology must be followed by
+    /// [`Assembly::topology_changed`], which the crate's rules do; other crates read it, move
+    /// vertices ([`Assembly::positions_mut`]) and choose states ([`Assembly::set_active_state`]).
+    data: AssemblyData,
     /// Per part: the rotation of its active rest state onto the current pose, as a unit
     /// complex number `(cos, sin)`.
     rotations: Vec<DVec2>,
@@ -175,6 +177,39 @@ impl Assembly {
     /// that hold an instance (see [`HeldInstance`]), and drops handles whose vertices no longer
     /// exist (rules that renumber vertices should remap handles first, through
     /// [`Assembly::handles_mut`]).
+    /// The contract data: positions, instances, docks, chains and parts.
+    pub fn data(&self) -> &AssemblyData {
+        &self.data
+    }
+
+    /// The data, for the crate's solver and rules, which keep the invariants (a rule that
+    /// changes parts, vertices or edges calls [`Assembly::topology_changed`]).
+    pub(crate) fn data_mut(&mut self) -> &mut AssemblyData {
+        &mut self.data
+    }
+
+    /// The data, leaving the assembly.
+    pub fn into_data(self) -> AssemblyData {
+        self.data
+    }
+
+    /// The vertex positions, to move (their number is fixed: moving changes no topology).
+    pub fn positions_mut(&mut self) -> &mut [DVec2] {
+        &mut self.data.positions
+    }
+
+    /// Makes `state` the active rest state of `part` (as the solver's local step does).
+    /// Returns false, changing nothing, when either index is out of range.
+    pub fn set_active_state(&mut self, part: usize, state: usize) -> bool {
+        match self.data.parts.get_mut(part) {
+            Some(p) if state < p.states.len() => {
+                p.active = state;
+                true
+            }
+            _ => false,
+        }
+    }
+
     pub fn topology_changed(&mut self) {
         self.generation += 1;
         self.rotations.resize(self.data.parts.len(), DVec2::X);
@@ -281,7 +316,7 @@ impl Assembly {
         &self.rotations
     }
 
-    pub fn rotations_mut(&mut self) -> &mut [DVec2] {
+    pub(crate) fn rotations_mut(&mut self) -> &mut [DVec2] {
         &mut self.rotations
     }
 
@@ -289,7 +324,7 @@ impl Assembly {
         &self.handles
     }
 
-    pub fn handles_mut(&mut self) -> &mut Vec<Handle> {
+    pub(crate) fn handles_mut(&mut self) -> &mut Vec<Handle> {
         &mut self.handles
     }
 

@@ -57,7 +57,7 @@ pub fn pictures(
         replay(&mut assembly, script, &mut Session::new(config)).map_err(|e| e.to_string())?;
         out.push(Picture {
             file: format!("{name}-after.png"),
-            png: render_png(grammar, &assembly.data, &options).map_err(|e| e.to_string())?,
+            png: render_png(grammar, assembly.data(), &options).map_err(|e| e.to_string())?,
         });
     }
     Ok(out)

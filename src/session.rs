@@ -177,7 +177,7 @@ impl Session {
             Some(rules) => rules.after_frame(asm, &report),
             None => {
                 let grammar = asm.grammar_arc().clone();
-                replace::replacement_events(&grammar, &mut asm.data, &report.switches)
+                replace::replacement_events(&grammar, asm.data_mut(), &report.switches)
             }
         };
         for e in &events {
@@ -233,7 +233,7 @@ impl Session {
     /// The pin holding `instance`, found by its stable id (its vertices change when rules
     /// rewrite the chain around it).
     pub fn pin_of(asm: &Assembly, instance: usize) -> Option<HandleId> {
-        let id = asm.data.instances.get(instance)?.id;
+        let id = asm.data().instances.get(instance)?.id;
         asm.handles()
             .iter()
             .find(|h| h.kind == HandleKind::Pin && h.held.as_ref().is_some_and(|x| x.id == id))
@@ -271,14 +271,14 @@ impl Session {
     pub fn cut_target(asm: &Assembly, point: DVec2) -> Option<usize> {
         let grammar = asm.grammar();
         let reach = CUT_REACH.max(2.0 * grammar.solver.merge_distance);
-        crate::rules::cut::nearest_dock(grammar, &asm.data, point)
+        crate::rules::cut::nearest_dock(grammar, asm.data(), point)
             .filter(|(_, d)| *d <= reach)
             .map(|(i, _)| i)
     }
 
     /// Where each connection (dock) is: the centre of its docked site (NaN if it has none).
     pub fn dock_centres(asm: &Assembly) -> Vec<DVec2> {
-        let (grammar, data) = (asm.grammar(), &asm.data);
+        let (grammar, data) = (asm.grammar(), &asm.data());
         data.docks
             .iter()
             .map(|d| crate::rules::site_centre(grammar, data, d.a).unwrap_or(DVec2::NAN))
@@ -287,7 +287,7 @@ impl Session {
 
     /// Why `part` is in the state it is in, under the solver's hysteresis.
     pub fn inspect(&self, asm: &Assembly, part: usize) -> Option<PartReport> {
-        let data = &asm.data;
+        let data = &asm.data();
         let p = data.parts.get(part)?;
         let states: Vec<(String, f64)> = p
             .states
@@ -366,7 +366,7 @@ impl Session {
         match *step {
             Step::Grab(sel) | Step::Pin(sel) => {
                 let Some(instance) = select(asm, sel) else {
-                    let why = if asm.data.instances.is_empty() {
+                    let why = if asm.data().instances.is_empty() {
                         "the model is empty"
                     } else {
                         "no instance is a finite distance away"

@@ -90,10 +90,10 @@ fn median(values: &[f64]) -> f64 {
 /// Connected components of the part graph (the solver's [`Components`], counted over the
 /// vertices that parts use).
 pub fn components(asm: &Assembly) -> usize {
-    let n = asm.data.positions.len();
-    let components = Components::build(&asm.data.parts, n);
+    let n = asm.data().positions.len();
+    let components = Components::build(&asm.data().parts, n);
     let mut used: Vec<usize> = asm
-        .data
+        .data()
         .parts
         .iter()
         .filter_map(|p| p.vertices.iter().copied().find(|&v| v < n))
@@ -115,7 +115,7 @@ pub fn summarize(
     let g = asm.grammar();
     let mut pieces = BTreeMap::new();
     let mut states: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
-    for inst in &asm.data.instances {
+    for inst in &asm.data().instances {
         let Some(piece) = g.pieces.get(inst.piece) else {
             continue;
         };
@@ -130,8 +130,8 @@ pub fn summarize(
             .entry(state.to_string())
             .or_insert(0) += 1;
     }
-    let finite = asm.data.positions.iter().all(|p| p.is_finite());
-    let bbox = match bbox(&asm.data.positions) {
+    let finite = asm.data().positions.iter().all(|p| p.is_finite());
+    let bbox = match bbox(&asm.data().positions) {
         Some((lo, hi)) => [lo.x, lo.y, hi.x, hi.y],
         None => [0.0; 4],
     };
@@ -161,8 +161,8 @@ pub fn summarize(
         .collect();
     Summary {
         frames: frame_ms.len(),
-        vertices: asm.data.positions.len(),
-        parts: asm.data.parts.len(),
+        vertices: asm.data().positions.len(),
+        parts: asm.data().parts.len(),
         pieces,
         states,
         rules_fired: RuleKind::ALL

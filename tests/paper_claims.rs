@@ -62,7 +62,7 @@ impl Session {
     fn states(&self, piece: &str) -> Vec<String> {
         let g = &self.grammar;
         self.asm
-            .data
+            .data()
             .instances
             .iter()
             .filter(|i| g.pieces[i.piece].name == piece)
@@ -95,7 +95,7 @@ impl Session {
     }
 
     fn bbox(&self) -> [f64; 4] {
-        let (lo, hi) = bbox(&self.asm.data.positions).unwrap();
+        let (lo, hi) = bbox(&self.asm.data().positions).unwrap();
         [lo.x, lo.y, hi.x, hi.y]
     }
 
@@ -115,7 +115,7 @@ impl Session {
             .collect();
         format!(
             "instances {}, max |strain| {:.4}, energy {:.3e}, bbox {:.4?}, fired {fired:?}",
-            self.asm.data.instances.len(),
+            self.asm.data().instances.len(),
             self.strain(),
             self.energy(),
             self.bbox()
@@ -326,11 +326,11 @@ fn grab_north(s: &mut Session, motion: impl Fn(DVec2, DVec2) -> DVec2) -> [f64; 
     s.run(r#"{"grab": {"extreme": "north"}}"#);
     let handle = s.asm.handle(s.replay.grabbed().unwrap()).unwrap();
     let (centre, held) = (handle.target_centre(), handle.vertices[0]);
-    let n = s.asm.data.positions.len();
-    let components = Components::build(&s.asm.data.parts, n);
+    let n = s.asm.data().positions.len();
+    let components = Components::build(&s.asm.data().parts, n);
     let expected: Vec<DVec2> = s
         .asm
-        .data
+        .data()
         .positions
         .iter()
         .enumerate()

@@ -26,7 +26,7 @@ fn replay(name: &str) -> Outcome {
     let mut session = clay::session::Session::new(SolverConfig::from_params(&g.solver));
     for (i, s) in script.steps.iter().enumerate() {
         session.step(&mut asm, i, s).unwrap();
-        asm.data.check(&g).unwrap();
+        asm.data().check(&g).unwrap();
         assert!(asm.validate().is_ok(), "{:?}", asm.validate());
     }
     let mut fired = BTreeMap::new();
@@ -41,7 +41,7 @@ fn replay(name: &str) -> Outcome {
         *fired.entry(k).or_default() += 1;
     }
     let mut pieces = BTreeMap::new();
-    for i in &asm.data.instances {
+    for i in &asm.data().instances {
         *pieces.entry(g.pieces[i.piece].name.clone()).or_default() += 1;
     }
     eprintln!(
@@ -51,7 +51,7 @@ fn replay(name: &str) -> Outcome {
     Outcome {
         fired,
         pieces,
-        components: cut::components(&asm.data),
+        components: cut::components(asm.data()),
         notes: session.notes().to_vec(),
     }
 }

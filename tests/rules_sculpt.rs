@@ -43,14 +43,14 @@ impl Session {
         let script = Script::parse(json).unwrap();
         for (i, s) in script.steps.iter().enumerate() {
             self.replay.step(&mut self.asm, i, s).unwrap();
-            self.asm.data.check(self.asm.grammar()).unwrap();
+            self.asm.data().check(self.asm.grammar()).unwrap();
         }
     }
 
     fn count(&self, piece: &str) -> usize {
         let g = self.asm.grammar();
         self.asm
-            .data
+            .data()
             .instances
             .iter()
             .filter(|i| g.pieces[i.piece].name == piece)
@@ -146,15 +146,15 @@ fn paper_fig8_a_small_stretch_inserts_a_brick_only_with_the_sub_quadratic_norm()
 /// Largest relative change of an instance's edge lengths from its piece's rest shape.
 fn brick_distortion(asm: &Assembly, instance: usize) -> f64 {
     let g = asm.grammar();
-    let inst = &asm.data.instances[instance];
+    let inst = &asm.data().instances[instance];
     let piece = &g.pieces[inst.piece];
     let rest = &piece.states[0].positions;
     piece
         .edges
         .iter()
         .map(|e| {
-            let now = asm.data.positions[inst.vertices[e[0]]]
-                .distance(asm.data.positions[inst.vertices[e[1]]]);
+            let now = asm.data().positions[inst.vertices[e[0]]]
+                .distance(asm.data().positions[inst.vertices[e[1]]]);
             (now / rest[e[0]].distance(rest[e[1]]) - 1.0).abs()
         })
         .fold(0.0, f64::max)
@@ -166,10 +166,10 @@ fn brick_distortion(asm: &Assembly, instance: usize) -> f64 {
 fn handles_follow_their_bricks(norm: Option<f64>) {
     let mut s = Session::new(grammar("wall.clay"), norm);
     s.run(&format!(r#"{{"steps": [{PIN_WEST_GRAB_EAST}]}}"#));
-    let west_at: Vec<_> = s.asm.data.instances[0]
+    let west_at: Vec<_> = s.asm.data().instances[0]
         .vertices
         .iter()
-        .map(|&v| s.asm.data.positions[v])
+        .map(|&v| s.asm.data().positions[v])
         .collect();
     // One brick each, not the two-brick stretch part around it.
     for h in s.asm.handles() {
@@ -195,7 +195,7 @@ fn one_brick_per_handle(a: &Assembly, west_at: &[glam::DVec2], norm: Option<f64>
     let west = a.instance_extreme(Compass::West).unwrap();
     for h in a.handles() {
         let ii = a
-            .data
+            .data()
             .instances
             .iter()
             .position(|i| i.vertices == h.vertices)
@@ -221,10 +221,10 @@ fn one_brick_per_handle(a: &Assembly, west_at: &[glam::DVec2], norm: Option<f64>
             h.kind
         );
     }
-    let now = a.data.instances[west]
+    let now = a.data().instances[west]
         .vertices
         .iter()
-        .map(|&v| a.data.positions[v]);
+        .map(|&v| a.data().positions[v]);
     for (p, q) in now.zip(west_at) {
         assert!(
             p.distance(*q) < 1e-3,
@@ -243,7 +243,7 @@ fn grab_and_pin_hold_one_brick_each_across_stretches() {
 
 /// The stretch part over elements `first`, `first + 1` of chain 0.
 fn stretch_part(a: &Assembly, first: usize) -> usize {
-    a.data
+    a.data()
         .parts
         .iter()
         .position(|p| p.kind == clay_dsl::compiled::PartKind::Stretch { chain: 0, first })
@@ -259,14 +259,14 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
     s.run(&format!(
         r#"{{"steps": [{PIN_WEST_GRAB_EAST}, {{"hold": {{"frames": 2}}}}]}}"#
     ));
-    let west_id = s.asm.data.instances[0].id;
-    let west_at: Vec<_> = s.asm.data.instances[0]
+    let west_id = s.asm.data().instances[0].id;
+    let west_at: Vec<_> = s.asm.data().instances[0]
         .vertices
         .iter()
-        .map(|&v| s.asm.data.positions[v])
+        .map(|&v| s.asm.data().positions[v])
         .collect();
     let k = stretch_part(&s.asm, 0);
-    s.asm.data.parts[k].active = clay::rules::stretch::THREE;
+    assert!(s.asm.set_active_state(k, clay::rules::stretch::THREE));
     let events = s
         .replay
         .rules_mut()
@@ -286,29 +286,29 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
         .unwrap();
     let west = s
         .asm
-        .data
+        .data()
         .instances
         .iter()
         .position(|i| i.id == west_id)
         .unwrap();
-    assert_eq!(pin.vertices, s.asm.data.instances[west].vertices);
+    assert_eq!(pin.vertices, s.asm.data().instances[west].vertices);
     assert_eq!(pin.anchor, west_at, "the pin's targets changed");
     // Solve a few frames: the pinned brick is back where it was, undistorted.
     s.run(r#"{"steps": [{"hold": {"frames": 20}}]}"#);
-    let now = s.asm.data.instances[west]
+    let now = s.asm.data().instances[west]
         .vertices
         .iter()
-        .map(|&v| s.asm.data.positions[v]);
+        .map(|&v| s.asm.data().positions[v]);
     for (p, q) in now.zip(&west_at) {
         assert!(p.distance(*q) < 1e-3, "pinned brick moved from {q} to {p}");
     }
     assert!(brick_distortion(&s.asm, west) < 0.02);
 
     // The east pair shrinks; the first element is kept (ties), so the grabbed brick goes.
-    let n = s.asm.data.chains[0].instances.len();
-    let east_id = s.asm.data.instances[s.asm.data.chains[0].instances[n - 1]].id;
+    let n = s.asm.data().chains[0].instances.len();
+    let east_id = s.asm.data().instances[s.asm.data().chains[0].instances[n - 1]].id;
     let k = stretch_part(&s.asm, n - 2);
-    s.asm.data.parts[k].active = clay::rules::stretch::ONE;
+    assert!(s.asm.set_active_state(k, clay::rules::stretch::ONE));
     let events = s
         .replay
         .rules_mut()
@@ -331,12 +331,12 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
         .expect("the grab still holds an instance");
     let kept = s
         .asm
-        .data
+        .data()
         .instances
         .iter()
         .position(|i| i.id == held.id)
         .unwrap();
-    assert_eq!(grab.vertices, s.asm.data.instances[kept].vertices);
+    assert_eq!(grab.vertices, s.asm.data().instances[kept].vertices);
     assert_eq!(Some(kept), s.asm.instance_extreme(Compass::East));
     // Dragging on moves the kept brick with the handle, undistorted.
     s.run(r#"{"steps": [{"drag": {"by": [0.5, 0], "frames": 10}}, {"hold": {"frames": 20}}]}"#);
@@ -347,7 +347,7 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
         .find(|h| h.kind == HandleKind::Grab)
         .unwrap();
     for k in 0..grab.vertices.len() {
-        let d = s.asm.data.positions[grab.vertices[k]].distance(grab.target(k));
+        let d = s.asm.data().positions[grab.vertices[k]].distance(grab.target(k));
         assert!(d < 1e-3, "grabbed vertex {k} is {d} from its target");
     }
     assert!(brick_distortion(&s.asm, kept) < 0.02);
@@ -356,35 +356,35 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
 #[test]
 fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
     let mut s = Session::new(grammar("junction.clay"), None);
-    assert_eq!(cut::components(&s.asm.data), 2);
+    assert_eq!(cut::components(s.asm.data()), 2);
     // The side street's free end is at (9, 2); the main street's north edge at y = 0.5.
     s.run(
         r#"{"steps": [{"pin": {"extreme": "west"}}, {"pin": {"at": [15, 0]}}, {"grab": {"at": [9, 3]}},
         {"drag": {"by": [0, -1.3], "frames": 40}}, {"hold": {"frames": 10}}]}"#,
     );
     assert_eq!(s.count("tee"), 1, "merged into a tee");
-    assert_eq!(cut::components(&s.asm.data), 1);
+    assert_eq!(cut::components(s.asm.data()), 1);
     // Dragging on (sideways and up) does not un-merge it.
     s.run(r#"{"steps": [{"drag": {"by": [1, 1], "frames": 30}}, {"hold": {"frames": 10}}]}"#);
     assert_eq!(s.count("tee"), 1);
-    assert_eq!(cut::components(&s.asm.data), 1);
+    assert_eq!(cut::components(s.asm.data()), 1);
     // Cut at the stem and pull the side street away.
     let tee = s
         .asm
-        .data
+        .data()
         .instances
         .iter()
         .position(|i| s.asm.grammar().pieces[i.piece].name == "tee")
         .unwrap();
     let g = s.asm.grammar();
-    let stem = g.pieces[s.asm.data.instances[tee].piece]
+    let stem = g.pieces[s.asm.data().instances[tee].piece]
         .sites
         .iter()
         .position(|x| x.name == "north")
         .unwrap();
     let at = clay::rules::site_centre(
         g,
-        &s.asm.data,
+        s.asm.data(),
         clay_dsl::compiled::InstanceSite {
             instance: tee,
             site: stem,
@@ -402,7 +402,7 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
         s.replay.notes()
     );
     assert_eq!(s.count("tee"), 0);
-    assert_eq!(cut::components(&s.asm.data), 2);
+    assert_eq!(cut::components(s.asm.data()), 2);
 }
 
 #[test]
@@ -416,7 +416,7 @@ fn centipede_stretched_to_three_times_keeps_the_variant_mix() {
     let g = s.asm.grammar();
     let rule = &g.stretch_rules[0];
     let mut counts: BTreeMap<usize, usize> = BTreeMap::new();
-    for i in &s.asm.data.instances {
+    for i in &s.asm.data().instances {
         if rule.variants.iter().any(|v| v.piece == i.piece) {
             *counts.entry(i.piece).or_default() += 1;
         }

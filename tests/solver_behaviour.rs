@@ -27,7 +27,7 @@ fn assembly(g: clay_dsl::CompiledGrammar) -> Assembly {
 }
 
 fn rigid_drag(mut asm: Assembly) {
-    let start = asm.data.positions.clone();
+    let start = asm.data().positions.clone();
     let mut solver = Solver::new(SolverConfig::from_params(&asm.grammar().solver));
     let part = asm.part_extreme(Compass::East).unwrap();
     let h = asm.hold_part(part, HandleKind::Grab).unwrap();
@@ -40,7 +40,7 @@ fn rigid_drag(mut asm: Assembly) {
     }
     let report = last.unwrap();
     assert!(report.energy < 1e-8, "energy {}", report.energy);
-    for (p, q) in asm.data.positions.iter().zip(&start) {
+    for (p, q) in asm.data().positions.iter().zip(&start) {
         assert!((*p - (*q + shift)).length() < 1e-3, "{p} vs {}", *q + shift);
     }
     asm.validate().unwrap();
@@ -85,9 +85,9 @@ fn bend_session(frames: u64) -> (Assembly, Session) {
 #[test]
 fn a_street_bent_round_a_pinned_end_switches_segments_to_turns() {
     let (asm, session) = bend_session(40);
-    let piece = &asm.grammar().pieces[asm.data.instances[0].piece];
+    let piece = &asm.grammar().pieces[asm.data().instances[0].piece];
     let names: Vec<&str> = asm
-        .data
+        .data()
         .instances
         .iter()
         .map(|i| piece.states[i.state].name.as_str())
@@ -134,7 +134,7 @@ fn holding_a_pose_on_a_state_boundary_switches_at_most_once() {
         handle.angle = std::f64::consts::FRAC_PI_2 * s;
         solver.frame(&mut asm).unwrap();
     }
-    let mut switches = vec![0usize; asm.data.parts.len()];
+    let mut switches = vec![0usize; asm.data().parts.len()];
     for _ in 0..100 {
         for s in solver.frame(&mut asm).unwrap().switches {
             switches[s.part] += 1;
@@ -148,11 +148,12 @@ fn holding_a_pose_on_a_state_boundary_switches_at_most_once() {
 
 /// Elongation of every brick's bottom edge beyond its base length, west to east.
 fn brick_stretch(asm: &Assembly) -> Vec<f64> {
-    asm.data
+    asm.data()
         .instances
         .iter()
         .map(|i| {
-            (asm.data.positions[i.vertices[1]] - asm.data.positions[i.vertices[0]]).length() - 1.0
+            (asm.data().positions[i.vertices[1]] - asm.data().positions[i.vertices[0]]).length()
+                - 1.0
         })
         .collect()
 }
@@ -160,7 +161,7 @@ fn brick_stretch(asm: &Assembly) -> Vec<f64> {
 fn top_tenth_share(asm: &mut Assembly, norm: f64) -> f64 {
     let mut config = SolverConfig::from_params(&asm.grammar().solver);
     config.norm = norm;
-    let length = asm.data.instances.len() as f64;
+    let length = asm.data().instances.len() as f64;
     let script = Script::parse(&format!(
         r#"{{"steps": [{{"pin": {{"extreme": "west"}}}}, {{"grab": {{"extreme": "east"}}}},
             {{"drag": {{"by": [{}, 0], "frames": 60}}}}, {{"hold": {{"frames": 10}}}}]}}"#,
@@ -213,7 +214,7 @@ fn cg_and_cholesky_agree_within_the_cg_tolerance() {
             )
             .unwrap();
             replay(&mut asm, &script, &mut Session::without_rules(config)).unwrap();
-            positions.push(asm.data.positions.clone());
+            positions.push(asm.data().positions.clone());
         }
         let size = clay::solver::bbox_diagonal(&positions[0]);
         let worst = positions[0]
@@ -267,9 +268,9 @@ fn castle_at_rest_with_nothing_held_converges_within_a_few_frames() {
     for r in &reports[first.unwrap()..] {
         assert!(r.converged && r.complete && r.switches.is_empty());
     }
-    let before = asm.data.positions.clone();
+    let before = asm.data().positions.clone();
     assert!(solver.frame(&mut asm).unwrap().converged);
-    assert_eq!(asm.data.positions, before);
+    assert_eq!(asm.data().positions, before);
 }
 
 #[test]
@@ -296,8 +297,8 @@ fn a_stretched_wall_settles_after_the_drag_and_a_converged_frame_is_a_fixed_poin
         settled.is_some(),
         "the stretched wall never settled after the handle stopped"
     );
-    let before = asm.data.positions.clone();
-    let states: Vec<usize> = asm.data.parts.iter().map(|p| p.active).collect();
+    let before = asm.data().positions.clone();
+    let states: Vec<usize> = asm.data().parts.iter().map(|p| p.active).collect();
     let size = clay::solver::bbox_diagonal(&before);
     let r = solver.frame(&mut asm).unwrap();
     assert!(
@@ -306,7 +307,11 @@ fn a_stretched_wall_settles_after_the_drag_and_a_converged_frame_is_a_fixed_poin
         r.moved
     );
     assert_eq!(
-        asm.data.parts.iter().map(|p| p.active).collect::<Vec<_>>(),
+        asm.data()
+            .parts
+            .iter()
+            .map(|p| p.active)
+            .collect::<Vec<_>>(),
         states
     );
 }
@@ -318,7 +323,7 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
     // dragged within one component, the drag deforms it (a free component would just follow
     // the handle rigidly, in one iteration)
     let grid: Vec<DVec2> = asm
-        .data
+        .data()
         .positions
         .iter()
         .copied()
@@ -352,7 +357,7 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
         assert_eq!((r.pass1_iterations, r.l2_iterations), (2, 1));
         assert!(r.objective <= r.warm_objective);
         assert!(r.linear_residual.unwrap() < 1e-9, "{:?}", r.linear_residual);
-        assert!(asm.data.positions.iter().all(|p| p.is_finite()));
+        assert!(asm.data().positions.iter().all(|p| p.is_finite()));
         if !r.complete {
             cut_short += 1;
             assert!(!r.converged);
@@ -370,7 +375,7 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
     // and the held vertices follow their handle after the budgeted frames
     let held = asm.handle(h).unwrap();
     for (k, &v) in held.vertices.iter().enumerate() {
-        assert!((asm.data.positions[v] - held.target(k)).length() < 1e-3);
+        assert!((asm.data().positions[v] - held.target(k)).length() < 1e-3);
     }
 }
 
@@ -381,7 +386,7 @@ fn the_splitting_pass_reuses_one_factor_while_irls_refactors_every_iteration() {
     // factorises once per pass-1 iteration. Both end with the same displayed-pose guarantees.
     for pass1 in [Pass1::Admm, Pass1::Irls] {
         let mut asm = Assembly::new(Arc::new(synthetic::city(1_000)));
-        let (lo, hi) = clay::solver::bbox(&asm.data.positions).unwrap();
+        let (lo, hi) = clay::solver::bbox(&asm.data().positions).unwrap();
         asm.hold_part(asm.part_nearest(lo).unwrap(), HandleKind::Pin);
         let h = asm
             .hold_part(asm.part_nearest(hi).unwrap(), HandleKind::Grab)

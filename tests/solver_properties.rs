@@ -49,7 +49,7 @@ proptest! {
             handle.translation = DVec2::new(by.0, by.1) * s;
             handle.angle = angle * s;
             let r = solver.frame(&mut asm).unwrap();
-            prop_assert!(asm.data.positions.iter().all(|p| p.is_finite()));
+            prop_assert!(asm.data().positions.iter().all(|p| p.is_finite()));
             let residual = r.linear_residual.unwrap();
             prop_assert!(residual < 1e-9, "relative residual {residual}");
             prop_assert!(

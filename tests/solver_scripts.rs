@@ -254,7 +254,7 @@ fn figures_that_are_not_finite_are_flagged_and_never_null() {
     };
     // Huge but finite coordinates: lengths and the energy overflow, the extent does not.
     let mut huge = Assembly::new(grammar.clone());
-    for p in &mut huge.data.positions {
+    for p in huge.positions_mut() {
         *p *= 1e300;
     }
     let s = summarize(&huge);
@@ -285,7 +285,7 @@ fn figures_that_are_not_finite_are_flagged_and_never_null() {
     );
     // A coordinate that is not a number: every figure it touches is named, none is null.
     let mut nan = Assembly::new(grammar);
-    nan.data.positions[0].x = f64::NAN;
+    nan.positions_mut()[0].x = f64::NAN;
     let s = summarize(&nan);
     assert!(!s.finite);
     assert_eq!(

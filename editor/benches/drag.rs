@@ -156,12 +156,12 @@ fn ms(d: Duration) -> f64 {
 /// the model's diagonal.
 fn corner_part(app: &EditorApp) -> Option<(usize, f64)> {
     let asm = app.sculpt.assembly();
-    let (lo, hi) = asm.data.positions.iter().fold(
+    let (lo, hi) = asm.data().positions.iter().fold(
         (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
     let top = asm
-        .data
+        .data()
         .positions
         .iter()
         .filter(|p| p.y >= 0.0)

@@ -349,7 +349,7 @@ impl Canvas {
     fn label_parts(&self, ui: &mut egui::Ui, sculpt: &Sculpt) {
         const MOST: usize = 2000;
         let asm = sculpt.assembly();
-        for part in 0..asm.data.parts.len().min(MOST) {
+        for part in 0..asm.data().parts.len().min(MOST) {
             let at = self.to_screen(asm.part_centroid(part));
             if !self.rect.contains(at) {
                 continue;

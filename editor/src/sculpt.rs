@@ -247,7 +247,7 @@ impl Sculpt {
     }
 
     pub fn data(&self) -> &AssemblyData {
-        &self.assembly.data
+        self.assembly.data()
     }
 
     pub fn grammar(&self) -> &Arc<CompiledGrammar> {
@@ -356,7 +356,7 @@ impl Sculpt {
 
     /// The instances a part covers (one for a piece part, two for a stretch part).
     fn part_instances(&self, part: usize) -> Vec<usize> {
-        let data = &self.assembly.data;
+        let data = &self.assembly.data();
         match data.parts.get(part).map(|p| p.kind) {
             Some(PartKind::Piece { instance }) => vec![instance],
             Some(PartKind::Stretch { chain, first }) => data
@@ -416,7 +416,7 @@ impl Sculpt {
                 };
                 self.release();
                 self.checkpoint();
-                let name = self.assembly.data.instances[instance].name.clone();
+                let name = self.assembly.data().instances[instance].name.clone();
                 match self.pin_of(instance) {
                     Some(id) => {
                         self.assembly.release(id);
@@ -499,7 +499,7 @@ impl Sculpt {
             && self.grammar().assembly.instances == grammar.assembly.instances
             && self.grammar().assembly.docks == grammar.assembly.docks
             && self.grammar().assembly.chains == grammar.assembly.chains;
-        let mut data = self.assembly.data.clone();
+        let mut data = self.assembly.data().clone();
         let keep = same_model && data.check(&grammar).is_ok();
         if keep {
             let old = std::mem::take(&mut data.parts);
@@ -680,7 +680,7 @@ impl Sculpt {
 
     /// Why `part` is in the state it is in.
     pub fn inspect(&self, part: usize) -> Option<PartReport> {
-        let data = &self.assembly.data;
+        let data = &self.assembly.data();
         let grammar = self.assembly.grammar();
         let p = data.parts.get(part)?;
         let name = |i: usize| data.instances.get(i).map_or("?", |x| x.name.as_str());
@@ -782,7 +782,7 @@ impl Sculpt {
     fn snapshot(&self) -> Snapshot {
         Snapshot {
             grammar: self.grammar().clone(),
-            data: self.assembly.data.clone(),
+            data: self.assembly.data().clone(),
             pins: self.pins(),
             log: self.log.clone(),
         }
@@ -807,7 +807,7 @@ impl Sculpt {
             // following it through rules; any other vertex set is held as it is.
             let instance = self
                 .assembly
-                .data
+                .data()
                 .instances
                 .iter()
                 .position(|i| i.vertices == pin.vertices);
@@ -873,7 +873,7 @@ impl Sculpt {
         let held: std::collections::HashSet<usize> = h.vertices.iter().copied().collect();
         if let Some(p) = self
             .assembly
-            .data
+            .data()
             .parts
             .iter()
             .position(|p| p.vertices.iter().all(|v| held.contains(v)))

@@ -399,24 +399,24 @@ impl Rules {
     pub fn after_frame(&mut self, asm: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent> {
         self.frame += 1;
         let grammar = asm.grammar_arc().clone();
-        let mut events = replace::replacement_events(&grammar, &mut asm.data, &report.switches);
+        let mut events = replace::replacement_events(&grammar, asm.data_mut(), &report.switches);
         let mut rewrites = Vec::new();
-        for (chain, first) in stretch::candidates(&grammar, &asm.data) {
+        for (chain, first) in stretch::candidates(&grammar, asm.data()) {
             // Earlier rewrites in this loop never renumber chains, and elements only within
             // their own chain, so (chain, first) is still valid here.
-            if let Ok(r) = stretch::rewrite_part(&grammar, &mut asm.data, chain, first) {
+            if let Ok(r) = stretch::rewrite_part(&grammar, asm.data_mut(), chain, first) {
                 self.carry(asm, &r);
                 rewrites.push(r.event);
             }
         }
         // a cut pair parts once no merge rule finds its sides within reach
         self.parted.retain(|&pair| {
-            merge::find_where(&grammar, &asm.data, |m, t| unordered(m, t) == pair).is_some()
+            merge::find_where(&grammar, asm.data(), |m, t| unordered(m, t) == pair).is_some()
         });
         let parted = &self.parted;
-        if let Some(found) = merge::find_where(&grammar, &asm.data, |m, t| {
+        if let Some(found) = merge::find_where(&grammar, asm.data(), |m, t| {
             !parted.contains(&unordered(m, t))
-        }) && let Ok(r) = merge::apply(&grammar, &mut asm.data, &found)
+        }) && let Ok(r) = merge::apply(&grammar, asm.data_mut(), &found)
         {
             self.carry(asm, &r);
             rewrites.push(r.event);
@@ -426,9 +426,9 @@ impl Rules {
             e.frame = self.frame;
         }
         debug_assert!(
-            asm.data.check(&grammar).is_ok(),
+            asm.data().check(&grammar).is_ok(),
             "{:?}",
-            asm.data.check(&grammar)
+            asm.data().check(&grammar)
         );
         self.log.extend(events.iter().cloned());
         events
@@ -437,7 +437,7 @@ impl Rules {
     /// Cuts the dock nearest `point` (see [`cut::cut_at`]).
     pub fn cut(&mut self, asm: &mut Assembly, point: DVec2) -> Result<RuleEvent, String> {
         let grammar = asm.grammar_arc().clone();
-        let r = cut::cut_at(&grammar, &mut asm.data, point)?;
+        let r = cut::cut_at(&grammar, asm.data_mut(), point)?;
         // every pair among the instances on the cut's sides (its new instance included)
         let ids = &r.event.instances;
         for (k, &a) in ids.iter().enumerate() {

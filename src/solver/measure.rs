@@ -28,8 +28,8 @@ pub fn bbox(positions: &[DVec2]) -> Option<(DVec2, DVec2)> {
 /// Elastic energy (Eq. 4, unit weights) of the assembly's current positions and active states,
 /// with each part's rotation fitted to the current pose.
 pub fn elastic_energy(asm: &Assembly, config: &SolverConfig) -> f64 {
-    let parts = &asm.data.parts;
-    let f = &asm.data.positions;
+    let parts = &asm.data().parts;
+    let f = &asm.data().positions;
     let rotations: Vec<DVec2> = parts.iter().map(|p| local::part_rotation(p, f)).collect();
     let vertex_parts = local::VertexParts::build(parts, f.len());
     let cos_cone = cone_cosine(config.rotation_cone_degrees);
@@ -68,9 +68,9 @@ pub fn max_edge_strain(asm: &Assembly) -> f64 {
 /// `length / rest length - 1` (signed) of every edge of every part's active state, part by
 /// part; edges of zero rest length are skipped.
 pub fn edge_strains(asm: &Assembly) -> Vec<f64> {
-    let f = &asm.data.positions;
+    let f = &asm.data().positions;
     let mut out = Vec::new();
-    for part in &asm.data.parts {
+    for part in &asm.data().parts {
         let Some(rest) = part.states.get(part.active) else {
             continue;
         };

@@ -139,8 +139,8 @@ impl Solver {
 
     /// Rebuilds the pattern and symbolic factorisation if the assembly changed structurally.
     fn prepare(&mut self, asm: &Assembly) -> Result<(), SolverError> {
-        let n = asm.data.positions.len();
-        let edge_count: usize = asm.data.parts.iter().map(|p| p.edges.len()).sum();
+        let n = asm.data().positions.len();
+        let edge_count: usize = asm.data().parts.iter().map(|p| p.edges.len()).sum();
         let stale = self.generation != Some(asm.generation())
             || self.pattern.n != n
             || self.pattern.edges.len() != edge_count
@@ -148,7 +148,7 @@ impl Solver {
                 .work
                 .rest
                 .as_ref()
-                .is_some_and(|c| c.parts() != asm.data.parts.len());
+                .is_some_and(|c| c.parts() != asm.data().parts.len());
         if !stale {
             return Ok(());
         }
@@ -158,7 +158,7 @@ impl Solver {
                 "the model has {n} vertices, more than the solver can index"
             )));
         }
-        for (i, p) in asm.data.parts.iter().enumerate() {
+        for (i, p) in asm.data().parts.iter().enumerate() {
             let m = p.vertices.len();
             if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m)
             {
@@ -167,11 +167,11 @@ impl Solver {
                 )));
             }
         }
-        self.pattern = Pattern::build(n, &asm.data.parts);
-        self.work.vertex_parts = local::VertexParts::build(&asm.data.parts, n);
-        self.work.rest = local::RestCache::build(&asm.data.parts, &self.work.vertex_parts);
-        self.components = follow::Components::build(&asm.data.parts, n);
-        self.mean_rest_edge = mean_rest_edge(&asm.data.parts);
+        self.pattern = Pattern::build(n, &asm.data().parts);
+        self.work.vertex_parts = local::VertexParts::build(&asm.data().parts, n);
+        self.work.rest = local::RestCache::build(&asm.data().parts, &self.work.vertex_parts);
+        self.components = follow::Components::build(&asm.data().parts, n);
+        self.mean_rest_edge = mean_rest_edge(&asm.data().parts);
         self.symbolic = match self.config.kind {
             SolverKind::Cholesky if n > 0 => Some(
                 SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
@@ -227,8 +227,8 @@ impl Solver {
             complete: true,
             ..FrameReport::default()
         };
-        let n = asm.data.positions.len();
-        if n == 0 || asm.data.parts.is_empty() {
+        let n = asm.data().positions.len();
+        if n == 0 || asm.data().parts.is_empty() {
             report.converged = true;
             report.ms = start.elapsed().as_secs_f64() * 1e3;
             return Ok(report);
@@ -239,7 +239,7 @@ impl Solver {
         // error path just drops them and the next frame reallocates).
         let mut warm = std::mem::take(&mut self.work.warm);
         warm.clear();
-        warm.extend_from_slice(&asm.data.positions);
+        warm.extend_from_slice(&asm.data().positions);
         if warm.iter().any(|p| !p.is_finite()) {
             return Err(SolverError(
                 "the warm start has non-finite positions".into(),
@@ -259,7 +259,7 @@ impl Solver {
         }
         self.follow_handles(&mut warm, &mut split, step_tolerance);
         let pass1 = self.pass1(
-            &mut asm.data.parts,
+            &mut asm.data_mut().parts,
             &mut split,
             cfg.pass1_tolerance * scale,
             deadline,
@@ -268,7 +268,7 @@ impl Solver {
         self.splitting = split;
         let pass1_converged = pass1?;
         let (f, terms, pass2_converged) = self.pass2(
-            &asm.data.parts,
+            &asm.data().parts,
             asm.handles(),
             &warm,
             step_tolerance,
@@ -280,8 +280,8 @@ impl Solver {
                 "the solve produced non-finite positions".into(),
             ));
         }
-        report.moved = max_move(&asm.data.positions, &f);
-        asm.data.positions.copy_from_slice(&f);
+        report.moved = max_move(&asm.data().positions, &f);
+        asm.positions_mut().copy_from_slice(&f);
         let rot = asm.rotations_mut();
         if rot.len() == self.work.rotations.len() {
             rot.copy_from_slice(&self.work.rotations);
@@ -1114,7 +1114,7 @@ fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
 
 /// Piece parts carry their active state to their instance (that is the replacement rule).
 fn sync_instance_states(asm: &mut Assembly) {
-    let data = &mut asm.data;
+    let data = asm.data_mut();
     for part in &data.parts {
         if let PartKind::Piece { instance } = part.kind
             && let Some(inst) = data.instances.get_mut(instance)

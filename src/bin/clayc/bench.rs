@@ -212,8 +212,8 @@ pub fn bench(args: BenchArgs) -> u8 {
     };
     let result = BenchResult {
         model,
-        parts: asm.data.parts.len(),
-        vertices: asm.data.positions.len(),
+        parts: asm.data().parts.len(),
+        vertices: asm.data().positions.len(),
         matrix_nonzeros: solver.matrix_nonzeros(),
         factor_values: solver.factor_values(),
         solver: match kind {
@@ -244,7 +244,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         rules_fired,
         converged_frames: reports.iter().filter(|r| r.converged).count(),
         energy: reports.last().map_or(0.0, |r| r.energy),
-        checksum: asm.data.positions.iter().map(|p| p.x + p.y).sum(),
+        checksum: asm.data().positions.iter().map(|p| p.x + p.y).sum(),
     };
     let text = if args.json {
         match serde_json::to_string_pretty(&result) {
@@ -287,7 +287,7 @@ pub fn bench(args: BenchArgs) -> u8 {
 
 /// South-west and north-east corners of the street grid (the parts above the wall).
 fn grid_corners(asm: &Assembly) -> (DVec2, DVec2) {
-    let above = asm.data.positions.iter().filter(|p| p.y >= 0.0);
+    let above = asm.data().positions.iter().filter(|p| p.y >= 0.0);
     let (lo, hi) = above.fold(
         (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),

@@ -157,7 +157,7 @@ fn replay(
             .collect()
     };
     let (handles, pins) = (vertices(HandleKind::Grab), vertices(HandleKind::Pin));
-    Ok((assembly.data, handles, pins))
+    Ok((assembly.into_data(), handles, pins))
 }
 
 fn wants_svg(output: &Path, flag: bool) -> bool {
