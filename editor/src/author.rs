@@ -260,8 +260,39 @@ impl Authoring {
                     }
                 }
             }
-            AuthorCommand::RenamePiece { from, to } => self.rename_piece(w, &from, to.trim()),
             AuthorCommand::Report(m) => self.say(m),
+            AuthorCommand::SetTolerance(t) => {
+                if !(t.is_finite() && t > 0.0) {
+                    self.say("the tolerance must be a positive number".into());
+                    return;
+                }
+                w.tolerance = t;
+                self.change(w, "use that tolerance");
+            }
+            AuthorCommand::Clear => {
+                let old = std::mem::replace(
+                    &mut self.work,
+                    Work {
+                        tolerance: w.tolerance,
+                        ..Work::default()
+                    },
+                );
+                if old != self.work {
+                    self.undo.push(old);
+                    self.redo.clear();
+                }
+                self.recompute();
+            }
+            // The rule declarations: names, types, stretch, variants, merges, states.
+            declaration => self.declare(w, declaration),
+        }
+    }
+
+    /// Applies a rule declaration (every command that changes names, site types, the
+    /// stretch rule, variants, merges or rest states) to the work `w`.
+    fn declare(&mut self, mut w: Work, command: AuthorCommand) {
+        match command {
+            AuthorCommand::RenamePiece { from, to } => self.rename_piece(w, &from, to.trim()),
             AuthorCommand::RenameSiteType { from, to } => {
                 let to = to.trim().to_string();
                 if let Err(e) = check_name(&to) {
@@ -284,41 +315,6 @@ impl Authoring {
                     w.site_names.insert(from, to);
                 }
                 self.change(w, "rename");
-            }
-            AuthorCommand::SetStretch(choice) => {
-                if let (Some(c), Ok(computed)) = (&choice, &self.result) {
-                    // Check it here so a wrong pick is refused instead of becoming a note.
-                    let mut d = computed.design.clone();
-                    if let Err(e) = d.make_stretchable(c) {
-                        self.say(e.to_string());
-                        return;
-                    }
-                }
-                w.stretch = choice;
-                self.change(w, "make that stretchable");
-            }
-            AuthorCommand::AddMerge(m) => {
-                let names = self.design().map(site_names).unwrap_or_default();
-                let sites = [Some(&m.mover), Some(&m.target), m.junction.as_ref()];
-                if let Some(missing) = sites.into_iter().flatten().find(|s| !names.contains(s)) {
-                    self.say(format!("there is no site {missing}"));
-                    return;
-                }
-                if m.mover == m.target {
-                    self.say("a site cannot merge onto itself".into());
-                    return;
-                }
-                if w.merges.contains(&m) {
-                    return;
-                }
-                w.merges.push(m);
-                self.change(w, "add that merge rule");
-            }
-            AuthorCommand::RemoveMerge { index } => {
-                if index < w.merges.len() {
-                    w.merges.remove(index);
-                    self.change(w, "remove that merge rule");
-                }
             }
             AuthorCommand::SetSiteType { site, site_type } => {
                 let site_type = site_type.trim().to_string();
@@ -353,6 +349,47 @@ impl Authoring {
                         others.join(", ")
                     ));
                 }
+            }
+            other => self.declare_rule(w, other),
+        }
+    }
+
+    /// Applies a rule declaration proper: the stretch rule, its variants, merges and rest
+    /// states.
+    fn declare_rule(&mut self, mut w: Work, command: AuthorCommand) {
+        match command {
+            AuthorCommand::SetStretch(choice) => {
+                if let (Some(c), Ok(computed)) = (&choice, &self.result) {
+                    // Check it here so a wrong pick is refused instead of becoming a note.
+                    let mut d = computed.design.clone();
+                    if let Err(e) = d.make_stretchable(c) {
+                        self.say(e.to_string());
+                        return;
+                    }
+                }
+                w.stretch = choice;
+                self.change(w, "make that stretchable");
+            }
+            AuthorCommand::AddMerge(m) => {
+                let names = self.design().map(site_names).unwrap_or_default();
+                let sites = [Some(&m.mover), Some(&m.target), m.junction.as_ref()];
+                if let Some(missing) = sites.into_iter().flatten().find(|s| !names.contains(s)) {
+                    self.say(format!("there is no site {missing}"));
+                    return;
+                }
+                if m.mover == m.target {
+                    self.say("a site cannot merge onto itself".into());
+                    return;
+                }
+                if w.merges.contains(&m) {
+                    return;
+                }
+                w.merges.push(m);
+                self.change(w, "add that merge rule");
+            }
+            AuthorCommand::RemoveMerge { index } if index < w.merges.len() => {
+                w.merges.remove(index);
+                self.change(w, "remove that merge rule");
             }
             AuthorCommand::SetVariants(mut variants) => {
                 if variants.is_empty() {
@@ -403,34 +440,12 @@ impl Authoring {
                 w.states.push(st);
                 self.change(w, "add that rest state");
             }
-            AuthorCommand::RemoveState { index } => {
-                if index < w.states.len() {
-                    w.states.remove(index);
-                    self.change(w, "remove that rest state");
-                }
+            AuthorCommand::RemoveState { index } if index < w.states.len() => {
+                w.states.remove(index);
+                self.change(w, "remove that rest state");
             }
-            AuthorCommand::SetTolerance(t) => {
-                if !(t.is_finite() && t > 0.0) {
-                    self.say("the tolerance must be a positive number".into());
-                    return;
-                }
-                w.tolerance = t;
-                self.change(w, "use that tolerance");
-            }
-            AuthorCommand::Clear => {
-                let old = std::mem::replace(
-                    &mut self.work,
-                    Work {
-                        tolerance: w.tolerance,
-                        ..Work::default()
-                    },
-                );
-                if old != self.work {
-                    self.undo.push(old);
-                    self.redo.clear();
-                }
-                self.recompute();
-            }
+            // Undo, redo and the drawing's commands are `apply`'s.
+            _ => {}
         }
     }
 

@@ -1,0 +1,607 @@
+//! Compiling a `piece` declaration: its vertices, edges, docking sites, proxy geometry and
+//! alternative rest states (paper 4.1), with the checks on each.
+
+use crate::compiled::*;
+use crate::diagnostic::Diagnostic;
+use crate::suggest::closest;
+use crate::syntax::{self, Ident, PieceStmt, Span};
+use glam::DVec2;
+
+use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, PieceSpans, codes, fmt};
+
+impl Compiler {
+    pub(super) fn piece_decl(&mut self, decl: &syntax::PieceDecl) {
+        if let Some(&first) = self.piece_index.get(&decl.name.name) {
+            let span = self.piece_spans[first].name;
+            self.duplicate("piece", &decl.name, span);
+            return;
+        }
+        let errors_before = self.diags.error_count();
+        let mut piece = Piece {
+            name: decl.name.name.clone(),
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            sites: Vec::new(),
+            states: Vec::new(),
+            axis: None,
+        };
+        let mut spans = PieceSpans {
+            name: decl.name.span,
+            ..Default::default()
+        };
+        let mut base = Vec::new();
+        // Vertices first: statements may come in any order and refer to later vertices.
+        for s in &decl.stmts {
+            if let PieceStmt::Vertex(v) = s {
+                if let Some(i) = piece.vertices.iter().position(|n| *n == v.name.name) {
+                    self.duplicate("vertex", &v.name, spans.vertices[i]);
+                    continue;
+                }
+                piece.vertices.push(v.name.name.clone());
+                spans.vertices.push(v.name.span);
+                base.push(self.point(&v.pos));
+            }
+        }
+        if piece.vertices.is_empty() {
+            self.error(
+                Diagnostic::error(
+                    codes::DEGENERATE,
+                    format!("piece `{}` has no vertices", decl.name.name),
+                    decl.name.span,
+                    "declared here",
+                )
+                .with_hint("add vertices with `vertex NAME (x, y)`"),
+            );
+        }
+        let mut edge_spans: Vec<Span> = Vec::new();
+        let mut axis: Option<&syntax::AxisDecl> = None;
+        let mut geometry = Vec::new();
+        for s in &decl.stmts {
+            match s {
+                PieceStmt::Edges(e) => {
+                    let mut edges = std::mem::take(&mut piece.edges);
+                    self.edges(&piece, e, &mut edges, &mut edge_spans);
+                    piece.edges = edges;
+                }
+                PieceStmt::Site(site) => {
+                    if let Some(i) = piece.sites.iter().position(|x| x.name == site.name.name) {
+                        self.duplicate("site", &site.name, spans.sites[i]);
+                        continue;
+                    }
+                    if let Some(compiled) = self.site(&piece, site) {
+                        piece.sites.push(compiled);
+                        spans.sites.push(site.name.span);
+                    }
+                }
+                PieceStmt::Axis(a) => {
+                    if let Some(first) = axis {
+                        let id = Ident {
+                            name: "axis".into(),
+                            span: a.span,
+                        };
+                        self.duplicate("declaration", &id, first.span);
+                    } else {
+                        axis = Some(a);
+                    }
+                }
+                PieceStmt::Geometry(g) => geometry.extend(self.geometry(g)),
+                PieceStmt::Vertex(_) | PieceStmt::State(_) => {}
+            }
+        }
+        // Edges are stored as given (first-written orientation) and deduplicated.
+        self.check_state_geometry(
+            &piece,
+            "base",
+            &base,
+            &spans.vertices,
+            decl.name.span,
+            &edge_spans,
+        );
+        piece.states.push(RestState {
+            name: "base".into(),
+            positions: base.clone(),
+            geometry: geometry.clone(),
+            geometry_frame: 0,
+        });
+        spans.edges = edge_spans;
+        let mut state_spans: Vec<Span> = Vec::new();
+        for s in &decl.stmts {
+            if let PieceStmt::State(st) = s {
+                if st.name.name == "base" {
+                    self.error(
+                        Diagnostic::error(
+                            codes::DUPLICATE,
+                            "state `base` is defined twice",
+                            st.name.span,
+                            "defined again here",
+                        )
+                        .with_secondary(
+                            decl.name.span,
+                            "`base` is the state given by the piece's `vertex` positions",
+                        )
+                        .with_hint("give the alternative state another name"),
+                    );
+                    continue;
+                }
+                if let Some(i) = piece
+                    .states
+                    .iter()
+                    .skip(1)
+                    .position(|x| x.name == st.name.name)
+                {
+                    self.duplicate("state", &st.name, state_spans[i]);
+                    continue;
+                }
+                let index = piece.states.len();
+                let state = self.state(&piece, &spans, st, index, &geometry);
+                piece.states.push(state);
+                state_spans.push(st.name.span);
+                spans
+                    .states
+                    .push(Span::new(st.span.start, st.name.span.end));
+            }
+        }
+        if let Some(a) = axis {
+            let from = self.site_on(&piece, &a.from);
+            let to = self.site_on(&piece, &a.to);
+            if let (Some(f), Some(t)) = (from, to)
+                && self.opposite(&piece, f, t, a.span, "axis")
+            {
+                piece.axis = Some([f, t]);
+            }
+        }
+        spans.sound = self.diags.error_count() == errors_before;
+        let index = self.pieces.len();
+        self.piece_index.insert(piece.name.clone(), index);
+        self.pieces.push(piece);
+        self.piece_spans.push(spans);
+    }
+
+    /// Resolves a site name against a piece under construction.
+    pub(super) fn site_on(&mut self, piece: &Piece, ident: &Ident) -> Option<usize> {
+        match piece.sites.iter().position(|s| s.name == ident.name) {
+            Some(i) => Some(i),
+            None => {
+                let names: Vec<&str> = piece.sites.iter().map(|s| s.name.as_str()).collect();
+                self.unknown(
+                    "site",
+                    ident,
+                    names,
+                    Some(format!("on piece `{}`", piece.name)),
+                );
+                None
+            }
+        }
+    }
+
+    /// Checks that sites `from` and `to` of a piece point roughly opposite ways.
+    pub fn opposite(
+        &mut self,
+        piece: &Piece,
+        from: usize,
+        to: usize,
+        span: Span,
+        what: &str,
+    ) -> bool {
+        let (f, t) = (&piece.sites[from], &piece.sites[to]);
+        let ok = from != to && f.out.dot(t.out) < -0.5;
+        if !ok {
+            let mut d = Diagnostic::error(
+                codes::NOT_OPPOSITE,
+                format!(
+                    "the {what} of piece `{}` needs two opposite sites",
+                    piece.name
+                ),
+                span,
+                if from == to {
+                    format!("`{}` is used at both ends", f.name)
+                } else {
+                    format!(
+                        "`{}` points ({}, {}) and `{}` points ({}, {})",
+                        f.name,
+                        fmt(f.out.x),
+                        fmt(f.out.y),
+                        t.name,
+                        fmt(t.out.x),
+                        fmt(t.out.y)
+                    )
+                },
+            );
+            d = d.with_hint("the `out` directions of the two sites must point roughly opposite ways (their dot product below -0.5)");
+            self.error(d);
+        }
+        ok
+    }
+
+    pub(super) fn vertex_index(&mut self, piece: &Piece, ident: &Ident) -> Option<usize> {
+        match piece.vertices.iter().position(|v| *v == ident.name) {
+            Some(i) => Some(i),
+            None => {
+                let names: Vec<&str> = piece.vertices.iter().map(String::as_str).collect();
+                self.unknown(
+                    "vertex",
+                    ident,
+                    names,
+                    Some(format!("in piece `{}`", piece.name)),
+                );
+                None
+            }
+        }
+    }
+
+    /// Adds the edges of one `edges` statement, reporting unknown vertices, loops and repeats.
+    pub(super) fn edges(
+        &mut self,
+        piece: &Piece,
+        e: &syntax::EdgesDecl,
+        edges: &mut Vec<[usize; 2]>,
+        spans: &mut Vec<Span>,
+    ) {
+        for path in &e.paths {
+            let ids: Vec<Option<usize>> =
+                path.iter().map(|v| self.vertex_index(piece, v)).collect();
+            for k in 0..path.len().saturating_sub(1) {
+                let (Some(a), Some(b)) = (ids[k], ids[k + 1]) else {
+                    continue;
+                };
+                let span = path[k].span.to(path[k + 1].span);
+                if a == b {
+                    self.error(
+                        Diagnostic::error(
+                            codes::ZERO_EDGE,
+                            format!("edge `{0}-{0}` joins a vertex to itself", path[k].name),
+                            span,
+                            "zero-length edge",
+                        )
+                        .with_hint("remove the repeated vertex from the path"),
+                    );
+                    continue;
+                }
+                if let Some(i) = edges
+                    .iter()
+                    .position(|&[x, y]| (x, y) == (a, b) || (x, y) == (b, a))
+                {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            codes::REPEATED_EDGE,
+                            format!(
+                                "edge `{}-{}` is listed twice",
+                                path[k].name,
+                                path[k + 1].name
+                            ),
+                            span,
+                            "repeated here",
+                        )
+                        .with_secondary(spans[i], "first listed here")
+                        .with_hint("edges are undirected: `a-b` and `b-a` are the same edge"),
+                    );
+                    continue;
+                }
+                edges.push([a, b]);
+                spans.push(span);
+            }
+        }
+    }
+
+    pub(super) fn site(&mut self, piece: &Piece, s: &syntax::SiteDecl) -> Option<Site> {
+        let site_type = match self.site_type_index(&s.site_type.name) {
+            Some(t) => Some(t),
+            None => {
+                let names: Vec<String> = self.site_types.iter().map(|t| t.name.clone()).collect();
+                self.unknown(
+                    "site type",
+                    &s.site_type,
+                    names.iter().map(String::as_str),
+                    None,
+                );
+                None
+            }
+        };
+        let mut vertices = Vec::new();
+        let mut ok = true;
+        for (k, v) in s.vertices.iter().enumerate() {
+            match self.vertex_index(piece, v) {
+                Some(i) => {
+                    if let Some(j) = s.vertices[..k].iter().position(|w| w.name == v.name) {
+                        self.duplicate("site vertex", v, s.vertices[j].span);
+                        ok = false;
+                    }
+                    vertices.push(i);
+                }
+                None => ok = false,
+            }
+        }
+        let out = self.point(&s.out);
+        let len = out.length();
+        if len < COINCIDENT_EPS {
+            self.error(
+                Diagnostic::error(codes::ZERO_OUT, format!("site `{}` has no outward direction", s.name.name), s.out.span, "zero vector")
+                    .with_hint("`out` is the direction pointing away from the piece, like `(1, 0)` for a site on the east side"),
+            );
+            ok = false;
+        }
+        if !ok {
+            return None;
+        }
+        Some(Site {
+            name: s.name.name.clone(),
+            site_type: site_type?,
+            vertices,
+            out: out / len,
+        })
+    }
+
+    pub(super) fn geometry(&mut self, g: &syntax::GeometryDecl) -> Option<Proxy> {
+        let binding = match g.binding {
+            Some((syntax::BindingKw::Skinned, _)) => Binding::Skinned,
+            _ => Binding::Rigid,
+        };
+        let fill = Rgba(g.fill.rgba);
+        let shape = match &g.shape {
+            syntax::ShapeDecl::Polygon { outer, holes } => {
+                let mut ok = self.enough_points(outer.len(), 3, "polygon", g.keyword);
+                let outer: Vec<DVec2> = outer.iter().map(|p| self.point(p)).collect();
+                let mut hs = Vec::new();
+                for h in holes {
+                    ok &= self.enough_points(h.points.len(), 3, "hole", h.span);
+                    hs.push(h.points.iter().map(|p| self.point(p)).collect());
+                }
+                if !ok {
+                    return None;
+                }
+                ProxyShape::Polygon { outer, holes: hs }
+            }
+            syntax::ShapeDecl::Polyline { width, points } => {
+                let ok = self.enough_points(points.len(), 2, "polyline", g.keyword);
+                let w = self.in_range(
+                    width,
+                    "polyline `width`",
+                    |w| w > 0.0 && w <= MAX_COORDINATE,
+                    "above 0",
+                );
+                let points = points.iter().map(|p| self.point(p)).collect();
+                if !ok {
+                    return None;
+                }
+                ProxyShape::Polyline { points, width: w? }
+            }
+        };
+        Some(Proxy {
+            shape,
+            fill,
+            binding,
+        })
+    }
+
+    pub(super) fn enough_points(&mut self, n: usize, min: usize, what: &str, span: Span) -> bool {
+        if n >= min {
+            return true;
+        }
+        self.error(
+            Diagnostic::error(
+                codes::DEGENERATE,
+                format!(
+                    "{what} has {n} point{}, needs at least {min}",
+                    if n == 1 { "" } else { "s" }
+                ),
+                span,
+                "too few points",
+            )
+            .with_hint(format!("a {what} needs at least {min} points `(x, y)`")),
+        );
+        false
+    }
+
+    /// Zero-length edges and coincident vertices of one rest state.
+    pub(super) fn check_state_geometry(
+        &mut self,
+        piece: &Piece,
+        state: &str,
+        pos: &[DVec2],
+        vspans: &[Span],
+        fallback: Span,
+        edge_spans: &[Span],
+    ) {
+        if pos.len() != piece.vertices.len() {
+            return;
+        }
+        let mut reported = vec![false; pos.len()];
+        for (k, &[a, b]) in piece.edges.iter().enumerate() {
+            if pos[a].distance(pos[b]) < COINCIDENT_EPS {
+                reported[a] = true;
+                reported[b] = true;
+                let mut d = Diagnostic::error(
+                    codes::ZERO_EDGE,
+                    format!(
+                        "edge `{}-{}` has zero length in state `{state}`",
+                        piece.vertices[a], piece.vertices[b]
+                    ),
+                    vspans.get(b).copied().unwrap_or(fallback),
+                    format!(
+                        "`{}` is at the same place as `{}`: ({}, {})",
+                        piece.vertices[b],
+                        piece.vertices[a],
+                        fmt(pos[b].x),
+                        fmt(pos[b].y)
+                    ),
+                );
+                if let Some(&e) = edge_spans.get(k) {
+                    d = d.with_secondary(e, "the edge is declared here");
+                }
+                self.error(d.with_hint("move one of the vertices, or merge them into one vertex"));
+            }
+        }
+        // Sorting by x keeps this near-linear for big pieces.
+        let mut order: Vec<usize> = (0..pos.len()).collect();
+        order.sort_by(|&i, &j| pos[i].x.total_cmp(&pos[j].x));
+        for (k, &i) in order.iter().enumerate() {
+            for &j in &order[k + 1..] {
+                if pos[j].x - pos[i].x >= COINCIDENT_EPS {
+                    break;
+                }
+                if pos[i].distance(pos[j]) < COINCIDENT_EPS && !(reported[i] && reported[j]) {
+                    let (a, b) = (i.min(j), i.max(j));
+                    reported[a] = true;
+                    reported[b] = true;
+                    self.error(
+                        Diagnostic::error(
+                            codes::COINCIDENT,
+                            format!(
+                                "vertices `{}` and `{}` are at the same place in state `{state}`",
+                                piece.vertices[a], piece.vertices[b]
+                            ),
+                            vspans.get(b).copied().unwrap_or(fallback),
+                            format!(
+                                "`{}` is at ({}, {})",
+                                piece.vertices[b],
+                                fmt(pos[b].x),
+                                fmt(pos[b].y)
+                            ),
+                        )
+                        .with_secondary(
+                            vspans.get(a).copied().unwrap_or(fallback),
+                            format!("`{}` is here too", piece.vertices[a]),
+                        )
+                        .with_hint("every vertex of a rest state needs its own position"),
+                    );
+                }
+            }
+        }
+    }
+
+    pub(super) fn state(
+        &mut self,
+        piece: &Piece,
+        spans: &PieceSpans,
+        st: &syntax::StateDecl,
+        index: usize,
+        base_geometry: &[Proxy],
+    ) -> RestState {
+        let n = piece.vertices.len();
+        let mut pos: Vec<Option<DVec2>> = vec![None; n];
+        let mut vspans: Vec<Span> = vec![st.name.span; n];
+        for p in &st.positions {
+            match piece.vertices.iter().position(|v| *v == p.name.name) {
+                Some(i) => {
+                    if pos[i].is_some() {
+                        self.duplicate("vertex position", &p.name, vspans[i]);
+                        continue;
+                    }
+                    pos[i] = Some(self.point(&p.pos));
+                    vspans[i] = p.name.span;
+                }
+                None => {
+                    let mut d = Diagnostic::error(
+                        codes::STATE_VERTICES,
+                        format!(
+                            "state `{}` adds vertex `{}`, which piece `{}` does not have",
+                            st.name.name, p.name.name, piece.name
+                        ),
+                        p.name.span,
+                        "not a vertex of the piece",
+                    )
+                    .with_secondary(spans.name, "piece declared here");
+                    if let Some(c) =
+                        closest(&p.name.name, piece.vertices.iter().map(String::as_str))
+                    {
+                        d = d.with_hint(format!("did you mean `{c}`?"));
+                    } else {
+                        d = d.with_hint("an alternative state may not add vertices: it gives new positions to the piece's own vertices");
+                    }
+                    self.error(d);
+                }
+            }
+        }
+        let missing: Vec<usize> = (0..n).filter(|&i| pos[i].is_none()).collect();
+        if !missing.is_empty() {
+            let names: Vec<String> = missing
+                .iter()
+                .map(|&i| format!("`{}`", piece.vertices[i]))
+                .collect();
+            let mut d = Diagnostic::error(
+                codes::STATE_VERTICES,
+                format!(
+                    "state `{}` gives no position for vertex {}",
+                    st.name.name,
+                    names.join(", ")
+                ),
+                st.name.span,
+                format!("missing {}", names.join(", ")),
+            );
+            if let Some(&i) = missing.first() {
+                d = d.with_secondary(
+                    spans.vertices.get(i).copied().unwrap_or(spans.name),
+                    format!("`{}` is declared here", piece.vertices[i]),
+                );
+            }
+            self.error(
+                d.with_hint("an alternative state gives a position for every vertex of its piece"),
+            );
+        }
+        // Restated edges must equal the piece's: the part's edge set is shared by all states.
+        for e in &st.edges {
+            let mut list = Vec::new();
+            let mut espans = Vec::new();
+            self.edges(piece, e, &mut list, &mut espans);
+            let key = |[a, b]: [usize; 2]| [a.min(b), a.max(b)];
+            let mine: Vec<[usize; 2]> = piece.edges.iter().map(|&e| key(e)).collect();
+            let theirs: Vec<[usize; 2]> = list.iter().map(|&e| key(e)).collect();
+            let extra: Vec<String> = theirs
+                .iter()
+                .filter(|e| !mine.contains(e))
+                .map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b]))
+                .collect();
+            let missing: Vec<String> = mine
+                .iter()
+                .filter(|e| !theirs.contains(e))
+                .map(|&[a, b]| format!("`{}-{}`", piece.vertices[a], piece.vertices[b]))
+                .collect();
+            if !extra.is_empty() || !missing.is_empty() {
+                let mut parts = Vec::new();
+                if !extra.is_empty() {
+                    parts.push(format!("adds {}", extra.join(", ")));
+                }
+                if !missing.is_empty() {
+                    parts.push(format!("lacks {}", missing.join(", ")));
+                }
+                self.error(
+                    Diagnostic::error(
+                        codes::STATE_EDGES,
+                        format!("the edges of state `{}` differ from piece `{}`'s", st.name.name, piece.name),
+                        e.span,
+                        parts.join("; "),
+                    )
+                    .with_secondary(spans.name, "piece declared here")
+                    .with_hint("a restated edge list must equal the piece's; or leave it out, the piece's edges apply"),
+                );
+            }
+        }
+        let positions: Vec<DVec2> = pos.iter().map(|p| p.unwrap_or(DVec2::ZERO)).collect();
+        if missing.is_empty() {
+            self.check_state_geometry(
+                piece,
+                &st.name.name,
+                &positions,
+                &vspans,
+                st.name.span,
+                &spans.edges,
+            );
+        }
+        let own: Vec<Proxy> = st
+            .geometry
+            .iter()
+            .filter_map(|g| self.geometry(g))
+            .collect();
+        let (geometry, geometry_frame) = if st.geometry.is_empty() {
+            (base_geometry.to_vec(), 0)
+        } else {
+            (own, index)
+        };
+        RestState {
+            name: st.name.name.clone(),
+            positions,
+            geometry,
+            geometry_frame,
+        }
+    }
+}
