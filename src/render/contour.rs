@@ -5,7 +5,10 @@
 
 use glam::DVec2;
 
-use super::draw::finite;
+/// Whether a pixel-space point is finite (NaN or infinity never reaches a picture).
+pub(crate) fn finite(p: &[f32; 2]) -> bool {
+    p[0].is_finite() && p[1].is_finite()
+}
 
 /// Meshes with fewer triangles are filled triangle by triangle: cheap at that size, and the
 /// pictures in `docs/pictures/` stay exactly as they are.

@@ -6,15 +6,10 @@ use std::collections::HashMap;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind, Rgba};
 use glam::DVec2;
 
+use super::contour::finite;
 use super::contour::{CONTOUR_MIN_TRIANGLES, contours};
 use super::pose::{WorldMesh, site_out};
 use super::text;
-
-/// A pixel-space drawing surface (x right, y down).
-/// Whether a pixel-space point is finite (NaN or infinity never reaches a picture).
-pub(crate) fn finite(p: &[f32; 2]) -> bool {
-    p[0].is_finite() && p[1].is_finite()
-}
 
 /// The triangles a canvas fills: those whose corners exist and are finite, all turned to one
 /// winding, so that under the nonzero rule their union is filled once, with no anti-aliasing
@@ -37,6 +32,7 @@ pub(crate) fn wound_triangles<'a>(
     })
 }
 
+/// A pixel-space drawing surface (x right, y down).
 pub trait Canvas {
     /// Fills the union of the triangles (each one's winding is normalised, so overlaps do not
     /// cancel or double-blend).

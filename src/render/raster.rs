@@ -6,7 +6,8 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform,
 };
 
-use super::draw::{Canvas, RenderOptions, View, bounds, draw_assembly, finite, wound_triangles};
+use super::contour::finite;
+use super::draw::{Canvas, RenderOptions, View, bounds, draw_assembly, wound_triangles};
 use super::pose::pose_assembly;
 use super::tessellate::TessellationCache;
 use super::text::{self, PathSink};

@@ -5,7 +5,8 @@ use std::fmt::Write;
 
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, Rgba};
 
-use super::draw::{Canvas, RenderOptions, draw_assembly, finite, hex, wound_triangles};
+use super::contour::finite;
+use super::draw::{Canvas, RenderOptions, draw_assembly, hex, wound_triangles};
 use super::pose::pose_assembly;
 use super::raster::view_for;
 use super::tessellate::TessellationCache;
