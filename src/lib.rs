@@ -1,4 +1,8 @@
 //! Clay: live assemblies, the mutable elastic solver, rules and rendering.
+
+// The library returns data; printing is the binaries' job (diagnostics at the CLI's edge).
+#![deny(clippy::print_stdout, clippy::print_stderr)]
+
 pub mod assembly;
 pub mod authoring;
 pub mod files;

@@ -6,6 +6,8 @@
 //! other crate reads) and [`syntax`] (the tree, which authoring builds) are modules; the phases
 //! are private and their entry points re-exported here, so every name has one path.
 
+#![deny(clippy::print_stdout, clippy::print_stderr)]
+
 pub mod compiled;
 pub mod syntax;
 
