@@ -2,6 +2,8 @@
 //! canvas sculpt the model, Ctrl+Z undoes the gesture, and a failed hot reload keeps the model
 //! and shows the diagnostics.
 
+mod common;
+
 use std::time::{Duration, Instant};
 
 use clay_dsl::compiled::PartKind;
@@ -11,23 +13,7 @@ use egui::{Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
-fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .with_max_steps(8)
-        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
-}
-
-/// Steps until the solver has settled (each step is one UI frame with its solver budget).
-fn settle(h: &mut Harness<'_, EditorApp>) {
-    for _ in 0..300 {
-        h.step();
-        if !h.state().sculpt.needs_work() {
-            return;
-        }
-    }
-    panic!("the model did not settle");
-}
+use common::{harness, settle};
 
 /// The first tower part (a piece part) of the castle.
 fn tower(app: &EditorApp) -> usize {

@@ -3,33 +3,20 @@
 //! the F1 help, the rule log following undo and kept in sessions and in the user's words,
 //! failed reloads in the log, and a click on a diagnostic showing its line.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use clay_editor::EditorApp;
 use clay_editor::compile::CASTLE_SOURCE;
 use clay_editor::sculpt::Command;
-use egui::{Shape, Vec2};
+use egui::Shape;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+
+use common::{harness, settle};
 use glam::DVec2;
-
-fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
-    Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .with_max_steps(8)
-        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
-}
-
-fn settle(h: &mut Harness<'_, EditorApp>) {
-    for _ in 0..300 {
-        h.step();
-        if !h.state().sculpt.needs_work() {
-            return;
-        }
-    }
-    panic!("the model did not settle");
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("clay-editor-view-{name}-{}", std::process::id()));

@@ -183,7 +183,7 @@ fn compass(out: DVec2) -> &'static str {
 }
 
 /// A name usable in a `.clay` file: letters, digits and `_`, not starting with a digit.
-fn clean_name(raw: &str) -> Option<String> {
+pub(crate) fn clean_name(raw: &str) -> Option<String> {
     let s: String = raw
         .chars()
         .map(|c| {

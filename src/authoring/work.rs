@@ -352,20 +352,7 @@ fn colour_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
 
 /// An SVG id as a name: `brick3` -> `brick` (as the library does), if it then is a name.
 fn name_from_id(raw: &str) -> Option<String> {
-    let s: String = raw
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    let s = s
-        .trim_end_matches(|c: char| c.is_ascii_digit() || c == '_')
-        .trim_start_matches(|c: char| c.is_ascii_digit() || c == '_');
-    check_name(s).is_ok().then(|| s.to_string())
+    super::pieces::clean_name(raw).filter(|s| check_name(s).is_ok())
 }
 
 /// Names the pieces and their instances; returns the generated names. A piece is named after
