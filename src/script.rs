@@ -37,6 +37,8 @@ pub enum Step {
     Grab(Selector),
     /// Fix the selected instance where it is.
     Pin(Selector),
+    /// Let go of the pin on the selected instance (the one it picks must be pinned).
+    Unpin(Selector),
     /// Move the current handle linearly over `frames` frames (0: jump, no frame).
     Drag { motion: Motion, frames: u64 },
     /// Turn the current handle about its centroid over `frames` frames.
@@ -188,7 +190,7 @@ fn step(v: &Value) -> Result<Step, Fault> {
         .ok_or_else(|| format!("a step must be an object, found {v}"))?;
     if obj.len() != 1 {
         return Err(format!(
-            "a step must have exactly one key (grab, pin, drag, rotate, release, hold, cut), found {}",
+            "a step must have exactly one key (grab, pin, unpin, drag, rotate, release, hold, cut), found {}",
             if obj.is_empty() {
                 "none".to_string()
             } else {
@@ -201,6 +203,7 @@ fn step(v: &Value) -> Result<Step, Fault> {
     match kind.as_str() {
         "grab" => Ok(Step::Grab(selector(body, "grab")?)),
         "pin" => Ok(Step::Pin(selector(body, "pin")?)),
+        "unpin" => Ok(Step::Unpin(selector(body, "unpin")?)),
         "drag" => {
             let o = object(body, "drag")?;
             only_keys(o, "drag", &["by", "to", "frames"])?;
@@ -246,7 +249,7 @@ fn step(v: &Value) -> Result<Step, Fault> {
             })
         }
         other => Err(format!(
-            "unknown step \"{other}\" (expected grab, pin, drag, rotate, release, hold or cut)"
+            "unknown step \"{other}\" (expected grab, pin, unpin, drag, rotate, release, hold or cut)"
         )
         .into()),
     }

@@ -381,6 +381,14 @@ impl Session {
                     self.pin(asm, instance);
                 }
             }
+            Step::Unpin(sel) => {
+                let unpinned = select(asm, sel).is_some_and(|i| self.unpin(asm, i));
+                if !unpinned {
+                    self.notes.push(format!(
+                        "step {index}: unpin found no pinned instance there"
+                    ));
+                }
+            }
             Step::Drag { motion, frames } => {
                 if self.grab.is_none() {
                     self.notes.push(format!(

@@ -108,3 +108,36 @@ fn a_sessions_counts_are_its_events_one_replace_per_instance_and_frame() {
     );
     assert_eq!(s.rules_fired()[&RuleKind::Stretch], 0);
 }
+
+#[test]
+fn an_unpinned_brick_follows_the_wall_again() {
+    let g = grammar("wall");
+    let run = |steps: &str| {
+        let mut asm = Assembly::new(Arc::new(g.clone()));
+        let mut s = Session::new(SolverConfig::from_params(&g.solver));
+        let script = Script::parse(&format!(r#"{{"steps": [{steps}]}}"#)).unwrap();
+        replay(&mut asm, &script, &mut s).unwrap();
+        let west = asm.data().instances[0].vertices[0];
+        (asm.data().positions[west], s.notes().to_vec())
+    };
+    let pin_west = r#"{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}}"#;
+    let pull = r#"{"drag": {"by": [3, 1], "frames": 20}}, {"hold": {"frames": 20}}"#;
+    let (held, _) = run(&format!("{pin_west}, {pull}"));
+    let (freed, notes) = run(&format!(
+        r#"{pin_west}, {{"unpin": {{"extreme": "west"}}}}, {pull}"#
+    ));
+    assert!(
+        held.length() < 1e-3,
+        "pinned: the west corner stays at {held}"
+    );
+    assert!(
+        freed.length() > 0.5,
+        "unpinned: the wall follows the grab rigidly, west corner at {freed}"
+    );
+    assert!(notes.is_empty(), "{notes:?}");
+    let (_, notes) = run(r#"{"unpin": {"extreme": "west"}}"#);
+    assert!(
+        notes[0].contains("unpin found no pinned instance"),
+        "{notes:?}"
+    );
+}
