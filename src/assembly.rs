@@ -176,7 +176,7 @@ impl Assembly {
     /// the solver rebuilds its pattern, resizes the rotations, re-reads the vertices of handles
     /// that hold an instance (see [`HeldInstance`]), and drops handles whose vertices no longer
     /// exist (rules that renumber vertices should remap handles first, through
-    /// [`Assembly::handles_mut`]).
+    /// `handles_mut`).
     /// The contract data: positions, instances, docks, chains and parts.
     pub fn data(&self) -> &AssemblyData {
         &self.data

@@ -21,7 +21,7 @@ pub enum Pass1 {
     /// pose every frame, one weight per part: a numeric factorisation per iteration.
     #[default]
     Irls,
-    /// Variable splitting ([`admm`]): least-squares solves with the pass-2 factor, per-edge
+    /// Variable splitting (`admm.rs`): least-squares solves with the pass-2 factor, per-edge
     /// gaps and duals carried from frame to frame. No factorisation while the assembly and
     /// the held vertices stay the same.
     Admm,
@@ -102,7 +102,7 @@ pub struct SolverConfig {
     /// Relative residual (against the right-hand side's edge terms, as `cg_tolerance`) the
     /// preconditioned pass-1 solves reach. Pass 2 is always solved directly.
     pub pcg_tolerance: f64,
-    /// A frame counts as converged ([`FrameReport::converged`]) when no state switched and the
+    /// A frame counts as converged ([`FrameReport::converged`](super::FrameReport::converged)) when no state switched and the
     /// displayed positions moved less than this fraction of the model's size.
     pub settle_tolerance: f64,
     /// Compute the relative residual of every linear solve into the report (one extra matrix

@@ -428,7 +428,8 @@ impl RestCache {
         self.spans.len().saturating_sub(1)
     }
 
-    /// Number of distinct rest data ([`Shape`]s) among the parts.
+    /// Number of distinct rest data ([`Shape`]s) among the parts (tests check the sharing).
+    #[cfg(test)]
     pub fn shapes(&self) -> usize {
         self.shapes.len()
     }

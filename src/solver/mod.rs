@@ -4,13 +4,13 @@
 //! norm (IRLS) and decides the active rest states; pass 2 is plain least squares with the
 //! states fixed, and its positions are what the user sees.
 
-pub mod admm;
-pub mod cg;
-pub mod cholesky;
+mod admm;
+mod cg;
+mod cholesky;
 mod config;
 pub mod follow;
-pub mod global;
-pub mod local;
+mod global;
+pub(crate) mod local;
 mod measure;
 mod report;
 

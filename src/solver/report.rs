@@ -12,7 +12,7 @@ pub struct StateSwitch {
 /// What one frame did.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct FrameReport {
-    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`]).
+    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`](super::SolverConfig::pass1)).
     pub pass1_iterations: usize,
     /// Least-squares (pass 2) iterations run.
     pub l2_iterations: usize,
@@ -29,12 +29,12 @@ pub struct FrameReport {
     /// Wall time of the frame in milliseconds.
     pub ms: f64,
     /// The frame left the model at rest: the frame was complete, no rest state switched, and
-    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`] times the
+    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`](super::SolverConfig::settle_tolerance) times the
     /// model's size (or both passes stopped on their step tolerance). Running another frame
     /// with the same handles would change nothing visible, so a caller can stop solving.
     pub converged: bool,
     /// The frame ran the iterations its passes asked for; `false` when
-    /// [`Solver::frame_budgeted`] cut it short to meet its time budget (the displayed
+    /// [`Solver::frame_budgeted`](super::Solver::frame_budgeted) cut it short to meet its time budget (the displayed
     /// positions are still a least-squares pose; the next call continues from them).
     pub complete: bool,
     /// Largest distance a displayed vertex moved this frame.
@@ -48,7 +48,7 @@ pub struct FrameReport {
     /// Where the frame's time went.
     pub phases: PhaseTimes,
     /// Largest relative residual `|b - A x| / |b|` of the frame's linear solves, when
-    /// [`SolverConfig::measure_residual`] is set.
+    /// [`SolverConfig::measure_residual`](super::SolverConfig::measure_residual) is set.
     pub linear_residual: Option<f64>,
 }
 
