@@ -476,6 +476,7 @@ impl Assembly {
 
     /// Checks indices and invariants of the data, the rotations and the handles. Returns every
     /// problem found, one line each.
+    // Long because: one short check per invariant of data, rotations and handles.
     pub fn validate(&self) -> Result<(), Vec<String>> {
         let mut errors = Vec::new();
         let d = &self.data;

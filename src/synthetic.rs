@@ -291,6 +291,7 @@ pub fn street(segments: usize) -> CompiledGrammar {
 
 /// A city of about `parts` parts: a square grid of junctions joined by streets of three
 /// segments, plus a long stretchable wall (a tenth of the parts) below it.
+// Long because: one recipe in order (grid, streets, wall, docks, placement); each step extends the half-built model the next one needs.
 pub fn city(parts: usize) -> CompiledGrammar {
     const SEGMENTS: usize = 3;
     const L: f64 = 2.0;

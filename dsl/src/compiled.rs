@@ -386,6 +386,7 @@ impl AssemblyData {
     /// it: indices in range, vertex counts matching pieces and rest states, docked sites sharing
     /// their vertices in opposite order, chains docked `to` -> `from` element by element, every
     /// position finite. Returns the first problem found, in words.
+    // Long because: one short check per invariant, in the order the invariants build on each other.
     pub fn check(&self, grammar: &CompiledGrammar) -> Result<(), String> {
         let nv = self.positions.len();
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {

@@ -199,6 +199,7 @@ fn drawing(
     }
 }
 
+// Long because: the Pieces panel's widgets in display order.
 fn pieces(
     ui: &mut egui::Ui,
     author: &Authoring,

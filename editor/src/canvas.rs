@@ -94,6 +94,7 @@ impl Canvas {
     }
 
     /// Draws the sculpt and collects the user's commands.
+    // Long because: the frame's input in the order egui delivers it (zoom, hover, gestures, keys), then painting.
     pub fn show(
         &mut self,
         ui: &mut egui::Ui,

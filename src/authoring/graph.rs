@@ -219,6 +219,7 @@ impl Graph {
     /// runs to the nearest other edge it meets (the far side of a strip, like the other rail of
     /// a road); those one or two points are the cut section. Each section vertex is split in
     /// two, one copy per side of the cut line, and the section edge is kept on both sides.
+    // Long because: one geometric construction (the cut line, its ends, the duplicated section) whose steps share the intersections.
     pub fn cut(&mut self, at: DVec2, snap: f64) -> Result<CutSection, AuthorError> {
         if !at.is_finite() {
             return Err(AuthorError("a cut point must be finite".into()));

@@ -201,6 +201,7 @@ pub(crate) fn clean_name(raw: &str) -> Option<String> {
 }
 
 /// Regions -> pieces, instances, site types, sites and docks.
+// Long because: the piece-finding steps in order (congruence classes, site types, sites, docks) over shared tables.
 pub fn find_pieces(
     graph: &Graph,
     regions: &[Region],
@@ -729,6 +730,7 @@ impl Design {
         }
     }
 
+    // Long because: the model block's items in order (instances, chains, placement, docks).
     fn model_block(&self) -> ModelBlock {
         let chains = self.chains();
         let mut chain_of: HashMap<usize, (usize, usize)> = HashMap::new();

@@ -163,6 +163,7 @@ pub fn check_name(s: &str) -> Result<(), String> {
 
 /// Runs the library's steps on the work. A stretch choice that no longer fits the design (the
 /// drawing or cuts changed under it) is dropped with a note rather than losing the design.
+// Long because: the library's steps in order, then the declarations applied to the design and its syntax tree.
 pub fn compute(work: &Work) -> Result<Computed, String> {
     if work.drawing.polylines.is_empty() {
         return Err("nothing drawn yet: import an SVG or draw on the canvas".into());
@@ -589,6 +590,7 @@ pub fn variant_map(design: &Design, p: usize, v: usize) -> Result<Vec<usize>, St
 
 /// Writes the variants into the stretch rule, each variant piece rewritten with the stretch
 /// piece's vertices, edges and sites at its own positions; or notes why they no longer apply.
+// Long because: each variant is matched, checked and rewritten in place in the syntax tree; the steps share the match tables.
 fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::File) {
     use clay_dsl::syntax::{Ident, Item, Number, PieceStmt, Span, VariantEntry, VariantsDecl};
     if work.variants.is_empty() {

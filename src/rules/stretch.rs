@@ -255,6 +255,7 @@ fn find_dock(data: &AssemblyData, x: InstanceSite, y: InstanceSite) -> Option<us
 /// Two elements -> three. The first and last keep their ids and outer site vertices; the new
 /// one goes in the middle and is the variant that brings the chain's histogram closest to
 /// the rule's frequencies.
+// Long because: one transaction: every index it rewrites must change together.
 pub fn stretch(
     grammar: &CompiledGrammar,
     data: &mut AssemblyData,

@@ -738,6 +738,7 @@ impl Solver {
         }
     }
 
+    // Long because: the global step's variants (Cholesky or CG, pass 1 or 2) share their set-up and fallbacks.
     fn solve_global_raw(
         &mut self,
         f: &[DVec2],

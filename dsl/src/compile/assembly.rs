@@ -41,6 +41,7 @@ enum Named {
     Broken,
 }
 
+// Long because: one ordered walk (instances, chains, docks, placement by docks) over tables each step fills for the next.
 pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> AssemblyData {
     let mut insts: Vec<Inst> = Vec::new();
     let mut docks: Vec<DockInfo> = Vec::new();

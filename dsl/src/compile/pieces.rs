@@ -10,6 +10,7 @@ use glam::DVec2;
 use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, PieceSpans, codes, fmt};
 
 impl Compiler {
+    // Long because: one pass over the piece's statements in source order, each a short arm of one match.
     pub(super) fn piece_decl(&mut self, decl: &syntax::PieceDecl) {
         if let Some(&first) = self.piece_index.get(&decl.name.name) {
             let span = self.piece_spans[first].name;
@@ -469,6 +470,7 @@ impl Compiler {
         }
     }
 
+    // Long because: a rest state's checks in order (names, vertex coverage, geometry), each reporting its own diagnostic.
     pub(super) fn state(
         &mut self,
         piece: &Piece,

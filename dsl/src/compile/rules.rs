@@ -76,6 +76,7 @@ impl Compiler {
         }
     }
 
+    // Long because: the stretch rule's checks in order, each with its own diagnostic.
     fn stretch(&mut self, s: &syntax::StretchDecl, claimed: &mut [Option<Span>]) {
         let Some(pi) = self.resolve_piece(&s.piece) else {
             return;
@@ -328,6 +329,7 @@ impl Compiler {
     }
 
     /// The two-element part: element 1 docked to element 0 through `to` -> `from`.
+    // Long because: the two-element part's vertices, edges and three rest states, built in order.
     fn stretch_part(
         &mut self,
         piece: &Piece,

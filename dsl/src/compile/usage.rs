@@ -65,6 +65,7 @@ impl Usage {
         }
     }
 
+    // Long because: one warning kind per declaration kind, in order.
     pub fn report(&self, c: &mut Compiler, file: &syntax::File) {
         if !self.complete {
             return;

@@ -108,6 +108,7 @@ fn stats(values: &[f64]) -> Ms {
     }
 }
 
+// Long because: one command's sequence: build the model, run the frames, then write every figure of the JSON.
 pub fn bench(args: BenchArgs) -> u8 {
     if args.frames == 0 || args.frames > 100_000 {
         errln!("error: --frames must be from 1 to 100000");
