@@ -67,3 +67,5 @@ pub const DEAD_RULE: &str = "W002";
 pub const REPEATED_EDGE: &str = "W003";
 /// `rotate` on an instance placed through its dock, where it has no effect.
 pub const IGNORED_ROTATE: &str = "W004";
+/// An empty grammar, or one with no `model` block: nothing to sculpt.
+pub const NO_MODEL: &str = "W005";

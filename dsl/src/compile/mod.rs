@@ -325,7 +325,11 @@ impl Compiler {
         self.check_skinned(file);
         let usage = usage::Usage::find(self, file, model);
         let assembly = assembly::build(self, model);
-        usage.report(self, file);
+        match model {
+            Some(_) => usage.report(self, file),
+            // Without a model every piece is unused: one warning says why, not one per piece.
+            None => self.no_model(file),
+        }
         let grammar = CompiledGrammar {
             format_version: FORMAT_VERSION,
             source: self.path.clone(),
@@ -354,6 +358,28 @@ impl Compiler {
             return;
         }
         self.grammar = Some(grammar);
+    }
+
+    /// W005: the file declares nothing to sculpt.
+    fn no_model(&mut self, file: &syntax::File) {
+        let end = Span::new(file.span.end, file.span.end);
+        let (message, label) = if file.items.is_empty() {
+            (
+                "the grammar is empty: there is nothing to sculpt",
+                "the file ends here",
+            )
+        } else {
+            (
+                "the grammar has no `model` block: there is nothing to sculpt",
+                "a `model { ... }` block would go here",
+            )
+        };
+        self.diags.push(
+            Diagnostic::warning(codes::NO_MODEL, message, end, label).with_hint(
+                "add a model that places pieces, e.g. `model { wall = chain brick x 8 }` \
+                 (docs/language.md, `model { ... }`)",
+            ),
+        );
     }
 
     fn solver_block(&mut self, s: &syntax::SolverBlock) {
