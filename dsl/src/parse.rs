@@ -354,6 +354,28 @@ fn unclosed(source: &str) -> Option<Span> {
 /// A hint for common slips, judged from what was expected and what is there.
 fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
     let text = source.get(span.start..span.end).unwrap_or("");
+    if let Some(c) = text
+        .chars()
+        .next()
+        .filter(|c| !c.is_ascii() && c.is_alphabetic())
+    {
+        return Some(format!(
+            "names are ASCII: letters `a`-`z` and `A`-`Z`, digits and `_`; `{c}` is not one of them"
+        ));
+    }
+    if text == ";" {
+        return Some("a statement ends with its line: remove the `;`".into());
+    }
+    let digit_then_letter = text
+        .char_indices()
+        .any(|(i, c)| c.is_ascii_alphabetic() && text[..i].ends_with(|d: char| d.is_ascii_digit()));
+    if positives.contains(&Rule::number) && digit_then_letter {
+        return Some(format!(
+            "`{text}` is not a number: a number is digits with an optional `.` and exponent \
+             (`2`, `0.5`, `2e3`); a letter cannot follow its digits"
+        ));
+    }
+
     if positives.contains(&Rule::colour) && text.starts_with('#') {
         return Some(
             "colours are `#` followed by 6 or 8 hexadecimal digits, like `#b5651d` or `#b5651d80`"
