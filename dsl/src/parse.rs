@@ -327,6 +327,16 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
                 && let Some(open) = unclosed(source)
             {
                 d = d.with_secondary(open, "this bracket is never closed");
+            } else if let Some((keyword, open)) = declaration_in_open_block(source, span) {
+                // `state down {` inside an unclosed `state up {`: `state` was read as a vertex
+                // name; the real mistake is the missing `}` before it.
+                let (line, _) = crate::line_col(source, open.start);
+                d = d
+                    .with_secondary(open, "this `{` is never closed")
+                    .with_hint(format!(
+                        "`{keyword}` starts a new declaration, but the block opened on line \
+                         {line} is still open: close it with `}}` first"
+                    ));
             }
             d
         }
@@ -334,6 +344,26 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
             Diagnostic::error(codes::SYNTAX, message.clone(), span, "here")
         }
     }
+}
+
+/// A declaration keyword just before the error (`state` of `state down {`) while a `{` is still
+/// open: the keyword and that brace.
+fn declaration_in_open_block(source: &str, span: Span) -> Option<(&str, Span)> {
+    const STARTS: [&str; 6] = ["state", "piece", "stretch", "merge", "cut", "model"];
+    let before = source.get(..span.start)?.trim_end();
+    let word_start = before
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .map_or(0, |i| i + 1);
+    let keyword = &before[word_start..];
+    let open = unclosed(&source[..word_start])?;
+    if !(STARTS.contains(&keyword) && source.as_bytes().get(open.start) == Some(&b'{')) {
+        return None;
+    }
+    // The block the brace opens, by the first word of its line: a `state` inside a `piece` is
+    // where it belongs, so that open brace is no mistake.
+    let line_start = source[..open.start].rfind('\n').map_or(0, |i| i + 1);
+    let block = source[line_start..open.start].split_whitespace().next();
+    (!(block == Some("piece") && keyword == "state")).then_some((keyword, open))
 }
 
 /// The innermost bracket left open at the end of the source (comments skipped).

@@ -46,3 +46,31 @@ fn a_number_followed_by_a_letter_says_what_a_number_is() {
         d.hints
     );
 }
+
+#[test]
+fn an_unclosed_state_points_at_its_brace() {
+    let src = "site type joint\npiece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \
+               vertex c (0, 1)\n    edges a-b-c-a\n    state up {\n        a (0, 0)\n        \
+               b (1, 0.1)\n        c (0, 1)\n    state down {\n        a (0, 0)\n        \
+               b (1, -0.1)\n        c (0, 1)\n    }\n}\nmodel {\n    x = p\n}\n";
+    let d = only_error(src);
+    let brace = src.find("up {").unwrap() + 3;
+    assert!(
+        d.secondary
+            .iter()
+            .any(|l| l.span.start == brace && l.message.contains("never closed")),
+        "{:?}",
+        d.secondary
+    );
+    assert!(
+        d.hints.iter().any(|h| h.contains("line 7 is still open")),
+        "{:?}",
+        d.hints
+    );
+}
+
+#[test]
+fn a_state_without_a_name_in_a_piece_does_not_blame_the_piece() {
+    let d = only_error("site type joint\npiece p {\n    vertex a (0, 0)\n    state {\n    }\n}\n");
+    assert!(d.secondary.is_empty(), "{:?}", d.secondary);
+}
