@@ -81,6 +81,8 @@ pub(crate) struct PieceSpans {
     pub states: Vec<Span>,
     /// False when the piece had errors: later passes skip geometric checks on it.
     pub sound: bool,
+    /// Sites declared with errors (already reported): a later use of one is not "unknown".
+    pub failed_sites: Vec<String>,
 }
 
 pub(crate) struct Compiler {
@@ -264,6 +266,14 @@ impl Compiler {
         let p = &self.pieces[piece];
         match p.sites.iter().position(|s| s.name == ident.name) {
             Some(i) => Some(i),
+            // Declared, but with an error that was reported: one error per mistake.
+            None if self
+                .piece_spans
+                .get(piece)
+                .is_some_and(|s| s.failed_sites.contains(&ident.name)) =>
+            {
+                None
+            }
             None => {
                 let names: Vec<String> = p.sites.iter().map(|s| s.name.clone()).collect();
                 let ctx = Some(format!("on piece `{}`", p.name));
@@ -482,7 +492,12 @@ impl Compiler {
             let Some(&pi) = self.piece_index.get(&decl.name.name) else {
                 continue;
             };
-            if self.piece_spans[pi].name != decl.name.span || self.pieces[pi].axis.is_some() {
+            // A piece named by a stretch rule gets its axis from the rule; if the rule failed,
+            // its own error says why, and "no axis" would only repeat it.
+            if self.piece_spans[pi].name != decl.name.span
+                || self.pieces[pi].axis.is_some()
+                || self.stretch_named.get(pi).copied().unwrap_or(false)
+            {
                 continue;
             }
             let mut geoms: Vec<&syntax::GeometryDecl> = Vec::new();

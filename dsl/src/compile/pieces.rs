@@ -69,9 +69,12 @@ impl Compiler {
                         self.duplicate("site", &site.name, spans.sites[i]);
                         continue;
                     }
-                    if let Some(compiled) = self.site(&piece, site) {
-                        piece.sites.push(compiled);
-                        spans.sites.push(site.name.span);
+                    match self.site(&piece, site) {
+                        Some(compiled) => {
+                            piece.sites.push(compiled);
+                            spans.sites.push(site.name.span);
+                        }
+                        None => spans.failed_sites.push(site.name.name.clone()),
                     }
                 }
                 PieceStmt::Axis(a) => {
@@ -142,7 +145,11 @@ impl Compiler {
                     .push(Span::new(st.span.start, st.name.span.end));
             }
         }
-        if let Some(a) = axis {
+        if let Some(a) = axis
+            && ![&a.from, &a.to]
+                .iter()
+                .any(|s| spans.failed_sites.contains(&s.name))
+        {
             let from = self.site_on(&piece, &a.from);
             let to = self.site_on(&piece, &a.to);
             if let (Some(f), Some(t)) = (from, to)

@@ -1,0 +1,40 @@
+//! One true error per mistake (issue 18): a mistake in one declaration is not followed by
+//! errors about names that exist, or about what depends on the failed declaration.
+
+use clay_dsl::compile;
+
+fn wall() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../grammars/wall.clay"
+    ))
+    .unwrap()
+}
+
+/// The codes and messages of a grammar that must not compile.
+fn errors(source: &str) -> Vec<(String, String)> {
+    compile(source, "wall.clay")
+        .unwrap_err()
+        .iter()
+        .map(|d| (d.code.to_string(), d.message.clone()))
+        .collect()
+}
+
+#[test]
+fn a_site_type_typo_is_one_error_not_six() {
+    let src = wall().replace("site west: joint", "site west: jiont");
+    assert_ne!(src, wall(), "the fixture edit applies");
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E011");
+    assert!(e[0].1.contains("unknown site type `jiont`"), "{e:?}");
+}
+
+#[test]
+fn a_failed_stretch_rule_does_not_add_no_axis_errors() {
+    let src = wall().replace("min 2", "min 1");
+    assert_ne!(src, wall(), "the fixture edit applies");
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E013", "{e:?}");
+}
