@@ -38,3 +38,19 @@ fn a_failed_stretch_rule_does_not_add_no_axis_errors() {
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].0, "E013", "{e:?}");
 }
+
+#[test]
+fn an_out_of_range_coordinate_is_one_error_wherever_it_is() {
+    for (from, to) in [
+        ("vertex ne (1, 0.5)", "vertex ne (1e10, 0.5)"),
+        ("out (1, 0)", "out (1e10, 0)"),
+        ("(0.97, 0.03) (0.97, 0.47)", "(1e10, 0.03) (0.97, 0.47)"),
+        ("at (0, 0)", "at (0, 1e12)"),
+    ] {
+        let src = wall().replacen(from, to, 1);
+        assert_ne!(src, wall(), "the edit `{to}` applies");
+        let e = errors(&src);
+        assert_eq!(e.len(), 1, "{to}: {e:?}");
+        assert_eq!(e[0].0, "E013", "{to}: {e:?}");
+    }
+}

@@ -239,7 +239,10 @@ impl Compiler {
                         "coordinates are metres and must lie within +/-{MAX_COORDINATE:e}"
                     )),
                 );
-                return DVec2::ZERO;
+                // Not a number: every later geometric test on it is false, so the reported
+                // E013 is not followed by a false "zero length" or "same place" (the grammar
+                // is not produced with an error, so the NaN never leaves the compiler).
+                return DVec2::NAN;
             }
         }
         DVec2::new(p.x.value, p.y.value)

@@ -321,7 +321,10 @@ impl Compiler {
         }
         let out = self.point(&s.out);
         let len = out.length();
-        if len < COINCIDENT_EPS {
+        if !out.is_finite() {
+            // Out of range: E013 was reported; the site fails quietly with it.
+            ok = false;
+        } else if len < COINCIDENT_EPS {
             self.error(
                 Diagnostic::error(codes::ZERO_OUT, format!("site `{}` has no outward direction", s.name.name), s.out.span, "zero vector")
                     .with_hint("`out` is the direction pointing away from the piece, like `(1, 0)` for a site on the east side"),
