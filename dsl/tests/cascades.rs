@@ -54,3 +54,25 @@ fn an_out_of_range_coordinate_is_one_error_wherever_it_is() {
         assert_eq!(e[0].0, "E013", "{to}: {e:?}");
     }
 }
+
+#[test]
+fn a_shadowed_merge_rule_is_warned_but_not_one_with_another_reach() {
+    let fixture = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/fixtures/invalid/W006-shadowed-merge.clay"
+    ))
+    .unwrap();
+    let codes = |src: &str| -> Vec<&'static str> {
+        compile(src, "m.clay")
+            .unwrap()
+            .warnings
+            .iter()
+            .map(|d| d.code)
+            .collect()
+    };
+    assert_eq!(codes(&fixture), ["W006"]);
+    // With its own `within` the later rule fires between the two reaches: no warning.
+    let reach = fixture.replace("into tee.side", "into tee.side within 2");
+    assert_ne!(reach, fixture);
+    assert_eq!(codes(&reach), Vec::<&str>::new());
+}

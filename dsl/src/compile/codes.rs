@@ -69,3 +69,5 @@ pub const REPEATED_EDGE: &str = "W003";
 pub const IGNORED_ROTATE: &str = "W004";
 /// An empty grammar, or one with no `model` block: nothing to sculpt.
 pub const NO_MODEL: &str = "W005";
+/// A merge rule with the mover and target of an earlier one: the earlier one always wins.
+pub const SHADOWED_MERGE: &str = "W006";

@@ -499,6 +499,29 @@ impl Compiler {
                 Some(j)
             }
         };
+        if let Some(first) = self
+            .merge_rules
+            .iter()
+            .position(|r| r.mover == mover && r.target == target && r.within == distance)
+        {
+            // The runtime takes the nearest match and, at equal distance, the earlier rule:
+            // for the same two sites within the same reach that is always the first. (With
+            // another `within`, the later rule still fires between the two distances.)
+            self.diags.push(
+                Diagnostic::warning(
+                    codes::SHADOWED_MERGE,
+                    format!(
+                        "a merge of `{}` onto `{}` is already declared: this one never fires",
+                        path_text(&m.mover),
+                        path_text(&m.target)
+                    ),
+                    m.span,
+                    "never fires",
+                )
+                .with_secondary(self.merge_spans[first], "this rule is tried first and always wins")
+                .with_hint("keep one merge rule per pair of sites; to change what the merge puts in place, change the first rule's `into`"),
+            );
+        }
         self.merge_rules.push(MergeRule {
             mover,
             target,
@@ -560,4 +583,9 @@ fn or_none(v: &[String]) -> String {
     } else {
         v.join(", ")
     }
+}
+
+/// `piece.site` as written.
+fn path_text(p: &syntax::SitePath) -> String {
+    format!("{}.{}", p.piece.name, p.site.name)
 }
