@@ -104,10 +104,6 @@ impl Session {
         &self.solver
     }
 
-    pub fn has_rules(&self) -> bool {
-        self.rules.is_some()
-    }
-
     /// The rules, for tests that drive them directly between frames.
     pub fn rules_mut(&mut self) -> Option<&mut Rules> {
         self.rules.as_mut()
@@ -217,12 +213,6 @@ impl Session {
             Some(id) => asm.release(id),
             None => false,
         }
-    }
-
-    /// Forgets the grab without touching the assembly (the assembly was replaced, e.g. by
-    /// undo, and its handles with it).
-    pub fn forget_grab(&mut self) {
-        self.grab = None;
     }
 
     /// Pins `instance` where it is.
