@@ -276,10 +276,32 @@ impl<'s> Printer<'s> {
 
     // ---- tokens ----------------------------------------------------------------------------
 
-    fn num(&self, n: &Number) -> String {
-        match self.src.and_then(|s| s.get(n.span.start..n.span.end)) {
-            Some(text) if !text.is_empty() && n.span.end > n.span.start => text.to_string(),
-            _ => format_number(n.value),
+    /// An expression in canonical spacing (`a + b * 2`, `-x`, `sin(30)`), parentheses as
+    /// written; a literal keeps the author's text.
+    fn num(&self, n: &Expr) -> String {
+        match &n.kind {
+            ExprKind::Number(value) => {
+                match self.src.and_then(|s| s.get(n.span.start..n.span.end)) {
+                    Some(text) if !text.is_empty() && n.span.end > n.span.start => text.to_string(),
+                    _ => format_number(*value),
+                }
+            }
+            ExprKind::Name(id) => id.name.clone(),
+            ExprKind::Unary(op, x) => {
+                let sign = match op {
+                    UnaryOp::Neg => "-",
+                    UnaryOp::Plus => "+",
+                };
+                format!("{sign}{}", self.num(x))
+            }
+            ExprKind::Binary(op, a, b) => {
+                format!("{} {} {}", self.num(a), op.symbol(), self.num(b))
+            }
+            ExprKind::Call(f, args) => {
+                let args: Vec<String> = args.iter().map(|a| self.num(a)).collect();
+                format!("{}({})", f.name, args.join(", "))
+            }
+            ExprKind::Paren(x) => format!("({})", self.num(x)),
         }
     }
 
@@ -316,7 +338,7 @@ impl<'s> Printer<'s> {
         format!("{}{index}.{}", p.instance.name, p.site.name)
     }
 
-    fn placement(&self, at: &Option<Point>, rotate: &Option<Number>) -> String {
+    fn placement(&self, at: &Option<Point>, rotate: &Option<Expr>) -> String {
         let mut s = String::new();
         if let Some(p) = at {
             s += &format!(" at {}", self.point(p));
@@ -350,6 +372,7 @@ impl<'s> Printer<'s> {
     fn one_line_kind(&self, item: &Item) -> Option<u8> {
         match item {
             Item::SiteType(_) => Some(1),
+            Item::Let(_) => Some(3),
             Item::Merge(_) | Item::Cut(_) => Some(2),
             Item::Stretch(s) if self.stretch_inline(s) => Some(2),
             _ => None,
@@ -358,6 +381,10 @@ impl<'s> Printer<'s> {
 
     fn item(&mut self, item: &Item) {
         match item {
+            Item::Let(l) => {
+                let t = format!("let {} = {}", l.name.name, self.num(&l.value));
+                self.stmt(0, &t, l.span);
+            }
             Item::Solver(s) => {
                 self.open(0, "solver", s.span.start, s.keyword.end);
                 for e in &s.entries {
@@ -568,7 +595,7 @@ impl<'s> Printer<'s> {
             return self.stmt(0, &t, s.span);
         }
         self.open(0, &header, s.span.start, s.to.span.end);
-        let mut body: Vec<(usize, Option<&Number>, Option<&VariantsDecl>)> = Vec::new();
+        let mut body: Vec<(usize, Option<&Expr>, Option<&VariantsDecl>)> = Vec::new();
         body.extend(s.min.iter().map(|m| (m.span.start, Some(m), None)));
         body.extend(s.variants.iter().map(|v| (v.span.start, None, Some(v))));
         if self.src.is_some() {

@@ -17,6 +17,33 @@ struct ClayParser;
 /// pest sees it, because pest recurses once per nested block comment.
 pub const MAX_NESTING: usize = 256;
 
+/// Deepest expression tree accepted (operators, signs and parentheses on one path), so that
+/// every pass over an expression can recurse safely. Real expressions are a few levels deep.
+pub const MAX_EXPR_DEPTH: usize = 128;
+
+/// Pops the top operator and its two operands and pushes their binary node (with its depth).
+fn reduce(operands: &mut Vec<(Expr, usize)>, operators: &mut Vec<BinaryOp>) {
+    let (Some(op), Some((rhs, dr)), Some((lhs, dl))) =
+        (operators.pop(), operands.pop(), operands.pop())
+    else {
+        return;
+    };
+    let span = lhs.span.to(rhs.span);
+    let depth = dl.max(dr) + 1;
+    if depth > MAX_EXPR_DEPTH {
+        // Too deep (reported by the caller): a leaf keeps the tree shallow.
+        operands.push((Expr::number(0.0, span), depth));
+        return;
+    }
+    operands.push((
+        Expr {
+            kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+            span,
+        },
+        dl.max(dr) + 1,
+    ));
+}
+
 /// Stable diagnostic codes emitted by the parser.
 pub mod codes {
     /// The text does not follow the grammar.
@@ -34,13 +61,20 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::EOI => "end of file",
         Rule::WHITESPACE | Rule::COMMENT | Rule::line_comment | Rule::block_comment => "whitespace",
         Rule::ident_char => "a letter, digit or `_`",
-        Rule::item => "`solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`",
+        Rule::item => "`let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`",
         Rule::piece_stmt => "a piece statement",
         Rule::state_stmt => "a state statement",
         Rule::stretch_stmt => "`min` or `variants`",
         Rule::model_stmt => "an instance or a `dock`",
         Rule::name => "a name",
         Rule::number => "a number",
+        Rule::expr | Rule::operand | Rule::primary => "a number",
+        Rule::prefix | Rule::neg | Rule::pos => "a sign",
+        Rule::infix | Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
+        Rule::call => "a function call like `sin(30)`",
+        Rule::paren_expr => "`(`",
+        Rule::let_decl => "a `let` constant",
+        Rule::kw_let => "`let`",
         Rule::integer => "a whole number",
         Rule::colour => "a colour like `#b5651d`",
         Rule::point => "a point `(x, y)`",
@@ -92,7 +126,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::dash => "`-`",
         Rule::dot => "`.`",
         Rule::file => {
-            "`solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
+            "`let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
         }
         Rule::solver_block => "a `solver` block",
         Rule::solver_entry => "a solver parameter `NAME = NUMBER`",
@@ -302,6 +336,8 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
                     words.push(w);
                 }
             }
+            // "an operator" is rarely what was meant: name it last (`,` or an operator).
+            words.sort_by_key(|w| *w == "an operator");
             let expected = one_of(&words);
             let mut d = Diagnostic::error(
                 codes::SYNTAX,
@@ -399,7 +435,10 @@ fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
     let digit_then_letter = text
         .char_indices()
         .any(|(i, c)| c.is_ascii_alphabetic() && text[..i].ends_with(|d: char| d.is_ascii_digit()));
-    if positives.contains(&Rule::number) && digit_then_letter {
+    let wants_number = [Rule::number, Rule::expr, Rule::neg, Rule::paren_expr]
+        .iter()
+        .any(|r| positives.contains(r));
+    if wants_number && digit_then_letter {
         return Some(format!(
             "`{text}` is not a number: a number is digits with an optional `.` and exponent \
              (`2`, `0.5`, `2e3`); a letter cannot follow its digits"
@@ -412,7 +451,8 @@ fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
                 .into(),
         );
     }
-    if positives.contains(&Rule::comma) && positives.contains(&Rule::rparen) {
+    let after_x = positives.contains(&Rule::comma) && positives.contains(&Rule::add);
+    if (positives.contains(&Rule::comma) && positives.contains(&Rule::rparen)) || after_x {
         return Some("points are written `(x, y)`".into());
     }
     if positives.contains(&Rule::kw_piece) && positives.contains(&Rule::kw_model) {
@@ -489,7 +529,7 @@ impl Lower {
             .collect()
     }
 
-    fn number(&mut self, p: Pair<Rule>) -> Number {
+    fn number(&mut self, p: Pair<Rule>) -> Expr {
         let span = span_of(&p);
         // The grammar only admits decimal literals, which Rust's float parser accepts; a
         // literal beyond f64's range parses to infinity and is reported here.
@@ -504,22 +544,145 @@ impl Lower {
                 )
                 .with_hint("numbers must be finite; the largest is about 1.8e308"),
             );
-            return Number { value: 0.0, span };
+            return Expr::number(0.0, span);
         }
-        Number { value, span }
+        Expr::number(value, span)
+    }
+
+    /// An `expr` pair (or a missing one, as zero at `fallback`) as a tree.
+    fn expr_or(&mut self, p: Option<Pair<Rule>>, fallback: Span) -> Expr {
+        match p {
+            Some(p) => self.expr(p).0,
+            None => Expr::number(0.0, fallback),
+        }
+    }
+
+    /// Lowers an `expr` pair, a flat list `operand (infix operand)*`, into a tree by
+    /// precedence (shunting-yard, so no recursion per operator), and returns it with its depth.
+    /// A tree deeper than [`MAX_EXPR_DEPTH`] is reported: every later pass walks it recursively.
+    fn expr(&mut self, p: Pair<Rule>) -> (Expr, usize) {
+        let span = span_of(&p);
+        let mut operands: Vec<(Expr, usize)> = Vec::new();
+        let mut operators: Vec<BinaryOp> = Vec::new();
+        let mut prefixes: Vec<(UnaryOp, usize)> = Vec::new();
+        for c in kids(p) {
+            let start = c.as_span().start();
+            let op = match c.as_rule() {
+                Rule::neg => {
+                    prefixes.push((UnaryOp::Neg, start));
+                    continue;
+                }
+                Rule::pos => {
+                    prefixes.push((UnaryOp::Plus, start));
+                    continue;
+                }
+                Rule::add => BinaryOp::Add,
+                Rule::sub => BinaryOp::Sub,
+                Rule::mul => BinaryOp::Mul,
+                Rule::div => BinaryOp::Div,
+                _ => {
+                    let mut operand = self.primary(c);
+                    // Never build a tree deeper than the limit (dropping one would recurse).
+                    if operand.1 + prefixes.len() > MAX_EXPR_DEPTH {
+                        prefixes.clear();
+                        operand = (Expr::number(0.0, operand.0.span), MAX_EXPR_DEPTH + 1);
+                    }
+                    while let Some((op, start)) = prefixes.pop() {
+                        let span = Span::new(start, operand.0.span.end);
+                        operand = (
+                            Expr {
+                                kind: ExprKind::Unary(op, Box::new(operand.0)),
+                                span,
+                            },
+                            operand.1 + 1,
+                        );
+                    }
+                    operands.push(operand);
+                    continue;
+                }
+            };
+            while operators
+                .last()
+                .is_some_and(|top| top.precedence() >= op.precedence())
+            {
+                reduce(&mut operands, &mut operators);
+            }
+            operators.push(op);
+        }
+        while !operators.is_empty() {
+            reduce(&mut operands, &mut operators);
+        }
+        let (tree, depth) = operands.pop().unwrap_or((Expr::number(0.0, span), 1));
+        if depth > MAX_EXPR_DEPTH {
+            self.diags.push(
+                Diagnostic::error(
+                    codes::TOO_DEEP,
+                    "expression is nested too deeply",
+                    span,
+                    format!("more than {MAX_EXPR_DEPTH} levels of operators and parentheses"),
+                )
+                .with_hint("split it into several `let` constants"),
+            );
+            return (Expr::number(0.0, span), 1);
+        }
+        (tree, depth)
+    }
+
+    fn primary(&mut self, c: Pair<Rule>) -> (Expr, usize) {
+        let span = span_of(&c);
+        match c.as_rule() {
+            Rule::number => (self.number(c), 1),
+            Rule::name => (
+                Expr {
+                    kind: ExprKind::Name(self.ident(c)),
+                    span,
+                },
+                1,
+            ),
+            Rule::paren_expr => {
+                let inner = first(&kids(c), Rule::expr).map(|e| self.expr(e));
+                let (inner, depth) = inner.unwrap_or((Expr::number(0.0, span), 1));
+                (
+                    Expr {
+                        kind: ExprKind::Paren(Box::new(inner)),
+                        span,
+                    },
+                    depth + 1,
+                )
+            }
+            Rule::call => {
+                let ch = kids(c);
+                let func = first(&ch, Rule::name).map_or(
+                    Ident {
+                        name: String::new(),
+                        span,
+                    },
+                    |n| self.ident(n),
+                );
+                let mut depth = 1;
+                let mut args = Vec::new();
+                for a in of(&ch, Rule::expr) {
+                    let (arg, d) = self.expr(a);
+                    depth = depth.max(d + 1);
+                    args.push(arg);
+                }
+                (
+                    Expr {
+                        kind: ExprKind::Call(func, args),
+                        span,
+                    },
+                    depth,
+                )
+            }
+            _ => (Expr::number(0.0, span), 1),
+        }
     }
 
     fn point(&mut self, p: Pair<Rule>) -> Point {
         let span = span_of(&p);
-        let mut nums = of(&kids(p), Rule::number).into_iter();
-        let x = nums
-            .next()
-            .map(|n| self.number(n))
-            .unwrap_or(Number { value: 0.0, span });
-        let y = nums
-            .next()
-            .map(|n| self.number(n))
-            .unwrap_or(Number { value: 0.0, span });
+        let mut nums = of(&kids(p), Rule::expr).into_iter();
+        let x = self.expr_or(nums.next(), span);
+        let y = self.expr_or(nums.next(), span);
         Point { x, y, span }
     }
 
@@ -550,6 +713,7 @@ impl Lower {
         let mut items = Vec::new();
         for c in kids(p) {
             let item = match c.as_rule() {
+                Rule::let_decl => Item::Let(self.let_decl(c)),
                 Rule::solver_block => Item::Solver(self.solver(c)),
                 Rule::site_type_decl => Item::SiteType(self.site_type(c)),
                 Rule::piece_decl => Item::Piece(self.piece(c)),
@@ -564,6 +728,20 @@ impl Lower {
         File { items, span }
     }
 
+    fn let_decl(&mut self, p: Pair<Rule>) -> LetDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let name = first(&ch, Rule::name).map_or(
+            Ident {
+                name: String::new(),
+                span,
+            },
+            |n| self.ident(n),
+        );
+        let value = self.expr_or(first(&ch, Rule::expr), span);
+        LetDecl { name, value, span }
+    }
+
     fn solver(&mut self, p: Pair<Rule>) -> SolverBlock {
         let span = span_of(&p);
         let ch = kids(p);
@@ -572,11 +750,11 @@ impl Lower {
         for e in of(&ch, Rule::solver_entry) {
             let espan = span_of(&e);
             let ec = kids(e);
-            let (Some(n), Some(v)) = (first(&ec, Rule::name), first(&ec, Rule::number)) else {
+            let (Some(n), Some(v)) = (first(&ec, Rule::name), first(&ec, Rule::expr)) else {
                 continue;
             };
             let name = self.ident(n);
-            let value = self.number(v);
+            let value = self.expr(v).0;
             entries.push(SolverEntry {
                 name,
                 value,
@@ -652,11 +830,11 @@ impl Lower {
             |n| self.ident(n),
         );
         let pos = first(&ch, Rule::point).map(|q| self.point(q));
-        let zero = Number { value: 0.0, span };
+        let zero = Expr::number(0.0, span);
         VertexDecl {
             name,
             pos: pos.unwrap_or(Point {
-                x: zero,
+                x: zero.clone(),
                 y: zero,
                 span,
             }),
@@ -685,14 +863,14 @@ impl Lower {
         let vertices_span = list.as_ref().map_or(span, span_of);
         let vertices = list.map(|l| self.idents(&kids(l))).unwrap_or_default();
         let out = first(&ch, Rule::point).map(|q| self.point(q));
-        let zero = Number { value: 0.0, span };
+        let zero = Expr::number(0.0, span);
         SiteDecl {
             name: names.first().cloned().unwrap_or(empty.clone()),
             site_type: names.get(1).cloned().unwrap_or(empty),
             vertices,
             vertices_span,
             out: out.unwrap_or(Point {
-                x: zero,
+                x: zero.clone(),
                 y: zero,
                 span,
             }),
@@ -743,8 +921,7 @@ impl Lower {
                 holes,
             }
         } else {
-            let width =
-                first(&ch, Rule::number).map_or(Number { value: 0.0, span }, |n| self.number(n));
+            let width = self.expr_or(first(&ch, Rule::expr), span);
             ShapeDecl::Polyline { width, points }
         };
         GeometryDecl {
@@ -796,8 +973,8 @@ impl Lower {
         };
         let min = of(&ch, Rule::min_decl)
             .into_iter()
-            .filter_map(|m| first(&kids(m), Rule::number))
-            .map(|n| self.number(n))
+            .filter_map(|m| first(&kids(m), Rule::expr))
+            .map(|n| self.expr(n).0)
             .collect();
         let variants = of(&ch, Rule::variants_decl)
             .into_iter()
@@ -815,13 +992,7 @@ impl Lower {
                             },
                             |n| self.ident(n),
                         );
-                        let frequency = first(&ec, Rule::number).map_or(
-                            Number {
-                                value: 0.0,
-                                span: espan,
-                            },
-                            |n| self.number(n),
-                        );
+                        let frequency = self.expr_or(first(&ec, Rule::expr), espan);
                         VariantEntry {
                             piece,
                             frequency,
@@ -879,7 +1050,7 @@ impl Lower {
         let mover = paths.next().unwrap_or(empty.clone());
         let target = paths.next().unwrap_or(empty);
         let junction = paths.next();
-        let within = first(&ch, Rule::number).map(|n| self.number(n));
+        let within = first(&ch, Rule::expr).map(|n| self.expr(n).0);
         MergeDecl {
             mover,
             target,
@@ -935,13 +1106,7 @@ impl Lower {
                         name: String::new(),
                         span: cspan,
                     };
-                    let count = first(&cc, Rule::number).map_or(
-                        Number {
-                            value: 0.0,
-                            span: cspan,
-                        },
-                        |n| self.number(n),
-                    );
+                    let count = self.expr_or(first(&cc, Rule::expr), cspan);
                     let along = first(&cc, Rule::along).and_then(|a| {
                         let n = self.idents(&kids(a));
                         Some((n.first()?.clone(), n.get(1)?.clone()))
@@ -983,13 +1148,13 @@ impl Lower {
         }
     }
 
-    fn placement(&mut self, ch: &[Pair<Rule>]) -> (Option<Point>, Option<Number>) {
+    fn placement(&mut self, ch: &[Pair<Rule>]) -> (Option<Point>, Option<Expr>) {
         let at = first(ch, Rule::at)
             .and_then(|a| first(&kids(a), Rule::point))
             .map(|p| self.point(p));
         let rotate = first(ch, Rule::rotate)
-            .and_then(|r| first(&kids(r), Rule::number))
-            .map(|n| self.number(n));
+            .and_then(|r| first(&kids(r), Rule::expr))
+            .map(|n| self.expr(n).0);
         (at, rotate)
     }
 

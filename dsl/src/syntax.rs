@@ -31,18 +31,97 @@ pub struct Ident {
     pub span: Span,
 }
 
-/// A number literal. `value` is finite: the parser rejects literals that overflow f64.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Number {
-    pub value: f64,
+/// A numeric expression as written, wherever the language takes a number (docs/language.md,
+/// "Expressions and constants"). Every sub-expression has its own span so diagnostics can point
+/// inside; the compiler folds the tree to one number, and the compiled grammar holds only numbers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    pub kind: ExprKind,
     pub span: Span,
 }
 
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    /// A literal; finite (the parser rejects literals that overflow f64).
+    Number(f64),
+    /// A constant: a `let` name or a built-in such as `pi`.
+    Name(Ident),
+    Unary(UnaryOp, Box<Expr>),
+    Binary(BinaryOp, Box<Expr>, Box<Expr>),
+    /// A built-in function applied to its arguments: `sin(30)`.
+    Call(Ident, Vec<Expr>),
+    /// `(e)`, kept so that the formatter prints the parentheses as written.
+    Paren(Box<Expr>),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnaryOp {
+    Neg,
+    Plus,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinaryOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+}
+
+impl BinaryOp {
+    /// How tightly the operator binds: `*` and `/` before `+` and `-`.
+    pub fn precedence(self) -> u8 {
+        match self {
+            BinaryOp::Add | BinaryOp::Sub => 1,
+            BinaryOp::Mul | BinaryOp::Div => 2,
+        }
+    }
+
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinaryOp::Add => "+",
+            BinaryOp::Sub => "-",
+            BinaryOp::Mul => "*",
+            BinaryOp::Div => "/",
+        }
+    }
+}
+
+impl Expr {
+    /// A literal, as tools that build trees (authoring) write numbers.
+    pub fn number(value: f64, span: Span) -> Self {
+        Self {
+            kind: ExprKind::Number(value),
+            span,
+        }
+    }
+
+    /// The value when the expression is a plain literal (or a signed one), without evaluating
+    /// names or calls.
+    pub fn literal(&self) -> Option<f64> {
+        match &self.kind {
+            ExprKind::Number(v) => Some(*v),
+            ExprKind::Unary(UnaryOp::Neg, e) => e.literal().map(|v| -v),
+            ExprKind::Unary(UnaryOp::Plus, e) | ExprKind::Paren(e) => e.literal(),
+            _ => None,
+        }
+    }
+}
+
 /// `(x, y)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Point {
-    pub x: Number,
-    pub y: Number,
+    pub x: Expr,
+    pub y: Expr,
+    pub span: Span,
+}
+
+/// `let NAME = EXPR`: a named constant, visible from the end of its declaration to the end of
+/// the file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LetDecl {
+    pub name: Ident,
+    pub value: Expr,
     pub span: Span,
 }
 
@@ -56,6 +135,7 @@ pub struct File {
 /// A top-level item.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Item {
+    Let(LetDecl),
     Solver(SolverBlock),
     SiteType(SiteTypeDecl),
     Piece(PieceDecl),
@@ -68,6 +148,7 @@ pub enum Item {
 impl Item {
     pub fn span(&self) -> Span {
         match self {
+            Item::Let(x) => x.span,
             Item::Solver(x) => x.span,
             Item::SiteType(x) => x.span,
             Item::Piece(x) => x.span,
@@ -90,7 +171,7 @@ pub struct SolverBlock {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolverEntry {
     pub name: Ident,
-    pub value: Number,
+    pub value: Expr,
     pub span: Span,
 }
 
@@ -182,7 +263,7 @@ pub enum ShapeDecl {
         holes: Vec<HoleDecl>,
     },
     Polyline {
-        width: Number,
+        width: Expr,
         points: Vec<Point>,
     },
 }
@@ -218,7 +299,7 @@ pub struct StretchDecl {
     pub from: Ident,
     pub to: Ident,
     /// Every `min N` written (more than one is reported).
-    pub min: Vec<Number>,
+    pub min: Vec<Expr>,
     /// Every `variants { ... }` written (more than one is reported).
     pub variants: Vec<VariantsDecl>,
     pub span: Span,
@@ -234,7 +315,7 @@ pub struct VariantsDecl {
 #[derive(Clone, Debug, PartialEq)]
 pub struct VariantEntry {
     pub piece: Ident,
-    pub frequency: Number,
+    pub frequency: Expr,
     pub span: Span,
 }
 
@@ -252,7 +333,7 @@ pub struct MergeDecl {
     pub mover: SitePath,
     pub target: SitePath,
     pub junction: Option<SitePath>,
-    pub within: Option<Number>,
+    pub within: Option<Expr>,
     pub span: Span,
 }
 
@@ -285,7 +366,7 @@ pub struct InstanceDecl {
     pub name: Ident,
     pub piece: Ident,
     pub at: Option<Point>,
-    pub rotate: Option<Number>,
+    pub rotate: Option<Expr>,
     pub span: Span,
 }
 
@@ -294,10 +375,10 @@ pub struct InstanceDecl {
 pub struct ChainDecl {
     pub name: Ident,
     pub piece: Ident,
-    pub count: Number,
+    pub count: Expr,
     pub along: Option<(Ident, Ident)>,
     pub at: Option<Point>,
-    pub rotate: Option<Number>,
+    pub rotate: Option<Expr>,
     pub span: Span,
 }
 

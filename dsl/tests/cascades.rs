@@ -76,3 +76,17 @@ fn a_shadowed_merge_rule_is_warned_but_not_one_with_another_reach() {
     assert_ne!(reach, fixture);
     assert_eq!(codes(&reach), Vec::<&str>::new());
 }
+
+#[test]
+fn a_frequency_out_of_range_is_one_error_not_also_a_wrong_sum() {
+    let centipede = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../grammars/centipede.clay"
+    ))
+    .unwrap();
+    let src = centipede.replace("seg_a 0.5, seg_b 0.3", "seg_a 1.5, seg_b 0.3");
+    assert_ne!(src, centipede, "the fixture edit applies");
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E013", "{e:?}");
+}

@@ -52,7 +52,8 @@ const TOKENS: &[&str] = &[
     "(", ")", "{", "}", "[", "]", ",", ".", "-", "->", ":", "=", "#", "#fff", "0", "-1", "1e400",
     "1e308", "9999999", "0.5", "brick", "piece", "site", "model", "stretch", "merge", "cut",
     "chain", "x", "dock", "state", "edges", "vertex", "wall[0]", "last", "/*", "*/", "//", "\n",
-    " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate",
+    " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate", "+", "*", "/", "let", "w", "sin(", "pi",
+    "1 / 0", "sqrt(-1)", "max()",
 ];
 
 fn mutate(rng: &mut Rng, src: &str) -> String {
@@ -224,6 +225,28 @@ fn deep_nesting_is_rejected_before_parsing() {
     // Nesting within the limit is an ordinary syntax error.
     let d = compile(&"(".repeat(200), "x").unwrap_err();
     assert_eq!(d.items[0].code, "E001");
+}
+
+#[test]
+fn deep_and_absurd_expressions_are_diagnosed_not_crashed() {
+    let base = EMBEDDED.replace("    axis north -> north\n", "");
+    let cases = [
+        format!("({}1{}, 0)", "(".repeat(250), ")".repeat(250)),
+        format!("({}1, 0)", "-".repeat(100_000)),
+        format!("({}, 0)", vec!["1"; 100_000].join("*")),
+        format!("(sin({}1{}), 0)", "cos(".repeat(200), ")".repeat(200)),
+        "(1e308 * 1e308 * 0, 0)".to_string(),
+        "(1e-320 / 1e-320 / 0, 0)".to_string(),
+        "(max(1e308, 1e308) + 1e308, 0)".to_string(),
+    ];
+    for case in cases {
+        let src = base.replacen("(1, 0)", &case, 1);
+        assert_ne!(src, base);
+        let d = compile(&src, "x").unwrap_err();
+        assert_spans_valid(&d, &src, "expression");
+        let codes: Vec<&str> = d.iter().map(|d| d.code).collect();
+        assert_eq!(codes.len(), 1, "{}: {codes:?}", &case[..case.len().min(40)]);
+    }
 }
 
 #[test]

@@ -770,7 +770,7 @@ impl Design {
             placed_root.entry(r).or_insert(i);
         }
         let anchored: HashSet<usize> = placed_root.values().copied().collect();
-        let place = |i: usize| -> (Option<Point>, Option<Number>) {
+        let place = |i: usize| -> (Option<Point>, Option<Expr>) {
             if !anchored.contains(&i) {
                 return (None, None);
             }
@@ -860,11 +860,8 @@ fn ident(name: &str) -> Ident {
     }
 }
 
-fn number(value: f64) -> Number {
-    Number {
-        value,
-        span: Span::default(),
-    }
+fn number(value: f64) -> Expr {
+    Expr::number(value, Span::default())
 }
 
 fn point(p: DVec2) -> Point {

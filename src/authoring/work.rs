@@ -592,7 +592,7 @@ pub fn variant_map(design: &Design, p: usize, v: usize) -> Result<Vec<usize>, St
 /// piece's vertices, edges and sites at its own positions; or notes why they no longer apply.
 // Long because: each variant is matched, checked and rewritten in place in the syntax tree; the steps share the match tables.
 fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::File) {
-    use clay_dsl::syntax::{Ident, Item, Number, PieceStmt, Span, VariantEntry, VariantsDecl};
+    use clay_dsl::syntax::{Expr, Ident, Item, PieceStmt, Span, VariantEntry, VariantsDecl};
     if work.variants.is_empty() {
         return;
     }
@@ -658,7 +658,7 @@ fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::F
         let own_decl = decl.stmts.clone();
         let position = |j: usize| {
             own_decl.iter().find_map(|s| match s {
-                PieceStmt::Vertex(v) if own.get(inverse[j]) == Some(&v.name) => Some(v.pos),
+                PieceStmt::Vertex(v) if own.get(inverse[j]) == Some(&v.name) => Some(v.pos.clone()),
                 _ => None,
             })
         };
@@ -680,7 +680,7 @@ fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::F
                         .iter()
                         .find(|o| matches!(o, PieceStmt::Site(o) if o.name == site.name))
                     {
-                        site.out = o.out;
+                        site.out = o.out.clone();
                     }
                     stmts.push(PieceStmt::Site(site));
                 }
@@ -714,10 +714,7 @@ fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::F
                 name: v.piece.clone(),
                 span: Span::default(),
             },
-            frequency: Number {
-                value: v.frequency,
-                span: Span::default(),
-            },
+            frequency: Expr::number(v.frequency, Span::default()),
             span: Span::default(),
         })
         .collect();
@@ -736,11 +733,8 @@ fn add_variants(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::F
 
 /// Writes the alternative rest states into their pieces, or notes why they no longer apply.
 fn add_states(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::File) {
-    use clay_dsl::syntax::{Ident, Item, Number, PieceStmt, Point, Span, StateDecl, VertexDecl};
-    let number = |value: f64| Number {
-        value: (value * 1e6).round() / 1e6,
-        span: Span::default(),
-    };
+    use clay_dsl::syntax::{Expr, Ident, Item, PieceStmt, Point, Span, StateDecl, VertexDecl};
+    let number = |value: f64| Expr::number((value * 1e6).round() / 1e6, Span::default());
     for st in &work.states {
         let piece = tree.items.iter_mut().find_map(|i| match i {
             Item::Piece(p) if p.name.name == st.piece => Some(p),

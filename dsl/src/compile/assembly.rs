@@ -70,8 +70,8 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                     name: d.name.name.clone(),
                     piece,
                     at,
-                    rotate: d.rotate.map_or(0.0, |r| r.value),
-                    rotate_span: d.rotate.map(|r| r.span),
+                    rotate: d.rotate.as_ref().and_then(|r| c.eval(r)).unwrap_or(0.0),
+                    rotate_span: d.rotate.as_ref().map(|r| r.span),
                     span: d.name.span,
                 });
             }
@@ -84,6 +84,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 let piece = c.resolve_piece(&d.piece);
                 let count = c.whole(&d.count, "the chain length", 1);
                 let at = d.at.as_ref().map(|p| c.point(p));
+                let turn = d.rotate.as_ref().and_then(|r| c.eval(r)).unwrap_or(0.0);
                 let (Some(piece), Some(count)) = (piece, count) else {
                     continue;
                 };
@@ -142,13 +143,9 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                         name: format!("{}[{k}]", d.name.name),
                         piece,
                         at: if k == 0 { at } else { None },
-                        rotate: if k == 0 {
-                            d.rotate.map_or(0.0, |r| r.value)
-                        } else {
-                            0.0
-                        },
+                        rotate: if k == 0 { turn } else { 0.0 },
                         rotate_span: if k == 0 {
-                            d.rotate.map(|r| r.span)
+                            d.rotate.as_ref().map(|r| r.span)
                         } else {
                             None
                         },

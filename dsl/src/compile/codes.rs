@@ -59,6 +59,13 @@ pub const CHAIN_SITES: &str = "E046";
 /// A stretch piece or variant that declares alternative rest states, which could never become active.
 pub const ELEMENT_STATES: &str = "E047";
 
+/// A division whose divisor is zero.
+pub const DIVISION_BY_ZERO: &str = "E050";
+/// A built-in function called with the wrong number of arguments.
+pub const BAD_CALL: &str = "E051";
+/// A constant used above its `let`.
+pub const USED_BEFORE_LET: &str = "E052";
+
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";
 /// A rule that can never fire.
@@ -71,3 +78,5 @@ pub const IGNORED_ROTATE: &str = "W004";
 pub const NO_MODEL: &str = "W005";
 /// A merge rule with the mover and target of an earlier one: the earlier one always wins.
 pub const SHADOWED_MERGE: &str = "W006";
+/// A `let` constant that nothing uses.
+pub const UNUSED_CONSTANT: &str = "W007";

@@ -5,6 +5,7 @@
 pub mod codes;
 
 mod assembly;
+mod constants;
 mod pieces;
 mod rules;
 mod usage;
@@ -16,7 +17,7 @@ use glam::DVec2;
 use crate::compiled::*;
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::suggest::closest;
-use crate::syntax::{self, Ident, Item, Number, PieceStmt, Point, Span};
+use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
 /// The result of a successful compilation: the grammar, and the warnings found on the way.
 #[derive(Clone, Debug, PartialEq)]
@@ -105,6 +106,8 @@ pub(crate) struct Compiler {
     /// Set when a `dock` statement had errors: unplaced instances are then not reported.
     pub dock_failed: bool,
     pub grammar: Option<CompiledGrammar>,
+    /// The `let` constants, read by every expression.
+    pub consts: constants::Constants,
 }
 
 impl Compiler {
@@ -127,6 +130,7 @@ impl Compiler {
             stretch_named: Vec::new(),
             dock_failed: false,
             grammar: None,
+            consts: constants::Constants::default(),
         }
     }
 
@@ -179,13 +183,14 @@ impl Compiler {
     /// A number that must lie in a range; reports and returns `None` otherwise.
     pub fn in_range(
         &mut self,
-        n: &Number,
+        n: &Expr,
         what: &str,
         ok: impl Fn(f64) -> bool,
         allowed: &str,
     ) -> Option<f64> {
-        if ok(n.value) {
-            Some(n.value)
+        let value = self.eval(n)?;
+        if ok(value) {
+            Some(value)
         } else {
             self.diags.push(
                 Diagnostic::error(
@@ -203,8 +208,8 @@ impl Compiler {
     }
 
     /// A whole number at least `min`.
-    pub fn whole(&mut self, n: &Number, what: &str, min: u64) -> Option<u64> {
-        let v = n.value;
+    pub fn whole(&mut self, n: &Expr, what: &str, min: u64) -> Option<u64> {
+        let v = self.eval(n)?;
         if v.fract() == 0.0 && v >= min as f64 && v <= u64::MAX as f64 / 2.0 {
             Some(v as u64)
         } else {
@@ -226,8 +231,12 @@ impl Compiler {
 
     /// A point whose coordinates are within [`MAX_COORDINATE`].
     pub fn point(&mut self, p: &Point) -> DVec2 {
-        for n in [&p.x, &p.y] {
-            if n.value.abs() > MAX_COORDINATE {
+        let (Some(x), Some(y)) = (self.eval(&p.x), self.eval(&p.y)) else {
+            // Reported (or poisoned): NaN keeps later checks silent, as below.
+            return DVec2::NAN;
+        };
+        for (n, v) in [(&p.x, x), (&p.y, y)] {
+            if v.abs() > MAX_COORDINATE {
                 self.diags.push(
                     Diagnostic::error(
                         codes::OUT_OF_RANGE,
@@ -245,7 +254,7 @@ impl Compiler {
                 return DVec2::NAN;
             }
         }
-        DVec2::new(p.x.value, p.y.value)
+        DVec2::new(x, y)
     }
 
     pub fn site_type_index(&self, name: &str) -> Option<usize> {
@@ -287,6 +296,7 @@ impl Compiler {
     }
 
     fn run(&mut self, file: &syntax::File) {
+        self.constants(&file.items);
         let mut solver_seen: Option<Span> = None;
         let mut model: Option<&syntax::ModelBlock> = None;
         for item in &file.items {
@@ -342,6 +352,10 @@ impl Compiler {
             Some(_) => usage.report(self, file),
             // Without a model every piece is unused: one warning says why, not one per piece.
             None => self.no_model(file),
+        }
+        // A declaration skipped for an error may hold the only use: warn only on clean files.
+        if !self.diags.has_errors() {
+            self.unused_constants();
         }
         let grammar = CompiledGrammar {
             format_version: FORMAT_VERSION,

@@ -82,6 +82,13 @@ impl Compiler {
             return;
         };
         self.stretch_named[pi] = true;
+        // Its variants are chain elements too (their axis comes from the rule), even when the
+        // rule fails: no "no axis" error follows for them.
+        for e in s.variants.iter().flat_map(|v| &v.entries) {
+            if let Some(&vp) = self.piece_index.get(&e.piece.name) {
+                self.stretch_named[vp] = true;
+            }
+        }
         // `stretch PIECE from A to B`, without its `{ ... }` block: what messages point at.
         let head = Span::new(s.span.start, s.to.span.end);
         let from = self.resolve_site(pi, &s.from);
@@ -110,6 +117,8 @@ impl Compiler {
                 self.duplicate("setting", &id, first.span);
             }
             let mut sum = 0.0;
+            // A frequency already reported leaves the sum unknown: no second error about it.
+            let mut sum_known = true;
             for (k, e) in first.entries.iter().enumerate() {
                 if let Some(j) = first.entries[..k]
                     .iter()
@@ -125,7 +134,10 @@ impl Compiler {
                     |f| f > 0.0 && f <= 1.0,
                     "above 0 and at most 1",
                 );
-                sum += e.frequency.value;
+                match f {
+                    Some(f) => sum += f,
+                    None => sum_known = false,
+                }
                 let Some(vp) = self.resolve_piece(&e.piece) else {
                     ok = false;
                     continue;
@@ -141,7 +153,7 @@ impl Compiler {
                     None => ok = false,
                 }
             }
-            if (sum - 1.0).abs() > 1e-6 {
+            if sum_known && (sum - 1.0).abs() > 1e-6 {
                 self.error(
                     Diagnostic::error(codes::FREQUENCIES, format!("variant frequencies sum to {}, not 1", fmt(sum)), first.span, "these frequencies")
                         .with_hint("the frequencies are target proportions of the chain's elements and must sum to 1"),
