@@ -374,3 +374,24 @@ fn tan_degrees(deg: f64) -> f64 {
         .find(|(at, _)| *at == r)
         .map_or_else(|| r.to_radians().tan(), |(_, v)| *v)
 }
+
+/// The folded values of a tree's constants (those that fold), for editors' hovers.
+pub(crate) fn constant_values(file: &crate::syntax::File) -> HashMap<String, f64> {
+    let mut c = Compiler::new("");
+    c.constants(&file.items);
+    c.consts
+        .table
+        .iter()
+        .filter_map(|(n, k)| k.value.map(|v| (n.clone(), v)))
+        .collect()
+}
+
+/// Whether `name` is a built-in function.
+pub(crate) fn is_function(name: &str) -> bool {
+    FUNCTIONS.iter().any(|(n, _, _)| *n == name)
+}
+
+/// The built-in functions' names and how to call them, for completion.
+pub(crate) fn functions() -> impl Iterator<Item = (&'static str, &'static str)> {
+    FUNCTIONS.iter().map(|(n, _, usage)| (*n, *usage))
+}

@@ -6,6 +6,8 @@ pub mod codes;
 
 mod assembly;
 mod constants;
+
+pub(crate) use constants::{constant_values, functions, is_function};
 mod pieces;
 mod rules;
 mod usage;

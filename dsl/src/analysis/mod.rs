@@ -1,0 +1,534 @@
+//! Analysis of one `.clay` text for editors: diagnostics, the symbol table, and the queries a
+//! language server answers (definition, references, hover, completion, outline, rename,
+//! semantic tokens, folding, fixes). No protocol types here: `clayc lsp` translates.
+//!
+//! Architecture Invariant: every query answers from byte offsets into the analysed text; the
+//! conversion to protocol positions goes through [`LineIndex`] only.
+//!
+//! Resilience: a text with a syntax error still answers for the declarations before the error
+//! (the longest prefix of whole top-level items that parses) and, given the analysis of the last
+//! text that parsed ([`Analysis::with_previous`]), for the rest: outside the edited region the
+//! old text is the new one, so the old symbols there keep their place (before the edit) or move
+//! by the change in length (after it).
+
+mod complete;
+mod line_index;
+mod symbols;
+mod tokens;
+
+use std::collections::HashMap;
+
+pub use complete::{Completion, CompletionKind};
+pub use line_index::{LineIndex, LinePos};
+pub use symbols::{Reference, Symbol, SymbolKind, Symbols};
+pub use tokens::{SemanticToken, TokenKind};
+
+use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::syntax::{File, Item, Span};
+
+/// Keywords of the language (contextual: a name may spell one). A rename to one is refused.
+pub const KEYWORDS: &[&str] = &[
+    "let", "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
+    "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
+    "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
+    "at", "rotate", "dock", "last",
+];
+
+/// Words that start a top-level item, where a parsed prefix may end.
+const ITEM_STARTS: &[&str] = &[
+    "let", "solver", "site", "piece", "stretch", "merge", "cut", "model",
+];
+
+/// A node of the outline (document symbols).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outline {
+    pub name: String,
+    /// `None` for the `model` block itself.
+    pub kind: Option<SymbolKind>,
+    pub span: Span,
+    /// The name (or keyword) to select.
+    pub selection: Span,
+    pub children: Vec<Outline>,
+}
+
+/// A fix for a diagnostic: text edits (span replaced by text).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fix {
+    pub title: String,
+    pub edits: Vec<(Span, String)>,
+}
+
+/// One text, analysed.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    index: LineIndex,
+    tree: Option<File>,
+    /// The text up to here is described by `tree` (the whole text when it parses).
+    parsed_to: usize,
+    symbols: Symbols,
+    diagnostics: Diagnostics,
+    /// Folded values of the constants (for hovers).
+    values: HashMap<String, f64>,
+}
+
+impl Analysis {
+    /// Analyses `text` (compiled as the file `path`).
+    pub fn new(text: &str, path: &str) -> Self {
+        let diagnostics = match crate::compile(text, path) {
+            Ok(c) => c.warnings,
+            Err(d) => d,
+        };
+        let (tree, parsed_to) = match crate::parse(text) {
+            Ok(tree) => (Some(tree), text.len()),
+            Err(d) => parsed_prefix(text, &d),
+        };
+        let symbols = tree.as_ref().map(Symbols::of).unwrap_or_default();
+        let values = tree
+            .as_ref()
+            .map(crate::compile::constant_values)
+            .unwrap_or_default();
+        Self {
+            index: LineIndex::new(text),
+            tree,
+            parsed_to,
+            symbols,
+            diagnostics,
+            values,
+        }
+    }
+
+    /// Analyses `text`; when it does not parse to the end, the declarations after the error are
+    /// taken from `previous` (the analysis of the last text that did), moved to where the
+    /// unchanged tail of that text now lies.
+    pub fn with_previous(text: &str, path: &str, previous: &Analysis) -> Self {
+        let mut a = Self::new(text, path);
+        if a.parsed_to < text.len() {
+            a.borrow_tail(previous);
+        }
+        a
+    }
+
+    fn borrow_tail(&mut self, previous: &Analysis) {
+        let old = previous.text();
+        let new = self.index.text();
+        // The edit lies between the common head and the common tail of the two texts: a span
+        // of the old text in its head keeps its offsets, one in its tail moves by the change
+        // in length, one that touches the edit is dropped.
+        let head = old
+            .bytes()
+            .zip(new.bytes())
+            .take_while(|(a, b)| a == b)
+            .count();
+        let tail = old
+            .bytes()
+            .rev()
+            .zip(new.bytes().rev())
+            .take_while(|(a, b)| a == b)
+            .count()
+            .min(old.len().min(new.len()) - head);
+        let (old_tail, new_tail) = (old.len() - tail, new.len() - tail);
+        let from = self.parsed_to;
+        let moved = |s: Span| {
+            let s = if s.end <= head {
+                s
+            } else if s.start >= old_tail {
+                Span::new(s.start - old_tail + new_tail, s.end - old_tail + new_tail)
+            } else {
+                return None;
+            };
+            (s.start >= from).then_some(s)
+        };
+        let mut map: HashMap<usize, usize> = HashMap::new();
+        for (i, sym) in previous.symbols.symbols.iter().enumerate() {
+            let (Some(span), Some(full)) = (moved(sym.span), moved(sym.full)) else {
+                continue;
+            };
+            let container = sym.container.and_then(|c| map.get(&c).copied());
+            map.insert(i, self.symbols.symbols.len());
+            self.symbols.symbols.push(Symbol {
+                span,
+                full,
+                container,
+                ..sym.clone()
+            });
+        }
+        for r in &previous.symbols.references {
+            let Some(span) = moved(r.span) else { continue };
+            let target = &previous.symbols.symbols[r.symbol];
+            let symbol = map.get(&r.symbol).copied().or_else(|| {
+                self.symbols
+                    .symbols
+                    .iter()
+                    .position(|s| s.kind == target.kind && s.name == target.name)
+            });
+            if let Some(symbol) = symbol {
+                self.symbols.references.push(Reference { span, symbol });
+            }
+        }
+    }
+
+    pub fn text(&self) -> &str {
+        self.index.text()
+    }
+
+    pub fn line_index(&self) -> &LineIndex {
+        &self.index
+    }
+
+    pub fn diagnostics(&self) -> &Diagnostics {
+        &self.diagnostics
+    }
+
+    pub fn symbols(&self) -> &Symbols {
+        &self.symbols
+    }
+
+    /// The tree of the text, or of its longest parsed prefix; `None` when nothing parsed.
+    pub fn tree(&self) -> Option<&File> {
+        self.tree.as_ref()
+    }
+
+    /// The symbol declared or used at `offset`.
+    pub fn symbol_at(&self, offset: usize) -> Option<usize> {
+        let inside = |s: Span| s.start <= offset && offset <= s.end;
+        self.symbols
+            .symbols
+            .iter()
+            .position(|s| s.kind != SymbolKind::Rule && inside(s.span))
+            .or_else(|| {
+                self.symbols
+                    .references
+                    .iter()
+                    .find(|r| inside(r.span))
+                    .map(|r| r.symbol)
+            })
+    }
+
+    /// Where the name at `offset` is declared.
+    pub fn definition(&self, offset: usize) -> Option<Span> {
+        self.symbol_at(offset).map(|i| self.symbols.symbols[i].span)
+    }
+
+    /// Every use of the name at `offset` (and its declaration when asked), in source order.
+    pub fn references(&self, offset: usize, declaration: bool) -> Vec<Span> {
+        let Some(i) = self.symbol_at(offset) else {
+            return Vec::new();
+        };
+        let mut spans: Vec<Span> = self
+            .symbols
+            .references
+            .iter()
+            .filter(|r| r.symbol == i)
+            .map(|r| r.span)
+            .collect();
+        if declaration {
+            spans.push(self.symbols.symbols[i].span);
+        }
+        spans.sort_by_key(|s| s.start);
+        spans
+    }
+
+    /// Markdown describing the name at `offset`, and the span it describes.
+    pub fn hover(&self, offset: usize) -> Option<(Span, String)> {
+        let i = self.symbol_at(offset)?;
+        let here = self
+            .symbols
+            .references
+            .iter()
+            .find(|r| r.symbol == i && r.span.start <= offset && offset <= r.span.end)
+            .map_or(self.symbols.symbols[i].span, |r| r.span);
+        Some((here, self.describe(i)))
+    }
+
+    fn first_line(&self, s: Span) -> &str {
+        let text = self.text().get(s.start..s.end).unwrap_or("");
+        text.lines()
+            .next()
+            .unwrap_or("")
+            .trim_end_matches('{')
+            .trim_end()
+    }
+
+    fn describe(&self, i: usize) -> String {
+        let sym = &self.symbols.symbols[i];
+        let mut out = format!("```clay\n{}\n```\n", self.first_line(sym.full));
+        let container = sym.container.map(|c| self.symbols.symbols[c].name.as_str());
+        match sym.kind {
+            SymbolKind::Piece => out += &self.describe_piece(i),
+            SymbolKind::Constant => {
+                if let Some(v) = self.values.get(&sym.name) {
+                    out += &format!("\n= `{}`\n", crate::format_number(*v));
+                }
+            }
+            SymbolKind::Vertex | SymbolKind::Site | SymbolKind::State => {
+                out += &format!(
+                    "\n{} of piece `{}`\n",
+                    sym.kind.word(),
+                    container.unwrap_or("?")
+                );
+            }
+            SymbolKind::Instance | SymbolKind::Chain => {
+                out += &format!(
+                    "\n{} of piece `{}`\n",
+                    sym.kind.word(),
+                    sym.piece.as_deref().unwrap_or("?")
+                );
+            }
+            SymbolKind::SiteType | SymbolKind::Rule => {}
+        }
+        out
+    }
+
+    fn describe_piece(&self, piece: usize) -> String {
+        let members = |kind: SymbolKind| -> Vec<&Symbol> {
+            self.symbols
+                .symbols
+                .iter()
+                .filter(|s| s.container == Some(piece) && s.kind == kind)
+                .collect()
+        };
+        let names = |list: &[&Symbol]| -> String {
+            list.iter()
+                .map(|s| format!("`{}`", s.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut out = String::new();
+        let vertices = members(SymbolKind::Vertex);
+        out += &format!("\n**{} vertices**: {}\n", vertices.len(), names(&vertices));
+        let sites = members(SymbolKind::Site);
+        if !sites.is_empty() {
+            out += "\n**sites**:\n";
+            for s in sites {
+                out += &format!(
+                    "- `{}`\n",
+                    self.first_line(s.full).trim_start_matches("site ")
+                );
+            }
+        }
+        let mut states = vec!["`base`".to_string()];
+        states.extend(
+            members(SymbolKind::State)
+                .iter()
+                .map(|s| format!("`{}`", s.name)),
+        );
+        out += &format!("\n**rest states**: {}\n", states.join(", "));
+        let rules: Vec<&str> = self
+            .symbols
+            .symbols
+            .iter()
+            .filter(|s| s.kind == SymbolKind::Rule)
+            .filter(|rule| {
+                self.symbols.references.iter().any(|r| {
+                    r.symbol == piece
+                        && rule.full.start <= r.span.start
+                        && r.span.end <= rule.full.end
+                })
+            })
+            .map(|rule| self.first_line(rule.full))
+            .collect();
+        if !rules.is_empty() {
+            out += "\n**rules**:\n";
+            for r in rules {
+                out += &format!("- `{r}`\n");
+            }
+        }
+        out
+    }
+
+    /// The outline: top-level declarations with their members, the model with its instances.
+    pub fn outline(&self) -> Vec<Outline> {
+        let syms = &self.symbols.symbols;
+        let node = |i: usize| Outline {
+            name: syms[i].name.clone(),
+            kind: Some(syms[i].kind),
+            span: syms[i].full,
+            selection: syms[i].span,
+            children: Vec::new(),
+        };
+        let mut out = Vec::new();
+        for (i, s) in syms.iter().enumerate() {
+            match s.kind {
+                SymbolKind::Vertex | SymbolKind::Site | SymbolKind::State => {}
+                SymbolKind::Instance | SymbolKind::Chain => {}
+                SymbolKind::Piece => {
+                    let mut n = node(i);
+                    n.children = (0..syms.len())
+                        .filter(|&j| syms[j].container == Some(i))
+                        .map(node)
+                        .collect();
+                    out.push(n);
+                }
+                _ => out.push(node(i)),
+            }
+        }
+        if let Some(model) = self
+            .tree
+            .iter()
+            .flat_map(|t| &t.items)
+            .find_map(|i| match i {
+                Item::Model(m) => Some(m),
+                _ => None,
+            })
+        {
+            out.push(Outline {
+                name: "model".into(),
+                kind: None,
+                span: model.span,
+                selection: model.keyword,
+                children: (0..syms.len())
+                    .filter(|&j| matches!(syms[j].kind, SymbolKind::Instance | SymbolKind::Chain))
+                    .map(node)
+                    .collect(),
+            });
+        }
+        out.sort_by_key(|o| o.span.start);
+        out
+    }
+
+    /// The edits that rename the name at `offset` to `new_name` everywhere, or why not.
+    pub fn rename(&self, offset: usize, new_name: &str) -> Result<Vec<(Span, String)>, String> {
+        let i = self
+            .symbol_at(offset)
+            .ok_or_else(|| "there is no name to rename here".to_string())?;
+        let sym = &self.symbols.symbols[i];
+        let valid = new_name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && new_name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !valid {
+            return Err(format!(
+                "`{new_name}` is not a name: names are ASCII letters, digits and `_`, not starting with a digit"
+            ));
+        }
+        if KEYWORDS.contains(&new_name) {
+            return Err(format!("`{new_name}` is a keyword"));
+        }
+        let namespace = |k: SymbolKind| match k {
+            SymbolKind::Instance | SymbolKind::Chain => SymbolKind::Instance,
+            k => k,
+        };
+        let clash = self.symbols.symbols.iter().find(|s| {
+            s.name == new_name
+                && namespace(s.kind) == namespace(sym.kind)
+                && s.container == sym.container
+        });
+        if let Some(other) = clash {
+            let at = self.index.position(other.span.start);
+            return Err(format!(
+                "{} `{new_name}` already exists (line {})",
+                other.kind.word(),
+                at.line + 1
+            ));
+        }
+        if sym.kind == SymbolKind::Constant
+            && (new_name == "pi" || crate::compile::is_function(new_name))
+        {
+            return Err(format!("`{new_name}` is built in"));
+        }
+        Ok(self
+            .references(offset, true)
+            .into_iter()
+            .map(|s| (s, new_name.to_string()))
+            .collect())
+    }
+
+    /// The canonical text, or `None` when the text does not parse.
+    pub fn format(&self) -> Option<String> {
+        crate::format(self.text()).ok()
+    }
+
+    /// Fixes offered for a diagnostic of this text.
+    pub fn fixes(&self, d: &Diagnostic) -> Vec<Fix> {
+        let mut fixes = Vec::new();
+        for hint in &d.hints {
+            if let Some(word) = between(hint, "did you mean `", "`?") {
+                fixes.push(Fix {
+                    title: format!("replace with `{word}`"),
+                    edits: vec![(d.primary.span, word.to_string())],
+                });
+            }
+            if let Some(fix) = between(hint, "declare `site type ", "`")
+                .and_then(|decl| self.allow_docking(decl))
+            {
+                fixes.push(fix);
+            }
+        }
+        fixes
+    }
+
+    /// `declare site type A docks B`: extend A's declaration so it also docks with B.
+    fn allow_docking(&self, decl: &str) -> Option<Fix> {
+        let (a, b) = decl.split_once(" docks ")?;
+        let tree = self.tree.as_ref()?;
+        let t = tree.items.iter().find_map(|i| match i {
+            Item::SiteType(t) if t.name.name == a => Some(t),
+            _ => None,
+        })?;
+        let end = Span::new(t.span.end, t.span.end);
+        let text = if t.docks.is_empty() {
+            // Without `docks` the type docks with itself: keep that.
+            format!(" docks {a}, {b}")
+        } else {
+            format!(", {b}")
+        };
+        Some(Fix {
+            title: format!("let `{a}` dock with `{b}`"),
+            edits: vec![(end, text)],
+        })
+    }
+
+    pub fn completions(&self, offset: usize) -> Vec<Completion> {
+        complete::at(self, offset)
+    }
+
+    pub fn semantic_tokens(&self) -> Vec<SemanticToken> {
+        tokens::semantic(self)
+    }
+
+    /// Ranges worth folding: multi-line blocks and block comments.
+    pub fn folding_ranges(&self) -> Vec<Span> {
+        tokens::folding(self)
+    }
+}
+
+/// The text between `open` and the next `close` in `s`.
+fn between<'a>(s: &'a str, open: &str, close: &str) -> Option<&'a str> {
+    let start = s.find(open)? + open.len();
+    let len = s[start..].find(close)?;
+    Some(&s[start..start + len])
+}
+
+/// The tree of the longest prefix of whole top-level items before the first syntax error.
+fn parsed_prefix(text: &str, diags: &Diagnostics) -> (Option<File>, usize) {
+    let error = diags
+        .iter()
+        .map(|d| d.primary.span.start)
+        .min()
+        .unwrap_or(0);
+    let mut cuts = vec![0];
+    cuts.extend(
+        text.match_indices('\n')
+            .map(|(i, _)| i + 1)
+            .filter(|&i| i <= error)
+            .filter(|&i| {
+                let rest = &text[i..];
+                ITEM_STARTS.iter().any(|w| {
+                    rest.starts_with(w)
+                        && !rest[w.len()..]
+                            .starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_')
+                })
+            }),
+    );
+    // The latest cut usually parses; a few earlier ones cover an error inside an item that
+    // starts at column 0 with its body's lines.
+    for &cut in cuts.iter().rev().take(4) {
+        if let Ok(tree) = crate::parse(&text[..cut]) {
+            return (Some(tree), cut);
+        }
+    }
+    (None, 0)
+}
