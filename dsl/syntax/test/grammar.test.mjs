@@ -455,3 +455,22 @@ test("a half-typed line does not colour the next one", () => {
     expectScope(text, "piece p", "piece", "keyword.other.piece.clay");
   }
 });
+
+test("editors/vscode contributes this grammar and a language configuration", () => {
+  const dir = path.join(root, "editors/vscode");
+  const pkg = JSON.parse(readFileSync(path.join(dir, "package.json"), "utf8"));
+  const [lang] = pkg.contributes.languages;
+  assert.equal(lang.id, "clay");
+  assert.deepEqual(lang.extensions, [".clay"]);
+  const [g] = pkg.contributes.grammars;
+  assert.equal(g.language, "clay");
+  assert.equal(g.scopeName, "source.clay");
+  // syntaxes/clay.tmLanguage.json is a symbolic link to dsl/syntax's file
+  assert.equal(readFileSync(path.join(dir, g.path), "utf8"), grammarText);
+  const conf = JSON.parse(readFileSync(path.join(dir, lang.configuration), "utf8"));
+  assert.deepEqual(conf.comments, { lineComment: "//", blockComment: ["/*", "*/"] });
+  assert.deepEqual(conf.brackets, [["{", "}"], ["[", "]"], ["(", ")"]]);
+  const word = new RegExp(`^(?:${conf.wordPattern})$`);
+  for (const w of ["tower_2", "0.5", "1e-3", "#b5651d", ".5"]) assert.match(w, word);
+  assert.doesNotMatch("a-b", word);
+});
