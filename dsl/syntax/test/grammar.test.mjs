@@ -474,3 +474,11 @@ test("editors/vscode contributes this grammar and a language configuration", () 
   for (const w of ["tower_2", "0.5", "1e-3", "#b5651d", ".5"]) assert.match(w, word);
   assert.doesNotMatch("a-b", word);
 });
+
+test("plist.mjs writes the same grammar as a property list (Sublime Text, TextMate)", async () => {
+  const { toPlist } = await import("./plist.mjs");
+  const json = JSON.parse(grammarText);
+  delete json.$schema;
+  const fromPlist = vsctm.parseRawGrammar(toPlist(JSON.parse(grammarText)), "Clay.tmLanguage");
+  assert.deepEqual(JSON.parse(JSON.stringify(fromPlist)), json);
+});
