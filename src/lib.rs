@@ -5,6 +5,7 @@
 
 pub mod assembly;
 pub mod authoring;
+pub mod export;
 pub mod files;
 pub mod fit;
 pub mod gallery;

@@ -451,8 +451,8 @@ impl Analysis {
                     edits: vec![(d.primary.span, word.to_string())],
                 });
             }
-            if let Some(fix) = between(hint, "declare `site type ", "`")
-                .and_then(|decl| self.allow_docking(decl))
+            if let Some(fix) =
+                between(hint, "declare `site type ", "`").and_then(|decl| self.allow_docking(decl))
             {
                 fixes.push(fix);
             }

@@ -13,6 +13,7 @@ mod out;
 mod author;
 mod bench;
 mod check;
+mod export;
 mod fmt;
 mod render;
 mod run;
@@ -40,6 +41,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Render an assembly to PNG (or SVG).
     Render(render::RenderArgs),
+    /// Export the assembly as 3D meshes (glTF or OBJ).
+    Export(export::ExportArgs),
     /// Render every piece and rest state of a grammar side by side.
     Sheet(render::SheetArgs),
     /// Print grammars in the canonical style (or --write / --check them).
@@ -64,6 +67,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::bench(args),
         Command::Render(args) => render::render(args),
         Command::Sheet(args) => render::sheet(args),
+        Command::Export(args) => export::export(args),
         Command::Fmt(args) => fmt::fmt(args),
         Command::Author(args) => author::author_cmd(args),
     };

@@ -90,7 +90,7 @@ const INPUT_ERROR: u8 = 1;
 use crate::out::IO_ERROR;
 
 /// Loads and compiles a grammar; on failure prints why and gives the exit code.
-fn load(path: &Path) -> Result<CompiledGrammar, u8> {
+pub(crate) fn load(path: &Path) -> Result<CompiledGrammar, u8> {
     let source = std::fs::read_to_string(path).map_err(|e| {
         errln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
@@ -130,7 +130,7 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
 /// Replays a sculpting script on the grammar's initial assembly (solver and rules, as
 /// `clayc run` does); gives the final assembly and the global vertices of its grab handles and
 /// of its pins.
-fn replay(
+pub(crate) fn replay(
     grammar: CompiledGrammar,
     path: &Path,
 ) -> Result<(AssemblyData, Vec<usize>, Vec<usize>), u8> {

@@ -1,0 +1,223 @@
+//! `clay::export` and `clayc export` (issue 20): every example exports to glTF that the `gltf`
+//! crate reads back with the assembly's nodes, names and triangles, to OBJ that `tobj` loads;
+//! the floor plan is the renderer's, heights are untouched by the deformation.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use clay::assembly::Assembly;
+use clay::export::{ExportOptions, Scene, gltf, obj, scene};
+use clay::render::{TessellationCache, pose_assembly};
+use clay::script::Script;
+use clay::session::Session;
+use clay::solver::SolverConfig;
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
+
+const EXAMPLES: [&str; 6] = ["wall", "castle", "streets", "centipede", "junction", "bend"];
+
+fn grammar(name: &str) -> CompiledGrammar {
+    let path = format!("{}/grammars/{name}.clay", env!("CARGO_MANIFEST_DIR"));
+    let source = std::fs::read_to_string(&path).unwrap();
+    clay_dsl::compile(&source, &path).unwrap().grammar
+}
+
+/// The assembly after the example's script, when it has one.
+fn sculpted(name: &str, g: &CompiledGrammar) -> Option<AssemblyData> {
+    let path = format!("{}/grammars/{name}.script.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).ok()?;
+    let script = Script::parse(&text).unwrap();
+    let mut assembly = Assembly::new(Arc::new(g.clone()));
+    let mut session = Session::new(SolverConfig::from_params(&g.solver));
+    clay::session::replay(&mut assembly, &script, &mut session).unwrap();
+    Some(assembly.into_data())
+}
+
+/// The renderer's floor-plan bounds of an assembly.
+fn rendered_bounds(g: &CompiledGrammar, a: &AssemblyData) -> ([f64; 2], [f64; 2]) {
+    let meshes = pose_assembly(g, a, &mut TessellationCache::default());
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for m in &meshes {
+        for p in &m.positions {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k] as f64);
+                hi[k] = hi[k].max(p[k] as f64);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+fn assert_bounds_match(s: &Scene, g: &CompiledGrammar, a: &AssemblyData, what: &str) {
+    let (lo, hi) = s.floor_bounds().expect("something exported");
+    let (rlo, rhi) = rendered_bounds(g, a);
+    for k in 0..2 {
+        assert!(
+            (lo[k] - rlo[k]).abs() < 1e-6,
+            "{what}: min {lo:?} vs {rlo:?}"
+        );
+        assert!(
+            (hi[k] - rhi[k]).abs() < 1e-6,
+            "{what}: max {hi:?} vs {rhi:?}"
+        );
+    }
+}
+
+#[test]
+fn the_floor_plan_is_the_renderers_and_heights_stay_after_a_script() {
+    let options = ExportOptions::default();
+    for name in EXAMPLES {
+        let g = grammar(name);
+        let s = scene(&g, &g.assembly, &options);
+        assert_bounds_match(&s, &g, &g.assembly, name);
+        if let Some(after) = sculpted(name, &g) {
+            assert_ne!(
+                after.positions, g.assembly.positions,
+                "{name}: the script moves it"
+            );
+            let s = scene(&g, &after, &options);
+            assert_bounds_match(&s, &g, &after, name);
+            // Every height is a rest height: the base, or a layer's top.
+            let tops: Vec<f64> = (0..64)
+                .map(|k| options.thickness + options.layer * k as f64)
+                .collect();
+            for p in s
+                .nodes
+                .iter()
+                .flat_map(|n| &n.primitives)
+                .flat_map(|p| &p.positions)
+            {
+                let y = p[1] as f64;
+                assert!(
+                    y == 0.0 || tops.iter().any(|t| (t - y).abs() < 1e-6),
+                    "{name}: height {y} is not a rest height"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn faces_wind_counter_clockwise_around_unit_normals() {
+    let g = grammar("castle");
+    let s = scene(&g, &g.assembly, &ExportOptions::default());
+    let mut up = 0;
+    for p in s.nodes.iter().flat_map(|n| &n.primitives) {
+        assert_eq!(p.positions.len(), p.normals.len());
+        for t in p.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| glam::Vec3::from(p.positions[i as usize]));
+            let n = glam::Vec3::from(p.normals[t[0] as usize]);
+            assert!((n.length() - 1.0).abs() < 1e-5);
+            assert!(
+                (b - a).cross(c - a).dot(n) > 0.0,
+                "a face winds against its normal"
+            );
+            up += usize::from(n.y > 0.99);
+        }
+    }
+    assert!(up > 0);
+}
+
+#[test]
+fn glb_and_gltf_read_back_with_the_assemblys_nodes_names_and_triangles() {
+    for name in EXAMPLES {
+        let g = grammar(name);
+        let s = scene(&g, &g.assembly, &ExportOptions::default());
+        for bytes in [gltf::to_glb(&s).unwrap(), gltf::to_gltf(&s).unwrap()] {
+            let doc = ::gltf::Gltf::from_slice(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let blob = match &doc.blob {
+                Some(b) => b.clone(),
+                None => {
+                    let uri = doc.buffers().next().unwrap();
+                    let ::gltf::buffer::Source::Uri(uri) = uri.source() else {
+                        panic!()
+                    };
+                    use base64::Engine as _;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(uri.split_once(',').unwrap().1)
+                        .unwrap()
+                }
+            };
+            let nodes: Vec<_> = doc.nodes().collect();
+            assert_eq!(nodes.len(), g.assembly.instances.len(), "{name}");
+            for (node, inst) in nodes.iter().zip(&g.assembly.instances) {
+                assert_eq!(node.name(), Some(inst.name.as_str()));
+                let extras: serde_json::Value =
+                    serde_json::from_str(node.extras().as_ref().unwrap().get()).unwrap();
+                assert_eq!(extras["piece"], g.pieces[inst.piece].name.as_str());
+                assert_eq!(
+                    extras["state"],
+                    g.pieces[inst.piece].states[inst.state].name.as_str()
+                );
+            }
+            let mut triangles = 0;
+            for mesh in doc.meshes() {
+                for prim in mesh.primitives() {
+                    let reader = prim.reader(|_| Some(&blob));
+                    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+                    let positions = reader.read_positions().unwrap().count();
+                    assert!(indices.iter().all(|&i| (i as usize) < positions));
+                    triangles += indices.len() / 3;
+                }
+            }
+            assert_eq!(triangles, s.triangle_count(), "{name}");
+        }
+    }
+}
+
+#[test]
+fn obj_loads_in_tobj_with_every_triangle_and_material() {
+    for name in EXAMPLES {
+        let g = grammar(name);
+        let s = scene(&g, &g.assembly, &ExportOptions::default());
+        let (obj_text, mtl_text) = obj::to_obj(&s, "model.mtl");
+        let (models, materials) = tobj::load_obj_buf(
+            &mut obj_text.as_bytes(),
+            &tobj::LoadOptions {
+                triangulate: false,
+                ..Default::default()
+            },
+            |p| {
+                assert_eq!(p, Path::new("model.mtl"));
+                tobj::load_mtl_buf(&mut mtl_text.as_bytes())
+            },
+        )
+        .unwrap();
+        assert_eq!(materials.unwrap().len(), s.materials.len(), "{name}");
+        let faces: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+        assert_eq!(faces, s.triangle_count(), "{name}");
+        let names: std::collections::BTreeSet<&str> =
+            models.iter().map(|m| m.name.as_str()).collect();
+        for inst in &g.assembly.instances {
+            assert!(names.contains(inst.name.as_str()), "{name}: {}", inst.name);
+        }
+    }
+}
+
+#[test]
+fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
+    let dir = std::env::temp_dir().join(format!("clay-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wall = format!("{}/grammars/wall.clay", env!("CARGO_MANIFEST_DIR"));
+    let script = format!("{}/grammars/wall.script.json", env!("CARGO_MANIFEST_DIR"));
+    for ext in ["glb", "gltf", "obj"] {
+        let out = dir.join(format!("wall.{ext}"));
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .args(["export", &wall, "--script", &script, "-o"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{ext}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 100);
+    }
+    assert!(dir.join("wall.mtl").exists());
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("wall.fbx"))
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains(".glb, .gltf or .obj"));
+    assert!(!dir.join("wall.fbx").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
