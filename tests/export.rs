@@ -221,3 +221,20 @@ fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
     assert!(!dir.join("wall.fbx").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_iso_view_draws_the_scene_the_same_way_every_time() {
+    let g = grammar("castle");
+    let s = scene(&g, &g.assembly, &ExportOptions::default());
+    let a = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
+    let b = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
+    assert_eq!(a.data(), b.data(), "deterministic");
+    let background = clay::render::draw::BACKGROUND.0;
+    let drawn = a.pixels().iter().filter(|p| {
+        let c = p.demultiply();
+        [c.red(), c.green(), c.blue()] != [background[0], background[1], background[2]]
+    });
+    let share = drawn.count() as f64 / (400.0 * 300.0);
+    assert!(share > 0.05 && share < 0.9, "{share}");
+    assert!(clay::export::iso::iso_pixmap(&s, 0, 300).is_err());
+}

@@ -15,6 +15,7 @@
 //! renderer's (`pose_assembly`), so a picture and an export of the same assembly agree.
 
 pub mod gltf;
+pub mod iso;
 pub mod obj;
 
 use std::collections::HashMap;

@@ -49,6 +49,16 @@ pub struct RenderArgs {
     /// Write SVG whatever the output's extension.
     #[arg(long)]
     pub svg: bool,
+    /// `plan` (from above, with overlays) or `iso` (an isometric view of the 3D export: heights
+    /// shown, PNG only, no overlays).
+    #[arg(long, value_enum, default_value_t = ViewKind::Plan)]
+    pub view: ViewKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ViewKind {
+    Plan,
+    Iso,
 }
 
 #[derive(clap::Args)]
@@ -167,6 +177,11 @@ fn wants_svg(output: &Path, flag: bool) -> bool {
 }
 
 pub fn render(args: RenderArgs) -> u8 {
+    if args.view == ViewKind::Iso && (wants_svg(&args.output, args.svg) || !args.overlay.is_empty())
+    {
+        errln!("error: the iso view is a PNG without overlays: drop --svg, .svg and --overlay");
+        return IO_ERROR;
+    }
     let grammar = match load(&args.file) {
         Ok(g) => g,
         Err(code) => return code,
@@ -178,6 +193,20 @@ pub fn render(args: RenderArgs) -> u8 {
             Err(code) => return code,
         },
     };
+    if args.view == ViewKind::Iso {
+        let scene = clay::export::scene(&grammar, &assembly, &Default::default());
+        let png = clay::export::iso::iso_pixmap(&scene, args.size.0, args.size.1).and_then(|p| {
+            p.encode_png()
+                .map_err(|e| clay::render::RenderError::Encode(e.to_string()))
+        });
+        return match png {
+            Ok(png) => out::write_output(&args.output, &png),
+            Err(e) => {
+                errln!("error: {e}");
+                IO_ERROR
+            }
+        };
+    }
     let has = |k: OverlayKind| args.overlay.contains(&k);
     let overlays = Overlays {
         part_graph: has(OverlayKind::Graph),
