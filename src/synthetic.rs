@@ -33,6 +33,7 @@ fn state(name: &str, positions: Vec<DVec2>, colour: [u8; 4], binding: Binding) -
             },
             fill: Rgba(colour),
             binding,
+            extrude: None,
         }],
         positions,
         geometry_frame: 0,

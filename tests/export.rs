@@ -238,3 +238,32 @@ fn the_iso_view_draws_the_scene_the_same_way_every_time() {
     assert!(share > 0.05 && share < 0.9, "{share}");
     assert!(clay::export::iso::iso_pixmap(&s, 0, 300).is_err());
 }
+
+#[test]
+fn extruded_proxies_keep_their_heights_when_the_floor_plan_deforms() {
+    let source = "site type s\npiece tower {\n    vertex a (0, 0)\n    vertex b (2, 0)\n    vertex c (1, 2)\n    \
+                  edges a-b-c-a\n    polygon fill #777777 extrude 6 above 2 {\n        (0, 0) (2, 0) (1, 2)\n    }\n    \
+                  polygon fill #aa3333 {\n        (0.5, 0.5) (1.5, 0.5) (1, 1.5)\n    }\n}\nmodel {\n    t = tower\n}\n";
+    let g = clay_dsl::compile(source, "t.clay").unwrap().grammar;
+    let mut a = g.assembly.clone();
+    // Shear the floor plan, as a drag would.
+    for p in &mut a.positions {
+        p.x += 0.3 * p.y;
+    }
+    let options = ExportOptions::default();
+    let s = scene(&g, &a, &options);
+    assert_bounds_match(&s, &g, &a, "sheared tower");
+    let [solid, flat] = [0, 1].map(|m| {
+        let mut hs: Vec<f32> = s.nodes[0].primitives[m]
+            .positions
+            .iter()
+            .map(|p| p[1])
+            .collect();
+        hs.sort_by(f32::total_cmp);
+        hs.dedup();
+        hs
+    });
+    assert_eq!(solid, vec![2.0, 8.0]);
+    // The flat proxy is the second layer: thickness plus one layer step.
+    assert_eq!(flat, vec![0.0, (options.thickness + options.layer) as f32]);
+}

@@ -43,6 +43,7 @@ fn grammar() -> CompiledGrammar {
                     },
                     fill: Rgba([90, 120, 200, 255]),
                     binding: Binding::Rigid,
+                    extrude: None,
                 }],
                 geometry_frame: 0,
             }],

@@ -48,6 +48,7 @@ fn polygon(outer: &[(f64, f64)], fill: Rgba, binding: Binding) -> Proxy {
         },
         fill,
         binding,
+        extrude: None,
     }
 }
 

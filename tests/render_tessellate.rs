@@ -165,6 +165,7 @@ fn proxy(shape: ProxyShape) -> Proxy {
         shape,
         fill: Rgba([1, 2, 3, 255]),
         binding: Binding::Rigid,
+        extrude: None,
     }
 }
 

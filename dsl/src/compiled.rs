@@ -112,6 +112,18 @@ pub struct Proxy {
     pub shape: ProxyShape,
     pub fill: Rgba,
     pub binding: Binding,
+    /// Heights for the 3D export (`extrude`); absent for flat geometry, which the export gives
+    /// a default thickness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extrude: Option<Extrude>,
+}
+
+/// A proxy's prism in the 3D export: its floor `base` metres above the ground, `height` metres
+/// tall. The solver's deformation moves the floor plan only; these stay (paper 6).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Extrude {
+    pub height: f64,
+    pub base: f64,
 }
 
 /// The outline of a proxy.

@@ -484,7 +484,16 @@ impl<'s> Printer<'s> {
                 )
             }
         };
-        self.open(indent, &header, g.span.start, g.fill.span.end);
+        let mut header = header;
+        let mut head_end = g.fill.span.end;
+        if let Some(e) = &g.extrude {
+            header += &format!(" extrude {}", self.num(&e.height));
+            if let Some(b) = &e.above {
+                header += &format!(" above {}", self.num(b));
+            }
+            head_end = e.span.end;
+        }
+        self.open(indent, &header, g.span.start, head_end);
         match &g.shape {
             ShapeDecl::Polygon { outer, holes } => {
                 self.points(indent + 1, outer);

@@ -75,6 +75,9 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::paren_expr => "`(`",
         Rule::let_decl => "a `let` constant",
         Rule::kw_let => "`let`",
+        Rule::kw_extrude => "`extrude`",
+        Rule::kw_above => "`above`",
+        Rule::extrude => "`extrude HEIGHT [above BASE]`",
         Rule::integer => "a whole number",
         Rule::colour => "a colour like `#b5651d`",
         Rule::point => "a point `(x, y)`",
@@ -924,10 +927,22 @@ impl Lower {
             let width = self.expr_or(first(&ch, Rule::expr), span);
             ShapeDecl::Polyline { width, points }
         };
+        let extrude = first(&ch, Rule::extrude).map(|e| {
+            let espan = span_of(&e);
+            let mut exprs = of(&kids(e), Rule::expr).into_iter();
+            let height = self.expr_or(exprs.next(), espan);
+            let above = exprs.next().map(|b| self.expr(b).0);
+            ExtrudeDecl {
+                height,
+                above,
+                span: espan,
+            }
+        });
         GeometryDecl {
             shape,
             binding,
             fill,
+            extrude,
             keyword,
             span,
         }

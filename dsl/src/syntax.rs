@@ -251,6 +251,8 @@ pub struct GeometryDecl {
     /// The binding keyword and its span, when written.
     pub binding: Option<(BindingKw, Span)>,
     pub fill: Colour,
+    /// `extrude HEIGHT [above BASE]`, when written.
+    pub extrude: Option<ExtrudeDecl>,
     /// Span of the `polygon`/`polyline` keyword.
     pub keyword: Span,
     pub span: Span,
@@ -266,6 +268,14 @@ pub enum ShapeDecl {
         width: Expr,
         points: Vec<Point>,
     },
+}
+
+/// `extrude HEIGHT [above BASE]`: the proxy's heights in the 3D export.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtrudeDecl {
+    pub height: Expr,
+    pub above: Option<Expr>,
+    pub span: Span,
 }
 
 /// `hole { POINT... }`.

@@ -705,6 +705,7 @@ impl Design {
                 },
                 binding,
                 fill,
+                extrude: None,
                 keyword: Span::default(),
                 span: Span::default(),
             })),
@@ -717,6 +718,7 @@ impl Design {
                         },
                         binding,
                         fill,
+                        extrude: None,
                         keyword: Span::default(),
                         span: Span::default(),
                     }));

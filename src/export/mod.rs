@@ -138,8 +138,11 @@ pub fn scene(grammar: &CompiledGrammar, assembly: &AssemblyData, options: &Expor
                 node.primitives.len() - 1
             }
         };
-        let top = options.thickness + options.layer * layer as f64;
-        extrude(mesh, 0.0, top, &mut node.primitives[at]);
+        let (base, top) = match mesh.extrude {
+            Some(e) => (e.base, e.base + e.height),
+            None => (0.0, options.thickness + options.layer * layer as f64),
+        };
+        extrude(mesh, base, top, &mut node.primitives[at]);
         layer += 1;
     }
     // Every instance is a node, also one without geometry (an empty node keeps the names

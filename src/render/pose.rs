@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Rgba};
+use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Extrude, Rgba};
 use glam::DVec2;
 
 use super::tessellate::{Mesh, TessellationCache, shown_geometry};
@@ -163,6 +163,8 @@ pub struct WorldMesh {
     /// Boundary edges for outlines.
     pub outline: Vec<[u32; 2]>,
     pub fill: Rgba,
+    /// The proxy's heights for the 3D export (`None`: flat geometry).
+    pub extrude: Option<Extrude>,
     /// The instance (index into [`AssemblyData::instances`]) the mesh belongs to.
     pub instance: usize,
 }
@@ -364,11 +366,13 @@ fn write_mesh(
             triangles: Vec::with_capacity(mesh.triangles.len()),
             outline: Vec::with_capacity(mesh.outline.len()),
             fill: mesh.fill,
+            extrude: mesh.extrude,
             instance: 0,
         });
     }
     let w = &mut out[at];
     w.fill = mesh.fill;
+    w.extrude = mesh.extrude;
     w.positions.clear();
     w.triangles.clear();
     w.outline.clear();
@@ -590,6 +594,7 @@ mod tests {
                 triangles,
                 outline,
                 fill: mesh.fill,
+                extrude: mesh.extrude,
                 instance: 0,
             })
         }

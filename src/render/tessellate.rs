@@ -13,7 +13,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use clay_dsl::compiled::{Binding, CompiledGrammar, Proxy, ProxyShape, Rgba};
+use clay_dsl::compiled::{Binding, CompiledGrammar, Extrude, Proxy, ProxyShape, Rgba};
 use glam::DVec2;
 use spade::handles::FixedUndirectedEdgeHandle;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
@@ -34,6 +34,8 @@ pub struct Mesh {
     pub outline: Vec<[u32; 2]>,
     pub fill: Rgba,
     pub binding: Binding,
+    /// The proxy's heights for the 3D export, when it has them.
+    pub extrude: Option<Extrude>,
 }
 
 impl Mesh {
@@ -64,6 +66,7 @@ pub fn tessellate_proxy(proxy: &Proxy) -> Option<Mesh> {
         outline,
         fill: proxy.fill,
         binding: proxy.binding,
+        extrude: proxy.extrude,
     })
 }
 

@@ -30,6 +30,8 @@ pub struct Compiled {
 
 /// Largest absolute coordinate accepted, in metres; keeps every later computation finite.
 pub const MAX_COORDINATE: f64 = 1e9;
+/// Largest `extrude` height or base, in metres (the tallest building is under 1 km).
+pub const MAX_HEIGHT: f64 = 10_000.0;
 /// Most instances a model may have (chains included).
 pub const MAX_INSTANCES: usize = 1_000_000;
 /// Distance below which two positions count as the same place.

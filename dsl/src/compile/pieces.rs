@@ -7,7 +7,7 @@ use crate::suggest::closest;
 use crate::syntax::{self, Ident, PieceStmt, Span};
 use glam::DVec2;
 
-use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, PieceSpans, codes, fmt};
+use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, MAX_HEIGHT, PieceSpans, codes, fmt};
 
 impl Compiler {
     // Long because: one pass over the piece's statements in source order, each a short arm of one match.
@@ -377,10 +377,35 @@ impl Compiler {
                 ProxyShape::Polyline { points, width: w? }
             }
         };
+        let extrude = match &g.extrude {
+            None => None,
+            Some(e) => {
+                let height = self.in_range(
+                    &e.height,
+                    "`extrude` height",
+                    |h| h > 0.0 && h <= MAX_HEIGHT,
+                    &format!("above 0 and at most {MAX_HEIGHT} metres"),
+                );
+                let base = match &e.above {
+                    None => Some(0.0),
+                    Some(b) => self.in_range(
+                        b,
+                        "`above` (the base height)",
+                        |b| b.abs() <= MAX_HEIGHT,
+                        &format!("within +/-{MAX_HEIGHT} metres"),
+                    ),
+                };
+                Some(Extrude {
+                    height: height?,
+                    base: base?,
+                })
+            }
+        };
         Some(Proxy {
             shape,
             fill,
             binding,
+            extrude,
         })
     }
 
