@@ -792,6 +792,7 @@ fn add_states(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::Fil
             positions,
             edges: Vec::new(),
             geometry: Vec::new(),
+            derive: None,
             span: Span::default(),
         }));
     }
