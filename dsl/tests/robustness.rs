@@ -52,7 +52,7 @@ const TOKENS: &[&str] = &[
     "(", ")", "{", "}", "[", "]", ",", ".", "-", "->", ":", "=", "#", "#fff", "0", "-1", "1e400",
     "1e308", "9999999", "0.5", "brick", "piece", "site", "model", "stretch", "merge", "cut",
     "chain", "x", "dock", "state", "edges", "vertex", "wall[0]", "last", "/*", "*/", "//", "\n",
-    " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate",
+    " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate", "bend", "mirror", "base", "360", "-90",
 ];
 
 fn mutate(rng: &mut Rng, src: &str) -> String {
