@@ -150,6 +150,9 @@ impl Bend {
         let Some(&first) = points.first() else {
             return Vec::new();
         };
+        if self.curvature == 0.0 {
+            return points.to_vec(); // no turn: nothing to follow
+        }
         let step = MAX_ARC_STEP_DEGREES.to_radians();
         let len = self.axis.length;
         let mut out = vec![first];
