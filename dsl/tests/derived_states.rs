@@ -313,3 +313,26 @@ fn tiny_and_odd_angles_stay_finite() {
         }
     }
 }
+
+#[test]
+fn mirroring_a_big_listed_piece_is_fast() {
+    // 20,000 vertices on two rails, a listed state and its mirror: near-linear, not quadratic.
+    let n = 10_000;
+    let mut src = String::from("site type t\npiece big {\n");
+    for i in 0..n {
+        src += &format!("vertex s{i} ({i}, -0.5)\nvertex n{i} ({i}, 0.5)\n");
+    }
+    src += &format!(
+        "site west: t [n0, s0] out (-1, 0)\nsite east: t [s{0}, n{0}] out (1, 0)\naxis west -> east\n",
+        n - 1
+    );
+    src += "state lean {\n";
+    for i in 0..n {
+        src += &format!("s{i} ({i}, -0.6) n{i} ({i}, 0.4)\n");
+    }
+    src += "}\nstate lean_back mirror lean\n}\nmodel { b = big }\n";
+    let t = std::time::Instant::now();
+    let g = ok(&src);
+    assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
+    assert!(pos(&g.pieces[0], "lean_back", "s7").distance(DVec2::new(7.0, -0.4)) < 1e-12);
+}

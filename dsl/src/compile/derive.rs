@@ -645,13 +645,21 @@ impl Compiler {
         index: usize,
     ) -> Option<RestState> {
         let base = &piece.states[0].positions;
+        // Vertices sorted by x, so finding each image is a binary search, not a scan.
+        let mut by_x: Vec<usize> = (0..base.len()).collect();
+        by_x.sort_by(|&i, &j| base[i].x.total_cmp(&base[j].x));
+        let image_of = |image: DVec2| {
+            let from = by_x.partition_point(|&i| base[i].x < image.x - MIRROR_TOLERANCE);
+            by_x[from..]
+                .iter()
+                .take_while(|&&i| base[i].x <= image.x + MIRROR_TOLERANCE)
+                .copied()
+                .find(|&i| base[i].distance(image) <= MIRROR_TOLERANCE)
+        };
         let mut partner = Vec::with_capacity(base.len());
         for (v, &p) in base.iter().enumerate() {
             let image = axis.mirror(p);
-            match base
-                .iter()
-                .position(|&q| q.distance(image) <= MIRROR_TOLERANCE)
-            {
+            match image_of(image) {
                 Some(w) => partner.push(w),
                 None => {
                     let mut diag = Diagnostic::error(
