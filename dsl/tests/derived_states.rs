@@ -336,3 +336,32 @@ fn mirroring_a_big_listed_piece_is_fast() {
     assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
     assert!(pos(&g.pieces[0], "lean_back", "s7").distance(DVec2::new(7.0, -0.4)) < 1e-12);
 }
+
+#[test]
+fn the_example_in_the_language_docs_compiles_as_it_says() {
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/language.md"))
+        .unwrap();
+    let start = doc
+        .find("```clay\n// bend.clay's road")
+        .expect("the example")
+        + 8;
+    let len = doc[start..].find("```").unwrap();
+    let src = format!(
+        "site type lane\n{}\nmodel {{ r = road }}\n",
+        &doc[start..start + len]
+    );
+    let g = ok(&src);
+    let p = &g.pieces[0];
+    // "east end at (1.27, 1.27)": the east site's centre.
+    let east = (pos(p, "left", "s2") + pos(p, "left", "n2")) / 2.0;
+    assert!(east.distance(DVec2::splat(4.0 / std::f64::consts::PI)) < 1e-12);
+    // "the same as `bend -90`".
+    let minus = ok(&src.replace("state right mirror left", "state right bend -90"));
+    for (a, b) in state(p, "right")
+        .positions
+        .iter()
+        .zip(&state(&minus.pieces[0], "right").positions)
+    {
+        assert!(a.distance(*b) < 1e-12);
+    }
+}
