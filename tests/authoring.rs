@@ -385,3 +385,23 @@ fn clayc_author_writes_merges_and_posed_states_as_the_editor_does() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn the_editor_refuses_every_keyword_of_the_grammar_as_a_name() {
+    // Every `kw_NAME` rule of the pest grammar is in the editor's keyword list.
+    let pest =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/dsl/src/grammar.pest"))
+            .unwrap();
+    let keywords: Vec<&str> = pest
+        .lines()
+        .filter_map(|l| l.strip_prefix("kw_"))
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert!(keywords.len() > 30 && keywords.contains(&"bend"));
+    for k in keywords {
+        assert!(
+            clay::authoring::work::KEYWORDS.contains(&k),
+            "`{k}` is a keyword of grammar.pest but not in authoring::work::KEYWORDS"
+        );
+    }
+}

@@ -555,6 +555,9 @@ impl<'s> Printer<'s> {
     }
 
     fn state(&mut self, indent: usize, s: &StateDecl) {
+        if let Some(d) = &s.derive {
+            return self.derived_state(indent, s, d);
+        }
         self.open(
             indent,
             &format!("state {}", s.name.name),
@@ -580,6 +583,26 @@ impl<'s> Printer<'s> {
                 St::Edges(e) => self.edges(indent + 1, e),
                 St::Geom(g) => self.geometry(indent + 1, g),
             }
+        }
+        self.close(indent, s.span);
+    }
+
+    /// `state NAME bend ANGLE` / `state NAME mirror OTHER`, with its geometry body if it has
+    /// geometry (an empty body is dropped: it means the same as none).
+    fn derived_state(&mut self, indent: usize, s: &StateDecl, d: &StateDerive) {
+        let how = match &d.kind {
+            DeriveKind::Bend(angle) => format!("bend {}", self.num(angle)),
+            DeriveKind::Mirror(other) => format!("mirror {}", other.name),
+        };
+        let header = format!("state {} {how}", s.name.name);
+        if s.geometry.is_empty() && !self.comment_within(Span::new(d.span.end, s.span.end)) {
+            // No comment sits in an empty `{ }` (checked above), so its braces can go.
+            self.stmt(indent, &header, s.span);
+            return;
+        }
+        self.open(indent, &header, s.span.start, d.span.end);
+        for g in &s.geometry {
+            self.geometry(indent + 1, g);
         }
         self.close(indent, s.span);
     }

@@ -116,6 +116,8 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::kw_rotate => "`rotate`",
         Rule::kw_dock => "`dock`",
         Rule::kw_last => "`last`",
+        Rule::kw_bend => "`bend`",
+        Rule::kw_mirror => "`mirror`",
         Rule::lbrace => "`{`",
         Rule::rbrace => "`}`",
         Rule::lparen => "`(`",
@@ -148,6 +150,11 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::point_list => "points",
         Rule::state_decl => "a `state`",
         Rule::state_position => "a vertex position `NAME (x, y)`",
+        Rule::state_derive => "`bend` or `mirror`",
+        Rule::state_bend => "`bend ANGLE`",
+        Rule::state_mirror => "`mirror STATE`",
+        Rule::derived_body => "`{`",
+        Rule::derived_stmt => "a `polygon` or `polyline`",
         Rule::stretch_decl => "a `stretch` rule",
         Rule::min_decl => "`min`",
         Rule::variants_decl => "`variants`",
@@ -961,11 +968,18 @@ impl Lower {
         let mut positions = Vec::new();
         let mut edges = Vec::new();
         let mut geometry = Vec::new();
+        let mut derive = None;
         for c in ch {
             match c.as_rule() {
                 Rule::state_position => positions.push(self.vertex(c)),
                 Rule::edges_decl => edges.push(self.edges(c)),
                 Rule::polygon_decl | Rule::polyline_decl => geometry.push(self.geometry(c)),
+                Rule::state_bend | Rule::state_mirror => derive = self.state_derive(c),
+                Rule::derived_body => {
+                    for g in kids(c) {
+                        geometry.push(self.geometry(g));
+                    }
+                }
                 _ => {}
             }
         }
@@ -974,8 +988,27 @@ impl Lower {
             positions,
             edges,
             geometry,
+            derive,
             span,
         }
+    }
+
+    /// `bend ANGLE` or `mirror OTHER`.
+    fn state_derive(&mut self, p: Pair<Rule>) -> Option<StateDerive> {
+        let span = span_of(&p);
+        let is_bend = p.as_rule() == Rule::state_bend;
+        let ch = kids(p);
+        let keyword = span_of(ch.first()?);
+        let kind = if is_bend {
+            DeriveKind::Bend(self.expr(first(&ch, Rule::expr)?).0)
+        } else {
+            DeriveKind::Mirror(self.ident(first(&ch, Rule::name)?))
+        };
+        Some(StateDerive {
+            kind,
+            keyword,
+            span,
+        })
     }
 
     fn stretch(&mut self, p: Pair<Rule>) -> StretchDecl {

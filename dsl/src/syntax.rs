@@ -292,13 +292,36 @@ pub struct Colour {
     pub span: Span,
 }
 
-/// `state NAME { ... }`.
+/// `state NAME { ... }`, or a derived state `state NAME bend ANGLE [{ ... }]` /
+/// `state NAME mirror OTHER [{ ... }]` (then `positions` and `edges` are empty and `geometry`
+/// is the optional body's).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateDecl {
     pub name: Ident,
     pub positions: Vec<VertexDecl>,
     pub edges: Vec<EdgesDecl>,
     pub geometry: Vec<GeometryDecl>,
+    /// How a derived state is made from another; `None` for a state that lists positions.
+    pub derive: Option<StateDerive>,
+    pub span: Span,
+}
+
+/// The transformation a derived rest state applies.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeriveKind {
+    /// `bend ANGLE`: the axis laid on a circular arc turning by ANGLE degrees (counter-clockwise).
+    Bend(Expr),
+    /// `mirror OTHER`: state OTHER (or `base`) reflected across the axis line.
+    Mirror(Ident),
+}
+
+/// `bend ANGLE` or `mirror OTHER` after a state's name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateDerive {
+    pub kind: DeriveKind,
+    /// Span of the `bend`/`mirror` keyword.
+    pub keyword: Span,
+    /// From the keyword to the end of its argument.
     pub span: Span,
 }
 

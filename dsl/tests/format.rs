@@ -204,6 +204,53 @@ fn a_messy_file_keeps_meaning_and_comments_and_reaches_a_fixed_point() {
 }
 
 #[test]
+fn derived_states_keep_their_form_with_canonical_spacing() {
+    let piece = "site type lane
+piece road {
+    vertex s (0, -0.5)
+    vertex e (2, -0.5)
+    vertex n (1, 0.5)
+    edges s-e-n-s
+    site west: lane [s] out (-1, 0)
+    site east: lane [e] out (1, 0)
+    axis west -> east
+    polygon skinned fill #4b4f56 { (0, -0.5) (2, -0.5) (1, 0.5) }
+STATES
+}
+model { r = road }
+";
+    let messy = piece.replace(
+        "STATES",
+        "state   left   bend    90.0   {  }\n   state right mirror   left\n\
+         state  own bend -45 {   polyline width 0.1 fill #FFFFFF { (0,0)  (1,0) } }\n\
+         state c bend 10 { // keep me\n}",
+    );
+    let once = format(&messy).unwrap();
+    let expected = piece.replace(
+        "STATES",
+        "    state left bend 90.0
+    state right mirror left
+    state own bend -45 {
+        polyline width 0.1 fill #ffffff {
+            (0, 0) (1, 0)
+        }
+    }
+    state c bend 10 { // keep me
+    }",
+    );
+    let expected = format(&expected).unwrap();
+    assert_eq!(once, expected);
+    assert!(once.contains("\n    state left bend 90.0\n"), "{once}");
+    assert_eq!(format(&once).unwrap(), once, "idempotent");
+    assert_eq!(meaning(&once), meaning(&messy), "meaning kept");
+    assert!(matches!(meaning(&once), Meaning::Grammar(_)));
+    // A tree built in code prints derived states too.
+    let printed = print_file(&clay_dsl::parse(&messy).unwrap());
+    assert_eq!(meaning(&printed), meaning(&messy));
+    assert!(printed.contains("state right mirror left"), "{printed}");
+}
+
+#[test]
 fn text_that_does_not_parse_is_reported_not_formatted() {
     let d = format("piece p { vertex a (0, }").unwrap_err();
     assert!(d.has_errors());

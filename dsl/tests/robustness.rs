@@ -53,7 +53,7 @@ const TOKENS: &[&str] = &[
     "1e308", "9999999", "0.5", "brick", "piece", "site", "model", "stretch", "merge", "cut",
     "chain", "x", "dock", "state", "edges", "vertex", "wall[0]", "last", "/*", "*/", "//", "\n",
     " ", "é", "\u{0}", "skinned", "rigid", "at", "rotate", "+", "*", "/", "let", "w", "sin(", "pi",
-    "1 / 0", "sqrt(-1)", "max()",
+    "1 / 0", "sqrt(-1)", "max()", "bend", "mirror", "base", "360", "-90",
 ];
 
 fn mutate(rng: &mut Rng, src: &str) -> String {

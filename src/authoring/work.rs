@@ -137,7 +137,7 @@ pub const KEYWORDS: &[&str] = &[
     "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
     "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
-    "at", "rotate", "dock", "last",
+    "at", "rotate", "dock", "last", "bend", "mirror",
 ];
 
 /// Why `s` cannot be a name in the grammar: an ASCII letter or `_`, then letters, digits and
@@ -786,6 +786,7 @@ fn add_states(work: &Work, design: &mut Design, tree: &mut clay_dsl::syntax::Fil
             positions,
             edges: Vec::new(),
             geometry: Vec::new(),
+            derive: None,
             span: Span::default(),
         }));
     }

@@ -447,7 +447,7 @@ fn draw_instance_sites(
             };
             // Docked sites are joints, not open ends: marked, but without an arrow.
             let out = (!docked.contains(&(ii, si)))
-                .then(|| site_out(grammar, inst.piece, si, &current))
+                .then(|| site_out(grammar, inst.piece, inst.state, si, &current))
                 .flatten();
             draw_site(canvas, &points, out, site_type_colour(site.site_type));
         }

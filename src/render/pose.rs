@@ -414,17 +414,35 @@ fn write_mesh(
     !w.triangles.is_empty()
 }
 
-/// The current outward direction of a site of an instance: the site's `out` (base-state
-/// coordinates) turned by the instance's best rigid motion from its base state.
+/// The current outward direction of a site of an instance in rest state `state`: the site's
+/// `out` (base-state coordinates) carried into the rest state by the site's own local frame,
+/// then turned by the instance's best rigid motion from that rest state. A site of two or more
+/// vertices turns with its first-to-last span, so the east end of a road bent a quarter turn
+/// (`state left bend 90`) points north, not halfway; a one-vertex site turns with the piece.
+/// An unknown state counts as the base state.
 pub fn site_out(
     grammar: &CompiledGrammar,
     piece: usize,
+    state: usize,
     site: usize,
     current: &[DVec2],
 ) -> Option<DVec2> {
     let p = grammar.pieces.get(piece)?;
-    let out = p.sites.get(site)?.out;
-    let motion = rigid_motion(&p.states.first()?.positions, current)?;
+    let s = p.sites.get(site)?;
+    let base = &p.states.first()?.positions;
+    let rest = p.states.get(state).map_or(base, |st| &st.positions);
+    let mut out = s.out;
+    if let (Some(&a), Some(&b)) = (s.vertices.first(), s.vertices.last())
+        && state != 0
+        && a != b
+    {
+        let span = |pos: &[DVec2]| Some(pos.get(b)? - pos.get(a)?).and_then(DVec2::try_normalize);
+        if let (Some(from), Some(to)) = (span(base), span(rest)) {
+            // The turn taking the base span onto the rest span, as a unit complex number.
+            out = DVec2::new(to.dot(from), from.perp_dot(to)).rotate(out);
+        }
+    }
+    let motion = rigid_motion(rest, current)?;
     motion.apply_direction(out).try_normalize()
 }
 

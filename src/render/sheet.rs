@@ -130,7 +130,7 @@ pub fn draw_sheet(canvas: &mut dyn Canvas, grammar: &CompiledGrammar) {
                 draw_site(
                     canvas,
                     &points,
-                    site_out(grammar, pi, k, current),
+                    site_out(grammar, pi, si, k, current),
                     site_type_colour(site.site_type),
                 );
             }

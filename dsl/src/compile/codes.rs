@@ -58,6 +58,14 @@ pub const TWO_STRETCH: &str = "E045";
 pub const CHAIN_SITES: &str = "E046";
 /// A stretch piece or variant that declares alternative rest states, which could never become active.
 pub const ELEMENT_STATES: &str = "E047";
+/// A derived rest state (`bend`, `mirror`) in a piece without an axis.
+pub const DERIVE_NO_AXIS: &str = "E055";
+/// A `bend` so tight that it folds the piece onto itself.
+pub const BEND_FOLDS: &str = "E056";
+/// A `mirror` of the state itself or of a state declared after it.
+pub const MIRROR_ORDER: &str = "E057";
+/// A `mirror` of a state that lists positions, on a piece not symmetric about its axis.
+pub const NOT_SYMMETRIC: &str = "E058";
 
 /// A division whose divisor is zero.
 pub const DIVISION_BY_ZERO: &str = "E050";

@@ -6,6 +6,7 @@ pub mod codes;
 
 mod assembly;
 mod constants;
+mod derive;
 
 pub(crate) use constants::{constant_values, functions, is_function};
 mod pieces;
@@ -519,6 +520,11 @@ impl Compiler {
                 || self.pieces[pi].axis.is_some()
                 || self.stretch_named.get(pi).copied().unwrap_or(false)
             {
+                continue;
+            }
+            // A derived state there already reports the missing axis (E055).
+            let derived = |s: &PieceStmt| matches!(s, PieceStmt::State(st) if st.derive.is_some());
+            if decl.stmts.iter().any(derived) {
                 continue;
             }
             let mut geoms: Vec<&syntax::GeometryDecl> = Vec::new();

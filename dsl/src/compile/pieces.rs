@@ -7,7 +7,7 @@ use crate::suggest::closest;
 use crate::syntax::{self, Ident, PieceStmt, Span};
 use glam::DVec2;
 
-use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, MAX_HEIGHT, PieceSpans, codes, fmt};
+use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, MAX_HEIGHT, PieceSpans, codes, derive, fmt};
 
 impl Compiler {
     // Long because: one pass over the piece's statements in source order, each a short arm of one match.
@@ -108,6 +108,8 @@ impl Compiler {
             geometry_frame: 0,
         });
         spans.edges = edge_spans;
+        let derive_axis = derive::AxisState::resolve(&piece, axis, &base);
+        let mut made = vec![derive::Made::Listed];
         let mut state_spans: Vec<Span> = Vec::new();
         for s in &decl.stmts {
             if let PieceStmt::State(st) = s {
@@ -137,7 +139,30 @@ impl Compiler {
                     continue;
                 }
                 let index = piece.states.len();
-                let state = self.state(&piece, &spans, st, index, &geometry);
+                let state = match &st.derive {
+                    Some(d) => {
+                        let cx = derive::DeriveContext {
+                            decl,
+                            spans: &spans,
+                            axis: derive_axis,
+                            base_geometry: &geometry,
+                            made: &made,
+                        };
+                        let (state, how) = self.derived_state(&piece, &cx, st, d, index);
+                        made.push(how);
+                        state
+                    }
+                    None => {
+                        let before = self.diags.error_count();
+                        let state = self.state(&piece, &spans, st, index, &geometry);
+                        made.push(if self.diags.error_count() == before {
+                            derive::Made::Listed
+                        } else {
+                            derive::Made::Failed
+                        });
+                        state
+                    }
+                };
                 piece.states.push(state);
                 state_spans.push(st.name.span);
                 spans
