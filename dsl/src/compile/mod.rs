@@ -99,8 +99,17 @@ pub fn compile_with(
 /// Compiles raw bytes; text that is not UTF-8 is reported (E003) at the first bad byte. Render
 /// the diagnostics against `String::from_utf8_lossy(bytes)`: offsets before that byte agree.
 pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> {
+    compile_bytes_with(bytes, path, &FsLoader)
+}
+
+/// [`compile_bytes`] reading imported files through `loader`.
+pub fn compile_bytes_with(
+    bytes: &[u8],
+    path: &str,
+    loader: &dyn Loader,
+) -> Result<Compiled, Diagnostics> {
     match std::str::from_utf8(bytes) {
-        Ok(source) => compile(source, path),
+        Ok(source) => compile_with(source, path, loader),
         Err(e) => {
             let at = e.valid_up_to();
             Err(Diagnostic::error(
