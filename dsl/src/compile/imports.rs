@@ -219,10 +219,19 @@ impl Imports<'_> {
         }
     }
 
-    /// E061: `target` is `stack[k]`, which is still being loaded.
+    /// E061: `target` is `stack[k]`, which is still being loaded. The primary span is the
+    /// first import of the cycle (in the outermost file), the others are secondary.
     fn cycle(&mut self, k: usize, target: &str, at: Span) {
-        let importer = &self.stack[self.stack.len() - 1].0;
-        let mut d = if k + 1 == self.stack.len() {
+        // Each import of the cycle: the file it is in, the file it imports, where.
+        let mut hops: Vec<(&str, &str, Span)> = Vec::new();
+        for w in self.stack[k..].windows(2) {
+            if let (from, (to, Some(span))) = (&w[0].0, &w[1]) {
+                hops.push((from, to, *span));
+            }
+        }
+        let last = &self.stack[self.stack.len() - 1].0;
+        hops.push((last, target, at));
+        let mut d = if hops.len() == 1 {
             Diagnostic::error(
                 codes::IMPORT_CYCLE,
                 format!("`{target}` imports itself"),
@@ -230,11 +239,9 @@ impl Imports<'_> {
                 "this is the file's own path",
             )
         } else {
-            let mut names: Vec<String> = self.stack[k..]
-                .iter()
-                .map(|(p, _)| format!("`{p}`"))
-                .collect();
+            let mut names: Vec<String> = hops.iter().map(|(f, _, _)| format!("`{f}`")).collect();
             names.push(format!("`{target}`"));
+            let (from, to, span) = hops[0];
             Diagnostic::error(
                 codes::IMPORT_CYCLE,
                 format!(
@@ -242,14 +249,12 @@ impl Imports<'_> {
                     names[0],
                     names[1..].join(", which imports ")
                 ),
-                at,
-                format!("`{importer}` imports `{target}` here"),
+                span,
+                format!("`{from}` imports `{to}` here"),
             )
         };
-        for w in self.stack[k..].windows(2) {
-            if let (from, (to, Some(span))) = (&w[0].0, &w[1]) {
-                d = d.with_secondary(*span, format!("`{from}` imports `{to}` here"));
-            }
+        for &(from, to, span) in hops.iter().skip(1) {
+            d = d.with_secondary(span, format!("`{from}` imports `{to}` here"));
         }
         self.diags.push(d.with_hint(
             "files may not import each other in a circle; move the shared declarations into a \
