@@ -25,6 +25,9 @@ pub const MAX_EXTENDS_DEPTH: usize = 64;
 /// Most statements inheritance may copy in one file, all children together.
 pub const MAX_INHERITED: usize = 1_000_000;
 
+/// Most pieces of an `extends` cycle named in its message and labels.
+const MAX_CYCLE_SHOWN: usize = 8;
+
 /// What the compiler keeps about a piece that extends another.
 #[derive(Clone, Debug)]
 pub(crate) struct Child {
@@ -249,6 +252,12 @@ impl Compiler {
             let mut names: Vec<String> =
                 cycle.iter().map(|p| format!("`{}`", p.name.name)).collect();
             names.push(format!("`{}`", head.name.name));
+            // A long cycle is named by its first pieces and how many there are.
+            if names.len() > MAX_CYCLE_SHOWN + 1 {
+                let n = cycle.len();
+                names.truncate(MAX_CYCLE_SHOWN);
+                names.push(format!("... ({n} pieces in all)"));
+            }
             Diagnostic::error(
                 codes::EXTENDS_CYCLE,
                 format!(
@@ -260,7 +269,7 @@ impl Compiler {
                 format!("`{}` extends `{}` here", head.name.name, at.name),
             )
         };
-        for p in rest {
+        for p in rest.iter().take(MAX_CYCLE_SHOWN) {
             if let Some(b) = &p.extends {
                 d = d.with_secondary(
                     b.span,
