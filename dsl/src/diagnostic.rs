@@ -7,7 +7,7 @@ use codespan_reporting::term;
 use codespan_reporting::term::termcolor::{Buffer, ColorChoice, StandardStream};
 use serde::Serialize;
 
-use crate::source_map::{Located, SourceMap};
+use crate::source_map::{Located, SourceMap, line_col};
 use crate::syntax::Span;
 
 /// How bad a diagnostic is: errors stop compilation, warnings travel with the result.
@@ -213,20 +213,6 @@ impl<'a> IntoIterator for &'a Diagnostics {
     fn into_iter(self) -> Self::IntoIter {
         self.items.iter()
     }
-}
-
-/// 1-based line and column (in chars) of byte offset `byte` of `source`; offsets past the end
-/// or inside a UTF-8 sequence are clamped back to the nearest valid position.
-pub fn line_col(source: &str, byte: usize) -> (usize, usize) {
-    let mut byte = byte.min(source.len());
-    while !source.is_char_boundary(byte) {
-        byte -= 1;
-    }
-    let before = &source[..byte];
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let col = source[line_start..byte].chars().count() + 1;
-    (line, col)
 }
 
 fn term_config() -> term::Config {

@@ -25,8 +25,8 @@ pub use compile::{
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{
     Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, Severity, emit_to_stderr,
-    line_col, render, to_json,
+    render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
 pub use parse::parse;
-pub use source_map::{Located, SourceFile, SourceMap};
+pub use source_map::{Located, SourceFile, SourceMap, line_col};

@@ -96,9 +96,23 @@ impl SourceMap {
         pos: usize,
     ) -> (&'a str, usize, usize) {
         let at = self.locate(source, path, Span::new(pos, pos));
-        let (line, col) = crate::diagnostic::line_col(at.text, at.start);
+        let (line, col) = line_col(at.text, at.start);
         (at.path, line, col)
     }
+}
+
+/// 1-based line and column (in chars) of byte offset `byte` of `source`; offsets past the end
+/// or inside a UTF-8 sequence are clamped back to the nearest valid position.
+pub fn line_col(source: &str, byte: usize) -> (usize, usize) {
+    let mut byte = byte.min(source.len());
+    while !source.is_char_boundary(byte) {
+        byte -= 1;
+    }
+    let before = &source[..byte];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = source[line_start..byte].chars().count() + 1;
+    (line, col)
 }
 
 #[cfg(test)]

@@ -93,22 +93,26 @@ fn same_json(a: &serde_json::Value, b: &serde_json::Value, at: &str) {
 }
 
 #[test]
-fn junction_written_with_extends_compiles_to_the_same_grammar() {
+fn examples_written_with_extends_compile_to_the_same_grammars_as_before() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let read = |p: &str| std::fs::read_to_string(format!("{root}/{p}")).unwrap();
-    let before = read("tests/fixtures/before/junction.clay");
-    let after = read("grammars/junction.clay");
-    assert!(
-        after.contains("piece tee extends road"),
-        "the example uses extends"
-    );
-    assert!(after.len() < before.len());
-    let json = |src: &str| {
-        let c = compile(src, "grammars/junction.clay").unwrap();
-        assert!(c.warnings.is_empty(), "{:?}", c.warnings);
-        serde_json::to_value(&c.grammar).unwrap()
-    };
-    same_json(&json(&before), &json(&after), "grammar");
+    for (name, child) in [
+        ("junction", "piece tee extends road"),
+        ("centipede", "piece seg_c extends seg_a"),
+    ] {
+        // The text before the example used `extends`.
+        let before = read(&format!("tests/fixtures/before/{name}.clay"));
+        let after = read(&format!("grammars/{name}.clay"));
+        assert!(after.contains(child), "{name} uses extends");
+        assert!(after.len() < before.len(), "{name} is shorter");
+        let path = format!("grammars/{name}.clay");
+        let json = |src: &str| {
+            let c = compile(src, &path).unwrap();
+            assert!(c.warnings.is_empty(), "{:?}", c.warnings);
+            serde_json::to_value(&c.grammar).unwrap()
+        };
+        same_json(&json(&before), &json(&after), name);
+    }
 }
 
 #[test]
