@@ -380,8 +380,11 @@ impl Compiler {
             let lacking: Vec<(String, Span)> = out
                 .iter()
                 .filter_map(|s| match s {
+                    // A state without positions lists none to miss (one derived from the
+                    // piece's vertices covers the child's too).
                     PieceStmt::State(st)
                         if !inside(child.span, st.span)
+                            && !st.positions.is_empty()
                             && added
                                 .iter()
                                 .any(|a| !st.positions.iter().any(|p| p.name.name == a.name)) =>
@@ -503,6 +506,46 @@ impl Compiler {
                 decl.name.name
             )
         })
+    }
+
+    /// Whether a rule names a poisoned piece: it is then not compiled and nothing is said about
+    /// it (a stretch rule still counts as naming its pieces, so their chains stay quiet too).
+    pub(super) fn quiet_rule(&mut self, item: &Item) -> bool {
+        let names: Vec<&str> = match item {
+            Item::Stretch(s) => std::iter::once(&s.piece)
+                .chain(
+                    s.variants
+                        .iter()
+                        .flat_map(|v| v.entries.iter().map(|e| &e.piece)),
+                )
+                .map(|i| i.name.as_str())
+                .collect(),
+            Item::Merge(m) => std::iter::once(&m.mover)
+                .chain(std::iter::once(&m.target))
+                .chain(m.junction.as_ref())
+                .map(|p| p.piece.name.as_str())
+                .collect(),
+            Item::Cut(c) => vec![c.junction.piece.name.as_str(), c.into.name.as_str()],
+            _ => return false,
+        };
+        let poisoned = |n: &str| {
+            self.piece_index
+                .get(n)
+                .is_some_and(|&i| self.piece_spans[i].poisoned)
+        };
+        if !names.iter().any(|n| poisoned(n)) {
+            return false;
+        }
+        if matches!(item, Item::Stretch(_)) {
+            for n in &names {
+                if let Some(&i) = self.piece_index.get(*n)
+                    && let Some(named) = self.stretch_named.get_mut(i)
+                {
+                    *named = true;
+                }
+            }
+        }
+        true
     }
 
     /// Drops the diagnostics that speak about a poisoned piece (a rule naming it, its unused
