@@ -271,7 +271,12 @@ model {{ w = chain brick x 2 along west -> east  t = tee at (0, 4)  dock t.east 
     // alone would not fit (its one-vertex site against a two-vertex one).
     let src = src.replace("[top, nw]", "[top]");
     let d = err(&src, &[]);
-    assert_eq!(codes(&d), ["E011"], "{}", render(&d, &src, "g/main.clay", false));
+    assert_eq!(
+        codes(&d),
+        ["E011"],
+        "{}",
+        render(&d, &src, "g/main.clay", false)
+    );
 }
 
 #[test]

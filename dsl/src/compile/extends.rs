@@ -102,7 +102,12 @@ impl Compiler {
                 first.entry(p.name.name.as_str()).or_insert(i);
             }
         }
-        let names: Vec<&str> = first.keys().copied().collect();
+        // In file order, so that suggestions and "known:" lists are deterministic.
+        let names: Vec<&str> = (0..n)
+            .filter_map(|i| piece(i).map(|p| (i, p.name.name.as_str())))
+            .filter(|(i, name)| first[name] == *i)
+            .map(|(_, name)| name)
+            .collect();
         let mut walk = vec![Walk::Todo; n];
         let mut expanded: Vec<Option<Vec<PieceStmt>>> = vec![None; n];
         let mut budget = MAX_INHERITED;
