@@ -185,3 +185,44 @@ fn several_files_are_checked_and_the_worst_exit_wins() {
     let out = clayc().arg("check").arg(&good).arg(&bad).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn a_problem_in_an_imported_file_is_shown_in_that_file() {
+    // The library has a typo in a site type; the main file is fine.
+    let dir = write_temp("imports.clay", b"")
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    std::fs::create_dir_all(dir.join("lib")).unwrap();
+    write_temp(
+        "lib/bricks.clay",
+        VALID
+            .replace("model { wall = chain brick x 3 }", "")
+            .replace("site east: joint", "site east: jiont")
+            .as_bytes(),
+    );
+    let main = write_temp(
+        "imports.clay",
+        b"import \"lib/bricks.clay\"\nmodel { wall = chain brick x 3 }\n",
+    );
+    let lib = main.parent().unwrap().join("lib/bricks.clay");
+    let out = clayc()
+        .args(["check", "--format", "json"])
+        .arg(&main)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let diags: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(diags.len(), 1, "{diags:?}");
+    let d = &diags[0];
+    assert_eq!(d["code"], "E011");
+    assert_eq!(d["file"], lib.display().to_string().as_str());
+    assert_eq!(d["line"], 10);
+    assert_eq!(d["labels"][0]["file"], d["file"]);
+    let out = clayc().arg("check").arg(&main).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("{}:10:16", lib.display())) && stderr.contains("jiont"),
+        "{stderr}"
+    );
+}

@@ -2,11 +2,12 @@
 //! renderings (rustc-style text through codespan-reporting, and JSON for tools).
 
 use codespan_reporting::diagnostic as cs;
-use codespan_reporting::files::SimpleFile;
+use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term;
 use codespan_reporting::term::termcolor::{Buffer, ColorChoice, StandardStream};
 use serde::Serialize;
 
+use crate::source_map::{Located, SourceMap, line_col};
 use crate::syntax::Span;
 
 /// How bad a diagnostic is: errors stop compilation, warnings travel with the result.
@@ -95,39 +96,43 @@ impl Diagnostic {
         self.severity == Severity::Error
     }
 
-    /// Clamps every span into `0..=len` on char boundaries, so rendering never fails.
-    fn clamped(&self, source: &str) -> Diagnostic {
-        let fix = |s: Span| {
-            let mut start = s.start.min(source.len());
-            let mut end = s.end.min(source.len()).max(start);
-            while !source.is_char_boundary(start) {
-                start -= 1;
-            }
-            while !source.is_char_boundary(end) {
-                end += 1;
-            }
-            Span { start, end }
-        };
-        let mut d = self.clone();
-        d.primary.span = fix(d.primary.span);
-        for l in &mut d.secondary {
-            l.span = fix(l.span);
+    /// The same diagnostic with every span moved `by` bytes later (a file parsed on its own,
+    /// placed at its position in the source map).
+    pub(crate) fn shifted(mut self, by: usize) -> Diagnostic {
+        let shift = |s: &mut Span| *s = Span::new(s.start + by, s.end + by);
+        shift(&mut self.primary.span);
+        for l in &mut self.secondary {
+            shift(&mut l.span);
         }
-        d
+        self
     }
 
-    fn to_codespan(&self) -> cs::Diagnostic<()> {
+    /// Maps every span back to its file (clamped into it on char boundaries, so rendering
+    /// never fails): the label spans become local offsets, paired with their file's index.
+    fn located<'a>(
+        &self,
+        map: &'a SourceMap,
+        source: &'a str,
+        path: &'a str,
+    ) -> (Located<'a>, Vec<Located<'a>>) {
+        let at = |s: Span| map.locate(source, path, s);
+        (
+            at(self.primary.span),
+            self.secondary.iter().map(|l| at(l.span)).collect(),
+        )
+    }
+
+    fn to_codespan(&self, primary: &Located, secondary: &[Located]) -> cs::Diagnostic<usize> {
         let severity = match self.severity {
             Severity::Error => cs::Severity::Error,
             Severity::Warning => cs::Severity::Warning,
         };
         let mut labels = vec![
-            cs::Label::primary((), self.primary.span.start..self.primary.span.end)
+            cs::Label::primary(primary.file, primary.start..primary.end)
                 .with_message(&self.primary.message),
         ];
-        for l in &self.secondary {
-            labels
-                .push(cs::Label::secondary((), l.span.start..l.span.end).with_message(&l.message));
+        for (l, at) in self.secondary.iter().zip(secondary) {
+            labels.push(cs::Label::secondary(at.file, at.start..at.end).with_message(&l.message));
         }
         cs::Diagnostic::new(severity)
             .with_code(self.code)
@@ -137,10 +142,13 @@ impl Diagnostic {
     }
 }
 
-/// An ordered collection of diagnostics.
+/// An ordered collection of diagnostics, with the imported files their spans may point into.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Diagnostics {
     pub items: Vec<Diagnostic>,
+    /// The files the main file imported (empty without imports); the renderers show a label
+    /// in an imported file against that file's text.
+    pub sources: SourceMap,
 }
 
 impl Diagnostics {
@@ -154,6 +162,9 @@ impl Diagnostics {
 
     pub fn extend(&mut self, other: Diagnostics) {
         self.items.extend(other.items);
+        if self.sources.is_empty() {
+            self.sources = other.sources;
+        }
     }
 
     pub fn has_errors(&self) -> bool {
@@ -189,7 +200,10 @@ impl Diagnostics {
 
 impl From<Diagnostic> for Diagnostics {
     fn from(d: Diagnostic) -> Self {
-        Self { items: vec![d] }
+        Self {
+            items: vec![d],
+            sources: SourceMap::default(),
+        }
     }
 }
 
@@ -201,20 +215,6 @@ impl<'a> IntoIterator for &'a Diagnostics {
     }
 }
 
-/// 1-based line and column (in chars) of byte offset `byte` of `source`; offsets past the end
-/// or inside a UTF-8 sequence are clamped back to the nearest valid position.
-pub fn line_col(source: &str, byte: usize) -> (usize, usize) {
-    let mut byte = byte.min(source.len());
-    while !source.is_char_boundary(byte) {
-        byte -= 1;
-    }
-    let before = &source[..byte];
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let col = source[line_start..byte].chars().count() + 1;
-    (line, col)
-}
-
 fn term_config() -> term::Config {
     term::Config::default()
 }
@@ -222,7 +222,7 @@ fn term_config() -> term::Config {
 /// Renders diagnostics rustc-style (`error[E011]: ...`, `--> file:line:col`, source line,
 /// labels, help notes). `color` adds ANSI colours; the caller decides (terminal, NO_COLOR).
 pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) -> String {
-    let file = SimpleFile::new(path, source);
+    let files = all_files(&diagnostics.sources, source, path);
     let mut buffer = if color {
         Buffer::ansi()
     } else {
@@ -230,23 +230,45 @@ pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) 
     };
     let config = term_config();
     for d in diagnostics {
-        let d = d.clamped(source);
+        let (primary, secondary) = d.located(&diagnostics.sources, source, path);
         // Emitting into a memory buffer with clamped spans cannot fail; if it ever does, fall
         // back to a plain line so the diagnostic is not lost.
-        if term::emit(&mut buffer, &config, &file, &d.to_codespan()).is_err() {
-            let (line, col) = line_col(source, d.primary.span.start);
+        if term::emit(
+            &mut buffer,
+            &config,
+            &files,
+            &d.to_codespan(&primary, &secondary),
+        )
+        .is_err()
+        {
+            let (line, col) = line_col(primary.text, primary.start);
             buffer_push(
                 &mut buffer,
                 &format!(
-                    "{}[{}]: {}\n --> {path}:{line}:{col}\n",
+                    "{}[{}]: {}\n --> {}:{line}:{col}\n",
                     sev_word(d.severity),
                     d.code,
-                    d.message
+                    d.message,
+                    primary.path
                 ),
             );
         }
     }
     String::from_utf8_lossy(buffer.as_slice()).into_owned()
+}
+
+/// The main file (id 0) and the imported files (ids 1..) for codespan.
+fn all_files<'a>(
+    map: &'a SourceMap,
+    source: &'a str,
+    path: &'a str,
+) -> SimpleFiles<&'a str, &'a str> {
+    let mut files = SimpleFiles::new();
+    files.add(path, source);
+    for f in &map.files {
+        files.add(f.path.as_str(), &*f.text);
+    }
+    files
 }
 
 fn buffer_push(buffer: &mut Buffer, text: &str) {
@@ -270,11 +292,16 @@ pub fn emit_to_stderr(diagnostics: &Diagnostics, source: &str, path: &str, color
         ColorChoice::Never
     };
     let mut stream = StandardStream::stderr(choice);
-    let file = SimpleFile::new(path, source);
+    let files = all_files(&diagnostics.sources, source, path);
     let config = term_config();
     for d in diagnostics {
-        let d = d.clamped(source);
-        let _ = term::emit(&mut stream, &config, &file, &d.to_codespan());
+        let (primary, secondary) = d.located(&diagnostics.sources, source, path);
+        let _ = term::emit(
+            &mut stream,
+            &config,
+            &files,
+            &d.to_codespan(&primary, &secondary),
+        );
     }
 }
 
@@ -290,9 +317,11 @@ pub struct JsonPos {
 pub struct JsonLabel {
     pub message: String,
     pub primary: bool,
+    /// The file the label is in: the checked file, or a file it imports.
+    pub file: String,
     pub start: JsonPos,
     pub end: JsonPos,
-    /// Byte offsets into the file.
+    /// Byte offsets into the label's file.
     pub byte_start: usize,
     pub byte_end: usize,
 }
@@ -303,6 +332,7 @@ pub struct JsonDiagnostic {
     pub code: &'static str,
     pub severity: Severity,
     pub message: String,
+    /// The file of the primary span: the checked file, or a file it imports.
     pub file: String,
     /// Where the primary span starts.
     pub line: usize,
@@ -315,33 +345,39 @@ pub struct JsonDiagnostic {
 
 /// The JSON form of diagnostics, one object per diagnostic.
 pub fn to_json(diagnostics: &Diagnostics, source: &str, path: &str) -> Vec<JsonDiagnostic> {
-    let pos = |b: usize| {
-        let (line, column) = line_col(source, b);
+    let pos = |at: &Located, b: usize| {
+        let (line, column) = line_col(at.text, b);
         JsonPos { line, column }
     };
-    let label = |l: &Label, primary: bool| JsonLabel {
+    let label = |l: &Label, at: &Located, primary: bool| JsonLabel {
         message: l.message.clone(),
         primary,
-        start: pos(l.span.start),
-        end: pos(l.span.end),
-        byte_start: l.span.start,
-        byte_end: l.span.end,
+        file: at.path.to_string(),
+        start: pos(at, at.start),
+        end: pos(at, at.end),
+        byte_start: at.start,
+        byte_end: at.end,
     };
     diagnostics
         .iter()
         .map(|d| {
-            let d = d.clamped(source);
-            let start = pos(d.primary.span.start);
-            let mut labels = vec![label(&d.primary, true)];
-            labels.extend(d.secondary.iter().map(|l| label(l, false)));
+            let (primary, secondary) = d.located(&diagnostics.sources, source, path);
+            let start = pos(&primary, primary.start);
+            let mut labels = vec![label(&d.primary, &primary, true)];
+            labels.extend(
+                d.secondary
+                    .iter()
+                    .zip(&secondary)
+                    .map(|(l, at)| label(l, at, false)),
+            );
             JsonDiagnostic {
                 code: d.code,
                 severity: d.severity,
                 message: d.message.clone(),
-                file: path.to_string(),
+                file: primary.path.to_string(),
                 line: start.line,
                 column: start.column,
-                end: pos(d.primary.span.end),
+                end: pos(&primary, primary.end),
                 labels,
                 hints: d.hints.clone(),
             }

@@ -371,6 +371,7 @@ impl<'s> Printer<'s> {
     /// kind need no blank line between them.
     fn one_line_kind(&self, item: &Item) -> Option<u8> {
         match item {
+            Item::Import(_) => Some(3),
             Item::SiteType(_) => Some(1),
             Item::Let(_) => Some(3),
             Item::Merge(_) | Item::Cut(_) => Some(2),
@@ -385,6 +386,7 @@ impl<'s> Printer<'s> {
                 let t = format!("let {} = {}", l.name.name, self.num(&l.value));
                 self.stmt(0, &t, l.span);
             }
+            Item::Import(i) => self.stmt(0, &format!("import \"{}\"", i.path.value), i.span),
             Item::Solver(s) => {
                 self.open(0, "solver", s.span.start, s.keyword.end);
                 for e in &s.entries {
@@ -428,12 +430,14 @@ impl<'s> Printer<'s> {
     }
 
     fn piece(&mut self, p: &PieceDecl) {
-        self.open(
-            0,
-            &format!("piece {}", p.name.name),
-            p.span.start,
-            p.name.span.end,
-        );
+        let (header, header_end) = match &p.extends {
+            Some(b) => (
+                format!("piece {} extends {}", p.name.name, b.name),
+                b.span.end,
+            ),
+            None => (format!("piece {}", p.name.name), p.name.span.end),
+        };
+        self.open(0, &header, p.span.start, header_end);
         for s in &p.stmts {
             match s {
                 PieceStmt::Vertex(v) => self.vertex(1, v, "vertex "),

@@ -16,13 +16,18 @@ mod compile;
 mod diagnostic;
 mod format;
 mod parse;
+mod source_map;
 mod suggest;
 
-pub use compile::{Compiled, MAX_COORDINATE, codes, compile, compile_bytes};
+pub use compile::{
+    Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH, MAX_IMPORT_BYTES, MAX_IMPORTS,
+    MAX_INHERITED, codes, compile, compile_bytes, compile_bytes_with, compile_with, resolve_import,
+};
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{
     Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, Severity, emit_to_stderr,
-    line_col, render, to_json,
+    render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
 pub use parse::parse;
+pub use source_map::{Located, SourceFile, SourceMap, line_col};

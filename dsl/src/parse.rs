@@ -61,7 +61,9 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::EOI => "end of file",
         Rule::WHITESPACE | Rule::COMMENT | Rule::line_comment | Rule::block_comment => "whitespace",
         Rule::ident_char => "a letter, digit or `_`",
-        Rule::item => "`let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`",
+        Rule::item => {
+            "`import`, `let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`"
+        }
         Rule::piece_stmt => "a piece statement",
         Rule::state_stmt => "a state statement",
         Rule::stretch_stmt => "`min` or `variants`",
@@ -118,6 +120,11 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::kw_last => "`last`",
         Rule::kw_bend => "`bend`",
         Rule::kw_mirror => "`mirror`",
+        Rule::kw_import => "`import`",
+        Rule::kw_extends => "`extends`",
+        Rule::string => "a file path in double quotes, like `\"lib.clay\"`",
+        Rule::import_decl => "an `import`",
+        Rule::extends => "`extends`",
         Rule::lbrace => "`{`",
         Rule::rbrace => "`}`",
         Rule::lparen => "`(`",
@@ -131,7 +138,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::dash => "`-`",
         Rule::dot => "`.`",
         Rule::file => {
-            "`let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
+            "`import`, `let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
         }
         Rule::solver_block => "a `solver` block",
         Rule::solver_entry => "a solver parameter `NAME = NUMBER`",
@@ -177,16 +184,17 @@ pub fn describe(rule: Rule) -> &'static str {
 /// Parses a whole file. Errors are returned as diagnostics; the tree is only returned for text
 /// that follows the grammar and whose numbers are all finite.
 pub fn parse(source: &str) -> Result<File, Diagnostics> {
+    let base = span_base();
     if let Some(d) = check_nesting(source) {
-        return Err(d.into());
+        return Err(d.shifted(base).into());
     }
     let mut pairs = match ClayParser::parse(Rule::file, source) {
         Ok(p) => p,
-        Err(e) => return Err(syntax_error(source, e).into()),
+        Err(e) => return Err(syntax_error(source, e).shifted(base).into()),
     };
     let Some(file) = pairs.next() else {
         return Err(
-            Diagnostic::error(codes::SYNTAX, "empty parse", Span::new(0, 0), "here").into(),
+            Diagnostic::error(codes::SYNTAX, "empty parse", Span::new(base, base), "here").into(),
         );
     };
     let mut lower = Lower {
@@ -466,7 +474,7 @@ fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
         return Some("points are written `(x, y)`".into());
     }
     if positives.contains(&Rule::kw_piece) && positives.contains(&Rule::kw_model) {
-        return Some("a file is a list of `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` and `model` items".into());
+        return Some("a file is a list of `import`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` and `model` items".into());
     }
     None
 }
@@ -484,7 +492,32 @@ fn span_of(p: &Pair<Rule>) -> Span {
     while let Some(child) = last.clone().into_inner().last() {
         last = child;
     }
-    Span::new(start, last.as_span().end().max(start))
+    let base = span_base();
+    Span::new(base + start, base + last.as_span().end().max(start))
+}
+
+thread_local! {
+    /// Where the text being parsed starts in the global positions of the source map
+    /// (`source_map.rs`): 0 for the main file, so a single file's spans are its byte offsets.
+    static SPAN_BASE: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+fn span_base() -> usize {
+    SPAN_BASE.with(std::cell::Cell::get)
+}
+
+/// Parses a file whose text starts at global position `base` (an imported file): every span
+/// of the tree and of the diagnostics is offset by `base`.
+pub(crate) fn parse_at(source: &str, base: usize) -> Result<File, Diagnostics> {
+    struct Reset;
+    impl Drop for Reset {
+        fn drop(&mut self) {
+            SPAN_BASE.with(|b| b.set(0));
+        }
+    }
+    let _reset = Reset;
+    SPAN_BASE.with(|b| b.set(base));
+    parse(source)
 }
 
 /// Children that carry meaning: punctuation is dropped.
@@ -724,6 +757,7 @@ impl Lower {
         for c in kids(p) {
             let item = match c.as_rule() {
                 Rule::let_decl => Item::Let(self.let_decl(c)),
+                Rule::import_decl => Item::Import(self.import(c)),
                 Rule::solver_block => Item::Solver(self.solver(c)),
                 Rule::site_type_decl => Item::SiteType(self.site_type(c)),
                 Rule::piece_decl => Item::Piece(self.piece(c)),
@@ -750,6 +784,24 @@ impl Lower {
         );
         let value = self.expr_or(first(&ch, Rule::expr), span);
         LetDecl { name, value, span }
+    }
+
+    fn import(&mut self, p: Pair<Rule>) -> ImportDecl {
+        let span = span_of(&p);
+        let path = first(&kids(p), Rule::string).map_or(
+            StringLit {
+                value: String::new(),
+                span,
+            },
+            |s| {
+                let text = s.as_str();
+                StringLit {
+                    value: text[1..text.len() - 1].to_string(),
+                    span: span_of(&s),
+                }
+            },
+        );
+        ImportDecl { path, span }
     }
 
     fn solver(&mut self, p: Pair<Rule>) -> SolverBlock {
@@ -802,6 +854,9 @@ impl Lower {
             },
             |n| self.ident(n),
         );
+        let extends = first(&ch, Rule::extends)
+            .and_then(|e| first(&kids(e), Rule::name))
+            .map(|n| self.ident(n));
         let mut stmts = Vec::new();
         for c in ch {
             let stmt = match c.as_rule() {
@@ -826,7 +881,12 @@ impl Lower {
             };
             stmts.push(stmt);
         }
-        PieceDecl { name, stmts, span }
+        PieceDecl {
+            name,
+            extends,
+            stmts,
+            span,
+        }
     }
 
     fn vertex(&mut self, p: Pair<Rule>) -> VertexDecl {

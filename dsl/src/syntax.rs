@@ -135,6 +135,7 @@ pub struct File {
 /// A top-level item.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Item {
+    Import(ImportDecl),
     Let(LetDecl),
     Solver(SolverBlock),
     SiteType(SiteTypeDecl),
@@ -148,6 +149,7 @@ pub enum Item {
 impl Item {
     pub fn span(&self) -> Span {
         match self {
+            Item::Import(x) => x.span,
             Item::Let(x) => x.span,
             Item::Solver(x) => x.span,
             Item::SiteType(x) => x.span,
@@ -158,6 +160,20 @@ impl Item {
             Item::Model(x) => x.span,
         }
     }
+}
+
+/// `import "PATH"`: the declarations of another file (relative to this one's folder).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportDecl {
+    pub path: StringLit,
+    pub span: Span,
+}
+
+/// A string literal; `value` is the text between the quotes, `span` includes them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StringLit {
+    pub value: String,
+    pub span: Span,
 }
 
 /// `solver { NAME = NUMBER ... }`; `keyword` is the span of `solver`.
@@ -183,10 +199,12 @@ pub struct SiteTypeDecl {
     pub span: Span,
 }
 
-/// `piece NAME { ... }`.
+/// `piece NAME [extends BASE] { ... }`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PieceDecl {
     pub name: Ident,
+    /// `extends BASE`: the piece inherits BASE's statements (docs/language.md).
+    pub extends: Option<Ident>,
     pub stmts: Vec<PieceStmt>,
     pub span: Span,
 }

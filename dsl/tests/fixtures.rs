@@ -3,7 +3,17 @@
 
 use std::path::{Path, PathBuf};
 
-use clay_dsl::{compile_bytes, line_col, render};
+use clay_dsl::{Loader, compile_bytes_with, line_col, render};
+
+/// Reads imports of the fixtures (shown as `tests/fixtures/invalid/...`) from the workspace
+/// root, whatever the test's working directory.
+struct FromRoot;
+
+impl Loader for FromRoot {
+    fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path))
+    }
+}
 
 fn fixtures() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/invalid");
@@ -65,7 +75,7 @@ fn fixtures_report_their_code_at_their_line_and_match_snapshots() {
         let (code, line) = expectation(&bytes);
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         let shown = format!("tests/fixtures/invalid/{name}.clay");
-        let diags = match compile_bytes(&bytes, &shown) {
+        let diags = match compile_bytes_with(&bytes, &shown, &FromRoot) {
             Ok(c) => c.warnings,
             Err(d) => d,
         };

@@ -391,3 +391,48 @@ proptest! {
         }
     }
 }
+
+/// Serves the libraries of [`REUSE`].
+struct Libs;
+
+impl clay_dsl::Loader for Libs {
+    fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
+        let text = match path {
+            "lib/types.clay" => "site type joint\n",
+            "lib/brick.clay" => {
+                "import \"types.clay\"\npiece brick { vertex a (0, 0) vertex b (1, 0) edges a-b site east: joint [b] out (1, 0) }\n"
+            }
+            _ => return Err(std::io::ErrorKind::NotFound.into()),
+        };
+        Ok(text.as_bytes().to_vec())
+    }
+}
+
+const REUSE: &str = "import   \"lib/types.clay\"\nimport \"lib/brick.clay\" // the brick\npiece  capped   extends\n  brick{ // child\n vertex top(0.5,1) edges a-top }\npiece bare extends brick{}\nmodel{c=capped b = bare at (0, 3)}\n";
+
+#[test]
+fn imports_and_extends_keep_their_form_and_meaning() {
+    let formatted = format(REUSE).unwrap();
+    let compiled = |s: &str| {
+        let mut g = clay_dsl::compile_with(s, "x.clay", &Libs)
+            .map_err(|d| clay_dsl::render(&d, s, "x.clay", false))
+            .unwrap()
+            .grammar;
+        g.source.clear();
+        g
+    };
+    assert_eq!(compiled(REUSE), compiled(&formatted));
+    assert_eq!(format(&formatted).unwrap(), formatted, "not idempotent");
+    assert!(
+        formatted.starts_with(
+            "import \"lib/types.clay\"\nimport \"lib/brick.clay\" // the brick\n\npiece capped extends brick { // child\n    vertex top (0.5, 1)\n"
+        ),
+        "{formatted}"
+    );
+    assert!(
+        formatted.contains("\npiece bare extends brick {\n}\n"),
+        "{formatted}"
+    );
+    let tree = clay_dsl::parse(REUSE).unwrap();
+    assert_eq!(compiled(&print_file(&tree)), compiled(REUSE));
+}

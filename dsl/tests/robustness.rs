@@ -276,3 +276,107 @@ fn a_million_instance_chain_compiles_in_reasonable_time() {
     assert_eq!(c.grammar.assembly.instances.len(), 200_001);
     assert!(t.elapsed().as_secs() < 30, "took {:?}", t.elapsed());
 }
+
+/// Serves `lib.clay` from memory.
+struct OneLib(Vec<u8>);
+
+impl clay_dsl::Loader for OneLib {
+    fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
+        match path {
+            "lib.clay" => Ok(self.0.clone()),
+            _ => Err(std::io::ErrorKind::NotFound.into()),
+        }
+    }
+}
+
+/// Every label lies inside the main file or inside one imported file, and renders.
+fn check_imported(main: &str, d: &Diagnostics, what: &str) {
+    for diag in d {
+        for l in std::iter::once(&diag.primary).chain(&diag.secondary) {
+            let in_main = l.span.end <= main.len();
+            let in_lib = d
+                .sources
+                .files
+                .iter()
+                .any(|f| f.base <= l.span.start && l.span.end <= f.end());
+            assert!(in_main || in_lib, "{what}: {} span {:?}", diag.code, l.span);
+        }
+    }
+    let _ = render(d, main, "main.clay", false);
+    let _ = clay_dsl::to_json(d, main, "main.clay");
+}
+
+#[test]
+fn imports_of_itself_of_a_missing_file_and_of_a_binary_file_are_diagnosed() {
+    let d = compile("import \"me.clay\"\n", "me.clay").unwrap_err();
+    assert_eq!(d.items[0].code, "E061");
+    assert_spans_valid(&d, "import \"me.clay\"\n", "self");
+    let d = compile("import \"no/such/file.clay\"", "x.clay").unwrap_err();
+    assert_eq!(d.items[0].code, "E060");
+    let d = compile("import \"\"", "x.clay").unwrap_err();
+    assert_eq!(d.items[0].code, "E060", "a folder is not a file");
+    let mut rng = Rng(7);
+    for _ in 0..50 {
+        let bytes: Vec<u8> = (0..rng.below(300)).map(|_| rng.next() as u8).collect();
+        let main = "import \"lib.clay\"\nmodel { }";
+        match clay_dsl::compile_with(main, "main.clay", &OneLib(bytes)) {
+            Ok(c) => check_imported(main, &c.warnings, "binary lib"),
+            Err(d) => check_imported(main, &d, "binary lib"),
+        }
+    }
+}
+
+#[test]
+fn mutated_libraries_and_children_never_panic_and_point_into_their_files() {
+    let mut rng = Rng(0x1a2b);
+    let lib = EMBEDDED.replace("    axis north -> north\n", "");
+    let lib = lib[..lib.find("model {").unwrap()].to_string();
+    let main = "import \"lib.clay\"
+piece brick2 extends brick { polygon fill #ff0000 { (0, 0) (1, 0) (1, 0.5) } }
+piece tower2 extends tower { vertex top (0, 2) edges p-top-q }
+model { w = chain brick x 3  t = tower2 at (0, 5)  b = brick2 at (0, 9) }";
+    for k in 0..600 {
+        let (m, l) = if k % 2 == 0 {
+            (mutate(&mut rng, main), lib.clone())
+        } else {
+            (main.to_string(), mutate(&mut rng, &lib))
+        };
+        let what = format!("mutation {k}");
+        match clay_dsl::compile_with(&m, "main.clay", &OneLib(l.into_bytes())) {
+            Ok(c) => check_imported(&m, &c.warnings, &what),
+            Err(d) => {
+                assert!(d.has_errors(), "{what}");
+                check_imported(&m, &d, &what);
+            }
+        }
+    }
+}
+
+#[test]
+fn deep_and_cyclic_extends_chains_return_quickly() {
+    let base = "piece p0 { vertex a (0, 0) vertex b (1, 0) edges a-b }\n";
+    for n in [100, 10_000] {
+        let mut src = base.to_string();
+        for i in 1..n {
+            src += &format!("piece p{i} extends p{} {{ vertex v{i} ({i}, 1) }}\n", i - 1);
+        }
+        src += &format!("model {{ x = p{} }}", n - 1);
+        let t = std::time::Instant::now();
+        let d = compile(&src, "deep.clay").unwrap_err();
+        assert_eq!(d.items.iter().filter(|d| d.is_error()).count(), 1, "{n}");
+        assert_eq!(d.items[0].code, "E063");
+        assert_spans_valid(&d, &src, "deep extends");
+        assert!(t.elapsed().as_secs() < 10, "took {:?}", t.elapsed());
+    }
+    // One long cycle: one error, every piece silent.
+    let mut src = String::new();
+    for i in 0..5000 {
+        src += &format!("piece p{i} extends p{} {{ }}\n", (i + 1) % 5000);
+    }
+    let d = compile(&src, "cycle.clay").unwrap_err();
+    assert_eq!(d.error_count(), 1);
+    let e = d.items.iter().find(|d| d.is_error()).unwrap();
+    assert_eq!(e.code, "E062");
+    assert!(e.message.contains("(5000 pieces in all)"), "{}", e.message);
+    assert!(e.secondary.len() <= 8);
+}

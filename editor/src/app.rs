@@ -73,6 +73,8 @@ pub struct EditorApp {
     pub sculpt: Sculpt,
     pub canvas: Canvas,
     watch: Option<FileWatch>,
+    /// The files the last good compile imported: hot reload watches them too.
+    imports: Vec<String>,
     session_path: Option<PathBuf>,
     dialog: Option<PathDialog>,
     /// An action that discards unsaved work, waiting for the user's yes.
@@ -197,6 +199,7 @@ impl EditorApp {
             sculpt: Sculpt::new(empty_grammar("")),
             canvas: Canvas::default(),
             watch: None,
+            imports: Vec::new(),
             session_path: None,
             dialog: None,
             confirm: None,
@@ -322,6 +325,7 @@ impl EditorApp {
 
     /// A good compile becomes the model: a new sculpt, the view fitted.
     fn adopt(&mut self, compiled: Compiled) {
+        self.watch_imports(compiled.imports.clone());
         self.problems = compiled.warnings;
         self.stale = false;
         self.sculpt = Sculpt::new(compiled.grammar);
@@ -334,6 +338,7 @@ impl EditorApp {
         match compile::compile(source, shown) {
             Ok(c) => self.adopt(c),
             Err(problems) => {
+                self.imports.clear();
                 self.problems = problems;
                 self.stale = true;
                 self.sculpt = Sculpt::new(empty_grammar(shown));
@@ -354,6 +359,14 @@ impl EditorApp {
         }
     }
 
+    /// Hot reload also follows the grammar's imported files.
+    fn watch_imports(&mut self, imports: Vec<String>) {
+        self.imports = imports;
+        if let Some(w) = &mut self.watch {
+            w.also(&self.imports);
+        }
+    }
+
     fn start_watch(&mut self, path: &Path) {
         let waker = self.waker.clone();
         match FileWatch::new(path, move || {
@@ -361,7 +374,10 @@ impl EditorApp {
                 ctx.request_repaint();
             }
         }) {
-            Ok(w) => self.watch = Some(w),
+            Ok(mut w) => {
+                w.also(&self.imports);
+                self.watch = Some(w);
+            }
             Err(e) => {
                 self.watch = None;
                 self.message = Some(format!(
@@ -381,6 +397,7 @@ impl EditorApp {
         let shown = path.display().to_string();
         match check_grammar(&path) {
             Ok(c) => {
+                self.watch_imports(c.imports.clone());
                 self.problems = c.warnings;
                 let first_good = self.stale && self.sculpt.data().parts.is_empty();
                 self.stale = false;

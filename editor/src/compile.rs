@@ -93,6 +93,8 @@ impl fmt::Display for Problem {
 pub struct Compiled {
     pub grammar: Arc<CompiledGrammar>,
     pub warnings: Vec<Problem>,
+    /// The files the grammar imports (as resolved from its path), for hot reload to watch.
+    pub imports: Vec<String>,
 }
 
 /// Compiles grammar text. `path` is used in messages and recorded in the grammar.
@@ -127,29 +129,33 @@ fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     Ok(Compiled {
         grammar: Arc::new(grammar),
         warnings: Vec::new(),
+        imports: Vec::new(),
     })
 }
 
 fn compile_clay(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     match clay_dsl::compile(source, path) {
         Ok(c) => Ok(Compiled {
-            grammar: Arc::new(c.grammar),
+            imports: c.imported_files().map(str::to_string).collect(),
             warnings: problems(&c.warnings, source, path),
+            grammar: Arc::new(c.grammar),
         }),
         Err(diagnostics) => Err(problems(&diagnostics, source, path)),
     }
 }
 
-/// The compiler's diagnostics located by line and column of their primary span, with the
+/// The compiler's diagnostics located by file, line and column of their primary span (a span in
+/// an imported file is shown in that file, through the diagnostics' source map), with the
 /// source line, the span's label, the secondary spans and the hints.
 fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Vec<Problem> {
+    let map = &diagnostics.sources;
     diagnostics
         .iter()
         .map(|d| {
-            let span = d.primary.span;
-            let (line, col) = clay_dsl::line_col(source, span.start);
-            let (end_line, end) = clay_dsl::line_col(source, span.end);
-            let snippet = source.lines().nth(line - 1).unwrap_or("").to_string();
+            let at = map.locate(source, path, d.primary.span);
+            let (line, col) = clay_dsl::line_col(at.text, at.start);
+            let (end_line, end) = clay_dsl::line_col(at.text, at.end);
+            let snippet = at.text.lines().nth(line - 1).unwrap_or("").to_string();
             let end_col = if end_line == line {
                 end
             } else {
@@ -160,8 +166,13 @@ fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Ve
                 .secondary
                 .iter()
                 .map(|l| {
-                    let (line, col) = clay_dsl::line_col(source, l.span.start);
-                    (line, col, l.message.clone())
+                    let (file, line, col) = map.line_col(source, path, l.span.start);
+                    let message = if file == at.path {
+                        l.message.clone()
+                    } else {
+                        format!("{} (in {file})", l.message)
+                    };
+                    (line, col, message)
                 })
                 .collect();
             Problem {
@@ -171,7 +182,7 @@ fn problems(diagnostics: &clay_dsl::Diagnostics, source: &str, path: &str) -> Ve
                     Severity::Warning
                 },
                 code: d.code.to_string(),
-                file: path.to_string(),
+                file: at.path.to_string(),
                 line,
                 col,
                 end_col,
@@ -233,6 +244,24 @@ mod tests {
             "{:?}",
             p.hints
         );
+    }
+
+    #[test]
+    fn a_problem_in_an_imported_file_names_that_file_and_its_line() {
+        let dir = std::env::temp_dir().join(format!("clay-editor-import-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("lib.clay"), "// line 1\nsite type x docks y\n").unwrap();
+        let main = dir.join("main.clay");
+        let shown = main.display().to_string();
+        let problems = compile("import \"lib.clay\"\nmodel {}\n", &shown).unwrap_err();
+        let p = problems.iter().find(|p| p.code == "E011").unwrap();
+        assert_eq!(p.file, dir.join("lib.clay").display().to_string());
+        assert_eq!((p.line, p.snippet.as_str()), (2, "site type x docks y"));
+        assert!(p.to_string().contains("lib.clay:2:"), "{p}");
+        std::fs::write(dir.join("lib.clay"), CASTLE_SOURCE).unwrap();
+        let c = compile("import \"lib.clay\"\nmodel { t = tower }\n", &shown).unwrap();
+        assert_eq!(c.imports, [dir.join("lib.clay").display().to_string()]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -1,6 +1,6 @@
-//! Hot reload's ears: watches the grammar file for changes (through its parent folder, since
-//! editors save by writing a new file and renaming it over the old one) and debounces bursts of
-//! events into one reload.
+//! Hot reload's ears: watches the grammar file, and the files it imports, for changes (through
+//! their parent folders, since editors save by writing a new file and renaming it over the old
+//! one) and debounces bursts of events into one reload.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
@@ -11,11 +11,15 @@ use notify::{EventKind, RecommendedWatcher, RecursiveMode, Watcher};
 /// How long the file must be quiet before it is reloaded.
 pub const DEBOUNCE: Duration = Duration::from_millis(200);
 
-/// Watches one file.
+/// Watches one file (and the files it imports, see [`FileWatch::also`]).
 pub struct FileWatch {
     path: PathBuf,
+    /// Imported files whose changes also count.
+    also: Vec<PathBuf>,
+    /// The folders being watched.
+    folders: Vec<PathBuf>,
     // Kept alive: dropping the watcher stops the events.
-    _watcher: RecommendedWatcher,
+    watcher: RecommendedWatcher,
     events: Receiver<notify::Result<notify::Event>>,
     /// When the last relevant event arrived, if a reload is pending.
     pending: Option<Instant>,
@@ -39,7 +43,9 @@ impl FileWatch {
         watcher.watch(&folder, RecursiveMode::NonRecursive)?;
         Ok(Self {
             path,
-            _watcher: watcher,
+            also: Vec::new(),
+            folders: vec![folder],
+            watcher,
             events,
             pending: None,
         })
@@ -47,6 +53,27 @@ impl FileWatch {
 
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Also reloads when one of `files` changes (the grammar's imports, as the last good
+    /// compile found them). A folder that cannot be watched is skipped: the grammar file itself
+    /// is still watched.
+    pub fn also(&mut self, files: &[String]) {
+        self.also = files
+            .iter()
+            .map(|f| std::path::absolute(f).unwrap_or_else(|_| PathBuf::from(f)))
+            .collect();
+        for f in &self.also {
+            let Some(folder) = f.parent() else { continue };
+            if !self.folders.iter().any(|w| w == folder)
+                && self
+                    .watcher
+                    .watch(folder, RecursiveMode::NonRecursive)
+                    .is_ok()
+            {
+                self.folders.push(folder.to_path_buf());
+            }
+        }
     }
 
     /// Drains the events; returns true once the file changed and then stayed quiet for
@@ -57,7 +84,10 @@ impl FileWatch {
                 continue;
             };
             let relevant = !matches!(event.kind, EventKind::Access(_))
-                && event.paths.iter().any(|p| same_file(p, &self.path));
+                && event
+                    .paths
+                    .iter()
+                    .any(|p| same_file(p, &self.path) || self.also.iter().any(|a| same_file(p, a)));
             if relevant {
                 self.pending = Some(Instant::now());
             }

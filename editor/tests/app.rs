@@ -187,6 +187,41 @@ fn a_failed_hot_reload_keeps_the_model_and_shows_diagnostics() {
 }
 
 #[test]
+fn hot_reload_follows_the_imported_files() {
+    let dir = std::env::temp_dir().join(format!("clay-editor-imports-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("lib")).unwrap();
+    // The castle's declarations in a library; the main file keeps only its model.
+    let at = CASTLE_SOURCE.find("\nmodel {").unwrap();
+    let lib = dir.join("lib/castle.clay");
+    std::fs::write(&lib, &CASTLE_SOURCE[..at]).unwrap();
+    let path = dir.join("main.clay");
+    let main = format!("import \"lib/castle.clay\"\n{}", &CASTLE_SOURCE[at..]);
+    std::fs::write(&path, &main).unwrap();
+
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    assert!(h.state().problems.is_empty(), "{:?}", h.state().problems);
+    assert!(!h.state().sculpt.data().parts.is_empty());
+
+    // Break the library: the main file did not change, yet the problem shows, in the library.
+    std::fs::write(&lib, format!("{}\npiece broken {{\n", &CASTLE_SOURCE[..at])).unwrap();
+    let start = Instant::now();
+    while h.state().problems.is_empty() && start.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(50));
+        h.step();
+    }
+    let app = h.state();
+    assert!(app.stale, "the broken library is reported");
+    assert!(
+        app.problems[0].file.ends_with("castle.clay") && app.problems[0].file.contains("lib"),
+        "{}",
+        app.problems[0]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn closing_with_unsaved_changes_asks_first() {
     let mut h = harness(EditorApp::bundled());
     h.step();

@@ -727,6 +727,7 @@ impl Design {
         }
         PieceDecl {
             name: ident(&p.name),
+            extends: None,
             stmts,
             span: Span::default(),
         }

@@ -79,6 +79,8 @@ struct Scope {
     instances: HashMap<String, usize>,
     /// (piece symbol, member name, kind) -> member symbol.
     members: HashMap<(usize, String, SymbolKind), usize>,
+    /// The piece each `extends` piece extends (by symbol), for inherited members.
+    bases: HashMap<usize, usize>,
 }
 
 impl Symbols {
@@ -89,6 +91,14 @@ impl Symbols {
         let mut scope = Scope::default();
         for item in &file.items {
             s.declare_item(item, &mut scope);
+        }
+        for item in &file.items {
+            if let Item::Piece(p) = item
+                && let (Some(&child), Some(base)) = (scope.pieces.get(&p.name.name), &p.extends)
+                && let Some(&parent) = scope.pieces.get(&base.name)
+            {
+                scope.bases.insert(child, parent);
+            }
         }
         for item in &file.items {
             s.resolve_item(item, &scope);
@@ -181,7 +191,7 @@ impl Symbols {
                     scope.instances.entry(id.name.clone()).or_insert(i);
                 }
             }
-            Item::Solver(_) => {}
+            Item::Solver(_) | Item::Import(_) => {}
         }
     }
 
@@ -197,9 +207,17 @@ impl Symbols {
     }
 
     fn member(&mut self, scope: &Scope, piece: Option<usize>, id: &Ident, kind: SymbolKind) {
-        let Some(p) = piece else { return };
-        let found = scope.members.get(&(p, id.name.clone(), kind)).copied();
-        self.use_of(id, found.as_ref());
+        // Own members first, then inherited ones up the `extends` chain (bounded: the compiler
+        // rejects deeper chains and cycles).
+        let mut at = piece;
+        for _ in 0..64 {
+            let Some(p) = at else { return };
+            if let Some(found) = scope.members.get(&(p, id.name.clone(), kind)).copied() {
+                self.use_of(id, Some(&found));
+                return;
+            }
+            at = scope.bases.get(&p).copied();
+        }
     }
 
     fn expr(&mut self, e: &Expr, scope: &Scope) {
@@ -255,6 +273,7 @@ impl Symbols {
     fn resolve_item(&mut self, item: &Item, scope: &Scope) {
         match item {
             Item::Let(l) => self.expr(&l.value, scope),
+            Item::Import(_) => {}
             Item::Solver(s) => {
                 for e in &s.entries {
                     self.parameters.push(e.name.span);
@@ -269,6 +288,10 @@ impl Symbols {
             }
             Item::Piece(p) => {
                 let pi = scope.pieces.get(&p.name.name).copied();
+                if let Some(base) = &p.extends {
+                    let found = scope.pieces.get(&base.name).copied();
+                    self.use_of(base, found.as_ref());
+                }
                 for stmt in &p.stmts {
                     self.piece_stmt(stmt, pi, scope);
                 }

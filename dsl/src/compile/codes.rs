@@ -74,6 +74,16 @@ pub const BAD_CALL: &str = "E051";
 /// A constant used above its `let`.
 pub const USED_BEFORE_LET: &str = "E052";
 
+/// An imported file that cannot be read (missing, a folder, not readable).
+pub const IMPORT_UNREADABLE: &str = "E060";
+/// A file that imports itself, directly or through other files.
+pub const IMPORT_CYCLE: &str = "E061";
+/// A piece that extends itself, directly or through other pieces.
+pub const EXTENDS_CYCLE: &str = "E062";
+/// Reuse beyond a limit: too many or too large imports, or an `extends` chain too deep or
+/// copying too much.
+pub const TOO_MUCH_REUSE: &str = "E063";
+
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";
 /// A rule that can never fire.

@@ -7,6 +7,8 @@ pub mod codes;
 mod assembly;
 mod constants;
 mod derive;
+mod extends;
+mod imports;
 
 pub(crate) use constants::{constant_values, functions, is_function};
 mod pieces;
@@ -22,11 +24,22 @@ use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::suggest::closest;
 use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
+pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
+pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
+
 /// The result of a successful compilation: the grammar, and the warnings found on the way.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Compiled {
     pub grammar: CompiledGrammar,
+    /// The warnings, with the imported files they may point into (`warnings.sources`).
     pub warnings: Diagnostics,
+}
+
+impl Compiled {
+    /// The files the grammar imported, directly or not (for a watcher, say).
+    pub fn imported_files(&self) -> impl Iterator<Item = &str> {
+        self.warnings.sources.files.iter().map(|f| f.path.as_str())
+    }
 }
 
 /// Largest absolute coordinate accepted, in metres; keeps every later computation finite.
@@ -40,13 +53,46 @@ pub const COINCIDENT_EPS: f64 = 1e-9;
 /// Tolerance for docked vertices meeting after placement, in metres.
 pub const DOCK_TOLERANCE: f64 = 1e-4;
 
-/// Compiles the text of a `.clay` file. `path` is only recorded in the result.
+/// Compiles the text of a `.clay` file. `path` is recorded in the result, and its folder is where
+/// `import`ed files are read from (through the file system, [`FsLoader`]).
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
+    compile_with(source, path, &FsLoader)
+}
+
+/// Like [`compile`], reading imported files through `loader` (a language server can serve
+/// unsaved buffers this way). Import paths are resolved against `path`'s folder first
+/// ([`resolve_import`]); the loader gets the resolved path.
+pub fn compile_with(
+    source: &str,
+    path: &str,
+    loader: &dyn Loader,
+) -> Result<Compiled, Diagnostics> {
     let file = crate::parse::parse(source)?;
+    let span = file.span;
+    let spliced = imports::splice(file, path, source.len(), loader);
+    if !spliced.diags.is_empty() {
+        // A file that failed to load would only add "unknown" errors for what it declares.
+        let mut diags = spliced.diags;
+        diags.sort();
+        diags.sources = spliced.sources;
+        return Err(diags);
+    }
+    let mut file = syntax::File {
+        items: spliced.items,
+        span,
+    };
     let mut c = Compiler::new(path);
+    c.expand_extends(&mut file);
     c.run(&file);
+    c.drop_poisoned();
     let mut diags = c.diags;
+    // A library's unused pieces and rules are not the importer's concern.
+    diags.items.retain(|d| {
+        d.primary.span.start <= source.len()
+            || !matches!(d.code, codes::UNUSED_PIECE | codes::DEAD_RULE)
+    });
     diags.sort();
+    diags.sources = spliced.sources;
     match c.grammar {
         Some(grammar) if !diags.has_errors() => Ok(Compiled {
             grammar,
@@ -59,8 +105,17 @@ pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
 /// Compiles raw bytes; text that is not UTF-8 is reported (E003) at the first bad byte. Render
 /// the diagnostics against `String::from_utf8_lossy(bytes)`: offsets before that byte agree.
 pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> {
+    compile_bytes_with(bytes, path, &FsLoader)
+}
+
+/// [`compile_bytes`] reading imported files through `loader`.
+pub fn compile_bytes_with(
+    bytes: &[u8],
+    path: &str,
+    loader: &dyn Loader,
+) -> Result<Compiled, Diagnostics> {
     match std::str::from_utf8(bytes) {
-        Ok(source) => compile(source, path),
+        Ok(source) => compile_with(source, path, loader),
         Err(e) => {
             let at = e.valid_up_to();
             Err(Diagnostic::error(
@@ -89,6 +144,8 @@ pub(crate) struct PieceSpans {
     pub sound: bool,
     /// Sites declared with errors (already reported): a later use of one is not "unknown".
     pub failed_sites: Vec<String>,
+    /// A piece extending one that failed (extends.rs): nothing is reported about it.
+    pub poisoned: bool,
 }
 
 pub(crate) struct Compiler {
@@ -110,6 +167,8 @@ pub(crate) struct Compiler {
     pub stretch_named: Vec<bool>,
     /// Set when a `dock` statement had errors: unplaced instances are then not reported.
     pub dock_failed: bool,
+    /// Pieces declared with `extends` (extends.rs).
+    pub inheritance: extends::Inheritance,
     pub grammar: Option<CompiledGrammar>,
     /// The `let` constants, read by every expression.
     pub consts: constants::Constants,
@@ -134,6 +193,7 @@ impl Compiler {
             cut_spans: Vec::new(),
             stretch_named: Vec::new(),
             dock_failed: false,
+            inheritance: extends::Inheritance::default(),
             grammar: None,
             consts: constants::Constants::default(),
         }
@@ -287,7 +347,7 @@ impl Compiler {
             None if self
                 .piece_spans
                 .get(piece)
-                .is_some_and(|s| s.failed_sites.contains(&ident.name)) =>
+                .is_some_and(|s| s.poisoned || s.failed_sites.contains(&ident.name)) =>
             {
                 None
             }
@@ -346,9 +406,10 @@ impl Compiler {
         self.site_type_decls(&decls);
         for item in &file.items {
             if let Item::Piece(p) = item {
-                self.piece_decl(p);
+                self.piece_item(p);
             }
         }
+        self.settle_children();
         self.rules(file);
         self.check_skinned(file);
         let usage = usage::Usage::find(self, file, model);
@@ -517,6 +578,7 @@ impl Compiler {
             // A piece named by a stretch rule gets its axis from the rule; if the rule failed,
             // its own error says why, and "no axis" would only repeat it.
             if self.piece_spans[pi].name != decl.name.span
+                || self.piece_spans[pi].poisoned
                 || self.pieces[pi].axis.is_some()
                 || self.stretch_named.get(pi).copied().unwrap_or(false)
             {
@@ -536,12 +598,16 @@ impl Compiler {
                 }
             }
             for g in geoms {
-                if let Some((syntax::BindingKw::Skinned, span)) = g.binding {
-                    self.error(
-                        Diagnostic::error(codes::NO_AXIS, format!("skinned geometry in piece `{}`, which has no axis", decl.name.name), span, "needs an axis to skin along")
+                if let Some((syntax::BindingKw::Skinned, span)) = g.binding
+                    && !self.inherited_skinned_is_quiet(decl, span)
+                {
+                    let mut d = Diagnostic::error(codes::NO_AXIS, format!("skinned geometry in piece `{}`, which has no axis", decl.name.name), span, "needs an axis to skin along")
                             .with_secondary(decl.name.span, "piece declared here")
-                            .with_hint("add `axis FROM -> TO` to the piece, name it in a `stretch` rule, or make the geometry `rigid`"),
-                    );
+                            .with_hint("add `axis FROM -> TO` to the piece, name it in a `stretch` rule, or make the geometry `rigid`");
+                    if let Some(h) = self.inherited_skinned_hint(decl, span) {
+                        d = d.with_hint(h);
+                    }
+                    self.error(d);
                     break;
                 }
             }

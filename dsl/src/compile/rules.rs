@@ -49,17 +49,23 @@ impl Compiler {
         let mut claimed: Vec<Option<Span>> = vec![None; self.pieces.len()];
         self.stretch_named = vec![false; self.pieces.len()];
         for item in &file.items {
-            if let Item::Stretch(s) = item {
+            if let Item::Stretch(s) = item
+                && !self.quiet_rule(item)
+            {
                 self.stretch(s, &mut claimed);
             }
         }
         for item in &file.items {
-            if let Item::Merge(m) = item {
+            if let Item::Merge(m) = item
+                && !self.quiet_rule(item)
+            {
                 self.merge(m);
             }
         }
         for item in &file.items {
-            if let Item::Cut(c) = item {
+            if let Item::Cut(c) = item
+                && !self.quiet_rule(item)
+            {
                 self.cut(c);
             }
         }

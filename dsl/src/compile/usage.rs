@@ -28,6 +28,12 @@ impl Usage {
         };
         for item in &file.items {
             match item {
+                // A base that other pieces extend is used by them.
+                Item::Piece(p) => {
+                    if let Some(b) = &p.extends {
+                        name(&b.name);
+                    }
+                }
                 Item::Stretch(s) => {
                     name(&s.piece.name);
                     s.variants

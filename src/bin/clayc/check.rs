@@ -73,6 +73,7 @@ impl Unreadable {
             labels: vec![JsonLabel {
                 message: "the file cannot be read".into(),
                 primary: true,
+                file: self.path.clone(),
                 start,
                 end: start,
                 byte_start: 0,
