@@ -202,17 +202,51 @@ impl<'a> IntoIterator for &'a Diagnostics {
 }
 
 /// 1-based line and column (in chars) of byte offset `byte` of `source`; offsets past the end
-/// or inside a UTF-8 sequence are clamped back to the nearest valid position.
+/// or inside a UTF-8 sequence are clamped back to the nearest valid position. O(byte): for many
+/// positions in one source, use a [`LineIndex`].
 pub fn line_col(source: &str, byte: usize) -> (usize, usize) {
-    let mut byte = byte.min(source.len());
-    while !source.is_char_boundary(byte) {
-        byte -= 1;
-    }
+    let byte = clamp_to_char(source, byte);
     let before = &source[..byte];
     let line = before.matches('\n').count() + 1;
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     let col = source[line_start..byte].chars().count() + 1;
     (line, col)
+}
+
+fn clamp_to_char(source: &str, byte: usize) -> usize {
+    let mut byte = byte.min(source.len());
+    while !source.is_char_boundary(byte) {
+        byte -= 1;
+    }
+    byte
+}
+
+/// The line starts of a source, built once (O(length)), so that each [`LineIndex::line_col`]
+/// costs a binary search and the length of its own line instead of a scan from the file's
+/// start: thousands of diagnostics in one large file stay linear.
+pub struct LineIndex<'a> {
+    source: &'a str,
+    /// Byte offset of the start of every line (the first is 0).
+    starts: Vec<usize>,
+}
+
+impl<'a> LineIndex<'a> {
+    pub fn new(source: &'a str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(source.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Self { source, starts }
+    }
+
+    /// The same as [`line_col`]`(source, byte)`.
+    pub fn line_col(&self, byte: usize) -> (usize, usize) {
+        let byte = clamp_to_char(self.source, byte);
+        // Lines starting at or before `byte`; a line starts after each '\n' before `byte`.
+        let line = self.starts.partition_point(|&s| s <= byte);
+        let line_start = self.starts[line - 1];
+        let col = self.source[line_start..byte].chars().count() + 1;
+        (line, col)
+    }
 }
 
 fn term_config() -> term::Config {
@@ -315,8 +349,9 @@ pub struct JsonDiagnostic {
 
 /// The JSON form of diagnostics, one object per diagnostic.
 pub fn to_json(diagnostics: &Diagnostics, source: &str, path: &str) -> Vec<JsonDiagnostic> {
+    let lines = LineIndex::new(source);
     let pos = |b: usize| {
-        let (line, column) = line_col(source, b);
+        let (line, column) = lines.line_col(b);
         JsonPos { line, column }
     };
     let label = |l: &Label, primary: bool| JsonLabel {

@@ -20,8 +20,8 @@ mod suggest;
 pub use compile::{Compiled, MAX_COORDINATE, codes, compile, compile_bytes};
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{
-    Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, Severity, emit_to_stderr,
-    line_col, render, to_json,
+    Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, LineIndex, Severity,
+    emit_to_stderr, line_col, render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
 pub use parse::parse;
