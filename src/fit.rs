@@ -54,6 +54,20 @@ impl RigidMotion {
 /// as the solver's shape distance. `None` when the slices differ in length, are empty, or hold
 /// non-finite points. A single point, or points that give no rotation, give a pure translation.
 pub fn rigid_motion(from: &[DVec2], to: &[DVec2]) -> Option<RigidMotion> {
+    let (motion, _) = fitted(from, to)?;
+    Some(motion)
+}
+
+/// The rotation of [`rigid_motion`] (a unit complex number `(cos, sin)`) when the points
+/// determine one; `None` also when they give no rotation (fewer than two distinct points on a
+/// side), where [`rigid_motion`] falls back to the identity.
+pub fn rigid_rotation(from: &[DVec2], to: &[DVec2]) -> Option<DVec2> {
+    let (motion, determined) = fitted(from, to)?;
+    determined.then_some(motion.rotation)
+}
+
+/// The fit, and whether the points determined its rotation.
+fn fitted(from: &[DVec2], to: &[DVec2]) -> Option<(RigidMotion, bool)> {
     if from.len() != to.len() || from.is_empty() || !from.iter().chain(to).all(|p| p.is_finite()) {
         return None;
     }
@@ -66,12 +80,15 @@ pub fn rigid_motion(from: &[DVec2], to: &[DVec2]) -> Option<RigidMotion> {
         dot += a.dot(b);
         cross += a.perp_dot(b);
     }
-    let rotation = DVec2::new(dot, cross).try_normalize().unwrap_or(DVec2::X);
-    Some(RigidMotion {
-        rotation,
-        from_centre,
-        to_centre,
-    })
+    let rotation = DVec2::new(dot, cross).try_normalize();
+    Some((
+        RigidMotion {
+            rotation: rotation.unwrap_or(DVec2::X),
+            from_centre,
+            to_centre,
+        },
+        rotation.is_some(),
+    ))
 }
 
 fn centroids(from: &[DVec2], to: &[DVec2]) -> (DVec2, DVec2) {

@@ -1,7 +1,8 @@
 //! Models built in code rather than from `.clay` files: a stretchable wall, a street with
 //! base/left/right states, a city (grid of streets and junctions plus a long wall) of about N
 //! parts for the benchmark, and the classic ARAP triangulated grid. Each returns a
-//! [`CompiledGrammar`] whose `assembly` is the model.
+//! [`CompiledGrammar`] whose `assembly` is the model. [`grammar_text`] instead writes a large
+//! grammar as `.clay` text, for timing the compiler.
 
 use clay_dsl::compiled::{
     AssemblyData, Binding, Chain, CompiledGrammar, Dock, ElementVertex, FORMAT_VERSION, Instance,
@@ -573,4 +574,146 @@ pub fn arap_grid(k: usize) -> CompiledGrammar {
     }
     g.assembly = data;
     g
+}
+
+/// The text of a `.clay` grammar of `pieces` pieces (rounded up to a multiple of four) that
+/// compiles clean, for timing the compiler (`benches/check.rs`, `docs/performance.md`). Per
+/// group of four: a stretchable 8-vertex road (three sites, skinned proxy, a stretch rule), its
+/// tee junction (four sites, a second rest state, a merge rule and a written cut), a 6-vertex
+/// segment with a `left` state bent a quarter turn, and a square post with a `leaning` state;
+/// the model has a chain of three roads and the segment docked to the post, per group.
+pub fn grammar_text(pieces: usize) -> String {
+    use std::fmt::Write;
+    let groups = pieces.div_ceil(4).max(1);
+    let mut s = String::with_capacity(groups * 2600);
+    s.push_str(
+        "// A synthetic grammar for timing the compiler (clay::synthetic::grammar_text).\n\
+         solver { merge_distance = 0.5 }\n\n\
+         site type lane\nsite type side docks lane\n",
+    );
+    const ROAD: &str = "    vertex s0 (0, -0.5)
+    vertex s1 (0.5, -0.5)
+    vertex s2 (1.5, -0.5)
+    vertex s3 (2, -0.5)
+    vertex n0 (0, 0.5)
+    vertex n1 (0.5, 0.5)
+    vertex n2 (1.5, 0.5)
+    vertex n3 (2, 0.5)
+    edges s0-s1-s2-s3-n3-n2-n1-n0-s0, n1-s1, n2-s2, s0-n1, s1-n2, s2-n3
+    site west: lane [n0, s0] out (-1, 0)
+    site east: lane [s3, n3] out (1, 0)
+    site north_side: side [n2, n1] out (0, 1)
+";
+    for g in 0..groups {
+        let _ = write!(
+            s,
+            "
+piece road_{g} {{
+{ROAD}    polygon skinned fill #4b4f56 {{
+        (0, -0.5) (2, -0.5) (2, 0.5) (0, 0.5)
+    }}
+    polyline skinned width 0.05 fill #e8e8e8 {{
+        (0, 0.4) (2, 0.4)
+    }}
+}}
+
+piece tee_{g} {{
+{ROAD}    vertex u_w (0.5, 1)
+    vertex u_e (1.5, 1)
+    edges n1-u_w-u_e-n2, n1-u_e
+    site north: lane [u_e, u_w] out (0, 1)
+    polygon fill #4b4f56 {{
+        (0, -0.5) (2, -0.5) (2, 0.5) (1.5, 0.5) (1.5, 1) (0.5, 1) (0.5, 0.5) (0, 0.5)
+    }}
+    state long {{
+        s0 (0, -0.5) s1 (0.5, -0.5) s2 (1.5, -0.5) s3 (2, -0.5)
+        n0 (0, 0.5) n1 (0.5, 0.5) n2 (1.5, 0.5) n3 (2, 0.5)
+        u_w (0.5, 1.25) u_e (1.5, 1.25)
+    }}
+}}
+
+piece bend_{g} {{
+    vertex s0 (0, -0.5)
+    vertex s1 (1, -0.5)
+    vertex s2 (2, -0.5)
+    vertex n0 (0, 0.5)
+    vertex n1 (1, 0.5)
+    vertex n2 (2, 0.5)
+    edges s0-s1-s2-n2-n1-n0-s0, n1-s1, s0-n1, s1-n2
+    site west: lane [n0, s0] out (-1, 0)
+    site east: lane [s2, n2] out (1, 0)
+    polygon fill #4b4f56 {{
+        (0, -0.5) (2, -0.5) (2, 0.5) (0, 0.5)
+    }}
+    state left {{
+        s0 (0, -0.5)
+        s1 (1.25387, 0.01937)
+        s2 (1.77324, 1.27324)
+        n0 (0, 0.5)
+        n1 (0.546763, 0.726477)
+        n2 (0.77324, 1.27324)
+        polygon fill #4b4f56 {{
+            (0, -0.5) (1.25387, 0.01937) (1.77324, 1.27324) (0.77324, 1.27324)
+            (0.546763, 0.726477) (0, 0.5)
+        }}
+    }}
+}}
+
+piece post_{g} {{
+    vertex sw (0, -0.5)
+    vertex se (1, -0.5)
+    vertex ne (1, 0.5)
+    vertex nw (0, 0.5)
+    edges sw-se-ne-nw-sw, sw-ne
+    site west: lane [nw, sw] out (-1, 0)
+    site east: lane [se, ne] out (1, 0)
+    polygon fill #8a8d91 {{
+        (0, -0.5) (1, -0.5) (1, 0.5) (0, 0.5)
+    }}
+    state leaning {{
+        sw (0, -0.5) se (1, -0.5) ne (1.2, 0.5) nw (0.2, 0.5)
+    }}
+}}
+
+stretch road_{g} from west to east {{ min 2 }}
+merge road_{g}.east onto road_{g}.north_side into tee_{g}.north
+cut tee_{g}.north into road_{g}
+"
+        );
+    }
+    s.push_str("\nmodel {\n");
+    for g in 0..groups {
+        let y = 4 * g;
+        let _ = writeln!(
+            s,
+            "    r_{g} = chain road_{g} x 3 at (0, {y})\n    b_{g} = bend_{g} at (10, {y})\n    \
+             p_{g} = post_{g}\n    dock b_{g}.east to p_{g}.west"
+        );
+    }
+    s.push_str("}\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_timing_grammar_compiles_clean_with_every_piece_and_rule() {
+        let text = grammar_text(8);
+        let c = match clay_dsl::compile(&text, "synthetic.clay") {
+            Ok(c) => c,
+            Err(d) => panic!("{}", clay_dsl::render(&d, &text, "synthetic.clay", false)),
+        };
+        assert!(c.warnings.is_empty(), "{:?}", c.warnings);
+        let g = c.grammar;
+        assert_eq!(g.pieces.len(), 8);
+        assert_eq!(g.stretch_rules.len(), 2);
+        assert_eq!(g.merge_rules.len(), 2);
+        assert_eq!(g.cut_rules.len(), 2);
+        assert!(g.pieces.iter().filter(|p| p.states.len() == 2).count() == 6);
+        // Per group: three roads in a chain, the segment and its post.
+        assert_eq!(g.assembly.instances.len(), 10);
+        assert_eq!(grammar_text(10_000).matches("\npiece ").count(), 10_000);
+    }
 }

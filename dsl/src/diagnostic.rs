@@ -7,6 +7,7 @@ use codespan_reporting::term;
 use codespan_reporting::term::termcolor::{Buffer, ColorChoice, StandardStream};
 use serde::Serialize;
 
+use crate::line_index::LineIndex;
 use crate::source_map::{Located, SourceMap, line_col};
 use crate::syntax::Span;
 
@@ -345,8 +346,19 @@ pub struct JsonDiagnostic {
 
 /// The JSON form of diagnostics, one object per diagnostic.
 pub fn to_json(diagnostics: &Diagnostics, source: &str, path: &str) -> Vec<JsonDiagnostic> {
+    let main = LineIndex::new(source);
+    let imported: Vec<LineIndex> = diagnostics
+        .sources
+        .files
+        .iter()
+        .map(|f| LineIndex::new(&f.text))
+        .collect();
     let pos = |at: &Located, b: usize| {
-        let (line, column) = line_col(at.text, b);
+        let index = match at.file {
+            0 => &main,
+            k => &imported[k - 1],
+        };
+        let (line, column) = index.line_col(b);
         JsonPos { line, column }
     };
     let label = |l: &Label, at: &Located, primary: bool| JsonLabel {

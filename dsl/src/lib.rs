@@ -15,6 +15,7 @@ pub mod syntax;
 mod compile;
 mod diagnostic;
 mod format;
+mod line_index;
 mod parse;
 mod source_map;
 mod suggest;
@@ -29,5 +30,6 @@ pub use diagnostic::{
     render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
+pub use line_index::{LineIndex, LinePos};
 pub use parse::parse;
 pub use source_map::{Located, SourceFile, SourceMap, line_col};

@@ -404,3 +404,20 @@ fn line_col_counts_lines_and_chars_from_one() {
     assert_eq!(clay_dsl::line_col(s, 5), (2, 2)); // inside é: clamped back
     assert_eq!(clay_dsl::line_col(s, 99), (3, 2));
 }
+
+#[test]
+fn a_line_index_agrees_with_line_col_at_every_offset() {
+    for s in [
+        "",
+        "\n",
+        "ab\ncé\nx",
+        "\n\né\r\n€x\n",
+        "no newline",
+        "end\n",
+    ] {
+        let index = clay_dsl::LineIndex::new(s);
+        for b in 0..=s.len() + 2 {
+            assert_eq!(index.line_col(b), clay_dsl::line_col(s, b), "{s:?} at {b}");
+        }
+    }
+}

@@ -3,6 +3,11 @@
 //! vertices from then on; with one, the target's instance is replaced by the junction piece
 //! (rigidly fitted over it, taking over its docks by site name) and the mover docks with the
 //! junction's stem. A merged connection is a dock like any other: only a cut undoes it.
+//!
+//! Two sites weld only when they face each other: the dot product of their current outward
+//! directions ([`site_out`]) is at most [`FACING_DOT`], so a site within reach that faces the
+//! same way or across (a street end passing alongside another street's side) does not weld.
+//! Which side of the target the mover is on is not tested (see [`FACING_DOT`]).
 
 use std::collections::HashSet;
 
@@ -12,8 +17,26 @@ use glam::DVec2;
 use super::proximity::SiteGrid;
 use super::{
     PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, fit, generated_name,
-    remove_instances, site_centre, transaction,
+    remove_instances, site_centre, site_out, transaction,
 };
+
+/// The most the dot product of two sites' current `out` directions may be for a merge to weld
+/// them: -cos 45 degrees, so the two directions are within 45 degrees of exactly opposite
+/// (head-on). Halfway between facing (-1) and perpendicular (0): a street end that runs along
+/// another street's side, or has turned a quarter away from it, never welds, while a drag that
+/// bends or turns the mover by less than 45 degrees still merges. The weld then snaps the two
+/// sites together, turning each by at most the remaining angle, which the solver absorbs.
+///
+/// The mover need not be in front of the target (the offset between the centres is not
+/// tested): within the merge distance, a mover that overshot its target in one frame of a fast
+/// drag (the pieces overlapping by less than that distance) is still facing it and welds, so a
+/// merge does not depend on the drag's speed; the weld itself puts the sites together.
+pub const FACING_DOT: f64 = -std::f64::consts::FRAC_1_SQRT_2;
+
+/// Whether two outward directions face each other closely enough to weld (see [`FACING_DOT`]).
+pub fn facing(a: DVec2, b: DVec2) -> bool {
+    a.dot(b) <= FACING_DOT
+}
 
 /// A merge the rules found: `mover` came within `distance` of `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,8 +52,9 @@ fn docked_sites(data: &AssemblyData) -> HashSet<InstanceSite> {
     data.docks.iter().flat_map(|d| [d.a, d.b]).collect()
 }
 
-/// The closest mover/target pair over all merge rules, if any is within its rule's distance.
-/// O(instances + docks) to list the free sites, then O(1) per free mover site (grid lookup).
+/// The closest mover/target pair over all merge rules, if any is within its rule's distance
+/// and the two sites face each other ([`facing`]). O(instances + docks) to list the free
+/// sites, then O(1) per free mover site (grid lookup).
 pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch> {
     find_where(grammar, data, |_, _| true)
 }
@@ -41,6 +65,26 @@ pub fn find_where(
     grammar: &CompiledGrammar,
     data: &AssemblyData,
     accept_ids: impl Fn(u64, u64) -> bool,
+) -> Option<MergeMatch> {
+    search(grammar, data, accept_ids, true)
+}
+
+/// [`find_where`] whichever way the sites face: the closest pair within reach. The rules ask
+/// this to tell when the sides of a cut have parted (moved beyond the merge distance); turning
+/// a side away is no parting, so it does not weld again when turned back.
+pub fn find_in_reach(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    accept_ids: impl Fn(u64, u64) -> bool,
+) -> Option<MergeMatch> {
+    search(grammar, data, accept_ids, false)
+}
+
+fn search(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    accept_ids: impl Fn(u64, u64) -> bool,
+    face: bool,
 ) -> Option<MergeMatch> {
     if grammar.merge_rules.is_empty() {
         return None;
@@ -96,10 +140,19 @@ pub fn find_where(
             let Some(c) = site_centre(grammar, data, m) else {
                 continue;
             };
+            // A site whose direction is unknown (collapsed) faces nothing.
+            let out = site_out(grammar, data, m);
+            if face && out.is_none() {
+                continue;
+            }
             let accept = |t: InstanceSite| {
                 t.instance != i
                     && !neighbours.contains(&(i, t.instance))
                     && accept_ids(inst.id, data.instances[t.instance].id)
+                    && (!face
+                        || out
+                            .zip(site_out(grammar, data, t))
+                            .is_some_and(|(a, b)| facing(a, b)))
             };
             if let Some((t, d)) = grid.nearest(c, distance, accept)
                 && best.is_none_or(|b| d < b.distance)

@@ -12,14 +12,13 @@
 //! by the change in length (after it).
 
 mod complete;
-mod line_index;
 mod symbols;
 mod tokens;
 
 use std::collections::HashMap;
 
+pub use crate::line_index::{LineIndex, LinePos};
 pub use complete::{Completion, CompletionKind};
-pub use line_index::{LineIndex, LinePos};
 pub use symbols::{Reference, Symbol, SymbolKind, Symbols};
 pub use tokens::{SemanticToken, TokenKind};
 

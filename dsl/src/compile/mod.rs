@@ -163,6 +163,11 @@ pub(crate) struct Compiler {
     pub merge_spans: Vec<Span>,
     pub cut_rules: Vec<CutRule>,
     pub cut_spans: Vec<Span>,
+    /// The first merge rule of each (mover, target, `within` bits): finds a shadowed rule
+    /// (W006) without a scan of the earlier rules.
+    pub merge_first: HashMap<(SiteRef, SiteRef, Option<u64>), usize>,
+    /// The cut rule of each junction site (`cut_rules` index).
+    pub cut_index: HashMap<SiteRef, usize>,
     /// Pieces named by a stretch rule (written, even if the rule had errors).
     pub stretch_named: Vec<bool>,
     /// Set when a `dock` statement had errors: unplaced instances are then not reported.
@@ -191,6 +196,8 @@ impl Compiler {
             merge_spans: Vec::new(),
             cut_rules: Vec::new(),
             cut_spans: Vec::new(),
+            merge_first: HashMap::new(),
+            cut_index: HashMap::new(),
             stretch_named: Vec::new(),
             dock_failed: false,
             inheritance: extends::Inheritance::default(),

@@ -72,7 +72,8 @@ impl Compiler {
         // Derived cuts: undo every merge into a junction unless a cut for that site is written.
         for m in self.merge_rules.clone() {
             let Some(j) = m.junction else { continue };
-            if !self.cut_rules.iter().any(|c| c.junction == j) {
+            if !self.cut_index.contains_key(&j) {
+                self.cut_index.insert(j, self.cut_rules.len());
                 self.cut_rules.push(CutRule {
                     junction: j,
                     into: m.target.piece,
@@ -517,11 +518,13 @@ impl Compiler {
                 Some(j)
             }
         };
-        if let Some(first) = self
-            .merge_rules
-            .iter()
-            .position(|r| r.mover == mover && r.target == target && r.within == distance)
-        {
+        // `within` as bits, -0 as 0 (a NaN is never equal, so it is never a key).
+        let key = match distance {
+            Some(d) if d.is_nan() => None,
+            Some(d) => Some((mover, target, Some((d + 0.0).to_bits()))),
+            None => Some((mover, target, None)),
+        };
+        if let Some(&first) = key.as_ref().and_then(|k| self.merge_first.get(k)) {
             // The runtime takes the nearest match and, at equal distance, the earlier rule:
             // for the same two sites within the same reach that is always the first. (With
             // another `within`, the later rule still fires between the two distances.)
@@ -540,6 +543,9 @@ impl Compiler {
                 .with_hint("keep one merge rule per pair of sites; to change what the merge puts in place, change the first rule's `into`"),
             );
         }
+        if let Some(k) = key {
+            self.merge_first.entry(k).or_insert(self.merge_rules.len());
+        }
         self.merge_rules.push(MergeRule {
             mover,
             target,
@@ -555,7 +561,7 @@ impl Compiler {
         let (Some(junction), Some(into)) = (junction, into) else {
             return;
         };
-        if let Some(i) = self.cut_rules.iter().position(|x| x.junction == junction) {
+        if let Some(&i) = self.cut_index.get(&junction) {
             let id = syntax::Ident {
                 name: format!("{}.{}", c.junction.piece.name, c.junction.site.name),
                 span: c.junction.span,
@@ -586,6 +592,7 @@ impl Compiler {
             );
             return;
         }
+        self.cut_index.insert(junction, self.cut_rules.len());
         self.cut_rules.push(CutRule {
             junction,
             into,

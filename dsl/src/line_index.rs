@@ -1,7 +1,11 @@
-//! Byte offsets <-> (line, UTF-16 column) for one text, built once per text.
+//! Byte offsets <-> positions for one text, built once per text (O(length)), so each lookup is a
+//! binary search plus the length of its own line instead of a scan from the file's start:
+//! thousands of diagnostics in one large file stay linear.
 //!
-//! The compiler's spans are byte offsets; the Language Server Protocol counts columns in UTF-16
-//! code units. Every conversion goes through this index so the two never disagree.
+//! The compiler's spans are byte offsets. Diagnostics show 1-based lines and columns in
+//! characters ([`LineIndex::line_col`], the same as [`crate::line_col`]); the Language Server
+//! Protocol counts 0-based columns in UTF-16 code units ([`LineIndex::position`]). Every
+//! conversion goes through this index so they never disagree.
 
 /// Line starts of one text, for converting positions both ways.
 #[derive(Clone, Debug)]
@@ -65,6 +69,18 @@ impl LineIndex {
             units = next;
         }
         end
+    }
+
+    /// 1-based line and column in characters of byte `offset` (clamped as [`Self::position`]):
+    /// what diagnostics show, the same as [`crate::line_col`].
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self.starts.partition_point(|&s| s <= offset) - 1;
+        let col = self.text[self.starts[line]..offset].chars().count();
+        (line + 1, col + 1)
     }
 
     pub fn line_count(&self) -> usize {
