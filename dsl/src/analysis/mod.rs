@@ -171,6 +171,12 @@ impl Analysis {
         self.index.text()
     }
 
+    /// Whether the whole text parses (then this analysis is the one to pass as `previous`
+    /// to [`Analysis::with_previous`] while later texts do not).
+    pub fn parses(&self) -> bool {
+        self.parsed_to == self.text().len()
+    }
+
     pub fn line_index(&self) -> &LineIndex {
         &self.index
     }
@@ -451,8 +457,8 @@ impl Analysis {
                     edits: vec![(d.primary.span, word.to_string())],
                 });
             }
-            if let Some(fix) = between(hint, "declare `site type ", "`")
-                .and_then(|decl| self.allow_docking(decl))
+            if let Some(fix) =
+                between(hint, "declare `site type ", "`").and_then(|decl| self.allow_docking(decl))
             {
                 fixes.push(fix);
             }

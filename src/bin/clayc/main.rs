@@ -14,6 +14,7 @@ mod author;
 mod bench;
 mod check;
 mod fmt;
+mod lsp;
 mod render;
 mod run;
 
@@ -21,7 +22,7 @@ mod run;
 #[command(
     name = "clayc",
     version,
-    about = "Check, build, run, render, format and author Clay grammars"
+    about = "Check, build, run, render, format and author Clay grammars, and serve them to editors"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -46,6 +47,8 @@ enum Command {
     Fmt(fmt::FmtArgs),
     /// Turn an SVG drawing into a grammar.
     Author(author::AuthorArgs),
+    /// Run the language server for editors (Language Server Protocol over stdio).
+    Lsp(lsp::LspArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +69,7 @@ fn main() -> ExitCode {
         Command::Sheet(args) => render::sheet(args),
         Command::Fmt(args) => fmt::fmt(args),
         Command::Author(args) => author::author_cmd(args),
+        Command::Lsp(args) => lsp::lsp(args),
     };
     ExitCode::from(code)
 }
