@@ -243,7 +243,7 @@ pub fn folding_ranges(index: &LineIndex, spans: &[Span]) -> Vec<lsp::FoldingRang
             let start = index.position(s.start).line;
             let end = index.position(s.end).line;
             let end = if comment { end } else { end.saturating_sub(1) };
-            (end > start).then(|| lsp::FoldingRange {
+            (end > start).then_some(lsp::FoldingRange {
                 start_line: start,
                 start_character: None,
                 end_line: end,

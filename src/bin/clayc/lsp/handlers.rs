@@ -14,7 +14,7 @@ use serde_json::Value;
 use super::Document;
 use super::convert;
 
-type Docs = HashMap<lsp::Uri, Document>;
+type Docs = HashMap<String, Document>;
 type Answer = Result<Value, ResponseError>;
 
 pub fn error(code: ErrorCode, message: impl Into<String>) -> ResponseError {
@@ -138,7 +138,7 @@ struct At<'a> {
 
 impl Open<'_> {
     fn analysis(&self, uri: &lsp::Uri) -> Result<&Analysis, ResponseError> {
-        let doc = self.0.get(uri).ok_or_else(|| not_open(uri))?;
+        let doc = self.0.get(uri.as_str()).ok_or_else(|| not_open(uri))?;
         doc.analysis.as_deref().ok_or_else(|| {
             error(
                 ErrorCode::RequestFailed,

@@ -79,6 +79,7 @@ pub fn lsp(_args: LspArgs) -> u8 {
 
 /// An open document.
 pub struct Document {
+    pub uri: lsp::Uri,
     pub text: String,
     pub version: i32,
     /// The analysis of `text` (of an earlier text while `dirty`).
@@ -89,8 +90,9 @@ pub struct Document {
 }
 
 impl Document {
-    fn new(text: String, version: i32) -> Self {
+    fn new(uri: lsp::Uri, text: String, version: i32) -> Self {
         Self {
+            uri,
             text,
             version,
             analysis: None,
@@ -132,7 +134,8 @@ enum State {
 struct Server<W: std::io::Write> {
     out: Writer<W>,
     state: State,
-    docs: HashMap<lsp::Uri, Document>,
+    /// By uri (as text: `Uri` caches its parts inside, so it is no key).
+    docs: HashMap<String, Document>,
     /// When the changed documents are to be checked.
     deadline: Option<Instant>,
     /// When the oldest unchecked change came.
@@ -238,14 +241,17 @@ impl<W: std::io::Write> Server<W> {
             note::DidOpenTextDocument::METHOD => {
                 let p: lsp::DidOpenTextDocumentParams = handlers::params(n.params)?;
                 let d = p.text_document;
-                self.docs.insert(d.uri, Document::new(d.text, d.version));
+                self.docs.insert(
+                    d.uri.as_str().to_string(),
+                    Document::new(d.uri, d.text, d.version),
+                );
                 self.changed();
             }
             note::DidChangeTextDocument::METHOD => {
                 let p: lsp::DidChangeTextDocumentParams = handlers::params(n.params)?;
                 let doc = self
                     .docs
-                    .get_mut(&p.text_document.uri)
+                    .get_mut(p.text_document.uri.as_str())
                     .ok_or_else(|| handlers::not_open(&p.text_document.uri))?;
                 for change in p.content_changes {
                     apply(&mut doc.text, change);
@@ -256,7 +262,7 @@ impl<W: std::io::Write> Server<W> {
             }
             note::DidCloseTextDocument::METHOD => {
                 let p: lsp::DidCloseTextDocumentParams = handlers::params(n.params)?;
-                if self.docs.remove(&p.text_document.uri).is_some() {
+                if self.docs.remove(p.text_document.uri.as_str()).is_some() {
                     return Ok(Some(p.text_document.uri));
                 }
             }
@@ -280,13 +286,13 @@ impl<W: std::io::Write> Server<W> {
         self.first_change = None;
         let mut ready = Vec::new();
         for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
-            if !doc.analyse(uri.as_str()) {
-                errln!("clayc lsp: the analysis of `{}` panicked", uri.as_str());
+            if !doc.analyse(uri) {
+                errln!("clayc lsp: the analysis of `{uri}` panicked");
                 continue;
             }
             let Some(a) = &doc.analysis else { continue };
-            let diagnostics = convert::diagnostics(uri, a.line_index(), a.diagnostics());
-            ready.push((uri.clone(), diagnostics, doc.version));
+            let diagnostics = convert::diagnostics(&doc.uri, a.line_index(), a.diagnostics());
+            ready.push((doc.uri.clone(), diagnostics, doc.version));
         }
         for (uri, diagnostics, version) in ready {
             self.publish(uri, diagnostics, Some(version))?;
