@@ -305,6 +305,14 @@ fn a_typo_is_e011_at_its_range_its_fix_is_a_code_action_and_fixing_clears_it() {
     let published = c.diagnostics();
     assert_eq!(published["version"], 2);
     assert_eq!(published["diagnostics"], json!([]));
+
+    // Closed with an error in it: its diagnostics are cleared, and it is no longer served.
+    c.change(3, &typo);
+    assert_eq!(c.diagnostics()["diagnostics"].as_array().unwrap().len(), 1);
+    c.notify("textDocument/didClose", json!({ "textDocument": doc() }));
+    assert_eq!(c.diagnostics()["diagnostics"], json!([]));
+    let gone = c.request("textDocument/hover", at_pos(&typo, 0));
+    assert_eq!(gone["error"]["code"], -32602, "{gone}");
     assert!(c.shutdown_and_exit().success());
 }
 
