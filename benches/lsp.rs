@@ -70,6 +70,10 @@ fn bench(c: &mut Criterion) {
             d
         })
     });
+    // The floor: what `clayc check` does with the same text (parse and compile).
+    g.bench_function("compile_only", |b| {
+        b.iter(|| clay_dsl::compile(&valid, "wall3000.clay").is_ok())
+    });
     g.finish();
 }
 

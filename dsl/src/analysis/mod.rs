@@ -74,13 +74,19 @@ pub struct Analysis {
 impl Analysis {
     /// Analyses `text` (compiled as the file `path`).
     pub fn new(text: &str, path: &str) -> Self {
-        let diagnostics = match crate::compile(text, path) {
-            Ok(c) => c.warnings,
-            Err(d) => d,
-        };
-        let (tree, parsed_to) = match crate::parse(text) {
-            Ok(tree) => (Some(tree), text.len()),
-            Err(d) => parsed_prefix(text, &d),
+        // One parse for the tree and the compiler (`compile` would parse again).
+        let (tree, parsed_to, diagnostics) = match crate::parse(text) {
+            Ok(tree) => {
+                let diagnostics = match crate::compile::compile_tree(&tree, path) {
+                    Ok(c) => c.warnings,
+                    Err(d) => d,
+                };
+                (Some(tree), text.len(), diagnostics)
+            }
+            Err(d) => {
+                let (tree, parsed_to) = parsed_prefix(text, &d);
+                (tree, parsed_to, d)
+            }
         };
         let symbols = tree.as_ref().map(Symbols::of).unwrap_or_default();
         let values = tree

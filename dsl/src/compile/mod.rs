@@ -39,9 +39,13 @@ pub const DOCK_TOLERANCE: f64 = 1e-4;
 
 /// Compiles the text of a `.clay` file. `path` is only recorded in the result.
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
-    let file = crate::parse::parse(source)?;
+    compile_tree(&crate::parse::parse(source)?, path)
+}
+
+/// Compiles a parsed file (the analysis layer parses once for its tree and the compiler).
+pub(crate) fn compile_tree(file: &syntax::File, path: &str) -> Result<Compiled, Diagnostics> {
     let mut c = Compiler::new(path);
-    c.run(&file);
+    c.run(file);
     let mut diags = c.diags;
     diags.sort();
     match c.grammar {

@@ -29,9 +29,9 @@ use lsp_types::notification::Notification as _;
 use transport::{Input, Writer};
 
 /// Quiet time after a change before the document is checked.
-pub const DEBOUNCE: Duration = Duration::from_millis(150);
+pub const DEBOUNCE: Duration = Duration::from_millis(100);
 /// Longest wait for a check while changes keep coming.
-pub const MAX_DELAY: Duration = Duration::from_millis(500);
+pub const MAX_DELAY: Duration = Duration::from_millis(300);
 
 #[derive(clap::Args)]
 pub struct LspArgs {
@@ -176,10 +176,9 @@ impl<W: std::io::Write> Server<W> {
         };
         let response = match (self.state, r.method.as_str()) {
             (State::Uninitialised, "initialize") => {
-                let reply = respond(r.id, || {
-                    let _: lsp::InitializeParams = handlers::params(r.params)?;
-                    handlers::to_value(handlers::initialize_result())
-                });
+                // The client's capabilities change nothing here, so they are not read: a
+                // client newer than lsp-types may send values it does not know.
+                let reply = respond(r.id, || handlers::to_value(handlers::initialize_result()));
                 if reply.response_result.is_ok() {
                     self.state = State::Running;
                 }
