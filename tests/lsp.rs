@@ -733,3 +733,35 @@ fn shutdown_then_exit_is_exit_code_0_and_exit_alone_is_1() {
     c.notify("exit", Value::Null);
     assert_eq!(c.wait().code(), Some(0));
 }
+
+#[test]
+fn every_advertised_capability_has_its_row_in_docs_editors_md() {
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let mut c = Client::spawn();
+    let init = c.request("initialize", json!({ "capabilities": {} }));
+    let caps = init["result"]["capabilities"].as_object().unwrap();
+    let method = |cap: &str| match cap {
+        "positionEncoding" => "`initialize`",
+        "textDocumentSync" => "`textDocument/didOpen`",
+        "hoverProvider" => "`textDocument/hover`",
+        "definitionProvider" => "`textDocument/definition`",
+        "referencesProvider" => "`textDocument/references`",
+        "documentHighlightProvider" => "`textDocument/documentHighlight`",
+        "completionProvider" => "`textDocument/completion`",
+        "documentFormattingProvider" => "`textDocument/formatting`",
+        "renameProvider" => "`textDocument/rename`",
+        "documentSymbolProvider" => "`textDocument/documentSymbol`",
+        "semanticTokensProvider" => "`textDocument/semanticTokens/full`",
+        "foldingRangeProvider" => "`textDocument/foldingRange`",
+        "codeActionProvider" => "`textDocument/codeAction`",
+        other => panic!("a capability this test does not know: {other}"),
+    };
+    for cap in caps.keys() {
+        let m = method(cap);
+        assert!(
+            doc.lines().any(|l| l.starts_with("| ") && l.contains(m)),
+            "docs/editors.md has no row for {m} ({cap})"
+        );
+    }
+}
