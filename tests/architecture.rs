@@ -1,7 +1,7 @@
 //! The architecture invariants of `docs/architecture.md` that a reading of the source can
 //! check: no import cycle between the modules of a crate, the editor uses only the library's
 //! surfaces (the session, rendering, authoring, and the solver's settings and report types),
-//! and rules never import sessions or scripts.
+//! rules never import sessions or scripts, and protocol types stay in the language server.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -226,5 +226,33 @@ fn the_editor_uses_the_librarys_surfaces_only() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn protocol_types_live_only_in_the_language_server() {
+    let server = root().join("src/bin/clayc/lsp");
+    let mut files = Vec::new();
+    for dir in ["src", "dsl/src", "editor/src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    let outside: Vec<&PathBuf> = files.iter().filter(|f| !f.starts_with(&server)).collect();
+    assert!(outside.len() > 20, "only {} files read", outside.len());
+    for f in outside {
+        let text = std::fs::read_to_string(f).unwrap();
+        for name in ["lsp_types", "lsp_server"] {
+            assert!(
+                !text.contains(name),
+                "{} names `{name}`: protocol types belong in src/bin/clayc/lsp",
+                f.display()
+            );
+        }
+    }
+    for manifest in ["dsl/Cargo.toml", "editor/Cargo.toml"] {
+        let text = std::fs::read_to_string(root().join(manifest)).unwrap();
+        assert!(
+            !text.contains("lsp-"),
+            "{manifest} depends on a protocol crate"
+        );
     }
 }

@@ -307,3 +307,15 @@ fn a_did_you_mean_hint_is_a_fix_that_compiles() {
     fixed.replace_range(span.start..span.end, with);
     assert_eq!(fixed, wall());
 }
+
+#[test]
+fn parses_tells_a_whole_parse_from_a_prefix() {
+    let good = wall();
+    assert!(Analysis::new(&good, "wall.clay").parses());
+    let broken = good.replace("min 2 }", "min }");
+    let a = Analysis::new(&broken, "wall.clay");
+    assert!(!a.parses());
+    // Borrowing the tail from a previous analysis does not make the text parse.
+    let previous = Analysis::new(&good, "wall.clay");
+    assert!(!Analysis::with_previous(&broken, "wall.clay", &previous).parses());
+}

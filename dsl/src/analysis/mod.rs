@@ -73,13 +73,21 @@ pub struct Analysis {
 impl Analysis {
     /// Analyses `text` (compiled as the file `path`).
     pub fn new(text: &str, path: &str) -> Self {
-        let diagnostics = match crate::compile(text, path) {
-            Ok(c) => c.warnings,
-            Err(d) => d,
-        };
-        let (tree, parsed_to) = match crate::parse(text) {
-            Ok(tree) => (Some(tree), text.len()),
-            Err(d) => parsed_prefix(text, &d),
+        // One parse for the tree and the compiler (`compile` would parse again).
+        let (tree, parsed_to, diagnostics) = match crate::parse(text) {
+            Ok(tree) => {
+                let compiled =
+                    crate::compile::compile_tree(tree.clone(), text.len(), path, &crate::FsLoader);
+                let diagnostics = match compiled {
+                    Ok(c) => c.warnings,
+                    Err(d) => d,
+                };
+                (Some(tree), text.len(), diagnostics)
+            }
+            Err(d) => {
+                let (tree, parsed_to) = parsed_prefix(text, &d);
+                (tree, parsed_to, d)
+            }
         };
         let symbols = tree.as_ref().map(Symbols::of).unwrap_or_default();
         let values = tree
@@ -168,6 +176,12 @@ impl Analysis {
 
     pub fn text(&self) -> &str {
         self.index.text()
+    }
+
+    /// Whether the whole text parses (then this analysis is the one to pass as `previous`
+    /// to [`Analysis::with_previous`] while later texts do not).
+    pub fn parses(&self) -> bool {
+        self.parsed_to == self.text().len()
     }
 
     pub fn line_index(&self) -> &LineIndex {

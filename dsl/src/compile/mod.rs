@@ -67,9 +67,19 @@ pub fn compile_with(
     path: &str,
     loader: &dyn Loader,
 ) -> Result<Compiled, Diagnostics> {
-    let file = crate::parse::parse(source)?;
+    compile_tree(crate::parse::parse(source)?, source.len(), path, loader)
+}
+
+/// Compiles a parsed file whose text is `source_len` bytes long (the analysis layer parses
+/// once, for its tree and the compiler).
+pub(crate) fn compile_tree(
+    file: syntax::File,
+    source_len: usize,
+    path: &str,
+    loader: &dyn Loader,
+) -> Result<Compiled, Diagnostics> {
     let span = file.span;
-    let spliced = imports::splice(file, path, source.len(), loader);
+    let spliced = imports::splice(file, path, source_len, loader);
     if !spliced.diags.is_empty() {
         // A file that failed to load would only add "unknown" errors for what it declares.
         let mut diags = spliced.diags;
@@ -88,7 +98,7 @@ pub fn compile_with(
     let mut diags = c.diags;
     // A library's unused pieces and rules are not the importer's concern.
     diags.items.retain(|d| {
-        d.primary.span.start <= source.len()
+        d.primary.span.start <= source_len
             || !matches!(d.code, codes::UNUSED_PIECE | codes::DEAD_RULE)
     });
     diags.sort();

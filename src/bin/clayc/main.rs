@@ -15,6 +15,7 @@ mod bench;
 mod check;
 mod export;
 mod fmt;
+mod lsp;
 mod render;
 mod run;
 
@@ -22,7 +23,7 @@ mod run;
 #[command(
     name = "clayc",
     version,
-    about = "Check, build, run, render, format and author Clay grammars"
+    about = "Check, build, run, render, format and author Clay grammars, and serve them to editors"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -49,6 +50,8 @@ enum Command {
     Fmt(fmt::FmtArgs),
     /// Turn an SVG drawing into a grammar.
     Author(author::AuthorArgs),
+    /// Run the language server for editors (Language Server Protocol over stdio).
+    Lsp(lsp::LspArgs),
 }
 
 fn main() -> ExitCode {
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Export(args) => export::export(args),
         Command::Fmt(args) => fmt::fmt(args),
         Command::Author(args) => author::author_cmd(args),
+        Command::Lsp(args) => lsp::lsp(args),
     };
     ExitCode::from(code)
 }

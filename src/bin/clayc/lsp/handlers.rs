@@ -1,0 +1,351 @@
+//! The requests: each reads its params (InvalidParams when they do not fit), asks the document's
+//! analysis, and converts the answer.
+
+use std::collections::HashMap;
+
+use clay_dsl::analysis::Analysis;
+use lsp_server::{ErrorCode, ResponseError};
+use lsp_types as lsp;
+use lsp_types::request::{self as req, Request as _};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use serde_json::Value;
+
+use super::Document;
+use super::convert;
+
+type Docs = HashMap<String, Document>;
+type Answer = Result<Value, ResponseError>;
+
+pub fn error(code: ErrorCode, message: impl Into<String>) -> ResponseError {
+    ResponseError {
+        code: code as i32,
+        message: message.into(),
+        data: None,
+    }
+}
+
+pub fn params<P: DeserializeOwned>(params: Value) -> Result<P, ResponseError> {
+    serde_json::from_value(params).map_err(|e| error(ErrorCode::InvalidParams, e.to_string()))
+}
+
+pub fn to_value(v: impl Serialize) -> Answer {
+    serde_json::to_value(v).map_err(|e| error(ErrorCode::InternalError, e.to_string()))
+}
+
+pub fn not_open(uri: &lsp::Uri) -> ResponseError {
+    error(
+        ErrorCode::InvalidParams,
+        format!("`{}` is not open", uri.as_str()),
+    )
+}
+
+pub fn initialize_result() -> lsp::InitializeResult {
+    use lsp::*;
+    InitializeResult {
+        capabilities: ServerCapabilities {
+            position_encoding: Some(PositionEncodingKind::UTF16),
+            text_document_sync: Some(TextDocumentSyncCapability::Options(
+                TextDocumentSyncOptions {
+                    open_close: Some(true),
+                    change: Some(TextDocumentSyncKind::FULL),
+                    ..Default::default()
+                },
+            )),
+            hover_provider: Some(HoverProviderCapability::Simple(true)),
+            definition_provider: Some(OneOf::Left(true)),
+            references_provider: Some(OneOf::Left(true)),
+            document_highlight_provider: Some(OneOf::Left(true)),
+            completion_provider: Some(CompletionOptions {
+                trigger_characters: Some(vec![".".into(), ":".into(), "[".into()]),
+                ..Default::default()
+            }),
+            document_formatting_provider: Some(OneOf::Left(true)),
+            rename_provider: Some(OneOf::Right(RenameOptions {
+                prepare_provider: Some(true),
+                work_done_progress_options: Default::default(),
+            })),
+            document_symbol_provider: Some(OneOf::Left(true)),
+            semantic_tokens_provider: Some(
+                SemanticTokensServerCapabilities::SemanticTokensOptions(SemanticTokensOptions {
+                    legend: convert::legend(),
+                    full: Some(SemanticTokensFullOptions::Bool(true)),
+                    range: None,
+                    work_done_progress_options: Default::default(),
+                }),
+            ),
+            folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
+            code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
+                code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
+                ..Default::default()
+            })),
+            ..Default::default()
+        },
+        server_info: Some(ServerInfo {
+            name: "clayc lsp".into(),
+            version: Some(env!("CARGO_PKG_VERSION").into()),
+        }),
+    }
+}
+
+/// Answers one request (not `initialize` or `shutdown`, which the server loop answers).
+pub fn handle(docs: &Docs, method: &str, p: Value) -> Answer {
+    let docs = Open(docs);
+    match method {
+        req::HoverRequest::METHOD => on::<req::HoverRequest>(p, |p| docs.hover(p)),
+        req::GotoDefinition::METHOD => on::<req::GotoDefinition>(p, |p| docs.definition(p)),
+        req::References::METHOD => on::<req::References>(p, |p| docs.references(p)),
+        req::DocumentHighlightRequest::METHOD => {
+            on::<req::DocumentHighlightRequest>(p, |p| docs.highlight(p))
+        }
+        req::Completion::METHOD => on::<req::Completion>(p, |p| docs.completion(p)),
+        req::Formatting::METHOD => on::<req::Formatting>(p, |p| docs.formatting(p)),
+        req::PrepareRenameRequest::METHOD => {
+            on::<req::PrepareRenameRequest>(p, |p| docs.prepare_rename(p))
+        }
+        req::Rename::METHOD => on::<req::Rename>(p, |p| docs.rename(p)),
+        req::DocumentSymbolRequest::METHOD => {
+            on::<req::DocumentSymbolRequest>(p, |p| docs.symbols(p))
+        }
+        req::SemanticTokensFullRequest::METHOD => {
+            on::<req::SemanticTokensFullRequest>(p, |p| docs.tokens(p))
+        }
+        req::FoldingRangeRequest::METHOD => on::<req::FoldingRangeRequest>(p, |p| docs.folding(p)),
+        req::CodeActionRequest::METHOD => on::<req::CodeActionRequest>(p, |p| docs.actions(p)),
+        _ => Err(error(
+            ErrorCode::MethodNotFound,
+            format!("`{method}` is not supported"),
+        )),
+    }
+}
+
+/// Reads the params of request `R`, runs `f`, writes its result.
+fn on<R: req::Request>(
+    p: Value,
+    f: impl FnOnce(R::Params) -> Result<R::Result, ResponseError>,
+) -> Answer {
+    to_value(f(params(p)?)?)
+}
+
+/// The open documents, as the handlers see them.
+struct Open<'a>(&'a Docs);
+
+/// A document's analysis and the byte offset of a position in it.
+struct At<'a> {
+    a: &'a Analysis,
+    offset: usize,
+}
+
+impl Open<'_> {
+    fn analysis(&self, uri: &lsp::Uri) -> Result<&Analysis, ResponseError> {
+        let doc = self.0.get(uri.as_str()).ok_or_else(|| not_open(uri))?;
+        doc.analysis.as_deref().ok_or_else(|| {
+            error(
+                ErrorCode::RequestFailed,
+                format!("`{}` could not be analysed", uri.as_str()),
+            )
+        })
+    }
+
+    fn at(&self, p: &lsp::TextDocumentPositionParams) -> Result<At<'_>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        let offset = convert::offset(a.line_index(), p.position);
+        Ok(At { a, offset })
+    }
+
+    fn hover(&self, p: lsp::HoverParams) -> Result<Option<lsp::Hover>, ResponseError> {
+        let At { a, offset } = self.at(&p.text_document_position_params)?;
+        Ok(a.hover(offset).map(|(span, markdown)| lsp::Hover {
+            contents: lsp::HoverContents::Markup(lsp::MarkupContent {
+                kind: lsp::MarkupKind::Markdown,
+                value: markdown,
+            }),
+            range: Some(convert::range(a.line_index(), span)),
+        }))
+    }
+
+    fn definition(
+        &self,
+        p: lsp::GotoDefinitionParams,
+    ) -> Result<Option<lsp::GotoDefinitionResponse>, ResponseError> {
+        let pos = &p.text_document_position_params;
+        let At { a, offset } = self.at(pos)?;
+        Ok(a.definition(offset).map(|span| {
+            lsp::GotoDefinitionResponse::Scalar(lsp::Location::new(
+                pos.text_document.uri.clone(),
+                convert::range(a.line_index(), span),
+            ))
+        }))
+    }
+
+    fn references(
+        &self,
+        p: lsp::ReferenceParams,
+    ) -> Result<Option<Vec<lsp::Location>>, ResponseError> {
+        let pos = &p.text_document_position;
+        let At { a, offset } = self.at(pos)?;
+        let uri = &pos.text_document.uri;
+        Ok(Some(
+            a.references(offset, p.context.include_declaration)
+                .into_iter()
+                .map(|s| lsp::Location::new(uri.clone(), convert::range(a.line_index(), s)))
+                .collect(),
+        ))
+    }
+
+    fn highlight(
+        &self,
+        p: lsp::DocumentHighlightParams,
+    ) -> Result<Option<Vec<lsp::DocumentHighlight>>, ResponseError> {
+        let At { a, offset } = self.at(&p.text_document_position_params)?;
+        let declaration = a.definition(offset);
+        Ok(Some(
+            a.references(offset, true)
+                .into_iter()
+                .map(|s| lsp::DocumentHighlight {
+                    range: convert::range(a.line_index(), s),
+                    kind: Some(if Some(s) == declaration {
+                        lsp::DocumentHighlightKind::WRITE
+                    } else {
+                        lsp::DocumentHighlightKind::READ
+                    }),
+                })
+                .collect(),
+        ))
+    }
+
+    fn completion(
+        &self,
+        p: lsp::CompletionParams,
+    ) -> Result<Option<lsp::CompletionResponse>, ResponseError> {
+        let At { a, offset } = self.at(&p.text_document_position)?;
+        let items = a
+            .completions(offset)
+            .into_iter()
+            .map(|c| lsp::CompletionItem {
+                kind: Some(convert::completion_kind(c.kind)),
+                detail: c.detail,
+                text_edit: Some(lsp::CompletionTextEdit::Edit(lsp::TextEdit::new(
+                    convert::range(a.line_index(), c.replace),
+                    c.label.clone(),
+                ))),
+                label: c.label,
+                ..Default::default()
+            })
+            .collect();
+        Ok(Some(lsp::CompletionResponse::Array(items)))
+    }
+
+    /// The whole document in the canonical style (`clayc fmt`); nothing while it does not parse.
+    fn formatting(
+        &self,
+        p: lsp::DocumentFormattingParams,
+    ) -> Result<Option<Vec<lsp::TextEdit>>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        let Some(formatted) = a.format() else {
+            return Ok(None);
+        };
+        if formatted == a.text() {
+            return Ok(Some(Vec::new()));
+        }
+        let whole = clay_dsl::syntax::Span::new(0, a.text().len());
+        Ok(Some(vec![lsp::TextEdit::new(
+            convert::range(a.line_index(), whole),
+            formatted,
+        )]))
+    }
+
+    fn prepare_rename(
+        &self,
+        p: lsp::TextDocumentPositionParams,
+    ) -> Result<Option<lsp::PrepareRenameResponse>, ResponseError> {
+        let At { a, offset } = self.at(&p)?;
+        let here = a
+            .references(offset, true)
+            .into_iter()
+            .find(|s| s.start <= offset && offset <= s.end);
+        Ok(here.map(|s| lsp::PrepareRenameResponse::Range(convert::range(a.line_index(), s))))
+    }
+
+    fn rename(&self, p: lsp::RenameParams) -> Result<Option<lsp::WorkspaceEdit>, ResponseError> {
+        let pos = &p.text_document_position;
+        let At { a, offset } = self.at(pos)?;
+        let edits = a
+            .rename(offset, &p.new_name)
+            .map_err(|why| error(ErrorCode::RequestFailed, why))?;
+        Ok(Some(convert::workspace_edit(
+            &pos.text_document.uri,
+            a.line_index(),
+            &edits,
+        )))
+    }
+
+    fn symbols(
+        &self,
+        p: lsp::DocumentSymbolParams,
+    ) -> Result<Option<lsp::DocumentSymbolResponse>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        Ok(Some(lsp::DocumentSymbolResponse::Nested(
+            convert::document_symbols(a.line_index(), &a.outline()),
+        )))
+    }
+
+    fn tokens(
+        &self,
+        p: lsp::SemanticTokensParams,
+    ) -> Result<Option<lsp::SemanticTokensResult>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        Ok(Some(lsp::SemanticTokensResult::Tokens(
+            lsp::SemanticTokens {
+                result_id: None,
+                data: convert::semantic_tokens(a.line_index(), &a.semantic_tokens()),
+            },
+        )))
+    }
+
+    fn folding(
+        &self,
+        p: lsp::FoldingRangeParams,
+    ) -> Result<Option<Vec<lsp::FoldingRange>>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        Ok(Some(convert::folding_ranges(
+            a.line_index(),
+            &a.folding_ranges(),
+        )))
+    }
+
+    /// Quick fixes for the request's diagnostics that are this text's (same code and range).
+    fn actions(
+        &self,
+        p: lsp::CodeActionParams,
+    ) -> Result<Option<lsp::CodeActionResponse>, ResponseError> {
+        let uri = &p.text_document.uri;
+        let a = self.analysis(uri)?;
+        let index = a.line_index();
+        let mut out = Vec::new();
+        for asked in &p.context.diagnostics {
+            let Some(lsp::NumberOrString::String(code)) = &asked.code else {
+                continue;
+            };
+            let ours = a
+                .diagnostics()
+                .iter()
+                .filter(|d| d.code == code && convert::range(index, d.primary.span) == asked.range);
+            for d in ours {
+                let fixes = a.fixes(d);
+                let one = fixes.len() == 1;
+                for fix in fixes {
+                    out.push(lsp::CodeActionOrCommand::CodeAction(lsp::CodeAction {
+                        title: fix.title,
+                        kind: Some(lsp::CodeActionKind::QUICKFIX),
+                        diagnostics: Some(vec![asked.clone()]),
+                        edit: Some(convert::workspace_edit(uri, index, &fix.edits)),
+                        is_preferred: Some(one),
+                        ..Default::default()
+                    }));
+                }
+            }
+        }
+        Ok(Some(out))
+    }
+}

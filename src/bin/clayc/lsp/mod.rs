@@ -1,0 +1,388 @@
+//! `clayc lsp`: a Language Server Protocol server over stdio for `.clay` files (docs/editors.md).
+//!
+//! The questions are answered by `clay_dsl::analysis`; this module only speaks the protocol:
+//! `transport` frames JSON-RPC, `convert` turns byte spans into UTF-16 positions and the
+//! analysis' kinds into the protocol's, `handlers` answers requests. Protocol types live here
+//! and nowhere else (docs/architecture.md).
+//!
+//! One thread answers everything in order. Documents are synced whole; a change only stores
+//! the text, and the analysis (and its published diagnostics) waits until no change has come
+//! for [`DEBOUNCE`] (at most [`MAX_DELAY`] after the first unchecked change) or until a
+//! request needs it, so a burst of typing is checked once. A panic in a handler or in the
+//! analysis becomes an error response (or a log line) and the server goes on.
+
+mod convert;
+mod handlers;
+mod transport;
+
+use std::collections::HashMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::rc::Rc;
+use std::sync::mpsc::RecvTimeoutError;
+use std::time::{Duration, Instant};
+
+use clay_dsl::analysis::{Analysis, LineIndex};
+use lsp_server::{ErrorCode, Message, Notification, Request, RequestId, Response, ResponseError};
+use lsp_types as lsp;
+use lsp_types::notification::Notification as _;
+
+use transport::{Input, Writer};
+
+/// Quiet time after a change before the document is checked.
+pub const DEBOUNCE: Duration = Duration::from_millis(100);
+/// Longest wait for a check while changes keep coming.
+pub const MAX_DELAY: Duration = Duration::from_millis(300);
+
+#[derive(clap::Args)]
+pub struct LspArgs {
+    /// Talk over standard input and output (the only transport; accepted because editor
+    /// clients pass it).
+    #[arg(long)]
+    pub stdio: bool,
+}
+
+/// Runs the server until `exit`: 0 after `shutdown`, 1 without it (or when the client goes).
+pub fn lsp(_args: LspArgs) -> u8 {
+    let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
+    let mut server = Server::new(Writer::new(std::io::stdout().lock()));
+    loop {
+        let next = match server.deadline {
+            Some(deadline) => {
+                match input.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                    Ok(m) => Some(m),
+                    Err(RecvTimeoutError::Timeout) => {
+                        if let Err(e) = server.check_changed() {
+                            errln!("clayc lsp: cannot write to the client: {e}");
+                            return 1;
+                        }
+                        continue;
+                    }
+                    Err(RecvTimeoutError::Disconnected) => None,
+                }
+            }
+            None => input.recv().ok(),
+        };
+        let Some(next) = next else {
+            errln!("clayc lsp: the client closed the connection without `exit`");
+            return 1;
+        };
+        match server.handle(next) {
+            Ok(Some(code)) => return code,
+            Ok(None) => {}
+            Err(e) => {
+                errln!("clayc lsp: cannot write to the client: {e}");
+                return 1;
+            }
+        }
+    }
+}
+
+/// An open document.
+pub struct Document {
+    pub uri: lsp::Uri,
+    pub text: String,
+    pub version: i32,
+    /// The analysis of `text` (of an earlier text while `dirty`).
+    pub analysis: Option<Rc<Analysis>>,
+    /// The last analysis whose text parsed: it answers for what lies after a syntax error.
+    pub last_parsed: Option<Rc<Analysis>>,
+    pub dirty: bool,
+}
+
+impl Document {
+    fn new(uri: lsp::Uri, text: String, version: i32) -> Self {
+        Self {
+            uri,
+            text,
+            version,
+            analysis: None,
+            last_parsed: None,
+            dirty: true,
+        }
+    }
+
+    /// Analyses the present text; `false` when the analysis panicked (then the old one stays).
+    fn analyse(&mut self, path: &str) -> bool {
+        let text = &self.text;
+        let previous = self.last_parsed.as_deref();
+        let fresh = catch_unwind(AssertUnwindSafe(|| match previous {
+            Some(p) => Analysis::with_previous(text, path, p),
+            None => Analysis::new(text, path),
+        }));
+        self.dirty = false;
+        match fresh {
+            Ok(a) => {
+                let a = Rc::new(a);
+                if a.parses() {
+                    self.last_parsed = Some(a.clone());
+                }
+                self.analysis = Some(a);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum State {
+    Uninitialised,
+    Running,
+    ShutDown,
+}
+
+struct Server<W: std::io::Write> {
+    out: Writer<W>,
+    state: State,
+    /// By uri (as text: `Uri` caches its parts inside, so it is no key).
+    docs: HashMap<String, Document>,
+    /// When the changed documents are to be checked.
+    deadline: Option<Instant>,
+    /// When the oldest unchecked change came.
+    first_change: Option<Instant>,
+}
+
+type Flow = std::io::Result<Option<u8>>;
+
+impl<W: std::io::Write> Server<W> {
+    fn new(out: Writer<W>) -> Self {
+        Self {
+            out,
+            state: State::Uninitialised,
+            docs: HashMap::new(),
+            deadline: None,
+            first_change: None,
+        }
+    }
+
+    fn handle(&mut self, input: Input) -> Flow {
+        match input {
+            Input::Malformed { id, code, message } => {
+                errln!("clayc lsp: {message}");
+                self.out.send_error(id, code, message)?;
+                Ok(None)
+            }
+            Input::Message(Message::Request(r)) => self.request(r),
+            Input::Message(Message::Notification(n)) => self.notification(n),
+            // We send no requests, so no response is awaited.
+            Input::Message(Message::Response(_)) => Ok(None),
+        }
+    }
+
+    fn request(&mut self, r: Request) -> Flow {
+        let id = r.id.clone();
+        let refuse = |code: ErrorCode, message: &str| {
+            Response::new_err(id.clone(), code as i32, message.to_string())
+        };
+        let response = match (self.state, r.method.as_str()) {
+            (State::Uninitialised, "initialize") => {
+                // The client's capabilities change nothing here, so they are not read: a
+                // client newer than lsp-types may send values it does not know.
+                let reply = respond(r.id, || handlers::to_value(handlers::initialize_result()));
+                if reply.response_result.is_ok() {
+                    self.state = State::Running;
+                }
+                reply
+            }
+            (State::Uninitialised, _) => refuse(
+                ErrorCode::ServerNotInitialized,
+                "the server is not initialised: send `initialize` first",
+            ),
+            (State::ShutDown, _) => refuse(
+                ErrorCode::InvalidRequest,
+                "the server is shut down: only `exit` is left",
+            ),
+            (State::Running, "initialize") => refuse(
+                ErrorCode::InvalidRequest,
+                "the server is initialised already",
+            ),
+            (State::Running, "shutdown") => {
+                self.state = State::ShutDown;
+                Response::new_ok(r.id, serde_json::Value::Null)
+            }
+            (State::Running, _) => {
+                // Answers are about the latest text.
+                self.check_changed()?;
+                let docs = &self.docs;
+                respond(r.id, || handlers::handle(docs, &r.method, r.params))
+            }
+        };
+        self.out.send(response)?;
+        Ok(None)
+    }
+
+    fn notification(&mut self, n: Notification) -> Flow {
+        use lsp::notification as note;
+        if n.method == note::Exit::METHOD {
+            return Ok(Some(if self.state == State::ShutDown { 0 } else { 1 }));
+        }
+        if self.state != State::Running {
+            return Ok(None);
+        }
+        let method = n.method.clone();
+        let applied = catch_unwind(AssertUnwindSafe(|| self.sync(n)));
+        match applied {
+            Ok(Ok(Some(closed))) => {
+                // A closed document keeps no diagnostics.
+                self.publish(closed, Vec::new(), None)?;
+            }
+            Ok(Ok(None)) => {}
+            Ok(Err(e)) => errln!("clayc lsp: ignored `{method}`: {}", e.message),
+            Err(_) => errln!("clayc lsp: `{method}` panicked; ignored"),
+        }
+        Ok(None)
+    }
+
+    /// Applies a document notification; returns the uri of a closed document.
+    fn sync(&mut self, n: Notification) -> Result<Option<lsp::Uri>, ResponseError> {
+        use lsp::notification as note;
+        match n.method.as_str() {
+            note::DidOpenTextDocument::METHOD => {
+                let p: lsp::DidOpenTextDocumentParams = handlers::params(n.params)?;
+                let d = p.text_document;
+                self.docs.insert(
+                    d.uri.as_str().to_string(),
+                    Document::new(d.uri, d.text, d.version),
+                );
+                self.changed();
+            }
+            note::DidChangeTextDocument::METHOD => {
+                let p: lsp::DidChangeTextDocumentParams = handlers::params(n.params)?;
+                let doc = self
+                    .docs
+                    .get_mut(p.text_document.uri.as_str())
+                    .ok_or_else(|| handlers::not_open(&p.text_document.uri))?;
+                for change in p.content_changes {
+                    apply(&mut doc.text, change);
+                }
+                doc.version = p.text_document.version;
+                doc.dirty = true;
+                self.changed();
+            }
+            note::DidCloseTextDocument::METHOD => {
+                let p: lsp::DidCloseTextDocumentParams = handlers::params(n.params)?;
+                if self.docs.remove(p.text_document.uri.as_str()).is_some() {
+                    return Ok(Some(p.text_document.uri));
+                }
+            }
+            // `initialized`, `didSave`, `$/cancelRequest` (answers are in order and quick),
+            // `$/setTrace` and the rest need nothing.
+            _ => {}
+        }
+        Ok(None)
+    }
+
+    /// A document changed: check it after the debounce.
+    fn changed(&mut self) {
+        let now = Instant::now();
+        let first = *self.first_change.get_or_insert(now);
+        self.deadline = Some((now + DEBOUNCE).min(first + MAX_DELAY));
+    }
+
+    /// Analyses every changed document once and publishes its diagnostics.
+    fn check_changed(&mut self) -> std::io::Result<()> {
+        self.deadline = None;
+        self.first_change = None;
+        let mut ready = Vec::new();
+        for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
+            if !doc.analyse(uri) {
+                errln!("clayc lsp: the analysis of `{uri}` panicked");
+                continue;
+            }
+            let Some(a) = &doc.analysis else { continue };
+            let diagnostics = convert::diagnostics(&doc.uri, a.line_index(), a.diagnostics());
+            ready.push((doc.uri.clone(), diagnostics, doc.version));
+        }
+        for (uri, diagnostics, version) in ready {
+            self.publish(uri, diagnostics, Some(version))?;
+        }
+        Ok(())
+    }
+
+    fn publish(
+        &mut self,
+        uri: lsp::Uri,
+        diagnostics: Vec<lsp::Diagnostic>,
+        version: Option<i32>,
+    ) -> std::io::Result<()> {
+        let params = lsp::PublishDiagnosticsParams {
+            uri,
+            diagnostics,
+            version,
+        };
+        self.out.send(Notification::new(
+            lsp::notification::PublishDiagnostics::METHOD.to_string(),
+            params,
+        ))
+    }
+}
+
+/// Applies one change: the whole text, or (from a client that ignores the full-sync
+/// capability) a range of it.
+fn apply(text: &mut String, change: lsp::TextDocumentContentChangeEvent) {
+    match change.range {
+        None => *text = change.text,
+        Some(range) => {
+            let s = convert::span(&LineIndex::new(text), range);
+            text.replace_range(s.start..s.end, &change.text);
+        }
+    }
+}
+
+/// Runs a handler; its error, or a panic, becomes an error response.
+fn respond(
+    id: RequestId,
+    f: impl FnOnce() -> Result<serde_json::Value, ResponseError>,
+) -> Response {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(value)) => Response::new_ok(id, value),
+        Ok(Err(error)) => Response {
+            id,
+            response_result: Err(error),
+        },
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic".into());
+            Response::new_err(
+                id,
+                ErrorCode::InternalError as i32,
+                format!("internal error: {what}"),
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panicking_handler_gives_an_internal_error_response() {
+        let r = respond(RequestId::from(3), || panic!("boom"));
+        let e = r.response_result.expect_err("an error");
+        assert_eq!(e.code, ErrorCode::InternalError as i32);
+        assert!(e.message.contains("boom"), "{}", e.message);
+        let r = respond(RequestId::from(4), || Ok(serde_json::json!(1)));
+        assert_eq!(r.response_result.unwrap(), serde_json::json!(1));
+    }
+
+    #[test]
+    fn a_ranged_change_is_applied_at_utf16_positions() {
+        let mut text = "// é😀 x\nab".to_string();
+        apply(
+            &mut text,
+            lsp::TextDocumentContentChangeEvent {
+                range: Some(lsp::Range::new(
+                    lsp::Position::new(0, 7),
+                    lsp::Position::new(0, 8),
+                )),
+                range_length: None,
+                text: "y".into(),
+            },
+        );
+        assert_eq!(text, "// é😀 y\nab");
+    }
+}

@@ -1,0 +1,767 @@
+//! `clayc lsp` (issue 19) driven as an editor drives it: the real binary, JSON-RPC with
+//! `Content-Length` framing over its stdin and stdout. Every wait for the server has a generous
+//! bound, so a hang fails the test instead of blocking it; nothing here measures time.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+
+/// The longest wait for one message (a debug build on a busy shared machine).
+const PATIENCE: Duration = Duration::from_secs(60);
+const URI: &str = "file:///grammars/wall.clay";
+
+fn wall() -> String {
+    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/grammars/wall.clay")).unwrap()
+}
+
+/// The byte offset of the `nth` occurrence of `needle`, plus `into` bytes.
+fn at(text: &str, needle: &str, nth: usize, into: usize) -> usize {
+    text.match_indices(needle)
+        .nth(nth)
+        .unwrap_or_else(|| panic!("no {nth}th `{needle}`"))
+        .0
+        + into
+}
+
+/// The protocol position of a byte offset, counted here independently of the server: the
+/// line, and the UTF-16 code units before the offset on it.
+fn pos(text: &str, offset: usize) -> Value {
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    json!({
+        "line": text[..offset].matches('\n').count(),
+        "character": text[line_start..offset].encode_utf16().count(),
+    })
+}
+
+fn range(text: &str, start: usize, end: usize) -> Value {
+    json!({ "start": pos(text, start), "end": pos(text, end) })
+}
+
+/// The byte offset of a protocol position.
+fn offset(text: &str, p: &Value) -> usize {
+    let line = p["line"].as_u64().unwrap() as usize;
+    let col = p["character"].as_u64().unwrap() as usize;
+    let start: usize = text.split_inclusive('\n').take(line).map(str::len).sum();
+    let mut units = 0;
+    for (i, c) in text[start..].char_indices() {
+        if units >= col || c == '\n' {
+            return start + i;
+        }
+        units += c.len_utf16();
+    }
+    text.len()
+}
+
+/// Applies text edits (`[{range, newText}]`) to `text`.
+fn apply(text: &str, edits: &[Value]) -> String {
+    let mut spans: Vec<(usize, usize, &str)> = edits
+        .iter()
+        .map(|e| {
+            (
+                offset(text, &e["range"]["start"]),
+                offset(text, &e["range"]["end"]),
+                e["newText"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    spans.sort_by_key(|s| std::cmp::Reverse(s.0));
+    let mut out = text.to_string();
+    for (a, b, with) in spans {
+        out.replace_range(a..b, with);
+    }
+    out
+}
+
+fn doc() -> Value {
+    json!({ "uri": URI })
+}
+
+fn at_pos(text: &str, offset: usize) -> Value {
+    json!({ "textDocument": doc(), "position": pos(text, offset) })
+}
+
+struct Client {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    messages: mpsc::Receiver<Value>,
+    /// Notifications read while waiting for something else.
+    stash: Vec<Value>,
+    next_id: i64,
+}
+
+impl Client {
+    fn spawn() -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .arg("lsp")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("clayc lsp starts");
+        let stdin = child.stdin.take();
+        let mut stdout = BufReader::new(child.stdout.take().unwrap());
+        let (tx, messages) = mpsc::channel();
+        std::thread::spawn(move || {
+            loop {
+                let mut length = None;
+                loop {
+                    let mut line = String::new();
+                    if stdout.read_line(&mut line).unwrap_or(0) == 0 {
+                        return;
+                    }
+                    let line = line.trim_end();
+                    if line.is_empty() {
+                        break;
+                    }
+                    if let Some(n) = line.strip_prefix("Content-Length: ") {
+                        length = Some(n.parse::<usize>().unwrap());
+                    }
+                }
+                let mut body = vec![0; length.expect("a Content-Length header")];
+                stdout.read_exact(&mut body).unwrap();
+                let value: Value = serde_json::from_slice(&body).expect("the server sends JSON");
+                if tx.send(value).is_err() {
+                    return;
+                }
+            }
+        });
+        Self {
+            child,
+            stdin,
+            messages,
+            stash: Vec::new(),
+            next_id: 1,
+        }
+    }
+
+    /// A server past `initialize` and `initialized`.
+    fn start() -> Self {
+        let mut c = Self::spawn();
+        let init = c.request("initialize", json!({ "capabilities": {} }));
+        assert!(init["result"]["capabilities"].is_object(), "{init}");
+        c.notify("initialized", json!({}));
+        c
+    }
+
+    fn send_raw(&mut self, bytes: &[u8]) {
+        let stdin = self.stdin.as_mut().expect("stdin is open");
+        stdin.write_all(bytes).unwrap();
+        stdin.flush().unwrap();
+    }
+
+    fn send(&mut self, message: &Value) {
+        let body = message.to_string();
+        self.send_raw(format!("Content-Length: {}\r\n\r\n{body}", body.len()).as_bytes());
+    }
+
+    fn notify(&mut self, method: &str, params: Value) {
+        self.send(&json!({ "jsonrpc": "2.0", "method": method, "params": params }));
+    }
+
+    fn recv(&mut self) -> Value {
+        self.messages
+            .recv_timeout(PATIENCE)
+            .expect("the server answers in time")
+    }
+
+    /// The response to a request with `id` (notifications meanwhile are kept).
+    fn response(&mut self, id: &Value) -> Value {
+        loop {
+            let m = self.recv();
+            if m.get("method").is_none() && &m["id"] == id {
+                return m;
+            }
+            self.stash.push(m);
+        }
+    }
+
+    /// Sends a request and returns the whole response (`result` or `error`).
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        let id = json!(self.next_id);
+        self.next_id += 1;
+        self.send(&json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params }));
+        self.response(&id)
+    }
+
+    fn result(&mut self, method: &str, params: Value) -> Value {
+        let r = self.request(method, params);
+        assert!(r.get("error").is_none(), "{method}: {r}");
+        r["result"].clone()
+    }
+
+    /// The next diagnostics published for the document.
+    fn diagnostics(&mut self) -> Value {
+        let is_ours = |m: &Value| {
+            m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == URI
+        };
+        if let Some(i) = self.stash.iter().position(is_ours) {
+            return self.stash.remove(i)["params"].clone();
+        }
+        loop {
+            let m = self.recv();
+            if is_ours(&m) {
+                return m["params"].clone();
+            }
+            self.stash.push(m);
+        }
+    }
+
+    fn open(&mut self, text: &str) -> Value {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": URI, "languageId": "clay", "version": 1, "text": text } }),
+        );
+        self.diagnostics()
+    }
+
+    fn change(&mut self, version: i32, text: &str) {
+        self.notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": URI, "version": version },
+                "contentChanges": [{ "text": text }],
+            }),
+        );
+    }
+
+    /// Closes stdin and waits for the process to end.
+    fn wait(mut self) -> ExitStatus {
+        drop(self.stdin.take());
+        let until = Instant::now() + PATIENCE;
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return status;
+            }
+            assert!(Instant::now() < until, "the server did not exit");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    fn shutdown_and_exit(mut self) -> ExitStatus {
+        let r = self.request("shutdown", Value::Null);
+        assert_eq!(r["result"], Value::Null, "{r}");
+        assert!(r.get("error").is_none(), "{r}");
+        self.notify("exit", Value::Null);
+        self.wait()
+    }
+}
+
+impl Drop for Client {
+    fn drop(&mut self) {
+        // A failed test leaves no server behind.
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn a_typo_is_e011_at_its_range_its_fix_is_a_code_action_and_fixing_clears_it() {
+    let good = wall();
+    let typo = good.replace("site west: joint", "site west: jiont");
+    let mut c = Client::start();
+    let published = c.open(&typo);
+    assert_eq!(published["version"], 1);
+    let diags = published["diagnostics"].as_array().unwrap();
+    assert_eq!(diags.len(), 1, "{diags:?}");
+    let d = &diags[0];
+    let start = at(&typo, "jiont", 0, 0);
+    assert_eq!(d["range"], range(&typo, start, start + 5));
+    assert_eq!(d["code"], "E011");
+    assert_eq!(d["severity"], 1);
+    assert_eq!(d["source"], "clay");
+    let href = d["codeDescription"]["href"].as_str().unwrap();
+    assert!(href.ends_with("/docs/language.md#e011"), "{href}");
+    let message = d["message"].as_str().unwrap();
+    assert!(
+        message.starts_with("unknown site type `jiont`"),
+        "{message}"
+    );
+    assert!(
+        message.contains("\nhelp: did you mean `joint`?"),
+        "{message}"
+    );
+
+    // The quick fix for it.
+    let actions = c.result(
+        "textDocument/codeAction",
+        json!({
+            "textDocument": doc(),
+            "range": d["range"],
+            "context": { "diagnostics": [d] },
+        }),
+    );
+    let actions = actions.as_array().unwrap();
+    assert_eq!(actions.len(), 1, "{actions:?}");
+    assert_eq!(actions[0]["kind"], "quickfix");
+    assert_eq!(actions[0]["title"], "replace with `joint`");
+    let edits = actions[0]["edit"]["changes"][URI].as_array().unwrap();
+    assert_eq!(apply(&typo, edits), good);
+
+    // Fixed: the diagnostics are cleared.
+    c.change(2, &good);
+    let published = c.diagnostics();
+    assert_eq!(published["version"], 2);
+    assert_eq!(published["diagnostics"], json!([]));
+
+    // Closed with an error in it: its diagnostics are cleared, and it is no longer served.
+    c.change(3, &typo);
+    assert_eq!(c.diagnostics()["diagnostics"].as_array().unwrap().len(), 1);
+    c.notify("textDocument/didClose", json!({ "textDocument": doc() }));
+    assert_eq!(c.diagnostics()["diagnostics"], json!([]));
+    let gone = c.request("textDocument/hover", at_pos(&typo, 0));
+    assert_eq!(gone["error"]["code"], -32602, "{gone}");
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn columns_are_utf16_code_units_after_non_ascii_text_on_the_line() {
+    let typo = wall().replace("    site west: joint", "    /* é😀 */ site west: jiont");
+    let mut c = Client::start();
+    let published = c.open(&typo);
+    let d = &published["diagnostics"][0];
+    let start = at(&typo, "jiont", 0, 0);
+    let line_start = typo[..start].rfind('\n').unwrap() + 1;
+    let before = &typo[line_start..start];
+    // UTF-16 units, not bytes or characters: é is 1 unit (2 bytes), the emoji 2 (4 bytes).
+    assert_eq!(before.encode_utf16().count(), before.len() - 3);
+    assert_eq!(before.encode_utf16().count(), before.chars().count() + 1);
+    assert_eq!(
+        d["range"]["start"]["character"],
+        before.encode_utf16().count()
+    );
+    assert_eq!(d["range"], range(&typo, start, start + 5));
+    // A hover just after the emoji, on the same line, lands on the site's name.
+    let west = at(&typo, "site west", 0, "site w".len());
+    let hover = c.result("textDocument/hover", at_pos(&typo, west));
+    assert_eq!(hover["range"], range(&typo, west - 1, west + 3), "{hover}");
+}
+
+#[test]
+fn hover_definition_references_and_highlights_of_a_piece() {
+    let text = wall();
+    let mut c = Client::start();
+    assert_eq!(c.open(&text)["diagnostics"], json!([]));
+    let brick_use = at(&text, "chain brick", 0, "chain b".len());
+    let hover = c.result("textDocument/hover", at_pos(&text, brick_use));
+    assert_eq!(hover["contents"]["kind"], "markdown");
+    let md = hover["contents"]["value"].as_str().unwrap();
+    assert!(md.contains("piece brick"), "{md}");
+    assert!(md.contains("**4 vertices**"), "{md}");
+    assert!(md.contains("`west: joint [nw, sw] out (-1, 0)`"), "{md}");
+    assert!(md.contains("stretch brick from west to east"), "{md}");
+    let chain_brick = at(&text, "chain brick", 0, "chain ".len());
+    assert_eq!(hover["range"], range(&text, chain_brick, chain_brick + 5));
+
+    let decl = at(&text, "piece brick", 0, "piece ".len());
+    let def = c.result("textDocument/definition", at_pos(&text, brick_use));
+    assert_eq!(def["uri"], URI);
+    assert_eq!(def["range"], range(&text, decl, decl + 5));
+
+    let mut params = at_pos(&text, decl + 1);
+    params["context"] = json!({ "includeDeclaration": true });
+    let refs = c.result("textDocument/references", params.clone());
+    let ranges: Vec<&Value> = refs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| &l["range"])
+        .collect();
+    let stretch_brick = at(&text, "stretch brick", 0, "stretch ".len());
+    assert_eq!(
+        ranges,
+        vec![
+            &range(&text, decl, decl + 5),
+            &range(&text, stretch_brick, stretch_brick + 5),
+            &range(&text, chain_brick, chain_brick + 5),
+        ]
+    );
+    params["context"] = json!({ "includeDeclaration": false });
+    let refs = c.result("textDocument/references", params);
+    assert_eq!(refs.as_array().unwrap().len(), 2);
+
+    let lights = c.result("textDocument/documentHighlight", at_pos(&text, brick_use));
+    let kinds: Vec<&Value> = lights
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| &h["kind"])
+        .collect();
+    // The declaration is written (3), the uses read (2).
+    assert_eq!(kinds, vec![&json!(3), &json!(2), &json!(2)]);
+
+    // Nothing to say about a keyword.
+    let hover = c.result(
+        "textDocument/hover",
+        at_pos(&text, at(&text, "model", 0, 1)),
+    );
+    assert_eq!(hover, Value::Null);
+}
+
+#[test]
+fn completion_after_a_site_colon_offers_the_site_types() {
+    let text = wall();
+    let mut c = Client::start();
+    c.open(&text);
+    let after = at(&text, "site west: ", 0, "site west: ".len());
+    let list = c.result("textDocument/completion", at_pos(&text, after));
+    let items = list.as_array().unwrap();
+    let labels: Vec<&str> = items.iter().map(|i| i["label"].as_str().unwrap()).collect();
+    assert_eq!(labels, vec!["joint"]);
+    assert_eq!(items[0]["kind"], 8, "a site type is an interface");
+    assert_eq!(items[0]["textEdit"]["newText"], "joint");
+    assert_eq!(items[0]["textEdit"]["range"], range(&text, after, after));
+
+    // A partly typed word is replaced.
+    let partial = text.replace("chain brick x 8", "chain br");
+    c.change(2, &partial);
+    let end = at(&partial, "chain br", 0, "chain br".len());
+    let list = c.result("textDocument/completion", at_pos(&partial, end));
+    let item = &list.as_array().unwrap()[0];
+    assert_eq!(item["label"], "brick");
+    assert_eq!(item["kind"], 7, "a piece is a class");
+    assert_eq!(item["textEdit"]["range"], range(&partial, end - 2, end));
+}
+
+#[test]
+fn formatting_gives_what_clayc_fmt_prints() {
+    let messy = wall()
+        .replace("    vertex se (1, 0)", "vertex   se (1,0)")
+        .replace(
+            "stretch brick from west to east { min 2 }",
+            "stretch brick from west to east {min 2}",
+        );
+    let mut fmt = Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["fmt", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    fmt.stdin
+        .take()
+        .unwrap()
+        .write_all(messy.as_bytes())
+        .unwrap();
+    let out = fmt.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let expected = String::from_utf8(out.stdout).unwrap();
+    assert_ne!(expected, messy);
+
+    let mut c = Client::start();
+    c.open(&messy);
+    let params =
+        json!({ "textDocument": doc(), "options": { "tabSize": 4, "insertSpaces": true } });
+    let edits = c.result("textDocument/formatting", params.clone());
+    assert_eq!(apply(&messy, edits.as_array().unwrap()), expected);
+    // Formatted already: no edits. Not parsing: nothing (no edit, no error).
+    c.change(2, &expected);
+    assert_eq!(
+        c.result("textDocument/formatting", params.clone()),
+        json!([])
+    );
+    c.change(3, &expected.replace("model {", "model {{"));
+    assert_eq!(c.result("textDocument/formatting", params), Value::Null);
+}
+
+#[test]
+fn rename_of_brick_compiles_clean_and_a_bad_name_is_refused() {
+    let text = wall();
+    let mut c = Client::start();
+    c.open(&text);
+    let decl = at(&text, "piece brick", 0, "piece ".len());
+    let prepared = c.result("textDocument/prepareRename", at_pos(&text, decl + 2));
+    assert_eq!(prepared, range(&text, decl, decl + 5));
+    let mut params = at_pos(&text, decl + 2);
+    params["newName"] = json!("block");
+    let edit = c.result("textDocument/rename", params.clone());
+    let edits = edit["changes"][URI].as_array().unwrap();
+    assert_eq!(edits.len(), 3);
+    let renamed = apply(&text, edits);
+    let compiled = clay_dsl::compile(&renamed, "wall.clay").expect("the renamed grammar compiles");
+    assert!(compiled.warnings.is_empty(), "{:?}", compiled.warnings);
+    assert_eq!(compiled.grammar.pieces[0].name, "block");
+    for use_ in ["piece block {", "stretch block from", "chain block x"] {
+        assert!(renamed.contains(use_), "{use_}");
+    }
+
+    params["newName"] = json!("piece");
+    let refused = c.request("textDocument/rename", params);
+    assert_eq!(refused["error"]["code"], -32803, "{refused}");
+    assert!(
+        refused["error"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("keyword"),
+        "{refused}"
+    );
+    // Nothing to rename on a keyword.
+    let prepared = c.result(
+        "textDocument/prepareRename",
+        at_pos(&text, at(&text, "model", 0, 1)),
+    );
+    assert_eq!(prepared, Value::Null);
+}
+
+#[test]
+fn document_symbols_nest_semantic_tokens_decode_and_blocks_fold() {
+    let text = wall();
+    let mut c = Client::start();
+    c.open(&text);
+    let symbols = c.result(
+        "textDocument/documentSymbol",
+        json!({ "textDocument": doc() }),
+    );
+    let top: Vec<&str> = symbols
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(top, vec!["joint", "brick", "stretch brick", "model"]);
+    let brick = &symbols[1];
+    assert_eq!(brick["kind"], 5, "a piece is a class");
+    let members: Vec<&str> = brick["children"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(members, vec!["sw", "se", "ne", "nw", "west", "east"]);
+    let decl = at(&text, "piece brick", 0, "piece ".len());
+    assert_eq!(brick["selectionRange"], range(&text, decl, decl + 5));
+    assert_eq!(symbols[3]["children"][0]["name"], "wall");
+
+    // The legend from initialize, then the tokens decoded against it.
+    let mut fresh = Client::spawn();
+    let init = fresh.request("initialize", json!({ "capabilities": {} }));
+    let legend = &init["result"]["capabilities"]["semanticTokensProvider"]["legend"];
+    let types: Vec<&str> = legend["tokenTypes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_str().unwrap())
+        .collect();
+    let tokens = c.result(
+        "textDocument/semanticTokens/full",
+        json!({ "textDocument": doc() }),
+    );
+    let data: Vec<u64> = tokens["data"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_u64().unwrap())
+        .collect();
+    assert!(!data.is_empty() && data.len().is_multiple_of(5));
+    let lines: Vec<&str> = text.lines().collect();
+    let (mut line, mut col) = (0usize, 0usize);
+    let mut decoded = Vec::new();
+    for t in data.chunks(5) {
+        if t[0] > 0 {
+            line += t[0] as usize;
+            col = 0;
+        }
+        col += t[1] as usize;
+        let units: Vec<u16> = lines[line].encode_utf16().collect();
+        let word = String::from_utf16(&units[col..col + t[2] as usize]).unwrap();
+        decoded.push((word, types[t[3] as usize], t[4]));
+    }
+    let has = |word: &str, ty: &str, modifiers: u64| {
+        decoded
+            .iter()
+            .any(|(w, t, m)| w == word && *t == ty && *m == modifiers)
+    };
+    assert!(has("piece", "keyword", 0), "{decoded:?}");
+    assert!(has("brick", "class", 1), "the declaration: {decoded:?}");
+    assert!(has("brick", "class", 0), "a use: {decoded:?}");
+    assert!(has("joint", "type", 0), "{decoded:?}");
+    assert!(has("#b5651d", "string", 0), "{decoded:?}");
+    assert!(has("0.97", "number", 0), "{decoded:?}");
+    assert!(has("hysteresis", "parameter", 0), "{decoded:?}");
+    assert!(
+        decoded
+            .iter()
+            .any(|(w, t, _)| w.starts_with("// a darker") && *t == "comment")
+    );
+
+    let folds = c.result(
+        "textDocument/foldingRange",
+        json!({ "textDocument": doc() }),
+    );
+    let piece_line = text[..decl].matches('\n').count();
+    let close_line = text[..at(&text, "\n}\n", 1, 1)].matches('\n').count();
+    assert!(
+        folds
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f["startLine"] == piece_line
+                && f["endLine"] == close_line - 1
+                && f["kind"] == "region"),
+        "the piece folds up to its closing brace: {folds}"
+    );
+    drop(fresh);
+}
+
+#[test]
+fn a_syntax_error_mid_file_is_e001_and_queries_still_answer() {
+    let good = wall();
+    let broken = good.replace(
+        "stretch brick from west to east { min 2 }",
+        "stretch brick from west to { min 2 }",
+    );
+    let mut c = Client::start();
+    assert_eq!(c.open(&good)["diagnostics"], json!([]));
+    c.change(2, &broken);
+    let published = c.diagnostics();
+    assert_eq!(published["version"], 2);
+    let diags = published["diagnostics"].as_array().unwrap();
+    assert_eq!(diags.len(), 1, "{diags:?}");
+    assert_eq!(diags[0]["code"], "E001");
+    let error_line = broken[..at(&broken, "to { min", 0, 0)]
+        .matches('\n')
+        .count();
+    assert_eq!(diags[0]["range"]["start"]["line"], error_line);
+
+    // Before the error: the piece answers from the parsed prefix.
+    let hover = c.result(
+        "textDocument/hover",
+        at_pos(&broken, at(&broken, "piece brick", 0, 7)),
+    );
+    let md = hover["contents"]["value"].as_str().unwrap();
+    assert!(md.contains("4 vertices"), "{md}");
+    // After it: the model answers from the last text that parsed, where it now lies.
+    let wall_at = at(&broken, "wall = chain", 0, 0);
+    let def = c.result("textDocument/definition", at_pos(&broken, wall_at + 1));
+    assert_eq!(def["range"], range(&broken, wall_at, wall_at + 4));
+
+    // A burst of changes, then a request: the request sees the last text, whose diagnostics
+    // are published before its answer.
+    for v in 3..8 {
+        let text = if v == 7 {
+            good.clone()
+        } else {
+            broken.replace("min 2", &format!("min {v}"))
+        };
+        c.change(v, &text);
+    }
+    let _ = c.result("textDocument/hover", at_pos(&good, 0));
+    let last = c
+        .stash
+        .iter()
+        .rev()
+        .find(|m| m["method"] == "textDocument/publishDiagnostics")
+        .expect("diagnostics before the answer")
+        .clone();
+    assert_eq!(last["params"]["version"], 7);
+    assert_eq!(last["params"]["diagnostics"], json!([]));
+}
+
+#[test]
+fn malformed_messages_and_unknown_methods_get_errors_and_the_server_goes_on() {
+    let text = wall();
+    let mut c = Client::spawn();
+    // Before initialize: refused, not fatal.
+    let early = c.request("textDocument/hover", at_pos(&text, 0));
+    assert_eq!(early["error"]["code"], -32002, "{early}");
+    let init = c.request("initialize", json!({ "capabilities": {} }));
+    assert!(init["result"].is_object(), "{init}");
+    c.notify("initialized", json!({}));
+    c.open(&text);
+
+    // A body that is not JSON: a parse error with a null id.
+    c.send_raw(b"Content-Length: 9\r\n\r\n{\"id\": 1,");
+    let m = c.recv();
+    assert_eq!(m["error"]["code"], -32700, "{m}");
+    assert_eq!(m["id"], Value::Null);
+    // JSON that is no message: an invalid request, with its id.
+    c.send(&json!({ "jsonrpc": "2.0", "id": 77 }));
+    let m = c.response(&json!(77));
+    assert_eq!(m["error"]["code"], -32600, "{m}");
+    // Bad params.
+    let bad = c.request("textDocument/hover", json!({ "textDocument": 5 }));
+    assert_eq!(bad["error"]["code"], -32602, "{bad}");
+    let bad = c.request("textDocument/completion", json!("nonsense"));
+    assert_eq!(bad["error"]["code"], -32602, "{bad}");
+    // A position far outside the text is clamped, not a crash.
+    let far = c.request(
+        "textDocument/hover",
+        json!({ "textDocument": doc(), "position": { "line": 99999, "character": 99999 } }),
+    );
+    assert!(far.get("error").is_none(), "{far}");
+    // A document that is not open.
+    let closed = c.request(
+        "textDocument/hover",
+        json!({ "textDocument": { "uri": "file:///nowhere.clay" }, "position": { "line": 0, "character": 0 } }),
+    );
+    assert_eq!(closed["error"]["code"], -32602, "{closed}");
+    // An unknown method.
+    let unknown = c.request("clay/nonsense", json!({}));
+    assert_eq!(unknown["error"]["code"], -32601, "{unknown}");
+    // A notification with bad params and an unknown one: ignored.
+    c.notify("textDocument/didChange", json!({ "contentChanges": 3 }));
+    c.notify("clay/whatever", json!([1, 2]));
+
+    // Still serving.
+    let brick = at(&text, "chain brick", 0, 7);
+    let hover = c.result("textDocument/hover", at_pos(&text, brick));
+    assert!(
+        hover["contents"]["value"]
+            .as_str()
+            .unwrap()
+            .contains("piece brick")
+    );
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn shutdown_then_exit_is_exit_code_0_and_exit_alone_is_1() {
+    let c = Client::start();
+    let status = c.shutdown_and_exit();
+    assert_eq!(status.code(), Some(0));
+
+    let mut c = Client::start();
+    c.notify("exit", Value::Null);
+    assert_eq!(c.wait().code(), Some(1));
+
+    // After shutdown only exit is left: requests are refused.
+    let mut c = Client::start();
+    let _ = c.request("shutdown", Value::Null);
+    let late = c.request("textDocument/hover", at_pos("", 0));
+    assert_eq!(late["error"]["code"], -32600, "{late}");
+    c.notify("exit", Value::Null);
+    assert_eq!(c.wait().code(), Some(0));
+}
+
+#[test]
+fn every_advertised_capability_has_its_row_in_docs_editors_md() {
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let mut c = Client::spawn();
+    let init = c.request("initialize", json!({ "capabilities": {} }));
+    let caps = init["result"]["capabilities"].as_object().unwrap();
+    let method = |cap: &str| match cap {
+        "positionEncoding" => "`initialize`",
+        "textDocumentSync" => "`textDocument/didOpen`",
+        "hoverProvider" => "`textDocument/hover`",
+        "definitionProvider" => "`textDocument/definition`",
+        "referencesProvider" => "`textDocument/references`",
+        "documentHighlightProvider" => "`textDocument/documentHighlight`",
+        "completionProvider" => "`textDocument/completion`",
+        "documentFormattingProvider" => "`textDocument/formatting`",
+        "renameProvider" => "`textDocument/rename`",
+        "documentSymbolProvider" => "`textDocument/documentSymbol`",
+        "semanticTokensProvider" => "`textDocument/semanticTokens/full`",
+        "foldingRangeProvider" => "`textDocument/foldingRange`",
+        "codeActionProvider" => "`textDocument/codeAction`",
+        other => panic!("a capability this test does not know: {other}"),
+    };
+    for cap in caps.keys() {
+        let m = method(cap);
+        assert!(
+            doc.lines().any(|l| l.starts_with("| ") && l.contains(m)),
+            "docs/editors.md has no row for {m} ({cap})"
+        );
+    }
+}
