@@ -133,12 +133,7 @@ pub struct Computed {
 
 /// The grammar's keywords (docs/language.md). They are contextual, but a name that spells one
 /// reads badly (`piece piece {`), so the editor refuses them as names.
-pub const KEYWORDS: &[&str] = &[
-    "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
-    "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
-    "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
-    "at", "rotate", "dock", "last", "bend", "mirror",
-];
+pub use clay_dsl::analysis::KEYWORDS;
 
 /// Why `s` cannot be a name in the grammar: an ASCII letter or `_`, then letters, digits and
 /// `_`, and not a keyword.

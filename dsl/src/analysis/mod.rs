@@ -30,7 +30,7 @@ pub const KEYWORDS: &[&str] = &[
     "let", "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
     "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
-    "at", "rotate", "dock", "last",
+    "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude", "above",
 ];
 
 /// Words that start a top-level item, where a parsed prefix may end.

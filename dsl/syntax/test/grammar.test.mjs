@@ -48,8 +48,8 @@ const INNER_KEYWORDS = {
   "site type": ["type", "docks"],
   site: ["out"],
   piece: ["extends"],
-  polygon: ["rigid", "skinned", "fill"],
-  polyline: ["rigid", "skinned", "width", "fill"],
+  polygon: ["rigid", "skinned", "fill", "extrude", "above"],
+  polyline: ["rigid", "skinned", "width", "fill", "extrude", "above"],
   state: ["bend", "mirror"],
   stretch: ["from", "to"],
   merge: ["onto", "into", "within"],
@@ -58,7 +58,7 @@ const INNER_KEYWORDS = {
   "=": ["chain", "x", "along", "at", "rotate"],
 };
 // Keywords being added to the language alongside this grammar (issue 19's neighbours).
-const NEW_KEYWORDS = ["import", "extends", "bend", "mirror"];
+const NEW_KEYWORDS = ["import", "extends", "bend", "mirror", "extrude", "above"];
 const ALL_KEYWORDS = new Set([...STATEMENT_KEYWORDS, ...Object.values(INNER_KEYWORDS).flat()]);
 const BUILTINS = new Set(["sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "abs", "min", "max"]);
 
