@@ -196,33 +196,23 @@ impl Primitive {
 }
 
 /// The prism of a posed proxy between heights `base` and `top`: top face up, bottom face down,
-/// and a wall on every boundary edge, facing out.
+/// and a wall on every boundary edge, facing out. Each face's winding is chosen from its
+/// normal, so a triangle that skinning folded over still faces the right way.
 fn extrude(mesh: &WorldMesh, base: f64, top: f64, out: &mut Primitive) {
     let p = &mesh.positions;
     let at = |i: u32| p.get(i as usize).copied();
     let up = DVec3::Y;
-    // Directed edges of the triangles, each oriented counter-clockwise in the floor plan: a
-    // boundary edge is one whose reverse is not there, with the inside on its left.
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
     for t in &mesh.triangles {
         let (Some(a), Some(b), Some(c)) = (at(t[0]), at(t[1]), at(t[2])) else {
             continue;
         };
-        let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-        let t = if area < 0.0 { [t[0], t[2], t[1]] } else { *t };
         out.triangle([lift(a, top), lift(b, top), lift(c, top)], up);
         out.triangle([lift(a, base), lift(b, base), lift(c, base)], -up);
-        for k in 0..3 {
-            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
-        }
     }
-    let mut walls: Vec<(u32, u32)> = directed
-        .keys()
-        .filter(|&&(a, b)| !directed.contains_key(&(b, a)))
-        .copied()
-        .collect();
-    // Hash order is not stable: sort so that the same assembly exports the same bytes.
-    walls.sort_unstable();
+    // The outline's edges are directed as in the counter-clockwise rest triangles: the inside
+    // is on their left (the tessellation's boundary edges, in its order, so the bytes of an
+    // export are the same every time).
+    let walls = mesh.outline.iter().map(|e| (e[0], e[1]));
     for (i, j) in walls {
         let (Some(a), Some(b)) = (at(i), at(j)) else {
             continue;
