@@ -13,6 +13,8 @@ pub enum Action {
     SaveSession(PathBuf),
     ExportPng(PathBuf),
     ExportJson(PathBuf),
+    /// The sculpted model as 3D meshes: `.glb`, `.gltf` or `.obj` (with its `.mtl`).
+    Export3d(PathBuf),
     /// Ask for a path first.
     Ask(FileKind),
     Quit,

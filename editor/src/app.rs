@@ -119,6 +119,7 @@ fn file_action(kind: FileKind, path: PathBuf) -> Action {
         FileKind::SaveSession => Action::SaveSession(path),
         FileKind::Png => Action::ExportPng(path),
         FileKind::Json => Action::ExportJson(path),
+        FileKind::Model3d => Action::Export3d(path),
     }
 }
 
@@ -667,6 +668,13 @@ impl EditorApp {
         {
             self.actions.push(Action::Ask(FileKind::Json));
         }
+        if ui
+            .button("Export 3D model…")
+            .on_hover_text("glTF (.glb, .gltf) or OBJ: heights from `extrude` (docs/export.md)")
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::Model3d));
+        }
         ui.separator();
         if ui.button("Quit").on_hover_text("Ctrl+Q").clicked() {
             self.actions.push(Action::Quit);
@@ -1059,6 +1067,9 @@ impl EditorApp {
             Action::ExportJson(p) => self
                 .export_json(&p)
                 .map(|()| Some(format!("exported {}", p.display()))),
+            Action::Export3d(p) => self
+                .export_3d(&p)
+                .map(|()| Some(format!("exported {}", p.display()))),
             Action::Quit => {
                 if self.sculpt.dirty {
                     self.confirm = Some(Action::Quit);
@@ -1126,6 +1137,7 @@ impl EditorApp {
             FileKind::Grammar => self.display_path(),
             FileKind::Png => "sculpt.png".to_string(),
             FileKind::Json => "sculpt.assembly.json".to_string(),
+            FileKind::Model3d => "sculpt.glb".to_string(),
         };
         if self.desktop.native_dialogs {
             self.native = Some(NativeDialog::open(kind, Path::new(&text)));
@@ -1275,6 +1287,41 @@ impl EditorApp {
         let text = serde_json::to_string_pretty(self.sculpt.data()).map_err(|e| e.to_string())?;
         clay::files::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from
+    /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it).
+    pub fn export_3d(&self, path: &Path) -> Result<(), String> {
+        use clay::export::{gltf, obj, scene};
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let scene = scene(
+            self.sculpt.grammar(),
+            self.sculpt.data(),
+            &Default::default(),
+        );
+        let write = |p: &Path, bytes: &[u8]| {
+            clay::files::write_atomic(p, bytes).map_err(|e| format!("{}: {e}", p.display()))
+        };
+        match ext.as_deref() {
+            Some("glb") => write(path, &gltf::to_glb(&scene)?),
+            Some("gltf") => write(path, &gltf::to_gltf(&scene)?),
+            Some("obj") => {
+                let mtl = path.with_extension("mtl");
+                let name = mtl
+                    .file_name()
+                    .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
+                let (obj_text, mtl_text) = obj::to_obj(&scene, &name);
+                write(&mtl, mtl_text.as_bytes())?;
+                write(path, obj_text.as_bytes())
+            }
+            _ => Err(format!(
+                "{}: name the file .glb, .gltf or .obj to say the format",
+                path.display()
+            )),
+        }
     }
 
     /// Whether a confirmation is waiting.

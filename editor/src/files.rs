@@ -18,6 +18,8 @@ pub enum FileKind {
     SaveSession,
     Png,
     Json,
+    /// The sculpted model as 3D meshes (glTF or OBJ, by extension).
+    Model3d,
 }
 
 impl FileKind {
@@ -28,12 +30,16 @@ impl FileKind {
             FileKind::SaveSession => "Save session as",
             FileKind::Png => "Export view as PNG",
             FileKind::Json => "Export deformed assembly as JSON",
+            FileKind::Model3d => "Export 3D model (glTF or OBJ)",
         }
     }
 
     /// Whether the file is written (a save dialog) rather than read.
     pub fn writes(self) -> bool {
-        matches!(self, FileKind::SaveSession | FileKind::Png | FileKind::Json)
+        matches!(
+            self,
+            FileKind::SaveSession | FileKind::Png | FileKind::Json | FileKind::Model3d
+        )
     }
 
     /// The dialog's filter: a name and the extensions it shows.
@@ -43,6 +49,7 @@ impl FileKind {
             FileKind::OpenSession | FileKind::SaveSession => ("Clay session", &["json"]),
             FileKind::Png => ("PNG image", &["png"]),
             FileKind::Json => ("JSON", &["json"]),
+            FileKind::Model3d => ("3D model", &["glb", "gltf", "obj"]),
         }
     }
 }

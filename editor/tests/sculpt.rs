@@ -341,6 +341,25 @@ fn exports_write_a_png_and_the_assembly_json() {
 }
 
 #[test]
+fn the_3d_export_writes_gltf_and_obj_of_the_sculpted_model() {
+    let dir = scratch("export3d");
+    let app = EditorApp::bundled();
+    for name in ["m.glb", "m.gltf", "m.obj"] {
+        let path = dir.join(name);
+        app.export_3d(&path).unwrap();
+        assert!(std::fs::metadata(&path).unwrap().len() > 100, "{name}");
+    }
+    assert!(dir.join("m.mtl").exists());
+    let glb = std::fs::read(dir.join("m.glb")).unwrap();
+    let doc = gltf::Gltf::from_slice(&glb).unwrap();
+    assert_eq!(doc.nodes().count(), app.sculpt.data().instances.len());
+    // An unknown extension is an error that names the formats, and writes nothing.
+    let err = app.export_3d(&dir.join("m.fbx")).unwrap_err();
+    assert!(err.contains(".glb, .gltf or .obj"), "{err}");
+    assert!(!dir.join("m.fbx").exists());
+}
+
+#[test]
 fn a_reload_with_the_same_model_keeps_the_sculpt() {
     let mut s = castle();
     let part = tower(&s);
