@@ -765,3 +765,29 @@ fn every_advertised_capability_has_its_row_in_docs_editors_md() {
         );
     }
 }
+
+#[test]
+fn imports_are_read_from_the_documents_folder_on_disk() {
+    // A folder with a space (escaped in the URI) holding a library and the grammar that
+    // imports it: the server compiles the document as the file its URI names.
+    let dir = std::env::temp_dir().join(format!("clay lsp {}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let lib = "site type joint\npiece brick {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \
+               vertex c (1, 1)\n    edges a-b-c-a\n}\n";
+    std::fs::write(dir.join("lib.clay"), lib).unwrap();
+    let main = "import \"lib.clay\"\n\nmodel {\n    b = brick\n}\n";
+    let uri = format!("file://{}/main.clay", dir.display()).replace(' ', "%20");
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": uri, "languageId": "clay", "version": 1, "text": main } }),
+    );
+    let published = loop {
+        let m = c.recv();
+        if m["method"] == "textDocument/publishDiagnostics" && m["params"]["uri"] == uri.as_str() {
+            break m["params"].clone();
+        }
+    };
+    assert_eq!(published["diagnostics"], json!([]), "{published}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -18,6 +18,17 @@ use lsp_types as lsp;
 /// in lower case). The repository address is the workspace's `repository` in `Cargo.toml`.
 pub const CODES_URL: &str = concat!(env!("CARGO_PKG_REPOSITORY"), "/blob/main/docs/language.md");
 
+/// The file-system path of a document, for the compiler (its folder is where `import`s are
+/// read from): a `file://` URI percent-decoded, anything else as it is.
+pub fn file_path(uri: &str) -> String {
+    match uri.strip_prefix("file://") {
+        Some(rest) => percent_encoding::percent_decode_str(rest)
+            .decode_utf8_lossy()
+            .into_owned(),
+        None => uri.to_string(),
+    }
+}
+
 pub fn position(index: &LineIndex, offset: usize) -> lsp::Position {
     let p = index.position(offset);
     lsp::Position::new(p.line, p.col)
@@ -272,5 +283,20 @@ pub fn workspace_edit(
     lsp::WorkspaceEdit {
         changes: Some(HashMap::from([(uri.clone(), edits)])),
         ..Default::default()
+    }
+}
+
+#[cfg(test)]
+mod path_tests {
+    use super::file_path;
+
+    #[test]
+    fn a_file_uri_becomes_a_path_with_its_escapes_decoded() {
+        assert_eq!(
+            file_path("file:///work/my%20grammars/wall.clay"),
+            "/work/my grammars/wall.clay"
+        );
+        assert_eq!(file_path("file:///tmp/caf%C3%A9.clay"), "/tmp/café.clay");
+        assert_eq!(file_path("untitled:Untitled-1"), "untitled:Untitled-1");
     }
 }

@@ -285,7 +285,7 @@ impl<W: std::io::Write> Server<W> {
         self.first_change = None;
         let mut ready = Vec::new();
         for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
-            if !doc.analyse(uri) {
+            if !doc.analyse(&convert::file_path(uri)) {
                 errln!("clayc lsp: the analysis of `{uri}` panicked");
                 continue;
             }
