@@ -297,7 +297,8 @@ impl<'s> Printer<'s> {
             ExprKind::Binary(op, a, b) => {
                 format!("{} {} {}", self.num(a), op.symbol(), self.num(b))
             }
-            ExprKind::Call(f, args) => {
+            ExprKind::Call(call) => {
+                let (f, args) = (&call.func, &call.args);
                 let args: Vec<String> = args.iter().map(|a| self.num(a)).collect();
                 format!("{}({})", f.name, args.join(", "))
             }

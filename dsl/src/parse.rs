@@ -69,7 +69,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::stretch_stmt => "`min` or `variants`",
         Rule::model_stmt => "an instance or a `dock`",
         Rule::name => "a name",
-        Rule::number => "a number",
+        Rule::number | Rule::plain => "a number",
         Rule::expr | Rule::operand | Rule::primary => "a number",
         Rule::prefix | Rule::neg | Rule::pos => "a sign",
         Rule::infix | Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
@@ -677,7 +677,7 @@ impl Lower {
             Rule::number => (self.number(c), 1),
             Rule::name => (
                 Expr {
-                    kind: ExprKind::Name(self.ident(c)),
+                    kind: ExprKind::Name(Box::new(self.ident(c))),
                     span,
                 },
                 1,
@@ -711,7 +711,7 @@ impl Lower {
                 }
                 (
                     Expr {
-                        kind: ExprKind::Call(func, args),
+                        kind: ExprKind::Call(Box::new(Call { func, args })),
                         span,
                     },
                     depth,
@@ -723,9 +723,16 @@ impl Lower {
 
     fn point(&mut self, p: Pair<Rule>) -> Point {
         let span = span_of(&p);
-        let mut nums = of(&kids(p), Rule::expr).into_iter();
-        let x = self.expr_or(nums.next(), span);
-        let y = self.expr_or(nums.next(), span);
+        let mut coords = kids(p)
+            .into_iter()
+            .filter(|c| matches!(c.as_rule(), Rule::expr | Rule::plain));
+        let mut coord = |s: &mut Self| match coords.next() {
+            // A plain literal (with its sign) is a number: its text parses as one.
+            Some(c) if c.as_rule() == Rule::plain => s.number(c),
+            c => s.expr_or(c, span),
+        };
+        let x = coord(self);
+        let y = coord(self);
         Point { x, y, span }
     }
 

@@ -44,14 +44,22 @@ pub struct Expr {
 pub enum ExprKind {
     /// A literal; finite (the parser rejects literals that overflow f64).
     Number(f64),
-    /// A constant: a `let` name or a built-in such as `pi`.
-    Name(Ident),
+    /// A constant: a `let` name or a built-in such as `pi`. Boxed, like `Call`, to keep every
+    /// number of a large grammar small (a literal is most of them).
+    Name(Box<Ident>),
     Unary(UnaryOp, Box<Expr>),
     Binary(BinaryOp, Box<Expr>, Box<Expr>),
     /// A built-in function applied to its arguments: `sin(30)`.
-    Call(Ident, Vec<Expr>),
+    Call(Box<Call>),
     /// `(e)`, kept so that the formatter prints the parentheses as written.
     Paren(Box<Expr>),
+}
+
+/// `FUNCTION(ARG, ...)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Call {
+    pub func: Ident,
+    pub args: Vec<Expr>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

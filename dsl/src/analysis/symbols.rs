@@ -233,7 +233,8 @@ impl Symbols {
                 self.expr(a, scope);
                 self.expr(b, scope);
             }
-            ExprKind::Call(f, args) => {
+            ExprKind::Call(call) => {
+                let (f, args) = (&call.func, &call.args);
                 self.builtins.push(f.span);
                 for a in args {
                     self.expr(a, scope);

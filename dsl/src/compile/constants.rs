@@ -175,7 +175,7 @@ impl Compiler {
                     BinaryOp::Div => x / y,
                 }
             }
-            ExprKind::Call(func, args) => self.call(e, func, args)?,
+            ExprKind::Call(call) => self.call(e, &call.func, &call.args)?,
         };
         if v.is_finite() {
             Ok(v)
@@ -327,11 +327,11 @@ impl Compiler {
             "is infinite"
         };
         let hint = match &e.kind {
-            ExprKind::Call(f, _) if f.name == "sqrt" => "`sqrt` takes a number of at least 0",
-            ExprKind::Call(f, _) if f.name == "tan" => {
+            ExprKind::Call(c) if c.func.name == "sqrt" => "`sqrt` takes a number of at least 0",
+            ExprKind::Call(c) if c.func.name == "tan" => {
                 "`tan` is infinite at 90 degrees (and 270, ...)"
             }
-            ExprKind::Call(f, _) if f.name == "asin" || f.name == "acos" => {
+            ExprKind::Call(c) if c.func.name == "asin" || c.func.name == "acos" => {
                 "`asin` and `acos` take a number from -1 to 1"
             }
             _ => "numbers must be finite; the largest is about 1.8e308",
