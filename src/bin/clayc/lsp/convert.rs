@@ -288,15 +288,19 @@ pub fn workspace_edit(
 
 #[cfg(test)]
 mod path_tests {
-    use super::file_path;
-
     #[test]
     fn a_file_uri_becomes_a_path_with_its_escapes_decoded() {
         assert_eq!(
-            file_path("file:///work/my%20grammars/wall.clay"),
+            super::file_path("file:///work/my%20grammars/wall.clay"),
             "/work/my grammars/wall.clay"
         );
-        assert_eq!(file_path("file:///tmp/caf%C3%A9.clay"), "/tmp/café.clay");
-        assert_eq!(file_path("untitled:Untitled-1"), "untitled:Untitled-1");
+        assert_eq!(
+            super::file_path("file:///tmp/caf%C3%A9.clay"),
+            "/tmp/café.clay"
+        );
+        assert_eq!(
+            super::file_path("untitled:Untitled-1"),
+            "untitled:Untitled-1"
+        );
     }
 }
