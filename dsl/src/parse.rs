@@ -565,6 +565,18 @@ impl Lower {
         }
     }
 
+    /// The first name among `children`, or an empty one at `span` (the grammar guarantees one;
+    /// this keeps lowering total).
+    fn name_or(&self, children: &[Pair<Rule>], span: Span) -> Ident {
+        first(children, Rule::name).map_or(
+            Ident {
+                name: String::new(),
+                span,
+            },
+            |n| self.ident(n),
+        )
+    }
+
     fn idents(&self, children: &[Pair<Rule>]) -> Vec<Ident> {
         of(children, Rule::name)
             .into_iter()
@@ -695,13 +707,7 @@ impl Lower {
             }
             Rule::call => {
                 let ch = kids(c);
-                let func = first(&ch, Rule::name).map_or(
-                    Ident {
-                        name: String::new(),
-                        span,
-                    },
-                    |n| self.ident(n),
-                );
+                let func = self.name_or(&ch, span);
                 let mut depth = 1;
                 let mut args = Vec::new();
                 for a in of(&ch, Rule::expr) {
@@ -782,13 +788,7 @@ impl Lower {
     fn let_decl(&mut self, p: Pair<Rule>) -> LetDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(
-            Ident {
-                name: String::new(),
-                span,
-            },
-            |n| self.ident(n),
-        );
+        let name = self.name_or(&ch, span);
         let value = self.expr_or(first(&ch, Rule::expr), span);
         LetDecl { name, value, span }
     }
@@ -854,13 +854,7 @@ impl Lower {
     fn piece(&mut self, p: Pair<Rule>) -> PieceDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(
-            Ident {
-                name: String::new(),
-                span,
-            },
-            |n| self.ident(n),
-        );
+        let name = self.name_or(&ch, span);
         let extends = first(&ch, Rule::extends)
             .and_then(|e| first(&kids(e), Rule::name))
             .map(|n| self.ident(n));
@@ -899,13 +893,7 @@ impl Lower {
     fn vertex(&mut self, p: Pair<Rule>) -> VertexDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(
-            Ident {
-                name: String::new(),
-                span,
-            },
-            |n| self.ident(n),
-        );
+        let name = self.name_or(&ch, span);
         let pos = first(&ch, Rule::point).map(|q| self.point(q));
         let zero = Expr::number(0.0, span);
         VertexDecl {
@@ -1025,13 +1013,7 @@ impl Lower {
     fn state(&mut self, p: Pair<Rule>) -> StateDecl {
         let span = span_of(&p);
         let ch = kids(p);
-        let name = first(&ch, Rule::name).map_or(
-            Ident {
-                name: String::new(),
-                span,
-            },
-            |n| self.ident(n),
-        );
+        let name = self.name_or(&ch, span);
         let mut positions = Vec::new();
         let mut edges = Vec::new();
         let mut geometry = Vec::new();
@@ -1100,13 +1082,7 @@ impl Lower {
                     .map(|e| {
                         let espan = span_of(&e);
                         let ec = kids(e);
-                        let piece = first(&ec, Rule::name).map_or(
-                            Ident {
-                                name: String::new(),
-                                span: espan,
-                            },
-                            |n| self.ident(n),
-                        );
+                        let piece = self.name_or(&ec, espan);
                         let frequency = self.expr_or(first(&ec, Rule::expr), espan);
                         VariantEntry {
                             piece,
