@@ -789,5 +789,53 @@ fn imports_are_read_from_the_documents_folder_on_disk() {
         }
     };
     assert_eq!(published["diagnostics"], json!([]), "{published}");
+
+    // A mistake inside the library: shown on the document's import line, naming the place in
+    // the library, which is the related information (with the library's own URI).
+    std::fs::write(
+        dir.join("lib.clay"),
+        lib.replace("edges a-b-c-a", "edges a-b-c-d"),
+    )
+    .unwrap();
+    c.notify(
+        "textDocument/didChange",
+        json!({
+            "textDocument": { "uri": uri, "version": 2 },
+            "contentChanges": [{ "text": format!("{main}\n") }],
+        }),
+    );
+    let published = loop {
+        let m = c.recv();
+        if m["method"] == "textDocument/publishDiagnostics"
+            && m["params"]["uri"] == uri.as_str()
+            && m["params"]["version"] == 2
+        {
+            break m["params"].clone();
+        }
+    };
+    let diags = published["diagnostics"].as_array().unwrap();
+    assert_eq!(diags.len(), 1, "{diags:?}");
+    let d = &diags[0];
+    assert_eq!(d["code"], "E011");
+    assert_eq!(d["range"]["start"], json!({ "line": 0, "character": 0 }));
+    assert_eq!(d["range"]["end"], json!({ "line": 0, "character": 17 }));
+    let message = d["message"].as_str().unwrap();
+    assert!(
+        message.contains("lib.clay:6:17: unknown vertex `d`"),
+        "{message}"
+    );
+    let place = &d["relatedInformation"][0]["location"];
+    assert!(
+        place["uri"].as_str().unwrap().ends_with("/lib.clay"),
+        "{place}"
+    );
+    assert!(
+        place["uri"].as_str().unwrap().contains("clay%20lsp"),
+        "{place}"
+    );
+    assert_eq!(
+        place["range"]["start"],
+        json!({ "line": 5, "character": 16 })
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -11,7 +11,7 @@ use clay_dsl::analysis::{
     CompletionKind, LineIndex, LinePos, Outline, SemanticToken, SymbolKind, TokenKind,
 };
 use clay_dsl::syntax::Span;
-use clay_dsl::{Diagnostic, Severity};
+use clay_dsl::{Diagnostic, Severity, SourceMap};
 use lsp_types as lsp;
 
 /// Where the table of diagnostic codes lives; each code's row has the anchor `#e011` (the code
@@ -56,26 +56,97 @@ pub fn code_url(code: &str) -> Option<lsp::Uri> {
     lsp::Uri::from_str(&format!("{CODES_URL}#{}", code.to_ascii_lowercase())).ok()
 }
 
+/// Characters escaped when a file path becomes a `file://` URI.
+const PATH_ESCAPES: &percent_encoding::AsciiSet = &percent_encoding::CONTROLS
+    .add(b' ')
+    .add(b'"')
+    .add(b'#')
+    .add(b'%')
+    .add(b'<')
+    .add(b'>')
+    .add(b'?')
+    .add(b'`')
+    .add(b'{')
+    .add(b'}');
+
+/// Where a span of the compiled text lies: in the open document, or in a file it imports (the
+/// diagnostics' source map gives that file's path and text).
+fn location(uri: &lsp::Uri, index: &LineIndex, sources: &SourceMap, span: Span) -> lsp::Location {
+    let at = sources.locate(index.text(), "", span);
+    if at.file == 0 {
+        return lsp::Location::new(uri.clone(), range(index, span));
+    }
+    let file_index = LineIndex::new(at.text);
+    let local = range(&file_index, Span::new(at.start, at.end));
+    let path = percent_encoding::utf8_percent_encode(at.path, PATH_ESCAPES).to_string();
+    let file_uri = lsp::Uri::from_str(&format!("file://{path}")).unwrap_or_else(|_| uri.clone());
+    lsp::Location::new(file_uri, local)
+}
+
+/// The `import` line of the document that brought in `path` (or the first import): where a
+/// diagnostic inside an imported file is shown in the document.
+fn import_range(index: &LineIndex, path: &str) -> lsp::Range {
+    let text = index.text();
+    let mut first = None;
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim_start();
+        if let Some(rest) = trimmed.strip_prefix("import") {
+            let start = offset + (line.len() - trimmed.len());
+            let span = Span::new(start, start + trimmed.trim_end().len());
+            let named = rest.trim().trim_matches('"');
+            if !named.is_empty() && path.ends_with(named.trim_start_matches("./")) {
+                return range(index, span);
+            }
+            first.get_or_insert(span);
+        }
+        offset += line.len();
+    }
+    range(index, first.unwrap_or_default())
+}
+
 /// One compiler diagnostic: the message with its hints (`help: ...`) appended, the code with
-/// its link, the secondary spans as related information.
-pub fn diagnostic(uri: &lsp::Uri, index: &LineIndex, d: &Diagnostic) -> lsp::Diagnostic {
+/// its link, the secondary spans as related information. A diagnostic inside an imported file
+/// is shown on the document's `import` line, its message naming where it is, with that place
+/// as related information.
+pub fn diagnostic(
+    uri: &lsp::Uri,
+    index: &LineIndex,
+    sources: &SourceMap,
+    d: &Diagnostic,
+) -> lsp::Diagnostic {
     let mut message = d.message.clone();
     for hint in &d.hints {
         message.push_str("\nhelp: ");
         message.push_str(hint);
     }
-    let related: Vec<lsp::DiagnosticRelatedInformation> = d
+    let mut related: Vec<lsp::DiagnosticRelatedInformation> = d
         .secondary
         .iter()
         .map(|l| lsp::DiagnosticRelatedInformation {
-            location: lsp::Location::new(uri.clone(), range(index, l.span)),
+            location: location(uri, index, sources, l.span),
             message: l.message.clone(),
         })
         .collect();
+    let primary = sources.locate(index.text(), "", d.primary.span);
+    let shown = if primary.file == 0 {
+        range(index, d.primary.span)
+    } else {
+        let (line, col) = clay_dsl::line_col(primary.text, primary.start);
+        message = format!("in {}:{line}:{col}: {message}", primary.path);
+        related.insert(
+            0,
+            lsp::DiagnosticRelatedInformation {
+                location: location(uri, index, sources, d.primary.span),
+                message: d.primary.message.clone(),
+            },
+        );
+        import_range(index, primary.path)
+    };
     // Unused declarations: editors grey them out.
     let unnecessary = matches!(d.code, "W001" | "W007");
     lsp::Diagnostic {
-        range: range(index, d.primary.span),
+        range: shown,
         severity: Some(match d.severity {
             Severity::Error => lsp::DiagnosticSeverity::ERROR,
             Severity::Warning => lsp::DiagnosticSeverity::WARNING,
@@ -90,12 +161,14 @@ pub fn diagnostic(uri: &lsp::Uri, index: &LineIndex, d: &Diagnostic) -> lsp::Dia
     }
 }
 
-pub fn diagnostics<'a>(
+pub fn diagnostics(
     uri: &lsp::Uri,
     index: &LineIndex,
-    ds: impl IntoIterator<Item = &'a Diagnostic>,
+    ds: &clay_dsl::Diagnostics,
 ) -> Vec<lsp::Diagnostic> {
-    ds.into_iter().map(|d| diagnostic(uri, index, d)).collect()
+    ds.iter()
+        .map(|d| diagnostic(uri, index, &ds.sources, d))
+        .collect()
 }
 
 pub fn completion_kind(k: CompletionKind) -> lsp::CompletionItemKind {
