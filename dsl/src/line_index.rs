@@ -83,10 +83,6 @@ impl LineIndex {
         (line + 1, col + 1)
     }
 
-    pub fn line_count(&self) -> usize {
-        self.starts.len()
-    }
-
     pub fn text(&self) -> &str {
         &self.text
     }

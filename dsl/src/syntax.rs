@@ -103,17 +103,6 @@ impl Expr {
             span,
         }
     }
-
-    /// The value when the expression is a plain literal (or a signed one), without evaluating
-    /// names or calls.
-    pub fn literal(&self) -> Option<f64> {
-        match &self.kind {
-            ExprKind::Number(v) => Some(*v),
-            ExprKind::Unary(UnaryOp::Neg, e) => e.literal().map(|v| -v),
-            ExprKind::Unary(UnaryOp::Plus, e) | ExprKind::Paren(e) => e.literal(),
-            _ => None,
-        }
-    }
 }
 
 /// `(x, y)`.

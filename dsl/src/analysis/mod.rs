@@ -196,11 +196,6 @@ impl Analysis {
         &self.symbols
     }
 
-    /// The tree of the text, or of its longest parsed prefix; `None` when nothing parsed.
-    pub fn tree(&self) -> Option<&File> {
-        self.tree.as_ref()
-    }
-
     /// The symbol declared or used at `offset`.
     pub fn symbol_at(&self, offset: usize) -> Option<usize> {
         let inside = |s: Span| s.start <= offset && offset <= s.end;
