@@ -380,3 +380,51 @@ fn deep_and_cyclic_extends_chains_return_quickly() {
     assert!(e.message.contains("(5000 pieces in all)"), "{}", e.message);
     assert!(e.secondary.len() <= 8);
 }
+
+/// The deepest nesting the nesting scan lets through parses on a small thread stack: pest
+/// runs without its own stack probe (dsl/src/lib.rs), so this bound is what keeps a spawned
+/// thread (2 MiB by default, as in the editor and the language server) from overflowing.
+#[test]
+fn the_deepest_accepted_nesting_fits_a_small_thread_stack() {
+    let base = EMBEDDED.replace("    axis north -> north\n", "");
+    // Brackets: the piece's `{`, the point's own `(` and 254 inside it make 256.
+    let depth = 254;
+    let cases = [
+        format!("({}1{}, 0)", "(".repeat(depth), ")".repeat(depth)),
+        format!(
+            "(sin({}1{}), 0)",
+            "cos(".repeat(depth - 1),
+            ")".repeat(depth - 1)
+        ),
+        format!(
+            "(1, 0) {}{}",
+            "/*".repeat(256), // the scan's MAX_NESTING
+            "*/".repeat(256)
+        ),
+    ];
+    for case in cases {
+        let src = base.replacen("(1, 0)", &case, 1);
+        assert_ne!(src, base);
+        let worker = std::thread::Builder::new()
+            .stack_size(512 * 1024)
+            .spawn(move || {
+                compile(&src, "deep.clay")
+                    .map(|_| ())
+                    .map_err(|d| (d.items[0].code, d.items[0].message.clone()))
+            })
+            .unwrap();
+        let got = worker.join().expect("parsing overflowed a 512 KiB stack");
+        // pest parsed it all: too deep an expression tree is the lowering's E002 (its own
+        // limit), never the nesting scan's, and a comment is fine.
+        match &got {
+            Ok(()) => {}
+            Err((code, message)) => {
+                assert_eq!(*code, "E002", "{message}");
+                assert!(
+                    message.contains("expression is nested too deeply"),
+                    "{message}"
+                );
+            }
+        }
+    }
+}
