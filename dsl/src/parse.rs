@@ -70,6 +70,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::model_stmt => "an instance or a `dock`",
         Rule::name => "a name",
         Rule::number | Rule::plain => "a number",
+        Rule::blank => "a space",
         Rule::expr | Rule::operand | Rule::primary => "a number",
         Rule::prefix | Rule::neg | Rule::pos => "a sign",
         Rule::infix | Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
@@ -82,7 +83,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::extrude => "`extrude HEIGHT [above BASE]`",
         Rule::integer => "a whole number",
         Rule::colour => "a colour like `#b5651d`",
-        Rule::point => "a point `(x, y)`",
+        Rule::point | Rule::plain_point => "a point `(x, y)`",
         Rule::kw_solver => "`solver`",
         Rule::kw_site => "`site`",
         Rule::kw_type => "`type`",
@@ -487,12 +488,24 @@ struct Lower {
 /// The span of a pair without the trailing whitespace and comments pest includes when an
 /// optional tail was tried and not found: it ends where its last token ends.
 fn span_of(p: &Pair<Rule>) -> Span {
-    let start = p.as_span().start();
+    let whole = p.as_span();
+    let start = whole.start();
+    let base = span_base();
+    // Fast path: a token never ends in whitespace or `/`, and a comment's last byte is a
+    // newline or `/` (`*/`) unless the file ends inside it; so a pair whose last byte is neither
+    // and which does not reach the end of the input has no trivia to trim.
+    let text = whole.as_str();
+    let ends_in_trivia = text
+        .as_bytes()
+        .last()
+        .is_some_and(|b| b.is_ascii_whitespace() || *b == b'/' || *b >= 0x80);
+    if !ends_in_trivia && whole.end() < whole.get_input().len() {
+        return Span::new(base + start, base + whole.end());
+    }
     let mut last = p.clone();
     while let Some(child) = last.clone().into_inner().last() {
         last = child;
     }
-    let base = span_base();
     Span::new(base + start, base + last.as_span().end().max(start))
 }
 
@@ -585,10 +598,14 @@ impl Lower {
     }
 
     fn number(&mut self, p: Pair<Rule>) -> Expr {
-        let span = span_of(&p);
+        self.literal(p.as_str(), span_of(&p))
+    }
+
+    /// A decimal literal's value, or E012 at `span` when it does not fit in an f64.
+    fn literal(&mut self, text: &str, span: Span) -> Expr {
         // The grammar only admits decimal literals, which Rust's float parser accepts; a
         // literal beyond f64's range parses to infinity and is reported here.
-        let value = p.as_str().parse::<f64>().unwrap_or(f64::NAN);
+        let value = text.parse::<f64>().unwrap_or(f64::NAN);
         if !value.is_finite() {
             self.diags.push(
                 Diagnostic::error(
@@ -729,6 +746,10 @@ impl Lower {
 
     fn point(&mut self, p: Pair<Rule>) -> Point {
         let span = span_of(&p);
+        let mut inner = p.clone().into_inner();
+        if let Some(q) = inner.next().filter(|q| q.as_rule() == Rule::plain_point) {
+            return self.plain_point(q.as_str(), span);
+        }
         let mut coords = kids(p)
             .into_iter()
             .filter(|c| matches!(c.as_rule(), Rule::expr | Rule::plain));
@@ -739,6 +760,23 @@ impl Lower {
         };
         let x = coord(self);
         let y = coord(self);
+        Point { x, y, span }
+    }
+
+    /// A `plain_point` token, `(x, y)` with two literals and only blanks between: its
+    /// coordinates are found in its text, each with the span of its digits.
+    fn plain_point(&mut self, text: &str, span: Span) -> Point {
+        let inside = &text[1..text.len() - 1];
+        let comma = inside.find(',').unwrap_or(inside.len());
+        let coord = |s: &mut Self, from: usize, to: usize| {
+            let part = &inside[from..to];
+            let lead = part.len() - part.trim_start().len();
+            let digits = part.trim();
+            let start = span.start + 1 + from + lead;
+            s.literal(digits, Span::new(start, start + digits.len()))
+        };
+        let x = coord(self, 0, comma);
+        let y = coord(self, (comma + 1).min(inside.len()), inside.len());
         Point { x, y, span }
     }
 

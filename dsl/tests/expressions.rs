@@ -298,3 +298,27 @@ fn an_expression_node_stays_small() {
         std::mem::size_of::<clay_dsl::syntax::Expr>()
     );
 }
+
+#[test]
+fn a_literal_too_large_is_marked_at_its_digits_in_either_form_of_point() {
+    // `(x, y)` of two literals is one token (grammar.pest's `plain_point`); with a comment
+    // inside, the same point takes the general form. Both mark the same digits.
+    for point in [
+        "(0,  1e999)",
+        "(\t-1e999 , 0)",
+        "(0, /* far */ 1e999)",
+        "(-1e999, 0 /* x */)",
+    ] {
+        let source = grammar("", point);
+        let d = compile(&source, "t.clay").unwrap_err().items;
+        assert_eq!(d.len(), 1, "{point}: {d:?}");
+        assert_eq!(d[0].code, "E012", "{point}");
+        let want = if point.contains("-1e999") {
+            "-1e999"
+        } else {
+            "1e999"
+        };
+        assert_eq!(text_at(&source, &d[0]), want, "{point}");
+    }
+    assert_eq!(vertex_a("", "( -0.5 ,\t2e1 )"), (-0.5, 20.0));
+}
