@@ -218,10 +218,14 @@ impl Client {
     }
 
     fn change(&mut self, version: i32, text: &str) {
+        self.change_uri(URI, version, text);
+    }
+
+    fn change_uri(&mut self, uri: &str, version: i32, text: &str) {
         self.notify(
             "textDocument/didChange",
             json!({
-                "textDocument": { "uri": URI, "version": version },
+                "textDocument": { "uri": uri, "version": version },
                 "contentChanges": [{ "text": text }],
             }),
         );
@@ -838,4 +842,228 @@ fn imports_are_read_from_the_documents_folder_on_disk() {
         json!({ "line": 5, "character": 16 })
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A library declaring `brick` (with its site type and sites) and a grammar using it, in a
+/// folder of their own; the URIs of both.
+struct Library {
+    dir: std::path::PathBuf,
+    lib: String,
+    main: String,
+    lib_uri: String,
+    main_uri: String,
+}
+
+const LIB: &str = "site type joint\n\npiece brick {\n    vertex sw (0, 0)\n    vertex se (1, 0)\n    \
+                   vertex ne (1, 0.5)\n    vertex nw (0, 0.5)\n    edges sw-se-ne-nw-sw, sw-ne\n    \
+                   site west: joint [nw, sw] out (-1, 0)\n    site east: joint [se, ne] out (1, 0)\n}\n";
+const MAIN: &str = "import \"lib.clay\"\n\nstretch brick from west to east\n\nmodel {\n    wall = chain brick x 3\n}\n";
+
+impl Library {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("clay-lsp-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("lib.clay"), LIB).unwrap();
+        std::fs::write(dir.join("main.clay"), MAIN).unwrap();
+        let uri = |f: &str| format!("file://{}/{f}", dir.display());
+        Self {
+            lib_uri: uri("lib.clay"),
+            main_uri: uri("main.clay"),
+            dir,
+            lib: LIB.into(),
+            main: MAIN.into(),
+        }
+    }
+}
+
+impl Drop for Library {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+impl Client {
+    /// Opens `text` as `uri` and returns its first published diagnostics.
+    fn open_as(&mut self, uri: &str, text: &str) -> Value {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": uri, "languageId": "clay", "version": 1, "text": text } }),
+        );
+        self.published(uri, None)
+    }
+
+    /// The next diagnostics published for `uri` (of `version`, when given).
+    fn published(&mut self, uri: &str, version: Option<i32>) -> Value {
+        let is_it = |m: &Value| {
+            m["method"] == "textDocument/publishDiagnostics"
+                && m["params"]["uri"] == uri
+                && version.is_none_or(|v| m["params"]["version"] == v)
+        };
+        if let Some(i) = self.stash.iter().position(is_it) {
+            return self.stash.remove(i)["params"].clone();
+        }
+        loop {
+            let m = self.recv();
+            if is_it(&m) {
+                return m["params"].clone();
+            }
+            self.stash.push(m);
+        }
+    }
+}
+
+fn at_in(uri: &str, text: &str, offset: usize) -> Value {
+    json!({ "textDocument": { "uri": uri }, "position": pos(text, offset) })
+}
+
+#[test]
+fn definition_hover_and_completion_reach_into_an_imported_file() {
+    let l = Library::new("queries");
+    let mut c = Client::start();
+    assert_eq!(c.open_as(&l.main_uri, &l.main)["diagnostics"], json!([]));
+    let brick_use = at(&l.main, "chain brick", 0, 6);
+
+    // Definition: the library's URI, the range of the name in the library.
+    let def = c.result(
+        "textDocument/definition",
+        at_in(&l.main_uri, &l.main, brick_use),
+    );
+    assert_eq!(def["uri"], l.lib_uri.as_str(), "{def}");
+    let decl = at(&l.lib, "piece brick", 0, 6);
+    assert_eq!(def["range"], range(&l.lib, decl, decl + 5));
+    // A site of the imported piece, from the rule in the document.
+    let west = at(&l.main, "from west", 0, 5);
+    let def = c.result("textDocument/definition", at_in(&l.main_uri, &l.main, west));
+    assert_eq!(def["uri"], l.lib_uri.as_str());
+    let site = at(&l.lib, "site west", 0, 5);
+    assert_eq!(def["range"], range(&l.lib, site, site + 4));
+
+    // Hover: the imported declaration, its members, and which file it is in.
+    let hover = c.result("textDocument/hover", at_in(&l.main_uri, &l.main, brick_use));
+    let text = hover["contents"]["value"].as_str().unwrap();
+    assert!(text.contains("piece brick"), "{text}");
+    assert!(
+        text.contains("`west: joint [nw, sw] out (-1, 0)`"),
+        "{text}"
+    );
+    assert!(text.contains("/lib.clay`"), "{text}");
+    assert_eq!(
+        hover["range"],
+        range(&l.main, brick_use, brick_use + 5),
+        "{hover}"
+    );
+
+    // Completion: the imported piece after `chain`, its sites after `brick.`.
+    let edited = l.main.replace("chain brick x 3", "chain b");
+    c.change_uri(&l.main_uri, 2, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, at(&edited, "chain b", 0, 7)),
+    );
+    let labels = |items: &Value| -> Vec<String> {
+        items
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|i| i["label"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert!(labels(&items).contains(&"brick".to_string()), "{items}");
+    let edited = format!("{}\nmerge brick.", l.main);
+    c.change_uri(&l.main_uri, 3, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, edited.len()),
+    );
+    assert_eq!(labels(&items), ["west", "east"], "{items}");
+    let edited = format!("{}\nsite type cap docks ", l.main);
+    c.change_uri(&l.main_uri, 4, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, edited.len()),
+    );
+    assert!(labels(&items).contains(&"joint".to_string()), "{items}");
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn references_and_rename_of_an_imported_piece_span_the_open_files() {
+    let l = Library::new("rename");
+    let mut c = Client::start();
+    c.open_as(&l.main_uri, &l.main);
+    c.open_as(&l.lib_uri, &l.lib);
+
+    // Asked in the library: its own declaration and the two uses in the open grammar.
+    let decl = at(&l.lib, "piece brick", 0, 6);
+    let refs = c.result(
+        "textDocument/references",
+        json!({
+            "textDocument": { "uri": l.lib_uri },
+            "position": pos(&l.lib, decl),
+            "context": { "includeDeclaration": true },
+        }),
+    );
+    let mut found: Vec<(String, Value)> = refs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["uri"].as_str().unwrap().to_string(), r["range"].clone()))
+        .collect();
+    found.sort_by_key(|f| (f.0.clone(), f.1.to_string()));
+    let in_main = |needle: &str| {
+        let s = at(&l.main, needle, 0, needle.len() - 5);
+        (l.main_uri.clone(), range(&l.main, s, s + 5))
+    };
+    let mut want = vec![
+        (l.lib_uri.clone(), range(&l.lib, decl, decl + 5)),
+        in_main("stretch brick"),
+        in_main("chain brick"),
+    ];
+    want.sort_by_key(|f| (f.0.clone(), f.1.to_string()));
+    assert_eq!(found, want);
+
+    // Rename from a use in the grammar: one edit list per file, and both check clean after.
+    let edit = c.result(
+        "textDocument/rename",
+        json!({
+            "textDocument": { "uri": l.main_uri },
+            "position": pos(&l.main, at(&l.main, "chain brick", 0, 7)),
+            "newName": "block",
+        }),
+    );
+    let changes = edit["changes"].as_object().unwrap();
+    assert_eq!(changes.len(), 2, "{edit}");
+    let lib = apply(&l.lib, changes[&l.lib_uri].as_array().unwrap());
+    let main = apply(&l.main, changes[&l.main_uri].as_array().unwrap());
+    assert_eq!(lib, l.lib.replace("piece brick", "piece block"));
+    assert_eq!(main, l.main.replace("brick", "block"));
+    c.change_uri(&l.lib_uri, 2, &lib);
+    c.change_uri(&l.main_uri, 2, &main);
+    // (The library alone has no model: a warning, no error.)
+    let lib_diags = c.published(&l.lib_uri, Some(2));
+    assert!(
+        lib_diags["diagnostics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|d| d["severity"] != 1),
+        "{lib_diags}"
+    );
+    assert_eq!(c.published(&l.main_uri, Some(2))["diagnostics"], json!([]));
+
+    // A clash in the library refuses the rename, naming the file.
+    let refused = c.request(
+        "textDocument/rename",
+        json!({
+            "textDocument": { "uri": l.main_uri },
+            "position": pos(&main, at(&main, "from west", 0, 5)),
+            "newName": "east",
+        }),
+    );
+    let message = refused["error"]["message"].as_str().unwrap();
+    assert!(
+        message.contains("site `east` already exists (`") && message.contains("lib.clay` line 10)"),
+        "{refused}"
+    );
+    assert!(c.shutdown_and_exit().success());
 }

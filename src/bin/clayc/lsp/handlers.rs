@@ -1,9 +1,10 @@
 //! The requests: each reads its params (InvalidParams when they do not fit), asks the document's
 //! analysis, and converts the answer.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use clay_dsl::analysis::Analysis;
+use clay_dsl::syntax::Span;
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types as lsp;
 use lsp_types::request::{self as req, Request as _};
@@ -153,6 +154,61 @@ impl Open<'_> {
         Ok(At { a, offset })
     }
 
+    /// The open documents' analyses, in order of their URIs.
+    fn analyses(&self) -> Vec<(&lsp::Uri, &Analysis)> {
+        let mut all: Vec<_> = self
+            .0
+            .values()
+            .filter_map(|d| Some((&d.uri, d.analysis.as_deref()?)))
+            .collect();
+        all.sort_by(|a, b| a.0.as_str().cmp(b.0.as_str()));
+        all
+    }
+
+    /// The URI of a file named by an analysis: the open document of that path, else the file.
+    fn uri_of(&self, path: &str) -> Option<lsp::Uri> {
+        self.analyses()
+            .into_iter()
+            .find(|(_, a)| a.path(0) == path)
+            .map(|(uri, _)| uri.clone())
+            .or_else(|| convert::file_uri(path))
+    }
+
+    /// Where a span of `a` (the analysis of the document `uri`) lies: in the document or in a
+    /// file it imports.
+    fn location(&self, uri: &lsp::Uri, a: &Analysis, span: Span) -> Option<lsp::Location> {
+        let place = a.place(span);
+        let range = convert::range(a.file_index(place.file)?, place.span);
+        let uri = match place.file {
+            0 => uri.clone(),
+            k => self.uri_of(a.path(k))?,
+        };
+        Some(lsp::Location::new(uri, range))
+    }
+
+    /// The symbol at a position as every open document's analysis knows it (the documents
+    /// that declare it, import its file, or are imported by the one asked): each analysis with
+    /// its index of the symbol, the asked document's first (its refusals name other files).
+    fn everywhere(
+        &self,
+        p: &lsp::TextDocumentPositionParams,
+    ) -> Result<Vec<(&lsp::Uri, &Analysis, usize)>, ResponseError> {
+        let At { a, offset } = self.at(p)?;
+        let Some(sym) = a.symbol_at(offset).map(|i| &a.symbols().symbols[i]) else {
+            return Ok(Vec::new());
+        };
+        let declared = a.place(sym.span);
+        let path = a.path(declared.file);
+        let asked = &p.text_document.uri;
+        let mut all: Vec<_> = self
+            .analyses()
+            .into_iter()
+            .filter_map(|(uri, b)| Some((uri, b, b.declared_at(path, declared.span)?)))
+            .collect();
+        all.sort_by_key(|(uri, _, _)| *uri != asked);
+        Ok(all)
+    }
+
     fn hover(&self, p: lsp::HoverParams) -> Result<Option<lsp::Hover>, ResponseError> {
         let At { a, offset } = self.at(&p.text_document_position_params)?;
         Ok(a.hover(offset).map(|(span, markdown)| lsp::Hover {
@@ -170,27 +226,29 @@ impl Open<'_> {
     ) -> Result<Option<lsp::GotoDefinitionResponse>, ResponseError> {
         let pos = &p.text_document_position_params;
         let At { a, offset } = self.at(pos)?;
-        Ok(a.definition(offset).map(|span| {
-            lsp::GotoDefinitionResponse::Scalar(lsp::Location::new(
-                pos.text_document.uri.clone(),
-                convert::range(a.line_index(), span),
-            ))
-        }))
+        Ok(a.definition(offset)
+            .and_then(|span| self.location(&pos.text_document.uri, a, span))
+            .map(lsp::GotoDefinitionResponse::Scalar))
     }
 
     fn references(
         &self,
         p: lsp::ReferenceParams,
     ) -> Result<Option<Vec<lsp::Location>>, ResponseError> {
-        let pos = &p.text_document_position;
-        let At { a, offset } = self.at(pos)?;
-        let uri = &pos.text_document.uri;
-        Ok(Some(
-            a.references(offset, p.context.include_declaration)
-                .into_iter()
-                .map(|s| lsp::Location::new(uri.clone(), convert::range(a.line_index(), s)))
-                .collect(),
-        ))
+        // Every open document's uses (and those in the files they import), once each.
+        let mut seen = HashSet::new();
+        let mut out = Vec::new();
+        for (uri, b, i) in self.everywhere(&p.text_document_position)? {
+            for s in b.references_of(i, p.context.include_declaration) {
+                let Some(l) = self.location(uri, b, s) else {
+                    continue;
+                };
+                if seen.insert((l.uri.as_str().to_string(), format!("{:?}", l.range))) {
+                    out.push(l);
+                }
+            }
+        }
+        Ok(Some(out))
     }
 
     fn highlight(
@@ -202,6 +260,7 @@ impl Open<'_> {
         Ok(Some(
             a.references(offset, true)
                 .into_iter()
+                .filter(|&s| a.place(s).file == 0)
                 .map(|s| lsp::DocumentHighlight {
                     range: convert::range(a.line_index(), s),
                     kind: Some(if Some(s) == declaration {
@@ -268,16 +327,39 @@ impl Open<'_> {
     }
 
     fn rename(&self, p: lsp::RenameParams) -> Result<Option<lsp::WorkspaceEdit>, ResponseError> {
-        let pos = &p.text_document_position;
-        let At { a, offset } = self.at(pos)?;
-        let edits = a
-            .rename(offset, &p.new_name)
-            .map_err(|why| error(ErrorCode::RequestFailed, why))?;
-        Ok(Some(convert::workspace_edit(
-            &pos.text_document.uri,
-            a.line_index(),
-            &edits,
-        )))
+        // Every file that declares or uses the name and that an open document knows: the open
+        // documents and the files they import. A name any of them refuses is not renamed.
+        let mut seen = HashSet::new();
+        // By URI text (a `Uri` is no key: it caches its parts inside).
+        let mut changes: HashMap<String, (lsp::Uri, Vec<lsp::TextEdit>)> = HashMap::new();
+        let everywhere = self.everywhere(&p.text_document_position)?;
+        if everywhere.is_empty() {
+            return Err(error(
+                ErrorCode::RequestFailed,
+                "there is no name to rename here",
+            ));
+        }
+        for (uri, b, i) in everywhere {
+            let edits = b
+                .rename_symbol(i, &p.new_name)
+                .map_err(|why| error(ErrorCode::RequestFailed, why))?;
+            for (s, text) in edits {
+                let Some(l) = self.location(uri, b, s) else {
+                    continue;
+                };
+                if seen.insert((l.uri.as_str().to_string(), format!("{:?}", l.range))) {
+                    changes
+                        .entry(l.uri.as_str().to_string())
+                        .or_insert_with(|| (l.uri.clone(), Vec::new()))
+                        .1
+                        .push(lsp::TextEdit::new(l.range, text));
+                }
+            }
+        }
+        Ok(Some(lsp::WorkspaceEdit {
+            changes: Some(changes.into_values().collect()),
+            ..Default::default()
+        }))
     }
 
     fn symbols(

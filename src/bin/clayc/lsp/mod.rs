@@ -22,6 +22,7 @@ use std::sync::mpsc::RecvTimeoutError;
 use std::time::{Duration, Instant};
 
 use clay_dsl::analysis::{Analysis, LineIndex};
+use clay_dsl::{FsLoader, Loader};
 use lsp_server::{ErrorCode, Message, Notification, Request, RequestId, Response, ResponseError};
 use lsp_types as lsp;
 use lsp_types::notification::Notification as _;
@@ -101,13 +102,13 @@ impl Document {
         }
     }
 
-    /// Analyses the present text; `false` when the analysis panicked (then the old one stays).
-    fn analyse(&mut self, path: &str) -> bool {
+    /// Analyses the present text, reading imports through `loader`; `false` when the analysis
+    /// panicked (then the old one stays).
+    fn analyse(&mut self, path: &str, loader: &dyn Loader) -> bool {
         let text = &self.text;
         let previous = self.last_parsed.as_deref();
-        let fresh = catch_unwind(AssertUnwindSafe(|| match previous {
-            Some(p) => Analysis::with_previous(text, path, p),
-            None => Analysis::new(text, path),
+        let fresh = catch_unwind(AssertUnwindSafe(|| {
+            Analysis::with_loader(text, path, previous, loader)
         }));
         self.dirty = false;
         match fresh {
@@ -240,11 +241,10 @@ impl<W: std::io::Write> Server<W> {
             note::DidOpenTextDocument::METHOD => {
                 let p: lsp::DidOpenTextDocumentParams = handlers::params(n.params)?;
                 let d = p.text_document;
-                self.docs.insert(
-                    d.uri.as_str().to_string(),
-                    Document::new(d.uri, d.text, d.version),
-                );
-                self.changed();
+                let key = d.uri.as_str().to_string();
+                self.docs
+                    .insert(key.clone(), Document::new(d.uri, d.text, d.version));
+                self.changed_document(&key);
             }
             note::DidChangeTextDocument::METHOD => {
                 let p: lsp::DidChangeTextDocumentParams = handlers::params(n.params)?;
@@ -257,11 +257,13 @@ impl<W: std::io::Write> Server<W> {
                 }
                 doc.version = p.text_document.version;
                 doc.dirty = true;
-                self.changed();
+                self.changed_document(p.text_document.uri.as_str());
             }
             note::DidCloseTextDocument::METHOD => {
                 let p: lsp::DidCloseTextDocumentParams = handlers::params(n.params)?;
                 if self.docs.remove(p.text_document.uri.as_str()).is_some() {
+                    // Its importers read it from the disk again.
+                    self.changed_document(p.text_document.uri.as_str());
                     return Ok(Some(p.text_document.uri));
                 }
             }
@@ -270,6 +272,21 @@ impl<W: std::io::Write> Server<W> {
             _ => {}
         }
         Ok(None)
+    }
+
+    /// The document `uri` changed (or opened, or closed): check it after the debounce, with the
+    /// documents that import it.
+    fn changed_document(&mut self, uri: &str) {
+        let path = normalised_path(uri);
+        for d in self.docs.values_mut() {
+            if d.analysis
+                .as_ref()
+                .is_some_and(|a| a.imported_paths().any(|p| p == path))
+            {
+                d.dirty = true;
+            }
+        }
+        self.changed();
     }
 
     /// A document changed: check it after the debounce.
@@ -283,9 +300,19 @@ impl<W: std::io::Write> Server<W> {
     fn check_changed(&mut self) -> std::io::Result<()> {
         self.deadline = None;
         self.first_change = None;
+        if !self.docs.values().any(|d| d.dirty) {
+            return Ok(());
+        }
+        // An import of an open document reads its text in the editor, saved or not.
+        let buffers = Buffers(
+            self.docs
+                .iter()
+                .map(|(uri, d)| (normalised_path(uri), d.text.clone()))
+                .collect(),
+        );
         let mut ready = Vec::new();
         for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
-            if !doc.analyse(&convert::file_path(uri)) {
+            if !doc.analyse(&convert::file_path(uri), &buffers) {
                 errln!("clayc lsp: the analysis of `{uri}` panicked");
                 continue;
             }
@@ -314,6 +341,23 @@ impl<W: std::io::Write> Server<W> {
             lsp::notification::PublishDiagnostics::METHOD.to_string(),
             params,
         ))
+    }
+}
+
+/// A document's path as the compiler names an imported file.
+fn normalised_path(uri: &str) -> String {
+    clay_dsl::resolve_import("", &convert::file_path(uri))
+}
+
+/// Imported files for the compiler: the open documents' texts, else the files on disk.
+struct Buffers(HashMap<String, String>);
+
+impl Loader for Buffers {
+    fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
+        match self.0.get(path) {
+            Some(text) => Ok(text.clone().into_bytes()),
+            None => FsLoader.load(path),
+        }
     }
 }
 
