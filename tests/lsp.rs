@@ -754,6 +754,7 @@ fn every_advertised_capability_has_its_row_in_docs_editors_md() {
         "documentHighlightProvider" => "`textDocument/documentHighlight`",
         "completionProvider" => "`textDocument/completion`",
         "documentFormattingProvider" => "`textDocument/formatting`",
+        "documentRangeFormattingProvider" => "`textDocument/rangeFormatting`",
         "renameProvider" => "`textDocument/rename`",
         "documentSymbolProvider" => "`textDocument/documentSymbol`",
         "semanticTokensProvider" => "`textDocument/semanticTokens/full`",
@@ -1065,5 +1066,54 @@ fn references_and_rename_of_an_imported_piece_span_the_open_files() {
         message.contains("site `east` already exists (`") && message.contains("lib.clay` line 10)"),
         "{refused}"
     );
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn range_formatting_prints_the_declarations_the_range_touches() {
+    let good = wall();
+    let model = "    wall = chain brick x 8 at (0, 0)";
+    let messy = good
+        .replace("    vertex sw (0, 0)", "  vertex   sw ( 0,0 )")
+        .replace(model, "  wall = chain brick x 8 at (0,0)");
+    let mut c = Client::start();
+    c.open(&messy);
+    // A range inside the piece: the piece is printed, the model stays as it was.
+    let inside = at(&messy, "vertex   sw", 0, 3);
+    let edits = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, inside, inside + 2),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    let edits = edits.as_array().unwrap();
+    assert_eq!(edits.len(), 1, "{edits:?}");
+    assert_eq!(
+        apply(&messy, edits),
+        good.replace(model, "  wall = chain brick x 8 at (0,0)")
+    );
+    // A range over both: all of it, as `textDocument/formatting` would.
+    let edits = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, 0, messy.len()),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    assert_eq!(apply(&messy, edits.as_array().unwrap()), good);
+    // While the text does not parse: nothing.
+    c.change(2, &format!("{messy}\npiece {{"));
+    let none = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, inside, inside + 2),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    assert_eq!(none, Value::Null);
     assert!(c.shutdown_and_exit().success());
 }

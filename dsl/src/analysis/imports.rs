@@ -59,7 +59,8 @@ mod tests {
 
     #[test]
     fn an_imported_piece_answers_also_while_the_text_does_not_parse() {
-        let dir = std::env::temp_dir().join(format!("clay-analysis-imports-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("clay-analysis-imports-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let lib = "site type joint\npiece brick {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \
                    vertex c (1, 1)\n    edges a-b-c-a\n}\n";
@@ -74,7 +75,10 @@ mod tests {
         assert!(good.path(1).ends_with("/lib.clay"), "{}", good.path(1));
         let decl = lib.find("brick").unwrap();
         assert_eq!((place.span.start, place.span.end), (decl, decl + 5));
-        assert_eq!(good.declared_at(good.path(1), place.span), good.symbol_at(use_at));
+        assert_eq!(
+            good.declared_at(good.path(1), place.span),
+            good.symbol_at(use_at)
+        );
 
         // A syntax error before the model: the imports of the last good text still answer.
         let broken = main.replace("\n\nmodel", "\npiece {\n\nmodel");

@@ -571,6 +571,29 @@ impl Analysis {
         crate::format(self.text()).ok()
     }
 
+    /// Edits that put the top-level declarations overlapping `range` in the canonical style
+    /// (each replaced whole by its printed form; the text between declarations is left as it
+    /// is), or `None` when the text does not parse.
+    pub fn format_range(&self, range: Span) -> Option<Vec<(Span, String)>> {
+        let ours = self.tree.as_ref().filter(|_| self.parses())?;
+        let formatted = crate::format(self.text()).ok()?;
+        // The printer keeps every item, in order: the nth item of its output is the nth here.
+        let theirs = crate::parse(&formatted).ok()?;
+        if theirs.items.len() != ours.items.len() {
+            return None;
+        }
+        let overlaps = |s: Span| s.start <= range.end && range.start <= s.end;
+        Some(
+            ours.items
+                .iter()
+                .zip(&theirs.items)
+                .map(|(a, b)| (a.span(), &formatted[b.span().start..b.span().end]))
+                .filter(|(a, b)| overlaps(*a) && self.source(*a) != *b)
+                .map(|(a, b)| (a, b.to_string()))
+                .collect(),
+        )
+    }
+
     /// Fixes offered for a diagnostic of this text.
     pub fn fixes(&self, d: &Diagnostic) -> Vec<Fix> {
         let mut fixes = Vec::new();

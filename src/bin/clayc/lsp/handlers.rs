@@ -62,6 +62,7 @@ pub fn initialize_result() -> lsp::InitializeResult {
                 ..Default::default()
             }),
             document_formatting_provider: Some(OneOf::Left(true)),
+            document_range_formatting_provider: Some(OneOf::Left(true)),
             rename_provider: Some(OneOf::Right(RenameOptions {
                 prepare_provider: Some(true),
                 work_done_progress_options: Default::default(),
@@ -101,6 +102,7 @@ pub fn handle(docs: &Docs, method: &str, p: Value) -> Answer {
         }
         req::Completion::METHOD => on::<req::Completion>(p, |p| docs.completion(p)),
         req::Formatting::METHOD => on::<req::Formatting>(p, |p| docs.formatting(p)),
+        req::RangeFormatting::METHOD => on::<req::RangeFormatting>(p, |p| docs.range_formatting(p)),
         req::PrepareRenameRequest::METHOD => {
             on::<req::PrepareRenameRequest>(p, |p| docs.prepare_rename(p))
         }
@@ -312,6 +314,22 @@ impl Open<'_> {
             convert::range(a.line_index(), whole),
             formatted,
         )]))
+    }
+
+    /// The top-level declarations the range touches, each in the canonical style; nothing
+    /// while the text does not parse.
+    fn range_formatting(
+        &self,
+        p: lsp::DocumentRangeFormattingParams,
+    ) -> Result<Option<Vec<lsp::TextEdit>>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        let index = a.line_index();
+        Ok(a.format_range(convert::span(index, p.range)).map(|edits| {
+            edits
+                .into_iter()
+                .map(|(s, text)| lsp::TextEdit::new(convert::range(index, s), text))
+                .collect()
+        }))
     }
 
     fn prepare_rename(
