@@ -94,8 +94,15 @@ struct Client {
 
 impl Client {
     fn spawn() -> Self {
+        // No following Clay editor: a folder that does not exist.
+        Self::spawn_following(&std::env::temp_dir().join("clay-lsp-tests-follow-nobody"))
+    }
+
+    /// A server whose channel to a following Clay editor is the folder `follow`.
+    fn spawn_following(follow: &std::path::Path) -> Self {
         let mut child = Command::new(env!("CARGO_BIN_EXE_clayc"))
             .arg("lsp")
+            .env("CLAY_FOLLOW_DIR", follow)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -139,7 +146,10 @@ impl Client {
 
     /// A server past `initialize` and `initialized`.
     fn start() -> Self {
-        let mut c = Self::spawn();
+        Self::initialised(Self::spawn())
+    }
+
+    fn initialised(mut c: Self) -> Self {
         let init = c.request("initialize", json!({ "capabilities": {} }));
         assert!(init["result"]["capabilities"].is_object(), "{init}");
         c.notify("initialized", json!({}));
@@ -1115,5 +1125,62 @@ fn range_formatting_prints_the_declarations_the_range_touches() {
         }),
     );
     assert_eq!(none, Value::Null);
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn the_cursor_is_published_for_the_clay_editor_and_its_reveal_shows_the_declaration() {
+    let l = Library::new("follow");
+    let channel = l.dir.join("follow");
+    std::fs::create_dir_all(&channel).unwrap();
+    let mut c = Client::initialised(Client::spawn_following(&channel));
+    c.open_as(&l.main_uri, &l.main);
+    let main_path = l.dir.join("main.clay").display().to_string();
+    let cursor = || -> Value {
+        serde_json::from_slice(&std::fs::read(channel.join("cursor.json")).unwrap()).unwrap()
+    };
+
+    // The cursor on the chain (a documentHighlight), then on a site of the imported piece (a
+    // hover): each is written for the Clay editor.
+    c.result(
+        "textDocument/documentHighlight",
+        at_in(&l.main_uri, &l.main, at(&l.main, "wall", 0, 1)),
+    );
+    assert_eq!(
+        cursor(),
+        json!({ "file": main_path, "kind": "chain", "name": "wall", "piece": "brick" })
+    );
+    c.result(
+        "textDocument/hover",
+        at_in(&l.main_uri, &l.main, at(&l.main, "from west", 0, 5)),
+    );
+    assert_eq!(
+        cursor(),
+        json!({ "file": main_path, "kind": "site", "name": "west", "piece": "brick" })
+    );
+
+    // The Clay editor asks for a site's declaration: the server asks the client to show it,
+    // in the library.
+    let reveal = json!({ "file": main_path, "kind": "site", "name": "east", "piece": "brick" });
+    let tmp = channel.join(".reveal.tmp");
+    std::fs::write(&tmp, reveal.to_string()).unwrap();
+    std::fs::rename(&tmp, channel.join("reveal.json")).unwrap();
+    let shown = loop {
+        let m = c.recv();
+        if m["method"] == "window/showDocument" {
+            break m;
+        }
+        c.stash.push(m);
+    };
+    assert!(
+        shown["id"].is_string() || shown["id"].is_number(),
+        "{shown}"
+    );
+    assert_eq!(shown["params"]["uri"], l.lib_uri.as_str());
+    assert_eq!(shown["params"]["takeFocus"], true);
+    let east = at(&l.lib, "site east", 0, 5);
+    assert_eq!(shown["params"]["selection"], range(&l.lib, east, east + 4));
+    // The client's answer is taken, and the server goes on.
+    c.send(&json!({ "jsonrpc": "2.0", "id": shown["id"], "result": { "success": true } }));
     assert!(c.shutdown_and_exit().success());
 }

@@ -18,6 +18,7 @@
 //! here (how `clayc lsp` gathers references and renames over every open file).
 
 mod complete;
+pub mod follow;
 mod imports;
 mod symbols;
 mod tokens;

@@ -4,6 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use clay_dsl::analysis::Analysis;
+use clay_dsl::analysis::follow::Focus;
 use clay_dsl::syntax::Span;
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types as lsp;
@@ -120,6 +121,23 @@ pub fn handle(docs: &Docs, method: &str, p: Value) -> Answer {
             format!("`{method}` is not supported"),
         )),
     }
+}
+
+/// Where the declaration a following Clay editor names lies: in the open documents of its
+/// file (or any open document that knows it), else in the file read from the disk.
+pub fn declaration(docs: &Docs, focus: &Focus) -> Option<lsp::Location> {
+    let open = Open(docs);
+    let mut all = open.analyses();
+    all.sort_by_key(|(_, a)| !super::follow::same_file(a.path(0), &focus.file));
+    for (uri, a) in all {
+        if let Some(span) = a.declaration_of(focus) {
+            return open.location(uri, a, span);
+        }
+    }
+    let text = std::fs::read_to_string(&focus.file).ok()?;
+    let a = Analysis::new(&text, &focus.file);
+    let span = a.declaration_of(focus)?;
+    open.location(&convert::file_uri(&focus.file)?, &a, span)
 }
 
 /// Reads the params of request `R`, runs `f`, writes its result.

@@ -12,6 +12,7 @@
 //! analysis becomes an error response (or a log line) and the server goes on.
 
 mod convert;
+mod follow;
 mod handlers;
 mod transport;
 
@@ -47,21 +48,25 @@ pub fn lsp(_args: LspArgs) -> u8 {
     let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
     let mut server = Server::new(Writer::new(std::io::stdout().lock()));
     loop {
-        let next = match server.deadline {
-            Some(deadline) => {
-                match input.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-                    Ok(m) => Some(m),
-                    Err(RecvTimeoutError::Timeout) => {
-                        if let Err(e) = server.check_changed() {
-                            errln!("clayc lsp: cannot write to the client: {e}");
-                            return 1;
-                        }
-                        continue;
-                    }
-                    Err(RecvTimeoutError::Disconnected) => None,
+        // Wake for the debounce's deadline, and every so often for the Clay editor's reveals.
+        let wait = server
+            .deadline
+            .map_or(follow::POLL, |d| {
+                d.saturating_duration_since(Instant::now())
+            })
+            .min(follow::POLL);
+        let next = match input.recv_timeout(wait) {
+            Ok(m) => Some(m),
+            Err(RecvTimeoutError::Timeout) => {
+                let due = server.deadline.is_some_and(|d| d <= Instant::now());
+                let done = if due { server.check_changed() } else { Ok(()) };
+                if let Err(e) = done.and_then(|()| server.reveal()) {
+                    errln!("clayc lsp: cannot write to the client: {e}");
+                    return 1;
                 }
+                continue;
             }
-            None => input.recv().ok(),
+            Err(RecvTimeoutError::Disconnected) => None,
         };
         let Some(next) = next else {
             errln!("clayc lsp: the client closed the connection without `exit`");
@@ -141,19 +146,76 @@ struct Server<W: std::io::Write> {
     deadline: Option<Instant>,
     /// When the oldest unchecked change came.
     first_change: Option<Instant>,
+    /// What the cursor is on, for a following Clay editor.
+    cursor: follow::Cursor,
+    reveals: follow::Reveals,
+    /// Requests sent to the client (`window/showDocument`), for their ids.
+    sent: u64,
 }
 
 type Flow = std::io::Result<Option<u8>>;
 
 impl<W: std::io::Write> Server<W> {
     fn new(out: Writer<W>) -> Self {
+        let channel = clay_dsl::analysis::follow::channel();
         Self {
             out,
             state: State::Uninitialised,
             docs: HashMap::new(),
             deadline: None,
             first_change: None,
+            cursor: follow::Cursor::new(channel.clone()),
+            reveals: follow::Reveals::new(&channel),
+            sent: 0,
         }
+    }
+
+    /// Publishes what the cursor is on when a request tells where it is (`documentHighlight`
+    /// and `hover` come as it moves).
+    fn follow_cursor(&mut self, method: &str, params: &serde_json::Value) {
+        use lsp::request::{DocumentHighlightRequest, HoverRequest, Request as _};
+        if method != DocumentHighlightRequest::METHOD && method != HoverRequest::METHOD {
+            return;
+        }
+        let docs = &self.docs;
+        let focus = catch_unwind(AssertUnwindSafe(|| {
+            let p: lsp::TextDocumentPositionParams = serde_json::from_value(params.clone()).ok()?;
+            let a = docs
+                .get(p.text_document.uri.as_str())?
+                .analysis
+                .as_deref()?;
+            a.focus(convert::offset(a.line_index(), p.position))
+        }));
+        self.cursor.publish(focus.ok().flatten());
+    }
+
+    /// Asks the client to show the declaration the Clay editor asked for, if one came.
+    fn reveal(&mut self) -> std::io::Result<()> {
+        let Some(focus) = self.reveals.poll() else {
+            return Ok(());
+        };
+        let docs = &self.docs;
+        let found = catch_unwind(AssertUnwindSafe(|| handlers::declaration(docs, &focus)));
+        let Ok(Some(at)) = found else {
+            errln!(
+                "clayc lsp: no declaration of {} `{}` to show",
+                focus.kind,
+                focus.name
+            );
+            return Ok(());
+        };
+        self.sent += 1;
+        let params = lsp::ShowDocumentParams {
+            uri: at.uri,
+            external: Some(false),
+            take_focus: Some(true),
+            selection: Some(at.range),
+        };
+        self.out.send(Request::new(
+            RequestId::from(format!("clay-reveal-{}", self.sent)),
+            "window/showDocument".to_string(),
+            params,
+        ))
     }
 
     fn handle(&mut self, input: Input) -> Flow {
@@ -163,7 +225,11 @@ impl<W: std::io::Write> Server<W> {
                 self.out.send_error(id, code, message)?;
                 Ok(None)
             }
-            Input::Message(Message::Request(r)) => self.request(r),
+            Input::Message(Message::Request(r)) => {
+                let flow = self.request(r);
+                self.reveal()?;
+                flow
+            }
             Input::Message(Message::Notification(n)) => self.notification(n),
             // We send no requests, so no response is awaited.
             Input::Message(Message::Response(_)) => Ok(None),
@@ -204,6 +270,7 @@ impl<W: std::io::Write> Server<W> {
             (State::Running, _) => {
                 // Answers are about the latest text.
                 self.check_changed()?;
+                self.follow_cursor(&r.method, &r.params);
                 let docs = &self.docs;
                 respond(r.id, || handlers::handle(docs, &r.method, r.params))
             }
