@@ -109,6 +109,8 @@ pub struct EditorApp {
     pub refused: Option<(String, Vec<Problem>)>,
     /// The source line the user clicked in the diagnostics.
     pub source_view: Option<panels::SourceView>,
+    /// Following the text editor's cursor (`--follow`).
+    pub follow: Option<crate::follow::Follow>,
 }
 
 /// The action a picked path is for.
@@ -224,6 +226,7 @@ impl EditorApp {
             title: String::new(),
             refused: None,
             source_view: None,
+            follow: None,
         }
     }
 
@@ -261,6 +264,11 @@ impl EditorApp {
     }
 
     /// The grammar file being edited (`None`: the bundled castle).
+    /// The files the last good compile imported.
+    pub fn imported_files(&self) -> &[String] {
+        &self.imports
+    }
+
     pub fn grammar_path(&self) -> Option<&Path> {
         self.grammar_path.as_deref()
     }
@@ -446,6 +454,7 @@ impl EditorApp {
             self.confirm = Some(Action::Quit);
         }
         self.poll_native_dialog(ctx);
+        crate::follow::logic(self, ctx);
         let title = self.title();
         if title != self.title {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
@@ -499,7 +508,10 @@ impl EditorApp {
             .show(ui, |ui| match self.mode {
                 Mode::Sculpt => {
                     self.canvas
-                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands)
+                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
+                    let followed = crate::follow::followed(self);
+                    let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
+                    crate::follow::paint(ui, &self.canvas, grammar, data, &followed);
                 }
                 Mode::Author => {
                     self.author_canvas
