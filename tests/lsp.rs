@@ -1184,3 +1184,115 @@ fn the_cursor_is_published_for_the_clay_editor_and_its_reveal_shows_the_declarat
     c.send(&json!({ "jsonrpc": "2.0", "id": shown["id"], "result": { "success": true } }));
     assert!(c.shutdown_and_exit().success());
 }
+
+/// What the Neovim check does once the grammar is open: wait for the diagnostics, hover at
+/// `CLAY_NVIM_HOVER_LINE`/`_COL`, write both to `CLAY_NVIM_OUT`, quit.
+const NVIM_CHECK: &str = r#"
+local lines = {}
+vim.wait(30000, function() return #vim.diagnostic.get(0) > 0 end, 50)
+for _, d in ipairs(vim.diagnostic.get(0)) do
+  local lsp = d.user_data and d.user_data.lsp or {}
+  table.insert(lines, string.format('diagnostic %s %d:%d %s', d.code or lsp.code or '?',
+    d.lnum + 1, d.col + 1, (d.message:gsub('\n.*', ''))))
+end
+local row = tonumber(os.getenv('CLAY_NVIM_HOVER_LINE'))
+local col = tonumber(os.getenv('CLAY_NVIM_HOVER_COL'))
+vim.api.nvim_win_set_cursor(0, { row, col })
+local params = vim.lsp.util.make_position_params()
+local replies = vim.lsp.buf_request_sync(0, 'textDocument/hover', params, 20000)
+for _, r in pairs(replies or {}) do
+  if r.result then
+    table.insert(lines, 'hover ' .. (r.result.contents.value:gsub('\n', ' | ')))
+  end
+end
+vim.fn.writefile(lines, os.getenv('CLAY_NVIM_OUT'))
+vim.cmd('qa!')
+"#;
+
+/// The first ```` ```lua ```` block after `heading` in docs/editors.md.
+fn lua_block_after(heading: &str) -> String {
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let from = doc.find(heading).expect("the heading");
+    let rest = &doc[from..];
+    let start = rest.find("```lua\n").expect("a lua block") + "```lua\n".len();
+    let len = rest[start..].find("```").unwrap();
+    rest[start..start + len].to_string()
+}
+
+#[test]
+fn neovim_with_the_documented_setup_shows_e011_and_hovers() {
+    // Real Neovim (0.7 or later) when it is installed; `.ci/run` installs it and sets
+    // CLAY_REQUIRE_NVIM so that a missing one fails there.
+    let found = Command::new("nvim")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !found {
+        assert!(
+            std::env::var_os("CLAY_REQUIRE_NVIM").is_none(),
+            "nvim is required"
+        );
+        eprintln!("nvim not installed: the Neovim check is skipped");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("clay-nvim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("init.lua"), lua_block_after("### Neovim")).unwrap();
+    std::fs::write(dir.join("check.lua"), NVIM_CHECK).unwrap();
+    let typo = wall().replace("site west: joint", "site west: jiont");
+    std::fs::write(dir.join("typo.clay"), &typo).unwrap();
+    let clayc = std::path::Path::new(env!("CARGO_BIN_EXE_clayc"));
+    let path = format!(
+        "{}:{}",
+        clayc.parent().unwrap().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let hover = at(&typo, "chain brick", 0, 7);
+    let line_start = typo[..hover].rfind('\n').unwrap() + 1;
+    let status = Command::new("timeout")
+        .args([
+            "120",
+            "nvim",
+            "--headless",
+            "-n",
+            "-i",
+            "NONE",
+            "-u",
+            "init.lua",
+        ])
+        .args(["typo.clay", "-c", "luafile check.lua"])
+        .current_dir(&dir)
+        .env("PATH", path)
+        .env("HOME", &dir)
+        .env("XDG_CONFIG_HOME", dir.join("config"))
+        .env("XDG_DATA_HOME", dir.join("data"))
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .env("XDG_CACHE_HOME", dir.join("cache"))
+        .env("CLAY_FOLLOW_DIR", dir.join("no-follow"))
+        .env("CLAY_NVIM_OUT", dir.join("out.txt"))
+        .env(
+            "CLAY_NVIM_HOVER_LINE",
+            (typo[..hover].matches('\n').count() + 1).to_string(),
+        )
+        .env("CLAY_NVIM_HOVER_COL", (hover - line_start).to_string())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "nvim: {status}");
+    let out = std::fs::read_to_string(dir.join("out.txt")).unwrap();
+    let jiont = at(&typo, "jiont", 0, 0);
+    let line = typo[..jiont].matches('\n').count() + 1;
+    let col = jiont - (typo[..jiont].rfind('\n').unwrap() + 1) + 1;
+    assert!(
+        out.contains(&format!(
+            "diagnostic E011 {line}:{col} unknown site type `jiont`"
+        )),
+        "{out}"
+    );
+    assert!(out.contains("hover ```clay | piece brick |"), "{out}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
