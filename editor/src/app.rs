@@ -264,9 +264,11 @@ impl EditorApp {
     }
 
     /// The grammar file being edited (`None`: the bundled castle).
-    /// The files the last good compile imported.
-    pub fn imported_files(&self) -> &[String] {
-        &self.imports
+    /// What the text editor's cursor is on, in the model (`--follow`).
+    pub fn followed(&self) -> crate::follow::Highlight {
+        self.follow.as_ref().map_or_else(Default::default, |f| {
+            f.followed(self.grammar_path.as_deref(), &self.imports, &self.sculpt)
+        })
     }
 
     pub fn grammar_path(&self) -> Option<&Path> {
@@ -454,7 +456,13 @@ impl EditorApp {
             self.confirm = Some(Action::Quit);
         }
         self.poll_native_dialog(ctx);
-        crate::follow::logic(self, ctx);
+        if let Some(f) = &mut self.follow {
+            let sculpting = self.mode == Mode::Sculpt;
+            let file = self.grammar_path.as_deref();
+            if let Some(m) = f.frame(ctx, sculpting, self.canvas.hovered, file, &self.sculpt) {
+                self.message = Some(m);
+            }
+        }
         let title = self.title();
         if title != self.title {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
@@ -509,9 +517,8 @@ impl EditorApp {
                 Mode::Sculpt => {
                     self.canvas
                         .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
-                    let followed = crate::follow::followed(self);
                     let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
-                    crate::follow::paint(ui, &self.canvas, grammar, data, &followed);
+                    crate::follow::paint(ui, &self.canvas, grammar, data, &self.followed());
                 }
                 Mode::Author => {
                     self.author_canvas

@@ -13,8 +13,8 @@ use clay_dsl::analysis::follow::{self, Focus};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use egui::{Color32, Key, Stroke};
 
-use crate::app::{EditorApp, Mode};
 use crate::canvas::Canvas;
+use crate::sculpt::Sculpt;
 
 /// How often the cursor file is looked at.
 pub const POLL: Duration = Duration::from_millis(150);
@@ -163,38 +163,42 @@ pub fn highlight(focus: &Focus, grammar: &CompiledGrammar, data: &AssemblyData) 
     h
 }
 
-/// Once a frame: reads the cursor file, and `G` over a part asks for its declaration.
-pub fn logic(app: &mut EditorApp, ctx: &egui::Context) {
-    let Some(follow) = &mut app.follow else {
-        return;
-    };
-    if follow.poll() {
-        ctx.request_repaint();
-    }
-    ctx.request_repaint_after(POLL);
-    let key = app.mode == Mode::Sculpt
-        && !ctx.egui_wants_keyboard_input()
-        && ctx.input(|i| i.key_pressed(Key::G));
-    if let (true, Some(part), Some(path)) = (key, app.canvas.hovered, app.grammar_path()) {
-        let path = path.to_path_buf();
-        let grammar = app.sculpt.grammar().clone();
-        if let Some(f) = &mut app.follow {
-            f.reveal(&path, &grammar, app.sculpt.data(), part);
-            app.message = f.message.take();
+impl Follow {
+    /// Once a frame: reads the cursor file, and `G` over the `hovered` part (while sculpting)
+    /// asks for its declaration. Returns a message for the status bar.
+    pub fn frame(
+        &mut self,
+        ctx: &egui::Context,
+        sculpting: bool,
+        hovered: Option<usize>,
+        grammar_file: Option<&Path>,
+        sculpt: &Sculpt,
+    ) -> Option<String> {
+        if self.poll() {
+            ctx.request_repaint();
         }
+        ctx.request_repaint_after(POLL);
+        let key =
+            sculpting && !ctx.egui_wants_keyboard_input() && ctx.input(|i| i.key_pressed(Key::G));
+        if let (true, Some(part), Some(path)) = (key, hovered, grammar_file) {
+            self.reveal(path, sculpt.grammar(), sculpt.data(), part);
+        }
+        self.message.take()
     }
-}
 
-/// The followed instances and sites, for the grammar on screen.
-pub fn followed(app: &EditorApp) -> Highlight {
-    let (Some(f), Some(path)) = (&app.follow, app.grammar_path()) else {
-        return Highlight::default();
-    };
-    match &f.focus {
-        Some(focus) if concerns(&focus.file, path, app.imported_files()) => {
-            highlight(focus, app.sculpt.grammar(), app.sculpt.data())
+    /// The followed instances and sites in the grammar `grammar_file` (importing `imports`).
+    pub fn followed(
+        &self,
+        grammar_file: Option<&Path>,
+        imports: &[String],
+        sculpt: &Sculpt,
+    ) -> Highlight {
+        match (&self.focus, grammar_file) {
+            (Some(focus), Some(path)) if concerns(&focus.file, path, imports) => {
+                highlight(focus, sculpt.grammar(), sculpt.data())
+            }
+            _ => Highlight::default(),
         }
-        _ => Highlight::default(),
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use clay_dsl::analysis::Analysis;
 use clay_dsl::analysis::follow::{self, Focus};
 use clay_editor::EditorApp;
-use clay_editor::follow::{Follow, followed};
+use clay_editor::follow::Follow;
 use egui_kittest::kittest::Queryable;
 
 use common::{harness, settle};
@@ -89,14 +89,14 @@ fn the_cursor_on_a_piece_a_site_or_the_chain_highlights_it_in_the_preview() {
         ("piece", "brick")
     );
     until_followed(&mut h, &piece);
-    let lit = followed(h.state());
+    let lit = h.state().followed();
     assert_eq!(lit.instances, (0..8).collect::<Vec<_>>());
     assert!(lit.sites.is_empty());
 
     // The site `west` (its declaration): the site on every brick.
     let site = s.cursor_at("site west", 5);
     until_followed(&mut h, &site);
-    let lit = followed(h.state());
+    let lit = h.state().followed();
     assert_eq!(lit.sites.len(), 8, "{lit:?}");
     let west = h.state().sculpt.grammar().pieces[0]
         .sites
@@ -109,7 +109,7 @@ fn the_cursor_on_a_piece_a_site_or_the_chain_highlights_it_in_the_preview() {
     let chain = s.cursor_at("wall = chain", 0);
     assert_eq!(chain.kind, "chain");
     until_followed(&mut h, &chain);
-    assert_eq!(followed(h.state()).instances.len(), 8);
+    assert_eq!(h.state().followed().instances.len(), 8);
 
     // A cursor in another grammar lights nothing here.
     let elsewhere = Focus {
@@ -118,7 +118,7 @@ fn the_cursor_on_a_piece_a_site_or_the_chain_highlights_it_in_the_preview() {
     };
     follow::write(&s.channel(), follow::CURSOR, &elsewhere).unwrap();
     until_followed(&mut h, &elsewhere);
-    assert_eq!(followed(h.state()), Default::default());
+    assert_eq!(h.state().followed(), Default::default());
     h.step();
 }
 
