@@ -138,8 +138,7 @@ pub fn highlight(focus: &Focus, grammar: &CompiledGrammar, data: &AssemblyData) 
                 .collect();
         }
         "site" => {
-            h.instances = of_piece(piece);
-            for &i in &h.instances {
+            for i in of_piece(piece) {
                 if let Some(s) = piece_of(i).sites.iter().position(|s| s.name == focus.name) {
                     h.sites.push((i, s));
                 }

@@ -98,6 +98,10 @@ fn the_cursor_on_a_piece_a_site_or_the_chain_highlights_it_in_the_preview() {
     until_followed(&mut h, &site);
     let lit = h.state().followed();
     assert_eq!(lit.sites.len(), 8, "{lit:?}");
+    assert!(
+        lit.instances.is_empty(),
+        "a site is ringed, its pieces are not outlined"
+    );
     let west = h.state().sculpt.grammar().pieces[0]
         .sites
         .iter()
