@@ -124,21 +124,30 @@ impl Analysis {
             }
         };
         let (imported, imported_items) = Imported::of(&sources, text.len());
-        // The text's own items, then what its imports declare.
-        let all = crate::syntax::File {
-            items: tree
-                .iter()
-                .flat_map(|t| t.items.iter().cloned())
-                .chain(imported_items)
-                .collect(),
-            span: Span::new(0, text.len()),
+        // The text's own items, then what its imports declare (a copy only when there are
+        // imports: the common case reads the tree as it is).
+        let joined;
+        let all = match &tree {
+            Some(t) if imported_items.is_empty() => t,
+            _ => {
+                joined = crate::syntax::File {
+                    items: tree
+                        .iter()
+                        .flat_map(|t| t.items.iter().cloned())
+                        .chain(imported_items)
+                        .collect(),
+                    span: Span::new(0, text.len()),
+                };
+                &joined
+            }
         };
+        let (symbols, values) = (Symbols::of(all), crate::compile::constant_values(all));
         let mut a = Self {
             index: LineIndex::new(text),
             path: crate::resolve_import("", path),
             imported,
-            symbols: Symbols::of(&all),
-            values: crate::compile::constant_values(&all),
+            symbols,
+            values,
             tree,
             parsed_to,
             diagnostics,
