@@ -1296,3 +1296,32 @@ fn neovim_with_the_documented_setup_shows_e011_and_hovers() {
     assert!(out.contains("hover ```clay | piece brick |"), "{out}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_open_library_is_read_from_its_buffer_and_its_change_rechecks_the_importer() {
+    let l = Library::new("buffers");
+    let mut c = Client::start();
+    assert_eq!(c.open_as(&l.main_uri, &l.main)["diagnostics"], json!([]));
+    c.open_as(&l.lib_uri, &l.lib);
+    // Opening the library re-checks the grammar that imports it (against the same text).
+    assert_eq!(c.published(&l.main_uri, None)["diagnostics"], json!([]));
+    // The library's piece renamed in the editor, not saved: the grammar importing it is
+    // checked again against the buffer, and its uses of `brick` are unknown now.
+    c.change_uri(&l.lib_uri, 2, &l.lib.replace("piece brick", "piece block"));
+    let published = c.published(&l.main_uri, None);
+    let diags = published["diagnostics"].as_array().unwrap();
+    assert!(!diags.is_empty(), "{published}");
+    assert!(
+        diags
+            .iter()
+            .all(|d| d["message"].as_str().unwrap().contains("`brick`")),
+        "{published}"
+    );
+    // The disk still has `brick`: closing the buffer re-checks the grammar against the file.
+    c.notify(
+        "textDocument/didClose",
+        json!({ "textDocument": { "uri": l.lib_uri } }),
+    );
+    assert_eq!(c.published(&l.main_uri, None)["diagnostics"], json!([]));
+    assert!(c.shutdown_and_exit().success());
+}
