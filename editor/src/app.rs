@@ -263,7 +263,6 @@ impl EditorApp {
         }
     }
 
-    /// The grammar file being edited (`None`: the bundled castle).
     /// What the text editor's cursor is on, in the model (`--follow`).
     pub fn followed(&self) -> crate::follow::Highlight {
         self.follow.as_ref().map_or_else(Default::default, |f| {
@@ -271,6 +270,7 @@ impl EditorApp {
         })
     }
 
+    /// The grammar file being edited (`None`: the bundled castle).
     pub fn grammar_path(&self) -> Option<&Path> {
         self.grammar_path.as_deref()
     }
