@@ -96,7 +96,7 @@ impl Follow {
             name,
         };
         self.message = Some(match follow::write(&self.dir, follow::REVEAL, &focus) {
-            Ok(()) => format!("shown in the text editor: `{}`", focus.name),
+            Ok(()) => format!("asked the text editor to show `{}`", focus.name),
             Err(e) => format!("cannot ask the text editor: {e}"),
         });
     }
