@@ -94,8 +94,15 @@ struct Client {
 
 impl Client {
     fn spawn() -> Self {
+        // No following Clay editor: a folder that does not exist.
+        Self::spawn_following(&std::env::temp_dir().join("clay-lsp-tests-follow-nobody"))
+    }
+
+    /// A server whose channel to a following Clay editor is the folder `follow`.
+    fn spawn_following(follow: &std::path::Path) -> Self {
         let mut child = Command::new(env!("CARGO_BIN_EXE_clayc"))
             .arg("lsp")
+            .env("CLAY_FOLLOW_DIR", follow)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -139,7 +146,10 @@ impl Client {
 
     /// A server past `initialize` and `initialized`.
     fn start() -> Self {
-        let mut c = Self::spawn();
+        Self::initialised(Self::spawn())
+    }
+
+    fn initialised(mut c: Self) -> Self {
         let init = c.request("initialize", json!({ "capabilities": {} }));
         assert!(init["result"]["capabilities"].is_object(), "{init}");
         c.notify("initialized", json!({}));
@@ -218,10 +228,14 @@ impl Client {
     }
 
     fn change(&mut self, version: i32, text: &str) {
+        self.change_uri(URI, version, text);
+    }
+
+    fn change_uri(&mut self, uri: &str, version: i32, text: &str) {
         self.notify(
             "textDocument/didChange",
             json!({
-                "textDocument": { "uri": URI, "version": version },
+                "textDocument": { "uri": uri, "version": version },
                 "contentChanges": [{ "text": text }],
             }),
         );
@@ -750,6 +764,7 @@ fn every_advertised_capability_has_its_row_in_docs_editors_md() {
         "documentHighlightProvider" => "`textDocument/documentHighlight`",
         "completionProvider" => "`textDocument/completion`",
         "documentFormattingProvider" => "`textDocument/formatting`",
+        "documentRangeFormattingProvider" => "`textDocument/rangeFormatting`",
         "renameProvider" => "`textDocument/rename`",
         "documentSymbolProvider" => "`textDocument/documentSymbol`",
         "semanticTokensProvider" => "`textDocument/semanticTokens/full`",
@@ -838,4 +853,475 @@ fn imports_are_read_from_the_documents_folder_on_disk() {
         json!({ "line": 5, "character": 16 })
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A library declaring `brick` (with its site type and sites) and a grammar using it, in a
+/// folder of their own; the URIs of both.
+struct Library {
+    dir: std::path::PathBuf,
+    lib: String,
+    main: String,
+    lib_uri: String,
+    main_uri: String,
+}
+
+const LIB: &str = "site type joint\n\npiece brick {\n    vertex sw (0, 0)\n    vertex se (1, 0)\n    \
+                   vertex ne (1, 0.5)\n    vertex nw (0, 0.5)\n    edges sw-se-ne-nw-sw, sw-ne\n    \
+                   site west: joint [nw, sw] out (-1, 0)\n    site east: joint [se, ne] out (1, 0)\n}\n";
+const MAIN: &str = "import \"lib.clay\"\n\nstretch brick from west to east\n\nmodel {\n    wall = chain brick x 3\n}\n";
+
+impl Library {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("clay-lsp-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("lib.clay"), LIB).unwrap();
+        std::fs::write(dir.join("main.clay"), MAIN).unwrap();
+        let uri = |f: &str| format!("file://{}/{f}", dir.display());
+        Self {
+            lib_uri: uri("lib.clay"),
+            main_uri: uri("main.clay"),
+            dir,
+            lib: LIB.into(),
+            main: MAIN.into(),
+        }
+    }
+}
+
+impl Drop for Library {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+impl Client {
+    /// Opens `text` as `uri` and returns its first published diagnostics.
+    fn open_as(&mut self, uri: &str, text: &str) -> Value {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": uri, "languageId": "clay", "version": 1, "text": text } }),
+        );
+        self.published(uri, None)
+    }
+
+    /// The next diagnostics published for `uri` (of `version`, when given).
+    fn published(&mut self, uri: &str, version: Option<i32>) -> Value {
+        let is_it = |m: &Value| {
+            m["method"] == "textDocument/publishDiagnostics"
+                && m["params"]["uri"] == uri
+                && version.is_none_or(|v| m["params"]["version"] == v)
+        };
+        if let Some(i) = self.stash.iter().position(is_it) {
+            return self.stash.remove(i)["params"].clone();
+        }
+        loop {
+            let m = self.recv();
+            if is_it(&m) {
+                return m["params"].clone();
+            }
+            self.stash.push(m);
+        }
+    }
+}
+
+fn at_in(uri: &str, text: &str, offset: usize) -> Value {
+    json!({ "textDocument": { "uri": uri }, "position": pos(text, offset) })
+}
+
+#[test]
+fn definition_hover_and_completion_reach_into_an_imported_file() {
+    let l = Library::new("queries");
+    let mut c = Client::start();
+    assert_eq!(c.open_as(&l.main_uri, &l.main)["diagnostics"], json!([]));
+    let brick_use = at(&l.main, "chain brick", 0, 6);
+
+    // Definition: the library's URI, the range of the name in the library.
+    let def = c.result(
+        "textDocument/definition",
+        at_in(&l.main_uri, &l.main, brick_use),
+    );
+    assert_eq!(def["uri"], l.lib_uri.as_str(), "{def}");
+    let decl = at(&l.lib, "piece brick", 0, 6);
+    assert_eq!(def["range"], range(&l.lib, decl, decl + 5));
+    // A site of the imported piece, from the rule in the document.
+    let west = at(&l.main, "from west", 0, 5);
+    let def = c.result("textDocument/definition", at_in(&l.main_uri, &l.main, west));
+    assert_eq!(def["uri"], l.lib_uri.as_str());
+    let site = at(&l.lib, "site west", 0, 5);
+    assert_eq!(def["range"], range(&l.lib, site, site + 4));
+
+    // Hover: the imported declaration, its members, and which file it is in.
+    let hover = c.result("textDocument/hover", at_in(&l.main_uri, &l.main, brick_use));
+    let text = hover["contents"]["value"].as_str().unwrap();
+    assert!(text.contains("piece brick"), "{text}");
+    assert!(
+        text.contains("`west: joint [nw, sw] out (-1, 0)`"),
+        "{text}"
+    );
+    assert!(text.contains("/lib.clay`"), "{text}");
+    assert_eq!(
+        hover["range"],
+        range(&l.main, brick_use, brick_use + 5),
+        "{hover}"
+    );
+
+    // Completion: the imported piece after `chain`, its sites after `brick.`.
+    let edited = l.main.replace("chain brick x 3", "chain b");
+    c.change_uri(&l.main_uri, 2, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, at(&edited, "chain b", 0, 7)),
+    );
+    let labels = |items: &Value| -> Vec<String> {
+        items
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|i| i["label"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert!(labels(&items).contains(&"brick".to_string()), "{items}");
+    let edited = format!("{}\nmerge brick.", l.main);
+    c.change_uri(&l.main_uri, 3, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, edited.len()),
+    );
+    assert_eq!(labels(&items), ["west", "east"], "{items}");
+    let edited = format!("{}\nsite type cap docks ", l.main);
+    c.change_uri(&l.main_uri, 4, &edited);
+    let items = c.result(
+        "textDocument/completion",
+        at_in(&l.main_uri, &edited, edited.len()),
+    );
+    assert!(labels(&items).contains(&"joint".to_string()), "{items}");
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn references_and_rename_of_an_imported_piece_span_the_open_files() {
+    let l = Library::new("rename");
+    let mut c = Client::start();
+    c.open_as(&l.main_uri, &l.main);
+    c.open_as(&l.lib_uri, &l.lib);
+
+    // Asked in the library: its own declaration and the two uses in the open grammar.
+    let decl = at(&l.lib, "piece brick", 0, 6);
+    let refs = c.result(
+        "textDocument/references",
+        json!({
+            "textDocument": { "uri": l.lib_uri },
+            "position": pos(&l.lib, decl),
+            "context": { "includeDeclaration": true },
+        }),
+    );
+    let mut found: Vec<(String, Value)> = refs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["uri"].as_str().unwrap().to_string(), r["range"].clone()))
+        .collect();
+    found.sort_by_key(|f| (f.0.clone(), f.1.to_string()));
+    let in_main = |needle: &str| {
+        let s = at(&l.main, needle, 0, needle.len() - 5);
+        (l.main_uri.clone(), range(&l.main, s, s + 5))
+    };
+    let mut want = vec![
+        (l.lib_uri.clone(), range(&l.lib, decl, decl + 5)),
+        in_main("stretch brick"),
+        in_main("chain brick"),
+    ];
+    want.sort_by_key(|f| (f.0.clone(), f.1.to_string()));
+    assert_eq!(found, want);
+
+    // Rename from a use in the grammar: one edit list per file, and both check clean after.
+    let edit = c.result(
+        "textDocument/rename",
+        json!({
+            "textDocument": { "uri": l.main_uri },
+            "position": pos(&l.main, at(&l.main, "chain brick", 0, 7)),
+            "newName": "block",
+        }),
+    );
+    let changes = edit["changes"].as_object().unwrap();
+    assert_eq!(changes.len(), 2, "{edit}");
+    let lib = apply(&l.lib, changes[&l.lib_uri].as_array().unwrap());
+    let main = apply(&l.main, changes[&l.main_uri].as_array().unwrap());
+    assert_eq!(lib, l.lib.replace("piece brick", "piece block"));
+    assert_eq!(main, l.main.replace("brick", "block"));
+    c.change_uri(&l.lib_uri, 2, &lib);
+    c.change_uri(&l.main_uri, 2, &main);
+    // (The library alone has no model: a warning, no error.)
+    let lib_diags = c.published(&l.lib_uri, Some(2));
+    assert!(
+        lib_diags["diagnostics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|d| d["severity"] != 1),
+        "{lib_diags}"
+    );
+    assert_eq!(c.published(&l.main_uri, Some(2))["diagnostics"], json!([]));
+
+    // A clash in the library refuses the rename, naming the file.
+    let refused = c.request(
+        "textDocument/rename",
+        json!({
+            "textDocument": { "uri": l.main_uri },
+            "position": pos(&main, at(&main, "from west", 0, 5)),
+            "newName": "east",
+        }),
+    );
+    let message = refused["error"]["message"].as_str().unwrap();
+    assert!(
+        message.contains("site `east` already exists (`") && message.contains("lib.clay` line 10)"),
+        "{refused}"
+    );
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn range_formatting_prints_the_declarations_the_range_touches() {
+    let good = wall();
+    let model = "    wall = chain brick x 8 at (0, 0)";
+    let messy = good
+        .replace("    vertex sw (0, 0)", "  vertex   sw ( 0,0 )")
+        .replace(model, "  wall = chain brick x 8 at (0,0)");
+    let mut c = Client::start();
+    c.open(&messy);
+    // A range inside the piece: the piece is printed, the model stays as it was.
+    let inside = at(&messy, "vertex   sw", 0, 3);
+    let edits = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, inside, inside + 2),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    let edits = edits.as_array().unwrap();
+    assert_eq!(edits.len(), 1, "{edits:?}");
+    assert_eq!(
+        apply(&messy, edits),
+        good.replace(model, "  wall = chain brick x 8 at (0,0)")
+    );
+    // A range over both: all of it, as `textDocument/formatting` would.
+    let edits = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, 0, messy.len()),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    assert_eq!(apply(&messy, edits.as_array().unwrap()), good);
+    // While the text does not parse: nothing.
+    c.change(2, &format!("{messy}\npiece {{"));
+    let none = c.result(
+        "textDocument/rangeFormatting",
+        json!({
+            "textDocument": doc(),
+            "range": range(&messy, inside, inside + 2),
+            "options": { "tabSize": 4, "insertSpaces": true },
+        }),
+    );
+    assert_eq!(none, Value::Null);
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn the_cursor_is_published_for_the_clay_editor_and_its_reveal_shows_the_declaration() {
+    let l = Library::new("follow");
+    let channel = l.dir.join("follow");
+    std::fs::create_dir_all(&channel).unwrap();
+    let mut c = Client::initialised(Client::spawn_following(&channel));
+    c.open_as(&l.main_uri, &l.main);
+    let main_path = l.dir.join("main.clay").display().to_string();
+    let cursor = || -> Value {
+        serde_json::from_slice(&std::fs::read(channel.join("cursor.json")).unwrap()).unwrap()
+    };
+
+    // The cursor on the chain (a documentHighlight), then on a site of the imported piece (a
+    // hover): each is written for the Clay editor.
+    c.result(
+        "textDocument/documentHighlight",
+        at_in(&l.main_uri, &l.main, at(&l.main, "wall", 0, 1)),
+    );
+    assert_eq!(
+        cursor(),
+        json!({ "file": main_path, "kind": "chain", "name": "wall", "piece": "brick" })
+    );
+    c.result(
+        "textDocument/hover",
+        at_in(&l.main_uri, &l.main, at(&l.main, "from west", 0, 5)),
+    );
+    assert_eq!(
+        cursor(),
+        json!({ "file": main_path, "kind": "site", "name": "west", "piece": "brick" })
+    );
+
+    // The Clay editor asks for a site's declaration: the server asks the client to show it,
+    // in the library.
+    let reveal = json!({ "file": main_path, "kind": "site", "name": "east", "piece": "brick" });
+    let tmp = channel.join(".reveal.tmp");
+    std::fs::write(&tmp, reveal.to_string()).unwrap();
+    std::fs::rename(&tmp, channel.join("reveal.json")).unwrap();
+    let shown = loop {
+        let m = c.recv();
+        if m["method"] == "window/showDocument" {
+            break m;
+        }
+        c.stash.push(m);
+    };
+    assert!(
+        shown["id"].is_string() || shown["id"].is_number(),
+        "{shown}"
+    );
+    assert_eq!(shown["params"]["uri"], l.lib_uri.as_str());
+    assert_eq!(shown["params"]["takeFocus"], true);
+    let east = at(&l.lib, "site east", 0, 5);
+    assert_eq!(shown["params"]["selection"], range(&l.lib, east, east + 4));
+    // The client's answer is taken, and the server goes on.
+    c.send(&json!({ "jsonrpc": "2.0", "id": shown["id"], "result": { "success": true } }));
+    assert!(c.shutdown_and_exit().success());
+}
+
+/// What the Neovim check does once the grammar is open: wait for the diagnostics, hover at
+/// `CLAY_NVIM_HOVER_LINE`/`_COL`, write both to `CLAY_NVIM_OUT`, quit.
+const NVIM_CHECK: &str = r#"
+local lines = {}
+vim.wait(30000, function() return #vim.diagnostic.get(0) > 0 end, 50)
+for _, d in ipairs(vim.diagnostic.get(0)) do
+  local lsp = d.user_data and d.user_data.lsp or {}
+  table.insert(lines, string.format('diagnostic %s %d:%d %s', d.code or lsp.code or '?',
+    d.lnum + 1, d.col + 1, (d.message:gsub('\n.*', ''))))
+end
+local row = tonumber(os.getenv('CLAY_NVIM_HOVER_LINE'))
+local col = tonumber(os.getenv('CLAY_NVIM_HOVER_COL'))
+vim.api.nvim_win_set_cursor(0, { row, col })
+local params = vim.lsp.util.make_position_params()
+local replies = vim.lsp.buf_request_sync(0, 'textDocument/hover', params, 20000)
+for _, r in pairs(replies or {}) do
+  if r.result then
+    table.insert(lines, 'hover ' .. (r.result.contents.value:gsub('\n', ' | ')))
+  end
+end
+vim.fn.writefile(lines, os.getenv('CLAY_NVIM_OUT'))
+vim.cmd('qa!')
+"#;
+
+/// The first ```` ```lua ```` block after `heading` in docs/editors.md.
+fn lua_block_after(heading: &str) -> String {
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let from = doc.find(heading).expect("the heading");
+    let rest = &doc[from..];
+    let start = rest.find("```lua\n").expect("a lua block") + "```lua\n".len();
+    let len = rest[start..].find("```").unwrap();
+    rest[start..start + len].to_string()
+}
+
+#[test]
+fn neovim_with_the_documented_setup_shows_e011_and_hovers() {
+    // Real Neovim (0.7 or later) when it is installed; `.ci/run` installs it and sets
+    // CLAY_REQUIRE_NVIM so that a missing one fails there.
+    let found = Command::new("nvim")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !found {
+        assert!(
+            std::env::var_os("CLAY_REQUIRE_NVIM").is_none(),
+            "nvim is required"
+        );
+        eprintln!("nvim not installed: the Neovim check is skipped");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("clay-nvim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("init.lua"), lua_block_after("### Neovim")).unwrap();
+    std::fs::write(dir.join("check.lua"), NVIM_CHECK).unwrap();
+    let typo = wall().replace("site west: joint", "site west: jiont");
+    std::fs::write(dir.join("typo.clay"), &typo).unwrap();
+    let clayc = std::path::Path::new(env!("CARGO_BIN_EXE_clayc"));
+    let path = format!(
+        "{}:{}",
+        clayc.parent().unwrap().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let hover = at(&typo, "chain brick", 0, 7);
+    let line_start = typo[..hover].rfind('\n').unwrap() + 1;
+    let status = Command::new("timeout")
+        .args([
+            "120",
+            "nvim",
+            "--headless",
+            "-n",
+            "-i",
+            "NONE",
+            "-u",
+            "init.lua",
+        ])
+        .args(["typo.clay", "-c", "luafile check.lua"])
+        .current_dir(&dir)
+        .env("PATH", path)
+        .env("HOME", &dir)
+        .env("XDG_CONFIG_HOME", dir.join("config"))
+        .env("XDG_DATA_HOME", dir.join("data"))
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .env("XDG_CACHE_HOME", dir.join("cache"))
+        .env("CLAY_FOLLOW_DIR", dir.join("no-follow"))
+        .env("CLAY_NVIM_OUT", dir.join("out.txt"))
+        .env(
+            "CLAY_NVIM_HOVER_LINE",
+            (typo[..hover].matches('\n').count() + 1).to_string(),
+        )
+        .env("CLAY_NVIM_HOVER_COL", (hover - line_start).to_string())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "nvim: {status}");
+    let out = std::fs::read_to_string(dir.join("out.txt")).unwrap();
+    let jiont = at(&typo, "jiont", 0, 0);
+    let line = typo[..jiont].matches('\n').count() + 1;
+    let col = jiont - (typo[..jiont].rfind('\n').unwrap() + 1) + 1;
+    assert!(
+        out.contains(&format!(
+            "diagnostic E011 {line}:{col} unknown site type `jiont`"
+        )),
+        "{out}"
+    );
+    assert!(out.contains("hover ```clay | piece brick |"), "{out}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_open_library_is_read_from_its_buffer_and_its_change_rechecks_the_importer() {
+    let l = Library::new("buffers");
+    let mut c = Client::start();
+    assert_eq!(c.open_as(&l.main_uri, &l.main)["diagnostics"], json!([]));
+    c.open_as(&l.lib_uri, &l.lib);
+    // Opening the library re-checks the grammar that imports it (against the same text).
+    assert_eq!(c.published(&l.main_uri, None)["diagnostics"], json!([]));
+    // The library's piece renamed in the editor, not saved: the grammar importing it is
+    // checked again against the buffer, and its uses of `brick` are unknown now.
+    c.change_uri(&l.lib_uri, 2, &l.lib.replace("piece brick", "piece block"));
+    let published = c.published(&l.main_uri, None);
+    let diags = published["diagnostics"].as_array().unwrap();
+    assert!(!diags.is_empty(), "{published}");
+    assert!(
+        diags
+            .iter()
+            .all(|d| d["message"].as_str().unwrap().contains("`brick`")),
+        "{published}"
+    );
+    // The disk still has `brick`: closing the buffer re-checks the grammar against the file.
+    c.notify(
+        "textDocument/didClose",
+        json!({ "textDocument": { "uri": l.lib_uri } }),
+    );
+    assert_eq!(c.published(&l.main_uri, None)["diagnostics"], json!([]));
+    assert!(c.shutdown_and_exit().success());
 }

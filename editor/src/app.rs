@@ -109,6 +109,8 @@ pub struct EditorApp {
     pub refused: Option<(String, Vec<Problem>)>,
     /// The source line the user clicked in the diagnostics.
     pub source_view: Option<panels::SourceView>,
+    /// Following the text editor's cursor (`--follow`).
+    pub follow: Option<crate::follow::Follow>,
 }
 
 /// The action a picked path is for.
@@ -224,6 +226,7 @@ impl EditorApp {
             title: String::new(),
             refused: None,
             source_view: None,
+            follow: None,
         }
     }
 
@@ -258,6 +261,13 @@ impl EditorApp {
         if let Some(path) = self.grammar_path.clone() {
             self.start_watch(&path);
         }
+    }
+
+    /// What the text editor's cursor is on, in the model (`--follow`).
+    pub fn followed(&self) -> crate::follow::Highlight {
+        self.follow.as_ref().map_or_else(Default::default, |f| {
+            f.followed(self.grammar_path.as_deref(), &self.imports, &self.sculpt)
+        })
     }
 
     /// The grammar file being edited (`None`: the bundled castle).
@@ -446,6 +456,13 @@ impl EditorApp {
             self.confirm = Some(Action::Quit);
         }
         self.poll_native_dialog(ctx);
+        if let Some(f) = &mut self.follow {
+            let sculpting = self.mode == Mode::Sculpt;
+            let file = self.grammar_path.as_deref();
+            if let Some(m) = f.frame(ctx, sculpting, self.canvas.hovered, file, &self.sculpt) {
+                self.message = Some(m);
+            }
+        }
         let title = self.title();
         if title != self.title {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
@@ -499,7 +516,9 @@ impl EditorApp {
             .show(ui, |ui| match self.mode {
                 Mode::Sculpt => {
                     self.canvas
-                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands)
+                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
+                    let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
+                    crate::follow::paint(ui, &self.canvas, grammar, data, &self.followed());
                 }
                 Mode::Author => {
                     self.author_canvas

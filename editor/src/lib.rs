@@ -9,6 +9,7 @@ pub mod camera;
 pub mod canvas;
 pub mod compile;
 pub mod files;
+pub mod follow;
 pub mod help;
 pub mod overlay;
 pub mod panels;

@@ -13,6 +13,10 @@ use clay_editor::EditorApp;
 struct Args {
     /// The grammar to open (`.clay`, or a compiled `.json`); the bundled castle without one.
     grammar: Option<PathBuf>,
+    /// Follow the text editor: highlight what its cursor is on (through `clayc lsp`), and
+    /// show a part's declaration there with G (docs/editors.md).
+    #[arg(long)]
+    follow: bool,
 }
 
 fn main() -> ExitCode {
@@ -37,6 +41,10 @@ fn main() -> ExitCode {
             };
             app.set_waker(cc.egui_ctx.clone());
             app.use_desktop(clay_editor::files::Desktop::detect());
+            if args.follow {
+                let channel = clay_dsl::analysis::follow::channel();
+                app.follow = Some(clay_editor::follow::Follow::new(channel));
+            }
             Ok(Box::new(app))
         }),
     );

@@ -12,7 +12,11 @@ fn help_and_version_print_and_exit_zero() {
     let out = editor().arg("--help").output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("Usage: clay-editor [GRAMMAR]"), "{text}");
+    assert!(
+        text.contains("Usage: clay-editor [OPTIONS] [GRAMMAR]"),
+        "{text}"
+    );
+    assert!(text.contains("--follow"), "{text}");
     assert!(text.contains("F1"), "points at the in-window help: {text}");
 
     let out = editor().arg("--version").output().unwrap();

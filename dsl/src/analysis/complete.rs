@@ -277,7 +277,9 @@ impl Offer<'_> {
             .symbols()
             .symbols
             .iter()
-            .filter(|s| s.kind == SymbolKind::Constant && s.full.end <= offset)
+            .filter(|s| s.kind == SymbolKind::Constant)
+            // Declared before here, or in an imported file (past the end of the text).
+            .filter(|s| s.full.end <= offset || s.span.start > a.text().len())
         {
             let value = a
                 .values

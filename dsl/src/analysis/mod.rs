@@ -10,8 +10,16 @@
 //! text that parsed ([`Analysis::with_previous`]), for the rest: outside the edited region the
 //! old text is the new one, so the old symbols there keep their place (before the edit) or move
 //! by the change in length (after it).
+//!
+//! Across files: the declarations of the imported files join the symbol table at their global
+//! positions (past the end of the text, as in the compiler's source map), so definition,
+//! hover, completion and references reach into them; [`Analysis::place`] maps such a span back
+//! to its file, and [`Analysis::declared_at`] finds a declaration of another file's analysis
+//! here (how `clayc lsp` gathers references and renames over every open file).
 
 mod complete;
+pub mod follow;
+mod imports;
 mod symbols;
 mod tokens;
 
@@ -19,11 +27,14 @@ use std::collections::HashMap;
 
 pub use crate::line_index::{LineIndex, LinePos};
 pub use complete::{Completion, CompletionKind};
+pub use imports::Place;
 pub use symbols::{Reference, Symbol, SymbolKind, Symbols};
 pub use tokens::{SemanticToken, TokenKind};
 
+use crate::compile::Loader;
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::syntax::{File, Item, Span};
+use imports::Imported;
 
 /// Keywords of the language (contextual: a name may spell one). A rename to one is refused.
 pub const KEYWORDS: &[&str] = &[
@@ -61,6 +72,9 @@ pub struct Fix {
 #[derive(Clone, Debug)]
 pub struct Analysis {
     index: LineIndex,
+    /// The analysed file's path, normalised as import paths are.
+    path: String,
+    imported: Imported,
     tree: Option<File>,
     /// The text up to here is described by `tree` (the whole text when it parses).
     parsed_to: usize,
@@ -71,45 +85,74 @@ pub struct Analysis {
 }
 
 impl Analysis {
-    /// Analyses `text` (compiled as the file `path`).
+    /// Analyses `text` (compiled as the file `path`, imports read from the file system).
     pub fn new(text: &str, path: &str) -> Self {
-        // One parse for the tree and the compiler (`compile` would parse again).
-        let (tree, parsed_to, diagnostics) = match crate::parse(text) {
-            Ok(tree) => {
-                let compiled =
-                    crate::compile::compile_tree(tree.clone(), text.len(), path, &crate::FsLoader);
-                let diagnostics = match compiled {
-                    Ok(c) => c.warnings,
-                    Err(d) => d,
-                };
-                (Some(tree), text.len(), diagnostics)
-            }
-            Err(d) => {
-                let (tree, parsed_to) = parsed_prefix(text, &d);
-                (tree, parsed_to, d)
-            }
-        };
-        let symbols = tree.as_ref().map(Symbols::of).unwrap_or_default();
-        let values = tree
-            .as_ref()
-            .map(crate::compile::constant_values)
-            .unwrap_or_default();
-        Self {
-            index: LineIndex::new(text),
-            tree,
-            parsed_to,
-            symbols,
-            diagnostics,
-            values,
-        }
+        Self::with_loader(text, path, None, &crate::FsLoader)
     }
 
     /// Analyses `text`; when it does not parse to the end, the declarations after the error are
     /// taken from `previous` (the analysis of the last text that did), moved to where the
     /// unchanged tail of that text now lies.
     pub fn with_previous(text: &str, path: &str, previous: &Analysis) -> Self {
-        let mut a = Self::new(text, path);
-        if a.parsed_to < text.len() {
+        Self::with_loader(text, path, Some(previous), &crate::FsLoader)
+    }
+
+    /// The general form: imported files come through `loader` (a server serves its open,
+    /// unsaved buffers this way). While the text does not parse, its imports are those of
+    /// `previous`.
+    pub fn with_loader(
+        text: &str,
+        path: &str,
+        previous: Option<&Analysis>,
+        loader: &dyn Loader,
+    ) -> Self {
+        // One parse for the tree and the compiler (`compile` would parse again).
+        let (tree, parsed_to, diagnostics, sources) = match crate::parse(text) {
+            Ok(tree) => {
+                let compiled = crate::compile::compile_tree(tree.clone(), text.len(), path, loader);
+                let diagnostics = match compiled {
+                    Ok(c) => c.warnings,
+                    Err(d) => d,
+                };
+                let sources = diagnostics.sources.clone();
+                (Some(tree), text.len(), diagnostics, sources)
+            }
+            Err(d) => {
+                let (tree, parsed_to) = parsed_prefix(text, &d);
+                let sources = previous.map(|p| p.imported.sources.clone());
+                (tree, parsed_to, d, sources.unwrap_or_default())
+            }
+        };
+        let (imported, imported_items) = Imported::of(&sources, text.len());
+        // The text's own items, then what its imports declare (a copy only when there are
+        // imports: the common case reads the tree as it is).
+        let joined;
+        let all = match &tree {
+            Some(t) if imported_items.is_empty() => t,
+            _ => {
+                joined = crate::syntax::File {
+                    items: tree
+                        .iter()
+                        .flat_map(|t| t.items.iter().cloned())
+                        .chain(imported_items)
+                        .collect(),
+                    span: Span::new(0, text.len()),
+                };
+                &joined
+            }
+        };
+        let (symbols, values) = (Symbols::of(all), crate::compile::constant_values(all));
+        let mut a = Self {
+            index: LineIndex::new(text),
+            path: crate::resolve_import("", path),
+            imported,
+            symbols,
+            values,
+            tree,
+            parsed_to,
+            diagnostics,
+        };
+        if let Some(previous) = previous.filter(|_| parsed_to < text.len()) {
             a.borrow_tail(previous);
         }
         a
@@ -146,7 +189,12 @@ impl Analysis {
             (s.start >= from).then_some(s)
         };
         let mut map: HashMap<usize, usize> = HashMap::new();
+        // Imported declarations (past the old text) are this analysis' own already.
+        let own = |s: Span| s.start <= old.len();
         for (i, sym) in previous.symbols.symbols.iter().enumerate() {
+            if !own(sym.span) {
+                continue;
+            }
             let (Some(span), Some(full)) = (moved(sym.span), moved(sym.full)) else {
                 continue;
             };
@@ -159,7 +207,7 @@ impl Analysis {
                 ..sym.clone()
             });
         }
-        for r in &previous.symbols.references {
+        for r in previous.symbols.references.iter().filter(|r| own(r.span)) {
             let Some(span) = moved(r.span) else { continue };
             let target = &previous.symbols.symbols[r.symbol];
             let symbol = map.get(&r.symbol).copied().or_else(|| {
@@ -196,6 +244,58 @@ impl Analysis {
         &self.symbols
     }
 
+    /// The analysed file's path (`file` 0) or that of its imported file `file` (a
+    /// [`Place`]'s), as the compiler resolved it.
+    pub fn path(&self, file: usize) -> &str {
+        match file.checked_sub(1) {
+            None => &self.path,
+            Some(k) => self.imported.sources.files.get(k).map_or("", |f| &f.path),
+        }
+    }
+
+    /// The line index of file `file` (0: the analysed text).
+    pub fn file_index(&self, file: usize) -> Option<&LineIndex> {
+        match file.checked_sub(1) {
+            None => Some(&self.index),
+            Some(k) => self.imported.indexes.get(k),
+        }
+    }
+
+    /// The files the text imports (directly or not), as [`Analysis::path`] names them.
+    pub fn imported_paths(&self) -> impl Iterator<Item = &str> {
+        self.imported.sources.files.iter().map(|f| f.path.as_str())
+    }
+
+    /// A span of this analysis (of the text, or past its end in an imported file) in its file.
+    pub fn place(&self, span: Span) -> Place {
+        let at = self.imported.sources.locate(self.text(), &self.path, span);
+        Place {
+            file: at.file,
+            span: Span::new(at.start, at.end),
+        }
+    }
+
+    /// The text of a span of this analysis, in whichever file it lies.
+    fn source(&self, span: Span) -> &str {
+        let at = self.imported.sources.locate(self.text(), &self.path, span);
+        &at.text[at.start..at.end]
+    }
+
+    /// The symbol whose name is declared at `span` of the file `path` (an analysis of another
+    /// file names its declarations so: [`Analysis::path`] and [`Place::span`]).
+    pub fn declared_at(&self, path: &str, span: Span) -> Option<usize> {
+        let file = if path == self.path {
+            0
+        } else {
+            1 + self.imported_paths().position(|p| p == path)?
+        };
+        let want = Place { file, span };
+        self.symbols
+            .symbols
+            .iter()
+            .position(|s| s.kind != SymbolKind::Rule && self.place(s.span) == want)
+    }
+
     /// The symbol declared or used at `offset`.
     pub fn symbol_at(&self, offset: usize) -> Option<usize> {
         let inside = |s: Span| s.start <= offset && offset <= s.end;
@@ -212,14 +312,24 @@ impl Analysis {
             })
     }
 
-    /// Where the name at `offset` is declared.
+    /// Where the name at `offset` is declared: past the end of the text when in an imported
+    /// file ([`Analysis::place`] says which).
     pub fn definition(&self, offset: usize) -> Option<Span> {
         self.symbol_at(offset).map(|i| self.symbols.symbols[i].span)
     }
 
-    /// Every use of the name at `offset` (and its declaration when asked), in source order.
+    /// Every use of the name at `offset` (and its declaration when asked), in the text and in
+    /// its imported files, in order of position.
     pub fn references(&self, offset: usize, declaration: bool) -> Vec<Span> {
-        let Some(i) = self.symbol_at(offset) else {
+        match self.symbol_at(offset) {
+            Some(i) => self.references_of(i, declaration),
+            None => Vec::new(),
+        }
+    }
+
+    /// Every use of symbol `i` (and its declaration when asked), in order of position.
+    pub fn references_of(&self, i: usize, declaration: bool) -> Vec<Span> {
+        let Some(sym) = self.symbols.symbols.get(i) else {
             return Vec::new();
         };
         let mut spans: Vec<Span> = self
@@ -230,7 +340,7 @@ impl Analysis {
             .map(|r| r.span)
             .collect();
         if declaration {
-            spans.push(self.symbols.symbols[i].span);
+            spans.push(sym.span);
         }
         spans.sort_by_key(|s| s.start);
         spans
@@ -249,8 +359,8 @@ impl Analysis {
     }
 
     fn first_line(&self, s: Span) -> &str {
-        let text = self.text().get(s.start..s.end).unwrap_or("");
-        text.lines()
+        self.source(s)
+            .lines()
             .next()
             .unwrap_or("")
             .trim_end_matches('{')
@@ -260,6 +370,10 @@ impl Analysis {
     fn describe(&self, i: usize) -> String {
         let sym = &self.symbols.symbols[i];
         let mut out = format!("```clay\n{}\n```\n", self.first_line(sym.full));
+        let file = self.place(sym.span).file;
+        if file > 0 {
+            out += &format!("\nin `{}`\n", self.path(file));
+        }
         let container = sym.container.map(|c| self.symbols.symbols[c].name.as_str());
         match sym.kind {
             SymbolKind::Piece => out += &self.describe_piece(i),
@@ -355,7 +469,8 @@ impl Analysis {
             children: Vec::new(),
         };
         let mut out = Vec::new();
-        for (i, s) in syms.iter().enumerate() {
+        let own = |s: &Symbol| s.span.start <= self.text().len();
+        for (i, s) in syms.iter().enumerate().filter(|(_, s)| own(s)) {
             match s.kind {
                 SymbolKind::Vertex | SymbolKind::Site | SymbolKind::State => {}
                 SymbolKind::Instance | SymbolKind::Chain => {}
@@ -394,12 +509,22 @@ impl Analysis {
         out
     }
 
-    /// The edits that rename the name at `offset` to `new_name` everywhere, or why not.
+    /// The edits that rename the name at `offset` to `new_name` everywhere (spans past the
+    /// end of the text lie in imported files), or why not.
     pub fn rename(&self, offset: usize, new_name: &str) -> Result<Vec<(Span, String)>, String> {
         let i = self
             .symbol_at(offset)
             .ok_or_else(|| "there is no name to rename here".to_string())?;
-        let sym = &self.symbols.symbols[i];
+        self.rename_symbol(i, new_name)
+    }
+
+    /// The edits that rename symbol `i` to `new_name`, or why not.
+    pub fn rename_symbol(&self, i: usize, new_name: &str) -> Result<Vec<(Span, String)>, String> {
+        let sym = self
+            .symbols
+            .symbols
+            .get(i)
+            .ok_or_else(|| "there is no such name".to_string())?;
         let valid = new_name
             .chars()
             .next()
@@ -425,11 +550,18 @@ impl Analysis {
                 && s.container == sym.container
         });
         if let Some(other) = clash {
-            let at = self.index.position(other.span.start);
+            let place = self.place(other.span);
+            let line = self
+                .file_index(place.file)
+                .map_or(0, |x| x.position(place.span.start).line + 1);
+            let file = if place.file > 0 {
+                format!("`{}` ", self.path(place.file))
+            } else {
+                String::new()
+            };
             return Err(format!(
-                "{} `{new_name}` already exists (line {})",
+                "{} `{new_name}` already exists ({file}line {line})",
                 other.kind.word(),
-                at.line + 1
             ));
         }
         if sym.kind == SymbolKind::Constant
@@ -438,7 +570,7 @@ impl Analysis {
             return Err(format!("`{new_name}` is built in"));
         }
         Ok(self
-            .references(offset, true)
+            .references_of(i, true)
             .into_iter()
             .map(|s| (s, new_name.to_string()))
             .collect())
@@ -447,6 +579,29 @@ impl Analysis {
     /// The canonical text, or `None` when the text does not parse.
     pub fn format(&self) -> Option<String> {
         crate::format(self.text()).ok()
+    }
+
+    /// Edits that put the top-level declarations overlapping `range` in the canonical style
+    /// (each replaced whole by its printed form; the text between declarations is left as it
+    /// is), or `None` when the text does not parse.
+    pub fn format_range(&self, range: Span) -> Option<Vec<(Span, String)>> {
+        let ours = self.tree.as_ref().filter(|_| self.parses())?;
+        let formatted = crate::format(self.text()).ok()?;
+        // The printer keeps every item, in order: the nth item of its output is the nth here.
+        let theirs = crate::parse(&formatted).ok()?;
+        if theirs.items.len() != ours.items.len() {
+            return None;
+        }
+        let overlaps = |s: Span| s.start <= range.end && range.start <= s.end;
+        Some(
+            ours.items
+                .iter()
+                .zip(&theirs.items)
+                .map(|(a, b)| (a.span(), &formatted[b.span().start..b.span().end]))
+                .filter(|(a, b)| overlaps(*a) && self.source(*a) != *b)
+                .map(|(a, b)| (a, b.to_string()))
+                .collect(),
+        )
     }
 
     /// Fixes offered for a diagnostic of this text.

@@ -78,9 +78,14 @@ fn location(uri: &lsp::Uri, index: &LineIndex, sources: &SourceMap, span: Span) 
     }
     let file_index = LineIndex::new(at.text);
     let local = range(&file_index, Span::new(at.start, at.end));
-    let path = percent_encoding::utf8_percent_encode(at.path, PATH_ESCAPES).to_string();
-    let file_uri = lsp::Uri::from_str(&format!("file://{path}")).unwrap_or_else(|_| uri.clone());
+    let file_uri = file_uri(at.path).unwrap_or_else(|| uri.clone());
     lsp::Location::new(file_uri, local)
+}
+
+/// The `file://` URI of a path (its unsafe characters escaped); `None` when that is no URI.
+pub fn file_uri(path: &str) -> Option<lsp::Uri> {
+    let path = percent_encoding::utf8_percent_encode(path, PATH_ESCAPES).to_string();
+    lsp::Uri::from_str(&format!("file://{path}")).ok()
 }
 
 /// The `import` line of the document that brought in `path` (or the first import): where a

@@ -1,9 +1,11 @@
 //! The requests: each reads its params (InvalidParams when they do not fit), asks the document's
 //! analysis, and converts the answer.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use clay_dsl::analysis::Analysis;
+use clay_dsl::analysis::follow::Focus;
+use clay_dsl::syntax::Span;
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types as lsp;
 use lsp_types::request::{self as req, Request as _};
@@ -61,6 +63,7 @@ pub fn initialize_result() -> lsp::InitializeResult {
                 ..Default::default()
             }),
             document_formatting_provider: Some(OneOf::Left(true)),
+            document_range_formatting_provider: Some(OneOf::Left(true)),
             rename_provider: Some(OneOf::Right(RenameOptions {
                 prepare_provider: Some(true),
                 work_done_progress_options: Default::default(),
@@ -100,6 +103,7 @@ pub fn handle(docs: &Docs, method: &str, p: Value) -> Answer {
         }
         req::Completion::METHOD => on::<req::Completion>(p, |p| docs.completion(p)),
         req::Formatting::METHOD => on::<req::Formatting>(p, |p| docs.formatting(p)),
+        req::RangeFormatting::METHOD => on::<req::RangeFormatting>(p, |p| docs.range_formatting(p)),
         req::PrepareRenameRequest::METHOD => {
             on::<req::PrepareRenameRequest>(p, |p| docs.prepare_rename(p))
         }
@@ -117,6 +121,23 @@ pub fn handle(docs: &Docs, method: &str, p: Value) -> Answer {
             format!("`{method}` is not supported"),
         )),
     }
+}
+
+/// Where the declaration a following Clay editor names lies: in the open documents of its
+/// file (or any open document that knows it), else in the file read from the disk.
+pub fn declaration(docs: &Docs, focus: &Focus) -> Option<lsp::Location> {
+    let open = Open(docs);
+    let mut all = open.analyses();
+    all.sort_by_key(|(_, a)| !super::follow::same_file(a.path(0), &focus.file));
+    for (uri, a) in all {
+        if let Some(span) = a.declaration_of(focus) {
+            return open.location(uri, a, span);
+        }
+    }
+    let text = std::fs::read_to_string(&focus.file).ok()?;
+    let a = Analysis::new(&text, &focus.file);
+    let span = a.declaration_of(focus)?;
+    open.location(&convert::file_uri(&focus.file)?, &a, span)
 }
 
 /// Reads the params of request `R`, runs `f`, writes its result.
@@ -153,6 +174,61 @@ impl Open<'_> {
         Ok(At { a, offset })
     }
 
+    /// The open documents' analyses, in order of their URIs.
+    fn analyses(&self) -> Vec<(&lsp::Uri, &Analysis)> {
+        let mut all: Vec<_> = self
+            .0
+            .values()
+            .filter_map(|d| Some((&d.uri, d.analysis.as_deref()?)))
+            .collect();
+        all.sort_by(|a, b| a.0.as_str().cmp(b.0.as_str()));
+        all
+    }
+
+    /// The URI of a file named by an analysis: the open document of that path, else the file.
+    fn uri_of(&self, path: &str) -> Option<lsp::Uri> {
+        self.analyses()
+            .into_iter()
+            .find(|(_, a)| a.path(0) == path)
+            .map(|(uri, _)| uri.clone())
+            .or_else(|| convert::file_uri(path))
+    }
+
+    /// Where a span of `a` (the analysis of the document `uri`) lies: in the document or in a
+    /// file it imports.
+    fn location(&self, uri: &lsp::Uri, a: &Analysis, span: Span) -> Option<lsp::Location> {
+        let place = a.place(span);
+        let range = convert::range(a.file_index(place.file)?, place.span);
+        let uri = match place.file {
+            0 => uri.clone(),
+            k => self.uri_of(a.path(k))?,
+        };
+        Some(lsp::Location::new(uri, range))
+    }
+
+    /// The symbol at a position as every open document's analysis knows it (the documents
+    /// that declare it, import its file, or are imported by the one asked): each analysis with
+    /// its index of the symbol, the asked document's first (its refusals name other files).
+    fn everywhere(
+        &self,
+        p: &lsp::TextDocumentPositionParams,
+    ) -> Result<Vec<(&lsp::Uri, &Analysis, usize)>, ResponseError> {
+        let At { a, offset } = self.at(p)?;
+        let Some(sym) = a.symbol_at(offset).map(|i| &a.symbols().symbols[i]) else {
+            return Ok(Vec::new());
+        };
+        let declared = a.place(sym.span);
+        let path = a.path(declared.file);
+        let asked = &p.text_document.uri;
+        let mut all: Vec<_> = self
+            .analyses()
+            .into_iter()
+            .filter_map(|(uri, b)| Some((uri, b, b.declared_at(path, declared.span)?)))
+            .collect();
+        all.sort_by_key(|(uri, _, _)| *uri != asked);
+        Ok(all)
+    }
+
     fn hover(&self, p: lsp::HoverParams) -> Result<Option<lsp::Hover>, ResponseError> {
         let At { a, offset } = self.at(&p.text_document_position_params)?;
         Ok(a.hover(offset).map(|(span, markdown)| lsp::Hover {
@@ -170,27 +246,29 @@ impl Open<'_> {
     ) -> Result<Option<lsp::GotoDefinitionResponse>, ResponseError> {
         let pos = &p.text_document_position_params;
         let At { a, offset } = self.at(pos)?;
-        Ok(a.definition(offset).map(|span| {
-            lsp::GotoDefinitionResponse::Scalar(lsp::Location::new(
-                pos.text_document.uri.clone(),
-                convert::range(a.line_index(), span),
-            ))
-        }))
+        Ok(a.definition(offset)
+            .and_then(|span| self.location(&pos.text_document.uri, a, span))
+            .map(lsp::GotoDefinitionResponse::Scalar))
     }
 
     fn references(
         &self,
         p: lsp::ReferenceParams,
     ) -> Result<Option<Vec<lsp::Location>>, ResponseError> {
-        let pos = &p.text_document_position;
-        let At { a, offset } = self.at(pos)?;
-        let uri = &pos.text_document.uri;
-        Ok(Some(
-            a.references(offset, p.context.include_declaration)
-                .into_iter()
-                .map(|s| lsp::Location::new(uri.clone(), convert::range(a.line_index(), s)))
-                .collect(),
-        ))
+        // Every open document's uses (and those in the files they import), once each.
+        let mut seen = HashSet::new();
+        let mut out = Vec::new();
+        for (uri, b, i) in self.everywhere(&p.text_document_position)? {
+            for s in b.references_of(i, p.context.include_declaration) {
+                let Some(l) = self.location(uri, b, s) else {
+                    continue;
+                };
+                if seen.insert((l.uri.as_str().to_string(), format!("{:?}", l.range))) {
+                    out.push(l);
+                }
+            }
+        }
+        Ok(Some(out))
     }
 
     fn highlight(
@@ -202,6 +280,7 @@ impl Open<'_> {
         Ok(Some(
             a.references(offset, true)
                 .into_iter()
+                .filter(|&s| a.place(s).file == 0)
                 .map(|s| lsp::DocumentHighlight {
                     range: convert::range(a.line_index(), s),
                     kind: Some(if Some(s) == declaration {
@@ -255,6 +334,22 @@ impl Open<'_> {
         )]))
     }
 
+    /// The top-level declarations the range touches, each in the canonical style; nothing
+    /// while the text does not parse.
+    fn range_formatting(
+        &self,
+        p: lsp::DocumentRangeFormattingParams,
+    ) -> Result<Option<Vec<lsp::TextEdit>>, ResponseError> {
+        let a = self.analysis(&p.text_document.uri)?;
+        let index = a.line_index();
+        Ok(a.format_range(convert::span(index, p.range)).map(|edits| {
+            edits
+                .into_iter()
+                .map(|(s, text)| lsp::TextEdit::new(convert::range(index, s), text))
+                .collect()
+        }))
+    }
+
     fn prepare_rename(
         &self,
         p: lsp::TextDocumentPositionParams,
@@ -268,16 +363,39 @@ impl Open<'_> {
     }
 
     fn rename(&self, p: lsp::RenameParams) -> Result<Option<lsp::WorkspaceEdit>, ResponseError> {
-        let pos = &p.text_document_position;
-        let At { a, offset } = self.at(pos)?;
-        let edits = a
-            .rename(offset, &p.new_name)
-            .map_err(|why| error(ErrorCode::RequestFailed, why))?;
-        Ok(Some(convert::workspace_edit(
-            &pos.text_document.uri,
-            a.line_index(),
-            &edits,
-        )))
+        // Every file that declares or uses the name and that an open document knows: the open
+        // documents and the files they import. A name any of them refuses is not renamed.
+        let mut seen = HashSet::new();
+        // By URI text (a `Uri` is no key: it caches its parts inside).
+        let mut changes: HashMap<String, (lsp::Uri, Vec<lsp::TextEdit>)> = HashMap::new();
+        let everywhere = self.everywhere(&p.text_document_position)?;
+        if everywhere.is_empty() {
+            return Err(error(
+                ErrorCode::RequestFailed,
+                "there is no name to rename here",
+            ));
+        }
+        for (uri, b, i) in everywhere {
+            let edits = b
+                .rename_symbol(i, &p.new_name)
+                .map_err(|why| error(ErrorCode::RequestFailed, why))?;
+            for (s, text) in edits {
+                let Some(l) = self.location(uri, b, s) else {
+                    continue;
+                };
+                if seen.insert((l.uri.as_str().to_string(), format!("{:?}", l.range))) {
+                    changes
+                        .entry(l.uri.as_str().to_string())
+                        .or_insert_with(|| (l.uri.clone(), Vec::new()))
+                        .1
+                        .push(lsp::TextEdit::new(l.range, text));
+                }
+            }
+        }
+        Ok(Some(lsp::WorkspaceEdit {
+            changes: Some(changes.into_values().collect()),
+            ..Default::default()
+        }))
     }
 
     fn symbols(

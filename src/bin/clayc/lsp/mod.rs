@@ -12,6 +12,7 @@
 //! analysis becomes an error response (or a log line) and the server goes on.
 
 mod convert;
+mod follow;
 mod handlers;
 mod transport;
 
@@ -22,6 +23,7 @@ use std::sync::mpsc::RecvTimeoutError;
 use std::time::{Duration, Instant};
 
 use clay_dsl::analysis::{Analysis, LineIndex};
+use clay_dsl::{FsLoader, Loader};
 use lsp_server::{ErrorCode, Message, Notification, Request, RequestId, Response, ResponseError};
 use lsp_types as lsp;
 use lsp_types::notification::Notification as _;
@@ -46,21 +48,25 @@ pub fn lsp(_args: LspArgs) -> u8 {
     let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
     let mut server = Server::new(Writer::new(std::io::stdout().lock()));
     loop {
-        let next = match server.deadline {
-            Some(deadline) => {
-                match input.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-                    Ok(m) => Some(m),
-                    Err(RecvTimeoutError::Timeout) => {
-                        if let Err(e) = server.check_changed() {
-                            errln!("clayc lsp: cannot write to the client: {e}");
-                            return 1;
-                        }
-                        continue;
-                    }
-                    Err(RecvTimeoutError::Disconnected) => None,
+        // Wake for the debounce's deadline, and every so often for the Clay editor's reveals.
+        let wait = server
+            .deadline
+            .map_or(follow::POLL, |d| {
+                d.saturating_duration_since(Instant::now())
+            })
+            .min(follow::POLL);
+        let next = match input.recv_timeout(wait) {
+            Ok(m) => Some(m),
+            Err(RecvTimeoutError::Timeout) => {
+                let due = server.deadline.is_some_and(|d| d <= Instant::now());
+                let done = if due { server.check_changed() } else { Ok(()) };
+                if let Err(e) = done.and_then(|()| server.reveal()) {
+                    errln!("clayc lsp: cannot write to the client: {e}");
+                    return 1;
                 }
+                continue;
             }
-            None => input.recv().ok(),
+            Err(RecvTimeoutError::Disconnected) => None,
         };
         let Some(next) = next else {
             errln!("clayc lsp: the client closed the connection without `exit`");
@@ -101,13 +107,13 @@ impl Document {
         }
     }
 
-    /// Analyses the present text; `false` when the analysis panicked (then the old one stays).
-    fn analyse(&mut self, path: &str) -> bool {
+    /// Analyses the present text, reading imports through `loader`; `false` when the analysis
+    /// panicked (then the old one stays).
+    fn analyse(&mut self, path: &str, loader: &dyn Loader) -> bool {
         let text = &self.text;
         let previous = self.last_parsed.as_deref();
-        let fresh = catch_unwind(AssertUnwindSafe(|| match previous {
-            Some(p) => Analysis::with_previous(text, path, p),
-            None => Analysis::new(text, path),
+        let fresh = catch_unwind(AssertUnwindSafe(|| {
+            Analysis::with_loader(text, path, previous, loader)
         }));
         self.dirty = false;
         match fresh {
@@ -140,19 +146,76 @@ struct Server<W: std::io::Write> {
     deadline: Option<Instant>,
     /// When the oldest unchecked change came.
     first_change: Option<Instant>,
+    /// What the cursor is on, for a following Clay editor.
+    cursor: follow::Cursor,
+    reveals: follow::Reveals,
+    /// Requests sent to the client (`window/showDocument`), for their ids.
+    sent: u64,
 }
 
 type Flow = std::io::Result<Option<u8>>;
 
 impl<W: std::io::Write> Server<W> {
     fn new(out: Writer<W>) -> Self {
+        let channel = clay_dsl::analysis::follow::channel();
         Self {
             out,
             state: State::Uninitialised,
             docs: HashMap::new(),
             deadline: None,
             first_change: None,
+            cursor: follow::Cursor::new(channel.clone()),
+            reveals: follow::Reveals::new(&channel),
+            sent: 0,
         }
+    }
+
+    /// Publishes what the cursor is on when a request tells where it is (`documentHighlight`
+    /// and `hover` come as it moves).
+    fn follow_cursor(&mut self, method: &str, params: &serde_json::Value) {
+        use lsp::request::{DocumentHighlightRequest, HoverRequest, Request as _};
+        if method != DocumentHighlightRequest::METHOD && method != HoverRequest::METHOD {
+            return;
+        }
+        let docs = &self.docs;
+        let focus = catch_unwind(AssertUnwindSafe(|| {
+            let p: lsp::TextDocumentPositionParams = serde_json::from_value(params.clone()).ok()?;
+            let a = docs
+                .get(p.text_document.uri.as_str())?
+                .analysis
+                .as_deref()?;
+            a.focus(convert::offset(a.line_index(), p.position))
+        }));
+        self.cursor.publish(focus.ok().flatten());
+    }
+
+    /// Asks the client to show the declaration the Clay editor asked for, if one came.
+    fn reveal(&mut self) -> std::io::Result<()> {
+        let Some(focus) = self.reveals.poll() else {
+            return Ok(());
+        };
+        let docs = &self.docs;
+        let found = catch_unwind(AssertUnwindSafe(|| handlers::declaration(docs, &focus)));
+        let Ok(Some(at)) = found else {
+            errln!(
+                "clayc lsp: no declaration of {} `{}` to show",
+                focus.kind,
+                focus.name
+            );
+            return Ok(());
+        };
+        self.sent += 1;
+        let params = lsp::ShowDocumentParams {
+            uri: at.uri,
+            external: Some(false),
+            take_focus: Some(true),
+            selection: Some(at.range),
+        };
+        self.out.send(Request::new(
+            RequestId::from(format!("clay-reveal-{}", self.sent)),
+            "window/showDocument".to_string(),
+            params,
+        ))
     }
 
     fn handle(&mut self, input: Input) -> Flow {
@@ -162,7 +225,11 @@ impl<W: std::io::Write> Server<W> {
                 self.out.send_error(id, code, message)?;
                 Ok(None)
             }
-            Input::Message(Message::Request(r)) => self.request(r),
+            Input::Message(Message::Request(r)) => {
+                let flow = self.request(r);
+                self.reveal()?;
+                flow
+            }
             Input::Message(Message::Notification(n)) => self.notification(n),
             // We send no requests, so no response is awaited.
             Input::Message(Message::Response(_)) => Ok(None),
@@ -203,6 +270,7 @@ impl<W: std::io::Write> Server<W> {
             (State::Running, _) => {
                 // Answers are about the latest text.
                 self.check_changed()?;
+                self.follow_cursor(&r.method, &r.params);
                 let docs = &self.docs;
                 respond(r.id, || handlers::handle(docs, &r.method, r.params))
             }
@@ -240,11 +308,10 @@ impl<W: std::io::Write> Server<W> {
             note::DidOpenTextDocument::METHOD => {
                 let p: lsp::DidOpenTextDocumentParams = handlers::params(n.params)?;
                 let d = p.text_document;
-                self.docs.insert(
-                    d.uri.as_str().to_string(),
-                    Document::new(d.uri, d.text, d.version),
-                );
-                self.changed();
+                let key = d.uri.as_str().to_string();
+                self.docs
+                    .insert(key.clone(), Document::new(d.uri, d.text, d.version));
+                self.changed_document(&key);
             }
             note::DidChangeTextDocument::METHOD => {
                 let p: lsp::DidChangeTextDocumentParams = handlers::params(n.params)?;
@@ -257,11 +324,13 @@ impl<W: std::io::Write> Server<W> {
                 }
                 doc.version = p.text_document.version;
                 doc.dirty = true;
-                self.changed();
+                self.changed_document(p.text_document.uri.as_str());
             }
             note::DidCloseTextDocument::METHOD => {
                 let p: lsp::DidCloseTextDocumentParams = handlers::params(n.params)?;
                 if self.docs.remove(p.text_document.uri.as_str()).is_some() {
+                    // Its importers read it from the disk again.
+                    self.changed_document(p.text_document.uri.as_str());
                     return Ok(Some(p.text_document.uri));
                 }
             }
@@ -270,6 +339,21 @@ impl<W: std::io::Write> Server<W> {
             _ => {}
         }
         Ok(None)
+    }
+
+    /// The document `uri` changed (or opened, or closed): check it after the debounce, with the
+    /// documents that import it.
+    fn changed_document(&mut self, uri: &str) {
+        let path = normalised_path(uri);
+        for d in self.docs.values_mut() {
+            if d.analysis
+                .as_ref()
+                .is_some_and(|a| a.imported_paths().any(|p| p == path))
+            {
+                d.dirty = true;
+            }
+        }
+        self.changed();
     }
 
     /// A document changed: check it after the debounce.
@@ -283,9 +367,19 @@ impl<W: std::io::Write> Server<W> {
     fn check_changed(&mut self) -> std::io::Result<()> {
         self.deadline = None;
         self.first_change = None;
+        if !self.docs.values().any(|d| d.dirty) {
+            return Ok(());
+        }
+        // An import of an open document reads its text in the editor, saved or not.
+        let buffers = Buffers(
+            self.docs
+                .iter()
+                .map(|(uri, d)| (normalised_path(uri), d.text.clone()))
+                .collect(),
+        );
         let mut ready = Vec::new();
         for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
-            if !doc.analyse(&convert::file_path(uri)) {
+            if !doc.analyse(&convert::file_path(uri), &buffers) {
                 errln!("clayc lsp: the analysis of `{uri}` panicked");
                 continue;
             }
@@ -314,6 +408,23 @@ impl<W: std::io::Write> Server<W> {
             lsp::notification::PublishDiagnostics::METHOD.to_string(),
             params,
         ))
+    }
+}
+
+/// A document's path as the compiler names an imported file.
+fn normalised_path(uri: &str) -> String {
+    clay_dsl::resolve_import("", &convert::file_path(uri))
+}
+
+/// Imported files for the compiler: the open documents' texts, else the files on disk.
+struct Buffers(HashMap<String, String>);
+
+impl Loader for Buffers {
+    fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
+        match self.0.get(path) {
+            Some(text) => Ok(text.clone().into_bytes()),
+            None => FsLoader.load(path),
+        }
     }
 }
 
