@@ -1,0 +1,224 @@
+//! `mesh "PATH"`: loads the 3D mesh assets of a grammar's pieces (through the same [`Loader`] as
+//! `import`, so a language server can serve them too), decodes them (`mesh_files.rs`) and keeps
+//! their triangles for the pieces' proxy geometry, so that a compiled grammar needs no other
+//! file. Every way an asset can fail is a diagnostic at the path string: missing (E064),
+//! unreadable (E065), not a mesh Clay reads (E066), beyond a limit (E067).
+//!
+//! A path is resolved against the folder of the file that declares the piece (an imported
+//! library's meshes sit next to the library). Each asset is read once however many pieces use it.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use super::Loader;
+use super::codes;
+use super::imports::resolve;
+use super::mesh_files::{self, Problem};
+use crate::compiled::{ProxyShape, Rgba};
+use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::source_map::SourceMap;
+use crate::syntax::{self, Item, PieceStmt, ShapeDecl, Span};
+
+/// Largest mesh asset file, with its external buffers (16 MiB).
+pub const MAX_MESH_BYTES: usize = 16 << 20;
+/// Most bytes all mesh assets of one grammar may have together (64 MiB).
+pub const MAX_MESH_TOTAL_BYTES: usize = 64 << 20;
+/// Most vertices one mesh asset may have (after its nodes are instanced).
+pub const MAX_MESH_VERTICES: usize = 200_000;
+/// Most triangles one mesh asset may have (after its nodes are instanced).
+pub const MAX_MESH_TRIANGLES: usize = 200_000;
+
+/// The triangles of one colour of a decoded asset, in piece coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct AssetPart {
+    /// The material's base colour (sRGB), when the asset gives one.
+    pub fill: Option<Rgba>,
+    pub shape: ProxyShape,
+}
+
+/// The decoded assets, by the global start of the `mesh` statement's path string (a piece
+/// copied by `extends` shares its base's statements and so its asset).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Meshes {
+    by_path_start: HashMap<usize, Arc<[AssetPart]>>,
+}
+
+impl Meshes {
+    /// The asset of the `mesh` statement whose path string is at `path`; `None` when it failed
+    /// to load (already reported).
+    pub fn get(&self, path: Span) -> Option<&[AssetPart]> {
+        self.by_path_start.get(&path.start).map(|a| &a[..])
+    }
+}
+
+/// Loads every asset named by a `mesh` statement of `file` (its main file `main_len` bytes
+/// long, shown as `main_path`), reporting the failures into `diags`.
+pub(super) fn load(
+    file: &syntax::File,
+    main_path: &str,
+    main_len: usize,
+    sources: &SourceMap,
+    loader: &dyn Loader,
+    diags: &mut Diagnostics,
+) -> Meshes {
+    let mut meshes = Meshes::default();
+    let mut by_file: HashMap<String, Option<Arc<[AssetPart]>>> = HashMap::new();
+    let mut total = 0usize;
+    for item in &file.items {
+        let Item::Piece(p) = item else { continue };
+        for s in &p.stmts {
+            let PieceStmt::Geometry(g) = s else { continue };
+            let ShapeDecl::Mesh { path, .. } = &g.shape else {
+                continue;
+            };
+            if meshes.by_path_start.contains_key(&path.span.start) {
+                continue;
+            }
+            let declared_in = file_of(path.span, main_path, main_len, sources);
+            let target = resolve(declared_in, &path.value);
+            let loaded = by_file
+                .entry(target.clone())
+                .or_insert_with(|| match read(&target, loader, &mut total) {
+                    Ok(parts) => Some(Arc::from(parts)),
+                    Err(problem) => {
+                        diags.push(diagnostic(problem, &target, path.span));
+                        None
+                    }
+                })
+                .clone();
+            if let Some(parts) = loaded {
+                meshes.by_path_start.insert(path.span.start, parts);
+            }
+        }
+    }
+    meshes
+}
+
+/// The path of the file a global span lies in.
+fn file_of<'a>(span: Span, main_path: &'a str, main_len: usize, sources: &'a SourceMap) -> &'a str {
+    sources
+        .files
+        .iter()
+        .rev()
+        .find(|f| f.base <= span.start && span.start > main_len)
+        .map_or(main_path, |f| f.path.as_str())
+}
+
+/// The format a path's extension names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Gltf,
+    Obj,
+}
+
+fn read(target: &str, loader: &dyn Loader, total: &mut usize) -> Result<Vec<AssetPart>, Problem> {
+    let ext = Path::new(target)
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let format = match ext.as_deref() {
+        Some("glb" | "gltf") => Format::Gltf,
+        Some("obj") => Format::Obj,
+        other => return Err(Problem::Format(other.map(str::to_string))),
+    };
+    let mut budget = Budget { total, loader };
+    let bytes = budget.load(target)?;
+    let parts = match format {
+        Format::Gltf => mesh_files::gltf(&bytes, target, &mut budget)?,
+        Format::Obj => mesh_files::obj(&bytes, target, &mut budget)?,
+    };
+    Ok(parts)
+}
+
+/// The loader with the byte limits: every file an asset reads (itself, its `.bin` buffers,
+/// its `.mtl` materials) counts towards [`MAX_MESH_BYTES`] and [`MAX_MESH_TOTAL_BYTES`].
+pub(super) struct Budget<'a> {
+    total: &'a mut usize,
+    loader: &'a dyn Loader,
+}
+
+impl Budget<'_> {
+    pub fn load(&mut self, path: &str) -> Result<Vec<u8>, Problem> {
+        let bytes = self
+            .loader
+            .load(path)
+            .map_err(|e| Problem::Io(path.to_string(), e))?;
+        if bytes.len() > MAX_MESH_BYTES {
+            return Err(Problem::TooLarge(format!(
+                "`{path}` has more than {} MiB",
+                MAX_MESH_BYTES >> 20
+            )));
+        }
+        *self.total += bytes.len();
+        if *self.total > MAX_MESH_TOTAL_BYTES {
+            return Err(Problem::TooLarge(format!(
+                "the grammar's mesh assets have more than {} MiB together",
+                MAX_MESH_TOTAL_BYTES >> 20
+            )));
+        }
+        Ok(bytes)
+    }
+}
+
+/// The one diagnostic of an asset that failed to load.
+fn diagnostic(problem: Problem, target: &str, at: Span) -> Diagnostic {
+    let folder = Path::new(target)
+        .parent()
+        .map_or(String::new(), |p| p.to_string_lossy().into_owned());
+    let formats =
+        "Clay reads glTF 2.0 (`.glb`, or `.gltf` with embedded or `.bin` buffers) and OBJ (`.obj`)";
+    match problem {
+        Problem::Io(file, e) if e.kind() == std::io::ErrorKind::NotFound => Diagnostic::error(
+            codes::MESH_MISSING,
+            format!("mesh asset `{file}` does not exist"),
+            at,
+            "no such file",
+        )
+        .with_hint(format!(
+            "the path is relative to the grammar's folder (`{}`)",
+            if folder.is_empty() { "." } else { &folder }
+        )),
+        Problem::Io(file, e) => {
+            let why = if e.kind() == std::io::ErrorKind::IsADirectory {
+                "it is a folder, not a file".to_string()
+            } else {
+                e.to_string()
+            };
+            Diagnostic::error(
+                codes::MESH_UNREADABLE,
+                format!("cannot read mesh asset `{file}`: {why}"),
+                at,
+                "cannot be read",
+            )
+            .with_hint("give the path of a `.glb`, `.gltf` or `.obj` file that can be read")
+        }
+        Problem::Format(ext) => Diagnostic::error(
+            codes::MESH_MALFORMED,
+            match ext {
+                Some(ext) => format!("`.{ext}` is not a mesh format Clay reads"),
+                None => format!("mesh asset `{target}` has no file extension"),
+            },
+            at,
+            "unknown mesh format",
+        )
+        .with_hint(format!("{formats}; export the model as `.glb` from your 3D tool")),
+        Problem::Malformed(why) => Diagnostic::error(
+            codes::MESH_MALFORMED,
+            format!("mesh asset `{target}` is not a mesh Clay can read: {why}"),
+            at,
+            "malformed mesh asset",
+        )
+        .with_hint(format!("{formats}; export the model again from your 3D tool")),
+        Problem::TooLarge(why) => Diagnostic::error(
+            codes::MESH_TOO_LARGE,
+            format!("mesh asset `{target}` is too large: {why}"),
+            at,
+            "too large",
+        )
+        .with_hint(format!(
+            "an asset may have {MAX_MESH_VERTICES} vertices, {MAX_MESH_TRIANGLES} triangles and {} MiB; \
+             decimate it in your 3D tool (proxy geometry needs few triangles)",
+            MAX_MESH_BYTES >> 20
+        )),
+    }
+}
