@@ -151,6 +151,12 @@ pub(super) fn gltf(
     budget: &mut Budget,
 ) -> Result<Vec<AssetPart>, Problem> {
     check_glb_header(bytes)?;
+    let text = !bytes.starts_with(b"glTF");
+    if text && bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
+        return Err(malformed(
+            "it is neither binary glTF (which starts with `glTF`) nor glTF JSON (which starts with `{`)",
+        ));
+    }
     let doc = gltf::Gltf::from_slice(bytes).map_err(|e| malformed(format!("{e}")))?;
     let buffers = buffers(&doc, target, budget)?;
     let placed = placements(&doc)?;

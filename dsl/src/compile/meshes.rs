@@ -82,7 +82,7 @@ pub(super) fn load(
                 .or_insert_with(|| match read(&target, loader, &mut total) {
                     Ok(parts) => Some(Arc::from(parts)),
                     Err(problem) => {
-                        diags.push(diagnostic(problem, &target, path.span));
+                        diags.push(diagnostic(problem, &target, declared_in, path.span));
                         None
                     }
                 })
@@ -161,8 +161,8 @@ impl Budget<'_> {
 }
 
 /// The one diagnostic of an asset that failed to load.
-fn diagnostic(problem: Problem, target: &str, at: Span) -> Diagnostic {
-    let folder = Path::new(target)
+fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Diagnostic {
+    let folder = Path::new(declared_in)
         .parent()
         .map_or(String::new(), |p| p.to_string_lossy().into_owned());
     let formats =
@@ -175,7 +175,7 @@ fn diagnostic(problem: Problem, target: &str, at: Span) -> Diagnostic {
             "no such file",
         )
         .with_hint(format!(
-            "the path is relative to the grammar's folder (`{}`)",
+            "the path is relative to the folder of the grammar that names it (`{}`); check the spelling",
             if folder.is_empty() { "." } else { &folder }
         )),
         Problem::Io(file, e) => {
