@@ -10,6 +10,7 @@ pub mod canvas;
 pub mod compile;
 pub mod files;
 pub mod help;
+pub mod iso;
 pub mod overlay;
 pub mod panels;
 pub mod sculpt;
