@@ -259,3 +259,24 @@ fn clayc_check_reports_a_broken_asset_at_its_path_and_fails() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn keep_with_its_roofs_loads_as_obj_in_tobj() {
+    let g = keep();
+    let s = scene(&g, &after_script(&g), &ExportOptions::default());
+    let (obj_text, mtl_text) = clay::export::obj::to_obj(&s, "keep.mtl");
+    let (models, materials) = tobj::load_obj_buf(
+        &mut obj_text.as_bytes(),
+        &tobj::LoadOptions::default(),
+        |_| tobj::load_mtl_buf(&mut mtl_text.as_bytes()),
+    )
+    .unwrap();
+    assert_eq!(materials.unwrap().len(), s.materials.len());
+    let faces: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    assert_eq!(faces, s.triangle_count());
+    let top = models
+        .iter()
+        .flat_map(|m| m.mesh.positions.chunks_exact(3).map(|p| p[1]))
+        .fold(f32::MIN, f32::max);
+    assert!((top - 9.8).abs() < 1e-4, "the spires' apex: {top}");
+}
