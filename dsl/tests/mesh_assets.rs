@@ -314,3 +314,21 @@ fn a_mirrored_state_turns_the_triangles_round_and_keeps_the_heights() {
         t0.iter().map(|&[a, b, c]| [a, c, b]).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn the_language_servers_analysis_reports_a_broken_asset_at_its_path() {
+    let dir = std::env::temp_dir().join(format!("clay-mesh-analysis-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tower.glb"), b"glTF\x02\0\0\0").unwrap();
+    let source = hut("mesh \"tower.glb\"");
+    let path = dir.join("hut.clay").to_string_lossy().into_owned();
+    let a = clay_dsl::analysis::Analysis::new(&source, &path);
+    let d: Vec<_> = a.diagnostics().iter().collect();
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(d[0].code, "E066");
+    let at = source.find("\"tower.glb\"").unwrap();
+    assert_eq!(d[0].primary.span.start, at);
+    // `mesh` is a keyword there too: highlighted, offered in a piece, refused as a new name.
+    assert!(clay_dsl::analysis::KEYWORDS.contains(&"mesh"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
