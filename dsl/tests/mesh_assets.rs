@@ -332,3 +332,82 @@ fn the_language_servers_analysis_reports_a_broken_asset_at_its_path() {
     assert!(clay_dsl::analysis::KEYWORDS.contains(&"mesh"));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn every_truncation_and_byte_flip_of_an_obj_or_gltf_json_is_an_error_or_a_mesh() {
+    for (name, bytes) in [
+        ("cube.obj", CUBE_OBJ.as_bytes().to_vec()),
+        ("big.gltf", declaring(3, 3).into_bytes()),
+    ] {
+        let source = hut(&format!("mesh \"{name}\""));
+        let path = format!("g/{name}");
+        let mut variants: Vec<Vec<u8>> = (0..bytes.len()).map(|n| bytes[..n].to_vec()).collect();
+        for at in 0..bytes.len() {
+            for flip in [0x01u8, 0x20, 0xa5] {
+                let mut b = bytes.clone();
+                b[at] ^= flip;
+                variants.push(b);
+            }
+        }
+        for b in variants {
+            let files = Files::default().with(&path, b.clone());
+            if let Err(d) = compile(&source, &files) {
+                let codes: Vec<_> = d.iter().map(|d| d.code).collect();
+                // A flip in `data:` makes the buffer a file beside the asset, which is missing.
+                let external =
+                    codes == ["E064"] && d.iter().any(|d| d.message.contains("refers to"));
+                assert!(
+                    codes == ["E066"] || codes == ["E067"] || external,
+                    "{name} {:?}: {codes:?}",
+                    String::from_utf8_lossy(&b)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_number_of_a_gltf_replaced_by_an_odd_one_is_an_error_or_a_mesh() {
+    // Indices, counts, offsets and lengths pointing anywhere: out of range, huge, negative.
+    let text = declaring(3, 3);
+    let source = hut("mesh \"big.gltf\"");
+    let numbers: Vec<(usize, usize)> = {
+        let b = text.as_bytes();
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i].is_ascii_digit() && (i == 0 || !b[i - 1].is_ascii_alphanumeric()) {
+                let start = i;
+                while i < b.len() && b[i].is_ascii_digit() {
+                    i += 1;
+                }
+                out.push((start, i));
+            }
+            i += 1;
+        }
+        out
+    };
+    assert!(numbers.len() > 20);
+    for &(start, end) in &numbers {
+        for odd in [
+            "0",
+            "1",
+            "2",
+            "7",
+            "4294967295",
+            "18446744073709551615",
+            "-1",
+            "1e30",
+        ] {
+            let changed = format!("{}{odd}{}", &text[..start], &text[end..]);
+            let files = Files::default().with("g/big.gltf", changed.clone());
+            if let Err(d) = compile(&source, &files) {
+                let codes: Vec<_> = d.iter().map(|d| d.code).collect();
+                assert!(
+                    codes == ["E066"] || codes == ["E067"],
+                    "{changed}: {codes:?}"
+                );
+            }
+        }
+    }
+}

@@ -157,7 +157,7 @@ pub(super) fn gltf(
             "it is neither binary glTF (which starts with `glTF`) nor glTF JSON (which starts with `{`)",
         ));
     }
-    let doc = gltf::Gltf::from_slice(bytes).map_err(|e| malformed(format!("{e}")))?;
+    let doc = validated(bytes)?;
     let buffers = buffers(&doc, target, budget)?;
     let placed = placements(&doc)?;
     let mut c = Collect::default();
@@ -173,6 +173,31 @@ pub(super) fn gltf(
         }
     }
     c.finish()
+}
+
+/// The document, validated by the `gltf` crate, whose validation itself trusts one reference
+/// (a primitive's `POSITION` accessor): that one is checked first.
+fn validated(bytes: &[u8]) -> Result<gltf::Gltf, Problem> {
+    let raw =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| malformed(format!("{e}")))?;
+    let json = raw.document.as_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for p in &mesh.primitives {
+            if let Some(a) = p.attributes.values().find(|a| a.value() >= accessors) {
+                return Err(malformed(format!(
+                    "mesh {m} refers to accessor {}, of {accessors}",
+                    a.value()
+                )));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(raw.document.into_json())
+        .map_err(|e| malformed(format!("{e}")))?;
+    Ok(gltf::Gltf {
+        document,
+        blob: raw.blob,
+    })
 }
 
 /// A GLB's header must hold its own length: the `gltf` crate assumes it does.

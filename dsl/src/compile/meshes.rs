@@ -160,6 +160,15 @@ impl Budget<'_> {
     }
 }
 
+/// How a file is named in a message: the asset itself, or a file it refers to (a `.bin`).
+fn shown(file: &str, target: &str) -> String {
+    if file == target {
+        format!("mesh asset `{file}`")
+    } else {
+        format!("`{file}`, a file that mesh asset `{target}` refers to,")
+    }
+}
+
 /// The one diagnostic of an asset that failed to load.
 fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Diagnostic {
     let folder = Path::new(declared_in)
@@ -170,7 +179,7 @@ fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Di
     match problem {
         Problem::Io(file, e) if e.kind() == std::io::ErrorKind::NotFound => Diagnostic::error(
             codes::MESH_MISSING,
-            format!("mesh asset `{file}` does not exist"),
+            format!("{} does not exist", shown(&file, target)),
             at,
             "no such file",
         )
@@ -186,7 +195,7 @@ fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Di
             };
             Diagnostic::error(
                 codes::MESH_UNREADABLE,
-                format!("cannot read mesh asset `{file}`: {why}"),
+                format!("cannot read {}: {why}", shown(&file, target)),
                 at,
                 "cannot be read",
             )
