@@ -1,6 +1,7 @@
 //! Decoding mesh asset files into triangles: glTF 2.0 through the `gltf` crate's document types
 //! (the bytes of every accessor read here, each range checked first, so no input can panic),
-//! and OBJ through `tobj`.
+//! and OBJ through `tobj`; with the limits every asset is held to (its bytes through [`Budget`],
+//! its declared vertices and triangles before any is read).
 //!
 //! Axis convention (both formats, as glTF defines it and OBJ exporters write by default): the
 //! asset is in metres with y up. Its x is the piece's x, its -z the piece's y, its y the
@@ -14,9 +15,60 @@ use base64::Engine;
 use glam::{DMat4, DVec2, DVec3};
 use gltf::mesh::Mode;
 
+use super::Loader;
 use super::imports::resolve;
-use super::meshes::{AssetPart, Budget, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 use crate::compiled::{ProxyShape, Rgba};
+
+/// Largest mesh asset file, with its external buffers (16 MiB).
+pub const MAX_MESH_BYTES: usize = 16 << 20;
+/// Most bytes all mesh assets of one grammar may have together (64 MiB).
+pub const MAX_MESH_TOTAL_BYTES: usize = 64 << 20;
+/// Most vertices one mesh asset may have (after its nodes are instanced).
+pub const MAX_MESH_VERTICES: usize = 200_000;
+/// Most triangles one mesh asset may have (after its nodes are instanced).
+pub const MAX_MESH_TRIANGLES: usize = 200_000;
+
+/// The triangles of one colour of a decoded asset, in piece coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct AssetPart {
+    /// The material's base colour (sRGB), when the asset gives one.
+    pub fill: Option<Rgba>,
+    pub shape: ProxyShape,
+}
+
+/// The loader with the byte limits: every file an asset reads (itself, its `.bin` buffers,
+/// its `.mtl` materials) counts towards [`MAX_MESH_BYTES`] and [`MAX_MESH_TOTAL_BYTES`].
+pub(super) struct Budget<'a> {
+    total: &'a mut usize,
+    loader: &'a dyn Loader,
+}
+
+impl<'a> Budget<'a> {
+    pub fn new(total: &'a mut usize, loader: &'a dyn Loader) -> Self {
+        Self { total, loader }
+    }
+
+    pub fn load(&mut self, path: &str) -> Result<Vec<u8>, Problem> {
+        let bytes = self
+            .loader
+            .load(path)
+            .map_err(|e| Problem::Io(path.to_string(), e))?;
+        if bytes.len() > MAX_MESH_BYTES {
+            return Err(Problem::TooLarge(format!(
+                "`{path}` has more than {} MiB",
+                MAX_MESH_BYTES >> 20
+            )));
+        }
+        *self.total += bytes.len();
+        if *self.total > MAX_MESH_TOTAL_BYTES {
+            return Err(Problem::TooLarge(format!(
+                "the grammar's mesh assets have more than {} MiB together",
+                MAX_MESH_TOTAL_BYTES >> 20
+            )));
+        }
+        Ok(bytes)
+    }
+}
 
 /// Most levels of nodes in a glTF scene (a deeper hierarchy is taken for a cycle).
 const MAX_NODE_DEPTH: usize = 64;

@@ -14,28 +14,13 @@ use std::sync::Arc;
 use super::Loader;
 use super::codes;
 use super::imports::resolve;
-use super::mesh_files::{self, Problem};
-use crate::compiled::{ProxyShape, Rgba};
+use super::mesh_files::{self, AssetPart, Budget, Problem};
+pub use super::mesh_files::{
+    MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES,
+};
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::source_map::SourceMap;
 use crate::syntax::{self, Item, PieceStmt, ShapeDecl, Span};
-
-/// Largest mesh asset file, with its external buffers (16 MiB).
-pub const MAX_MESH_BYTES: usize = 16 << 20;
-/// Most bytes all mesh assets of one grammar may have together (64 MiB).
-pub const MAX_MESH_TOTAL_BYTES: usize = 64 << 20;
-/// Most vertices one mesh asset may have (after its nodes are instanced).
-pub const MAX_MESH_VERTICES: usize = 200_000;
-/// Most triangles one mesh asset may have (after its nodes are instanced).
-pub const MAX_MESH_TRIANGLES: usize = 200_000;
-
-/// The triangles of one colour of a decoded asset, in piece coordinates.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct AssetPart {
-    /// The material's base colour (sRGB), when the asset gives one.
-    pub fill: Option<Rgba>,
-    pub shape: ProxyShape,
-}
 
 /// The decoded assets, by the global start of the `mesh` statement's path string (a piece
 /// copied by `extends` shares its base's statements and so its asset).
@@ -121,43 +106,13 @@ fn read(target: &str, loader: &dyn Loader, total: &mut usize) -> Result<Vec<Asse
         Some("obj") => Format::Obj,
         other => return Err(Problem::Format(other.map(str::to_string))),
     };
-    let mut budget = Budget { total, loader };
+    let mut budget = Budget::new(total, loader);
     let bytes = budget.load(target)?;
     let parts = match format {
         Format::Gltf => mesh_files::gltf(&bytes, target, &mut budget)?,
         Format::Obj => mesh_files::obj(&bytes, target, &mut budget)?,
     };
     Ok(parts)
-}
-
-/// The loader with the byte limits: every file an asset reads (itself, its `.bin` buffers,
-/// its `.mtl` materials) counts towards [`MAX_MESH_BYTES`] and [`MAX_MESH_TOTAL_BYTES`].
-pub(super) struct Budget<'a> {
-    total: &'a mut usize,
-    loader: &'a dyn Loader,
-}
-
-impl Budget<'_> {
-    pub fn load(&mut self, path: &str) -> Result<Vec<u8>, Problem> {
-        let bytes = self
-            .loader
-            .load(path)
-            .map_err(|e| Problem::Io(path.to_string(), e))?;
-        if bytes.len() > MAX_MESH_BYTES {
-            return Err(Problem::TooLarge(format!(
-                "`{path}` has more than {} MiB",
-                MAX_MESH_BYTES >> 20
-            )));
-        }
-        *self.total += bytes.len();
-        if *self.total > MAX_MESH_TOTAL_BYTES {
-            return Err(Problem::TooLarge(format!(
-                "the grammar's mesh assets have more than {} MiB together",
-                MAX_MESH_TOTAL_BYTES >> 20
-            )));
-        }
-        Ok(bytes)
-    }
 }
 
 /// How a file is named in a message: the asset itself, or a file it refers to (a `.bin`).
