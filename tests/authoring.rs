@@ -329,7 +329,8 @@ fn fmt_prints_checks_and_writes_with_the_documented_exit_codes() {
         let o = clayc(&["fmt", p.to_str().unwrap()]);
         assert_eq!(o.status.code(), Some(0), "{}", p.display());
         assert!(
-            clay_dsl::compile(&String::from_utf8(o.stdout).unwrap(), "x").is_ok(),
+            // At the file's own path: its `mesh` assets are found beside it.
+            clay_dsl::compile(&String::from_utf8(o.stdout).unwrap(), p.to_str().unwrap()).is_ok(),
             "{}",
             p.display()
         );

@@ -137,6 +137,15 @@ pub enum ProxyShape {
     },
     /// A thick open polyline.
     Polyline { points: Vec<DVec2>, width: f64 },
+    /// Triangles of a 3D mesh asset (`mesh "tower.glb"`), embedded so that a compiled grammar
+    /// needs no other file. Vertex `i` is at floor-plan point `points[i]` (piece coordinates,
+    /// which the part's deformation moves) and `heights[i]` metres above the ground (which it
+    /// never changes, paper 6). Triangles are counter-clockwise seen from outside the solid.
+    Mesh {
+        points: Vec<DVec2>,
+        heights: Vec<f64>,
+        triangles: Vec<[u32; 3]>,
+    },
 }
 
 /// How proxy geometry follows its part.

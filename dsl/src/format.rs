@@ -480,6 +480,13 @@ impl<'s> Printer<'s> {
             Some((BindingKw::Skinned, _)) => " skinned",
         };
         let header = match &g.shape {
+            ShapeDecl::Mesh { path, fill } => {
+                let fill = fill
+                    .as_ref()
+                    .map_or(String::new(), |c| format!(" fill {}", Self::colour(c)));
+                let text = format!("mesh{binding} \"{}\"{fill}", path.value);
+                return self.stmt(indent, &text, g.span);
+            }
             ShapeDecl::Polygon { .. } => format!("polygon{binding} fill {}", Self::colour(&g.fill)),
             ShapeDecl::Polyline { width, .. } => {
                 format!(
@@ -514,6 +521,7 @@ impl<'s> Printer<'s> {
                 }
             }
             ShapeDecl::Polyline { points, .. } => self.points(indent + 1, points),
+            ShapeDecl::Mesh { .. } => {}
         }
         self.close(indent, g.span);
     }

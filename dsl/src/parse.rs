@@ -123,6 +123,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::kw_mirror => "`mirror`",
         Rule::kw_import => "`import`",
         Rule::kw_extends => "`extends`",
+        Rule::kw_mesh => "`mesh`",
         Rule::string => "a file path in double quotes, like `\"lib.clay\"`",
         Rule::import_decl => "an `import`",
         Rule::extends => "`extends`",
@@ -155,6 +156,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::polygon_decl => "a `polygon`",
         Rule::hole => "a `hole`",
         Rule::polyline_decl => "a `polyline`",
+        Rule::mesh_decl => "a `mesh`",
         Rule::point_list => "points",
         Rule::state_decl => "a `state`",
         Rule::state_position => "a vertex position `NAME (x, y)`",
@@ -833,7 +835,13 @@ impl Lower {
 
     fn import(&mut self, p: Pair<Rule>) -> ImportDecl {
         let span = span_of(&p);
-        let path = first(&kids(p), Rule::string).map_or(
+        let path = self.string_or(first(&kids(p), Rule::string), span);
+        ImportDecl { path, span }
+    }
+
+    /// A quoted path without its quotes (empty at `span` when the parser recovered without one).
+    fn string_or(&mut self, s: Option<Pair<Rule>>, span: Span) -> StringLit {
+        s.map_or(
             StringLit {
                 value: String::new(),
                 span,
@@ -845,8 +853,7 @@ impl Lower {
                     span: span_of(&s),
                 }
             },
-        );
-        ImportDecl { path, span }
+        )
     }
 
     fn solver(&mut self, p: Pair<Rule>) -> SolverBlock {
@@ -914,7 +921,9 @@ impl Lower {
                         span: aspan,
                     })
                 }
-                Rule::polygon_decl | Rule::polyline_decl => PieceStmt::Geometry(self.geometry(c)),
+                Rule::polygon_decl | Rule::polyline_decl | Rule::mesh_decl => {
+                    PieceStmt::Geometry(self.geometry(c))
+                }
                 Rule::state_decl => PieceStmt::State(self.state(c)),
                 _ => continue,
             };
@@ -983,7 +992,7 @@ impl Lower {
 
     fn geometry(&mut self, p: Pair<Rule>) -> GeometryDecl {
         let span = span_of(&p);
-        let is_polygon = p.as_rule() == Rule::polygon_decl;
+        let rule = p.as_rule();
         let ch = kids(p);
         let keyword = ch.first().map_or(span, span_of);
         let binding = first(&ch, Rule::binding).map(|b| {
@@ -1005,7 +1014,12 @@ impl Lower {
         let points = first(&ch, Rule::point_list)
             .map(|l| self.points(l))
             .unwrap_or_default();
-        let shape = if is_polygon {
+        let shape = if rule == Rule::mesh_decl {
+            ShapeDecl::Mesh {
+                path: self.string_or(first(&ch, Rule::string), span),
+                fill: first(&ch, Rule::colour).map(|c| self.colour(c)),
+            }
+        } else if rule == Rule::polygon_decl {
             let holes = of(&ch, Rule::hole)
                 .into_iter()
                 .map(|h| {

@@ -283,6 +283,12 @@ pub enum ShapeDecl {
         width: Expr,
         points: Vec<Point>,
     },
+    /// `mesh [rigid|skinned] "PATH" [fill COLOUR]`: a 3D mesh asset (`GeometryDecl::fill` is
+    /// unused; `fill` here overrides the asset's own colours when written).
+    Mesh {
+        path: StringLit,
+        fill: Option<Colour>,
+    },
 }
 
 /// `extrude HEIGHT [above BASE]`: the proxy's heights in the 3D export.

@@ -76,7 +76,7 @@ fn signed_area(ring: &[DVec2]) -> f64 {
 fn outer(s: &RestState, k: usize) -> &[DVec2] {
     match &s.geometry[k].shape {
         ProxyShape::Polygon { outer, .. } => outer,
-        ProxyShape::Polyline { points, .. } => points,
+        ProxyShape::Polyline { points, .. } | ProxyShape::Mesh { points, .. } => points,
     }
 }
 

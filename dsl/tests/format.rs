@@ -51,7 +51,12 @@ enum Meaning {
 }
 
 fn meaning(source: &str) -> Meaning {
-    match compile(source, "x.clay") {
+    meaning_at(source, "x.clay")
+}
+
+/// [`meaning`] of a file at `path` (where its `mesh` assets are found).
+fn meaning_at(source: &str, path: &str) -> Meaning {
+    match compile(source, path) {
         Ok(c) => {
             let mut g = c.grammar;
             g.source.clear();
@@ -78,14 +83,14 @@ fn comment_texts(source: &str) -> Vec<String> {
 fn formatting_keeps_the_compiled_grammar_of_every_example() {
     for (path, source) in all_sources() {
         let formatted = format(&source).unwrap_or_else(|d| panic!("{path} does not parse: {d:?}"));
-        let before = meaning(&source);
+        let before = meaning_at(&source, &path);
         assert!(
             matches!(before, Meaning::Grammar(_)),
             "{path} should compile clean: {before:?}"
         );
         assert_eq!(
             before,
-            meaning(&formatted),
+            meaning_at(&formatted, &path),
             "{path}: formatting changed the compiled grammar"
         );
     }
@@ -264,8 +269,8 @@ fn printing_the_parsed_tree_without_source_keeps_the_meaning() {
         let tree = clay_dsl::parse(&source).unwrap();
         let printed = print_file(&tree);
         assert_eq!(
-            meaning(&source),
-            meaning(&printed),
+            meaning_at(&source, &path),
+            meaning_at(&printed, &path),
             "{path}: print_file changed the meaning"
         );
         assert!(comment_spans(&printed).is_empty());

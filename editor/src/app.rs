@@ -724,6 +724,10 @@ impl EditorApp {
             .on_hover_text("The grabbed part's vertices as rings, pinned ones as squares");
         ui.checkbox(&mut o.part_graph, "Part outlines")
             .on_hover_text("The edges and vertices the solver works on");
+        ui.checkbox(&mut self.canvas.iso, "Isometric 3D")
+            .on_hover_text(
+                "I: the model in 3D, as `clayc render --view iso` draws it; sculpting is off",
+            );
         ui.separator();
         if ui.button("Fit").on_hover_text("F").clicked() {
             self.fit();

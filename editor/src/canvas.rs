@@ -54,6 +54,10 @@ pub struct Canvas {
     pub cut_target: Option<usize>,
     /// The canvas rectangle of the last frame (screen points).
     pub rect: Rect,
+    /// Show the model in the isometric 3D view instead of the floor plan (View menu, I).
+    pub iso: bool,
+    /// The isometric view's last picture.
+    pub iso_picture: Option<crate::iso::IsoPicture>,
 }
 
 impl Default for Canvas {
@@ -68,6 +72,8 @@ impl Default for Canvas {
             hovered: None,
             cut_target: None,
             rect: Rect::from_min_size(Pos2::ZERO, Vec2::splat(1.0)),
+            iso: false,
+            iso_picture: None,
         }
     }
 }
@@ -129,6 +135,18 @@ impl Canvas {
         });
         let pointer = pointer.filter(|p| self.rect.contains(*p));
         let keyboard_free = !ui.ctx().egui_wants_keyboard_input();
+        if keyboard_free && ui.input(|i| i.key_pressed(Key::I)) {
+            self.iso = !self.iso;
+        }
+        if self.iso {
+            // A picture, not the floor plan: no gesture maps onto it, so none starts.
+            if self.drag.take().is_some_and(|d| !matches!(d, Drag::Pan)) {
+                commands.push(Command::Release);
+            }
+            (self.hovered, self.cut_target) = (None, None);
+            crate::iso::paint(ui, &painter, self.rect, sculpt, &mut self.iso_picture);
+            return;
+        }
 
         // Zoom toward the cursor: wheel, pinch or Ctrl + wheel.
         if let Some(p) = pointer {

@@ -30,6 +30,10 @@ pub const SCULPT: &[Row] = &[
     ("Ctrl + click", "cut that connection"),
     ("F", "fit the model into the view"),
     (
+        "I",
+        "isometric 3D view on or off (View menu); sculpting is off while it is on",
+    ),
+    (
         "Hover a part",
         "the Inspector says why it is in its rest state",
     ),

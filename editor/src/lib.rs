@@ -11,6 +11,7 @@ pub mod compile;
 pub mod files;
 pub mod follow;
 pub mod help;
+pub mod iso;
 pub mod overlay;
 pub mod panels;
 pub mod sculpt;

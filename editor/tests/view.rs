@@ -329,3 +329,82 @@ fn opened_files_are_remembered_and_offered_in_the_open_dialog() {
     }
     assert_eq!(h.state().grammar_path(), Some(remembered.as_path()));
 }
+
+#[test]
+fn the_iso_view_draws_the_live_model_as_clayc_does_and_takes_no_drags() {
+    let mut h = harness(EditorApp::open(&grammar("keep.clay")));
+    settle(&mut h);
+    h.get_by_label("View").click();
+    h.step();
+    h.step();
+    h.get_by_label("Isometric 3D").click();
+    h.step();
+    h.step();
+    assert!(
+        h.state().canvas.iso,
+        "the menu's checkbox turns the iso view on"
+    );
+    let same_as_clayc = |h: &Harness<'_, EditorApp>| {
+        let app = h.state();
+        let picture = app.canvas.iso_picture.as_ref().expect("a picture is shown");
+        let scene = clay::export::scene(
+            app.sculpt.grammar(),
+            app.sculpt.data(),
+            &clay::export::ExportOptions::default(),
+        );
+        let want = clay::export::iso::iso_pixmap(&scene, picture.size[0], picture.size[1]).unwrap();
+        assert!(
+            picture.pixels == want.data(),
+            "the picture is clayc's iso view"
+        );
+        picture.size
+    };
+    let size = same_as_clayc(&h);
+    assert!(size[0] > 100 && size[1] > 100, "{size:?}");
+
+    // A drag across the picture neither grabs nor moves anything.
+    let before = h.state().sculpt.data().positions.clone();
+    let centre = h.state().canvas.rect.center();
+    let button = |pos: egui::Pos2, pressed: bool| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    };
+    h.hover_at(centre);
+    h.event(button(centre, true));
+    h.step();
+    for k in 1..=6 {
+        h.hover_at(centre + egui::Vec2::new(20.0 * k as f32, 0.0));
+        h.step();
+    }
+    h.event(button(centre + egui::Vec2::new(120.0, 0.0), false));
+    settle(&mut h);
+    assert!(h.state().sculpt.grabbed().is_none());
+    assert!(h.state().sculpt.data().positions == before, "nothing moved");
+
+    // The live model: a change to the sculpt is drawn again, still as clayc draws it.
+    pull_tower(&mut h);
+    assert!(h.state().sculpt.data().positions != before);
+    same_as_clayc(&h);
+
+    // I goes back to the floor plan.
+    h.key_press(egui::Key::I);
+    h.step();
+    assert!(!h.state().canvas.iso);
+}
+
+/// Pulls the keep's first part 2 m north through commands (as the canvas would) and lets go.
+fn pull_tower(h: &mut Harness<'_, EditorApp>) {
+    let at = h.state().sculpt.assembly().part_centroid(0);
+    h.state_mut().command(Command::Grab { part: 0, at });
+    for k in 1..=20 {
+        h.state_mut().command(Command::MoveGrab {
+            translation: DVec2::new(0.0, 2.0 * k as f64 / 20.0),
+            angle: 0.0,
+        });
+        h.step();
+    }
+    h.state_mut().command(Command::Release);
+    settle(h);
+}

@@ -3,7 +3,9 @@
 //! floor-plan, leaving the height unchanged)": every proxy of every instance is posed exactly
 //! as the renderer poses it (`render::pose`), then extruded between its base and top heights.
 //! Flat proxy geometry gets a small default thickness so nothing is invisible, each later proxy
-//! of a piece a little higher than the one before (as it is drawn on top in 2D).
+//! of a piece a little higher than the one before (as it is drawn on top in 2D). A mesh asset
+//! (`mesh "tower.glb"`) is written as its own triangles, every vertex at its posed floor-plan
+//! point and the height it has in the asset.
 //!
 //! Data flows one way: assembly -> [`scene`] ([`Scene`]: one [`Node`] per instance, one
 //! [`Primitive`] per fill colour) -> [`gltf`] (`.glb`, `.gltf`) or [`obj`] (`.obj` + `.mtl`).
@@ -23,7 +25,7 @@ use std::collections::HashMap;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, Instance, Rgba};
 use glam::DVec3;
 
-use crate::render::{TessellationCache, WorldMesh, pose_assembly};
+use crate::render::{Solid, TessellationCache, WorldMesh, pose_assembly};
 
 /// How flat geometry is given volume.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,7 +144,10 @@ pub fn scene(grammar: &CompiledGrammar, assembly: &AssemblyData, options: &Expor
             Some(e) => (e.base, e.base + e.height),
             None => (0.0, options.thickness + options.layer * layer as f64),
         };
-        extrude(mesh, base, top, &mut node.primitives[at]);
+        match &mesh.solid {
+            Some(solid) => surface(mesh, solid, &mut node.primitives[at]),
+            None => extrude(mesh, base, top, &mut node.primitives[at]),
+        }
         layer += 1;
     }
     // Every instance is a node, also one without geometry (an empty node keeps the names
@@ -223,6 +228,20 @@ fn extrude(mesh: &WorldMesh, base: f64, top: f64, out: &mut Primitive) {
         let (a0, b0, a1, b1) = (lift(a, base), lift(b, base), lift(a, top), lift(b, top));
         out.triangle([a0, b0, b1], normal);
         out.triangle([a0, b1, a1], normal);
+    }
+}
+
+/// A mesh asset's own triangles, each vertex at its posed floor-plan point and its rest height.
+fn surface(mesh: &WorldMesh, solid: &Solid, out: &mut Primitive) {
+    let corner = |i: u32| {
+        let p = mesh.positions.get(i as usize)?;
+        Some(lift(*p, *solid.heights.get(i as usize)?))
+    };
+    for t in &solid.triangles {
+        let (Some(a), Some(b), Some(c)) = (corner(t[0]), corner(t[1]), corner(t[2])) else {
+            continue;
+        };
+        out.triangle([a, b, c], (b - a).cross(c - a));
     }
 }
 

@@ -27,5 +27,5 @@ pub use raster::{RenderError, render_pixmap, render_png};
 pub use sheet::{sheet_pixmap, sheet_png, sheet_svg};
 pub use svg::render_svg;
 pub use tessellate::{
-    Mesh, TessellationCache, tessellate_polygon, tessellate_polyline, tessellate_proxy,
+    Mesh, Solid, TessellationCache, tessellate_polygon, tessellate_polyline, tessellate_proxy,
 };

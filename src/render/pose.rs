@@ -8,7 +8,7 @@ use std::sync::Arc;
 use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Extrude, Rgba};
 use glam::DVec2;
 
-use super::tessellate::{Mesh, TessellationCache, shown_geometry};
+use super::tessellate::{Mesh, Solid, TessellationCache, shown_geometry};
 pub use crate::fit::{RigidMotion, rigid_motion};
 
 /// The frame of one axis site: its vertex centroid and its tangent (first to last site vertex),
@@ -165,6 +165,8 @@ pub struct WorldMesh {
     pub fill: Rgba,
     /// The proxy's heights for the 3D export (`None`: flat geometry).
     pub extrude: Option<Extrude>,
+    /// The 3D surface of a mesh asset over `positions` (heights unchanged by posing).
+    pub solid: Option<Arc<Solid>>,
     /// The instance (index into [`AssemblyData::instances`]) the mesh belongs to.
     pub instance: usize,
 }
@@ -357,7 +359,7 @@ fn write_mesh(
     out: &mut Vec<WorldMesh>,
     at: usize,
 ) -> bool {
-    if mesh.triangles.is_empty() {
+    if mesh.triangles.is_empty() && mesh.solid.is_none() {
         return false;
     }
     if at == out.len() {
@@ -367,12 +369,14 @@ fn write_mesh(
             outline: Vec::with_capacity(mesh.outline.len()),
             fill: mesh.fill,
             extrude: mesh.extrude,
+            solid: mesh.solid.clone(),
             instance: 0,
         });
     }
     let w = &mut out[at];
     w.fill = mesh.fill;
     w.extrude = mesh.extrude;
+    w.solid.clone_from(&mesh.solid);
     w.positions.clear();
     w.triangles.clear();
     w.outline.clear();
@@ -400,6 +404,9 @@ fn write_mesh(
         }
         return true;
     }
+    // A placeholder cannot be told from a real origin, so ask the map again (it is pure). A
+    // mesh asset's surface would need every vertex: its footprint is all that is left of it.
+    w.solid = None;
     // A placeholder cannot be told from a real origin, so ask the map again (it is pure).
     let ok = |i: u32| {
         finite(&{
@@ -613,6 +620,7 @@ mod tests {
                 outline,
                 fill: mesh.fill,
                 extrude: mesh.extrude,
+                solid: mesh.solid.clone(),
                 instance: 0,
             })
         }

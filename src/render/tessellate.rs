@@ -36,6 +36,17 @@ pub struct Mesh {
     pub binding: Binding,
     /// The proxy's heights for the 3D export, when it has them.
     pub extrude: Option<Extrude>,
+    /// The 3D triangles of a mesh asset over these vertices (`None` for polygons and polylines).
+    pub solid: Option<Arc<Solid>>,
+}
+
+/// The 3D surface of a mesh asset (`mesh "tower.glb"`): a height per vertex of its [`Mesh`] and
+/// its triangles, counter-clockwise seen from outside. Posing moves the vertices' floor-plan
+/// coordinates and shares this unchanged (paper 6: the height stays).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solid {
+    pub heights: Vec<f64>,
+    pub triangles: Vec<[u32; 3]>,
 }
 
 impl Mesh {
@@ -55,9 +66,19 @@ impl Mesh {
 /// Tessellates one proxy; `None` when its shape is degenerate (too few distinct points, zero
 /// area, non-finite coordinates or width).
 pub fn tessellate_proxy(proxy: &Proxy) -> Option<Mesh> {
+    let mut solid = None;
     let (vertices, triangles) = match &proxy.shape {
         ProxyShape::Polygon { outer, holes } => tessellate_polygon(outer, holes)?,
         ProxyShape::Polyline { points, width } => tessellate_polyline(points, *width)?,
+        ProxyShape::Mesh {
+            points,
+            heights,
+            triangles,
+        } => {
+            let (footprint, s) = footprint(points, heights, triangles)?;
+            solid = Some(Arc::new(s));
+            (points.clone(), footprint)
+        }
     };
     let outline = boundary_edges(&triangles);
     Some(Mesh {
@@ -67,7 +88,36 @@ pub fn tessellate_proxy(proxy: &Proxy) -> Option<Mesh> {
         fill: proxy.fill,
         binding: proxy.binding,
         extrude: proxy.extrude,
+        solid,
     })
+}
+
+/// A mesh asset's footprint, what the 2D pictures draw of it: its triangles seen from above,
+/// counter-clockwise, those standing on edge left out; and its 3D surface. `None` when an index
+/// is out of range, a number is not finite or the asset has no triangle.
+fn footprint(
+    points: &[DVec2],
+    heights: &[f64],
+    triangles: &[[u32; 3]],
+) -> Option<(Vec<[u32; 3]>, Solid)> {
+    let n = points.len();
+    let sound = heights.len() == n
+        && points.iter().all(|p| p.is_finite())
+        && heights.iter().all(|h| h.is_finite())
+        && triangles.iter().flatten().all(|&i| (i as usize) < n);
+    if !sound || triangles.is_empty() {
+        return None;
+    }
+    let seen = triangles
+        .iter()
+        .filter(|&&t| triangle_area(t.map(|i| points[i as usize])) > 0.0)
+        .map(|&t| ccw(points, t))
+        .collect();
+    let solid = Solid {
+        heights: heights.to_vec(),
+        triangles: triangles.to_vec(),
+    };
+    Some((seen, solid))
 }
 
 /// Triangulates a polygon with holes; triangles are counter-clockwise. Holes that are

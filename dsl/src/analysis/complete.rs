@@ -39,7 +39,7 @@ const ITEM_KEYWORDS: &[&str] = &[
     "model",
 ];
 const PIECE_KEYWORDS: &[&str] = &[
-    "vertex", "edges", "site", "axis", "polygon", "polyline", "state",
+    "vertex", "edges", "site", "axis", "polygon", "polyline", "mesh", "state",
 ];
 const STATE_KEYWORDS: &[&str] = &["edges", "polygon", "polyline"];
 const PARAMETERS: &[&str] = &["hysteresis", "norm", "irls_epsilon", "merge_distance"];

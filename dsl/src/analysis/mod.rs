@@ -42,6 +42,7 @@ pub const KEYWORDS: &[&str] = &[
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
     "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
     "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude", "above",
+    "mesh",
 ];
 
 /// Words that start a top-level item, where a parsed prefix may end.

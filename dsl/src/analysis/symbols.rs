@@ -261,6 +261,7 @@ impl Symbols {
                     self.point(p, scope);
                 }
             }
+            ShapeDecl::Mesh { .. } => {}
         }
     }
 

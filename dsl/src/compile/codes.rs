@@ -83,6 +83,15 @@ pub const EXTENDS_CYCLE: &str = "E062";
 /// Reuse beyond a limit: too many or too large imports, or an `extends` chain too deep or
 /// copying too much.
 pub const TOO_MUCH_REUSE: &str = "E063";
+/// A `mesh` asset that does not exist.
+pub const MESH_MISSING: &str = "E064";
+/// A `mesh` asset that exists but cannot be read (a folder, no permission).
+pub const MESH_UNREADABLE: &str = "E065";
+/// A `mesh` asset that is not a mesh Clay reads: an unknown extension, or a file that is not
+/// valid glTF 2.0 or OBJ, or has no triangles, or refers to data it does not contain.
+pub const MESH_MALFORMED: &str = "E066";
+/// A `mesh` asset beyond a limit: its file size, its vertices or its triangles.
+pub const MESH_TOO_LARGE: &str = "E067";
 
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";

@@ -189,8 +189,27 @@ impl Bend {
 }
 
 /// Every ring and polyline of a proxy, transformed by `f(points, closed)`.
-fn map_proxy(p: &Proxy, f: &impl Fn(&[DVec2], bool) -> Vec<DVec2>) -> Proxy {
+///
+/// A mesh's vertices are mapped one by one (bend cuts no triangle); when `reflects`, its
+/// triangles are turned round so that they still face out of the solid.
+fn map_proxy(p: &Proxy, f: &impl Fn(&[DVec2], bool) -> Vec<DVec2>, reflects: bool) -> Proxy {
     let shape = match &p.shape {
+        ProxyShape::Mesh {
+            points,
+            heights,
+            triangles,
+        } => ProxyShape::Mesh {
+            points: points
+                .iter()
+                .map(|&q| f(&[q], false).first().copied().unwrap_or(q))
+                .collect(),
+            heights: heights.clone(),
+            triangles: if reflects {
+                triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
+            } else {
+                triangles.clone()
+            },
+        },
         ProxyShape::Polygon { outer, holes } => ProxyShape::Polygon {
             outer: f(outer, true),
             holes: holes.iter().map(|h| f(h, true)).collect(),
@@ -216,7 +235,7 @@ pub(crate) fn bend_geometry(bend: &Bend, geometry: &[Proxy]) -> Vec<Proxy> {
             .map(|p| bend.apply(p))
             .collect()
     };
-    geometry.iter().map(|p| map_proxy(p, &f)).collect()
+    geometry.iter().map(|p| map_proxy(p, &f, false)).collect()
 }
 
 /// Proxy geometry reflected across the axis line. A reflection turns every ring the other way
@@ -229,7 +248,7 @@ pub(crate) fn mirror_geometry(axis: &AxisLine, geometry: &[Proxy]) -> Vec<Proxy>
         }
         m
     };
-    geometry.iter().map(|p| map_proxy(p, &f)).collect()
+    geometry.iter().map(|p| map_proxy(p, &f, true)).collect()
 }
 
 /// The axis of a piece as far as derived states need it, resolved without reporting (the
@@ -351,11 +370,7 @@ impl Compiler {
         let AxisState::Line(axis) = cx.axis else {
             return (failed, Made::Failed);
         };
-        let body: Vec<Proxy> = st
-            .geometry
-            .iter()
-            .filter_map(|g| self.geometry(g))
-            .collect();
+        let body: Vec<Proxy> = st.geometry.iter().flat_map(|g| self.geometry(g)).collect();
         let own_body = !st.geometry.is_empty();
         let (state, made) = match made {
             Made::Failed => return (failed, Made::Failed),
@@ -578,13 +593,13 @@ impl Compiler {
             let f = |pts: &[DVec2], closed: bool| bend.subdivide(pts, closed);
             cx.base_geometry
                 .iter()
-                .map(|p| map_proxy(p, &f))
+                .map(|p| map_proxy(p, &f, false))
                 .flat_map(|p| match p.shape {
                     ProxyShape::Polygon { outer, holes } => outer
                         .into_iter()
                         .chain(holes.into_iter().flatten())
                         .collect(),
-                    ProxyShape::Polyline { points, .. } => points,
+                    ProxyShape::Polyline { points, .. } | ProxyShape::Mesh { points, .. } => points,
                 })
                 .find_map(|p| {
                     bend.folds(p).map(|off| {

@@ -9,6 +9,8 @@ mod constants;
 mod derive;
 mod extends;
 mod imports;
+mod mesh_files;
+mod meshes;
 
 pub(crate) use constants::{constant_values, functions, is_function};
 mod pieces;
@@ -26,6 +28,7 @@ use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
 pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
 pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
+pub use meshes::{MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 
 /// The result of a successful compilation: the grammar, and the warnings found on the way.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,6 +96,14 @@ pub(crate) fn compile_tree(
     };
     let mut c = Compiler::new(path);
     c.expand_extends(&mut file);
+    c.meshes = meshes::load(
+        &file,
+        path,
+        source_len,
+        &spliced.sources,
+        loader,
+        &mut c.diags,
+    );
     c.run(&file);
     c.drop_poisoned();
     let mut diags = c.diags;
@@ -187,6 +198,8 @@ pub(crate) struct Compiler {
     pub grammar: Option<CompiledGrammar>,
     /// The `let` constants, read by every expression.
     pub consts: constants::Constants,
+    /// The decoded `mesh` assets, by the global start of their path string (meshes.rs).
+    pub meshes: meshes::Meshes,
 }
 
 impl Compiler {
@@ -213,6 +226,7 @@ impl Compiler {
             inheritance: extends::Inheritance::default(),
             grammar: None,
             consts: constants::Constants::default(),
+            meshes: meshes::Meshes::default(),
         }
     }
 
@@ -649,6 +663,9 @@ impl CompiledGrammar {
                     outer.iter().all(v) && holes.iter().flatten().all(v)
                 }
                 ProxyShape::Polyline { points, width } => points.iter().all(v) && width.is_finite(),
+                ProxyShape::Mesh {
+                    points, heights, ..
+                } => points.iter().all(v) && heights.iter().all(|h| h.is_finite()),
             })
         };
         self.pieces.iter().all(|p| {

@@ -9,6 +9,9 @@ use glam::DVec2;
 
 use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, MAX_HEIGHT, PieceSpans, codes, derive, fmt};
 
+/// The colour of a `mesh` whose asset gives none and that has no `fill` (a light stone grey).
+const MESH_FILL: Rgba = Rgba([0xb8, 0xb2, 0xa7, 0xff]);
+
 impl Compiler {
     // Long because: one pass over the piece's statements in source order, each a short arm of one match.
     pub(super) fn piece_decl(&mut self, decl: &syntax::PieceDecl) {
@@ -367,13 +370,36 @@ impl Compiler {
         })
     }
 
-    pub(super) fn geometry(&mut self, g: &syntax::GeometryDecl) -> Option<Proxy> {
+    /// The proxies of a geometry statement: one, or none after an error; a `mesh` gives one
+    /// per colour of its asset.
+    pub(super) fn geometry(&mut self, g: &syntax::GeometryDecl) -> Vec<Proxy> {
         let binding = match g.binding {
             Some((syntax::BindingKw::Skinned, _)) => Binding::Skinned,
             _ => Binding::Rigid,
         };
+        if let syntax::ShapeDecl::Mesh { path, fill } = &g.shape {
+            let parts = self.meshes.get(path.span).unwrap_or_default();
+            return parts
+                .iter()
+                .map(|part| Proxy {
+                    shape: part.shape.clone(),
+                    fill: fill
+                        .as_ref()
+                        .map(|c| Rgba(c.rgba))
+                        .or(part.fill)
+                        .unwrap_or(MESH_FILL),
+                    binding,
+                    extrude: None,
+                })
+                .collect();
+        }
+        self.flat_geometry(g, binding).into_iter().collect()
+    }
+
+    fn flat_geometry(&mut self, g: &syntax::GeometryDecl, binding: Binding) -> Option<Proxy> {
         let fill = Rgba(g.fill.rgba);
         let shape = match &g.shape {
+            syntax::ShapeDecl::Mesh { .. } => return None,
             syntax::ShapeDecl::Polygon { outer, holes } => {
                 let mut ok = self.enough_points(outer.len(), 3, "polygon", g.keyword);
                 let outer: Vec<DVec2> = outer.iter().map(|p| self.point(p)).collect();
@@ -649,11 +675,7 @@ impl Compiler {
                 &spans.edges,
             );
         }
-        let own: Vec<Proxy> = st
-            .geometry
-            .iter()
-            .filter_map(|g| self.geometry(g))
-            .collect();
+        let own: Vec<Proxy> = st.geometry.iter().flat_map(|g| self.geometry(g)).collect();
         let (geometry, geometry_frame) = if st.geometry.is_empty() {
             (base_geometry.to_vec(), 0)
         } else {

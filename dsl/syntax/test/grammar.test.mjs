@@ -41,7 +41,7 @@ const grammar = await registry.loadGrammar("source.clay");
 // Keywords that begin a statement (or a block).
 const STATEMENT_KEYWORDS = new Set([
   "import", "let", "solver", "site", "piece", "vertex", "edges", "axis", "polygon", "polyline",
-  "hole", "state", "stretch", "min", "variants", "merge", "cut", "model", "dock",
+  "mesh", "hole", "state", "stretch", "min", "variants", "merge", "cut", "model", "dock",
 ]);
 // Keywords inside a statement, by the statement's first keyword ("=" for `NAME = ...`).
 const INNER_KEYWORDS = {
@@ -50,6 +50,7 @@ const INNER_KEYWORDS = {
   piece: ["extends"],
   polygon: ["rigid", "skinned", "fill", "extrude", "above"],
   polyline: ["rigid", "skinned", "width", "fill", "extrude", "above"],
+  mesh: ["rigid", "skinned", "fill"],
   state: ["bend", "mirror"],
   stretch: ["from", "to"],
   merge: ["onto", "into", "within"],
@@ -58,7 +59,7 @@ const INNER_KEYWORDS = {
   "=": ["chain", "x", "along", "at", "rotate"],
 };
 // Keywords being added to the language alongside this grammar (issue 19's neighbours).
-const NEW_KEYWORDS = ["import", "extends", "bend", "mirror", "extrude", "above"];
+const NEW_KEYWORDS = ["import", "extends", "bend", "mirror", "extrude", "above", "mesh"];
 const ALL_KEYWORDS = new Set([...STATEMENT_KEYWORDS, ...Object.values(INNER_KEYWORDS).flat()]);
 const BUILTINS = new Set(["sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "abs", "min", "max"]);
 
