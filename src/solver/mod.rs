@@ -7,6 +7,7 @@
 mod admm;
 mod cg;
 mod cholesky;
+mod chunks;
 mod config;
 pub mod follow;
 mod global;
@@ -66,6 +67,28 @@ struct Work {
     shown: Vec<DVec2>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
+    /// The local step already evaluated at the pose pass 2 starts from (see [`Start`]).
+    start: Start,
+    /// Per part: the state the last local step chose, and its squared stacked residual.
+    chosen: Vec<usize>,
+    residuals: Vec<f64>,
+}
+
+/// Rotations, edge targets and elastic energy of the pose pass 2 starts from (the displayed
+/// pose after rigid following), when a step already computed them: the first IRLS
+/// iteration of this frame (it evaluates that pose, and its rotations are those of the
+/// states it chose), or the last accepted pass-2 iterate of the previous frame (the pose
+/// displayed since). Pass 2 takes them instead of evaluating the same pose again; they are
+/// the same numbers bit for bit, since the local step depends only on the pose, the active
+/// states and the settings.
+#[derive(Debug, Default)]
+struct Start {
+    rotations: Vec<DVec2>,
+    targets: Vec<DVec2>,
+    elastic: f64,
+    /// Valid for this assembly generation and settings while exactly this many state
+    /// switches have been reported in the frame (a later switch changes the rest edges).
+    valid: Option<(u64, SolverConfig, usize)>,
 }
 
 /// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
@@ -90,6 +113,9 @@ pub struct Solver {
     /// The mean rest edge length of the active states when the generation was prepared (the
     /// splitting threshold's unit).
     mean_rest_edge: f64,
+    /// Whether some component has no held vertex this frame (only then do solves shift
+    /// centroids back).
+    any_free: bool,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
@@ -113,6 +139,7 @@ impl Solver {
             splitting: admm::Splitting::default(),
             components: follow::Components::default(),
             centroid_shift: Vec::new(),
+            any_free: true,
             mean_rest_edge: 1.0,
             shifted: Vec::new(),
             factor_slot: Vec::new(),
@@ -235,6 +262,7 @@ impl Solver {
         }
         let cfg = self.config;
         self.gather_handles(asm.handles(), n);
+        self.any_free = self.components.any_free(&self.work.handle_count);
         // Position buffers live in `work` between frames (taken here, put back at the end; an
         // error path just drops them and the next frame reallocates).
         let mut warm = std::mem::take(&mut self.work.warm);
@@ -258,24 +286,38 @@ impl Solver {
             split.reset(asm.generation(), m, &warm);
         }
         self.follow_handles(&mut warm, &mut split, step_tolerance);
+        let generation = self.generation.unwrap_or(u64::MAX);
+        let start_key = Some((generation, cfg, 0));
+        if self.work.start.valid != start_key || self.work.shown != warm {
+            self.work.start.valid = None;
+        }
+        let from_warm = split.pose == warm;
+        report.phases.bookkeeping += ms_since(start);
         let pass1 = self.pass1(
             &mut asm.data_mut().parts,
             &mut split,
+            from_warm,
             cfg.pass1_tolerance * scale,
             deadline,
             &mut report,
         );
         self.splitting = split;
+        // a frame that fails leaves no evaluation to reuse (its states may have switched)
+        self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
-        let (f, terms, pass2_converged) = self.pass2(
+        let pass2 = self.pass2(
             &asm.data().parts,
             asm.handles(),
             &warm,
             step_tolerance,
             deadline,
             &mut report,
-        )?;
+        );
+        self.work.start.valid.take_if(|_| pass2.is_err());
+        let (f, terms, pass2_converged) = pass2?;
+        let t = Instant::now();
         if f.iter().any(|p| !p.is_finite()) {
+            self.work.start.valid = None;
             return Err(SolverError(
                 "the solve produced non-finite positions".into(),
             ));
@@ -287,6 +329,16 @@ impl Solver {
             rot.copy_from_slice(&self.work.rotations);
         }
         sync_instance_states(asm);
+        // the accepted iterate's evaluation is the next frame's start while `f` stays shown
+        let w = &mut self.work;
+        if cfg.l2_iterations > 0 && w.rotations.len() == asm.data().parts.len() {
+            std::mem::swap(&mut w.start.rotations, &mut w.rotations);
+            std::mem::swap(&mut w.start.targets, &mut w.targets);
+            w.start.elastic = terms.elastic;
+            w.start.valid = Some((generation, cfg, 0));
+        } else {
+            w.start.valid = None;
+        }
         report.energy = terms.elastic;
         report.objective = terms.total();
         let settled = report.moved <= cfg.settle_tolerance * scale;
@@ -294,6 +346,7 @@ impl Solver {
             && report.switches.is_empty()
             && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
+        report.phases.bookkeeping += ms_since(t);
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         (self.work.warm, self.work.f) = (warm, f);
         Ok(report)
@@ -333,10 +386,12 @@ impl Solver {
     /// vertex moves more than `tolerance` and no state switches, or the configured count, or
     /// (after [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns
     /// whether it converged.
+    #[allow(clippy::too_many_arguments)]
     fn pass1(
         &mut self,
         parts: &mut [Part],
         split: &mut admm::Splitting,
+        from_warm: bool,
         tolerance: f64,
         deadline: Option<Instant>,
         report: &mut FrameReport,
@@ -362,8 +417,20 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            self.local_step_switching(parts, &f, cfg.hysteresis, &mut report.switches);
-            self.edge_targets(parts);
+            let elastic = self.evaluate_switching(parts, &f, &mut report.switches);
+            if it == 0 && from_warm && cfg.pass1 == Pass1::Irls {
+                // this is the pose pass 2 starts from (`Start`)
+                let w = &mut self.work;
+                w.start.rotations.clone_from(&w.rotations);
+                w.start.targets.clone_from(&w.targets);
+                w.start.elastic = elastic;
+                let key = (
+                    self.generation.unwrap_or(u64::MAX),
+                    cfg,
+                    report.switches.len(),
+                );
+                w.start.valid = Some(key);
+            }
             report.phases.local += ms_since(t);
             let solved = match cfg.pass1 {
                 Pass1::Admm => {
@@ -463,7 +530,7 @@ impl Solver {
     }
 
     /// One IRLS iteration (paper 5.2): weights `1 / (|r| + eps)^(2 - p)` from the residuals
-    /// at `f`, then the weighted global step.
+    /// at `f` (the last local step's, per part), then the weighted global step.
     fn irls_iteration(
         &mut self,
         f: &[DVec2],
@@ -482,9 +549,7 @@ impl Solver {
         while k < edges.len() {
             let part = edges[k].part;
             let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
-            let d2: f64 = (k..end)
-                .map(|j| (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared())
-                .sum();
+            let d2 = w.residuals[part];
             let weight = irls_weight(d2.sqrt() + eps, p);
             let weight = if weight.is_finite() {
                 weight
@@ -525,9 +590,27 @@ impl Solver {
         next.clear();
         next.resize(f.len(), DVec2::ZERO);
         let t = Instant::now();
-        self.rotations_at(parts, &f);
-        self.edge_targets(parts);
-        let mut terms = self.terms_at(&self.work.targets, handles, &f);
+        let w = &mut self.work;
+        let key = (
+            self.generation.unwrap_or(u64::MAX),
+            cfg,
+            report.switches.len(),
+        );
+        let mut terms = if cfg.l2_iterations > 0 && w.start.valid == Some(key) {
+            // the local step at `warm` was done already (`Start`)
+            std::mem::swap(&mut w.start.rotations, &mut w.rotations);
+            std::mem::swap(&mut w.start.targets, &mut w.targets);
+            w.start.valid = None;
+            Terms {
+                elastic: w.start.elastic,
+                handle: handle_term(handles, &f, cfg.handle_weight),
+            }
+        } else {
+            Terms {
+                elastic: self.evaluate_fixed(parts, &f),
+                handle: handle_term(handles, &f, cfg.handle_weight),
+            }
+        };
         report.warm_objective = terms.total();
         report.phases.local += ms_since(t);
         let mut converged = cfg.l2_iterations == 0;
@@ -545,9 +628,10 @@ impl Solver {
             let w = &mut self.work;
             std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
             std::mem::swap(&mut w.targets, &mut w.kept_targets);
-            self.rotations_at(parts, &next);
-            self.edge_targets(parts);
-            let next_terms = self.terms_at(&self.work.targets, handles, &next);
+            let next_terms = Terms {
+                elastic: self.evaluate_fixed(parts, &next),
+                handle: handle_term(handles, &next, cfg.handle_weight),
+            };
             report.phases.local += ms_since(t);
             // Only an iterate that lowers the objective is taken: a frame never ends worse
             // than it started, and a model at rest stays exactly where it is (a solve of a
@@ -584,6 +668,103 @@ impl Solver {
                     .extend(parts.iter().map(|part| local::part_rotation(part, f)));
             }
         }
+    }
+
+    /// Whether the rest cache fits the assembly (else the reference functions run).
+    fn cache_fits(&self, parts: usize) -> bool {
+        let edges = self.pattern.edges.len();
+        (self.work.rest.as_ref()).is_some_and(|c| c.parts() == parts && c.edges() == edges)
+    }
+
+    /// The local step at `f` with the states fixed: rotations, edge targets and per-part
+    /// residuals into the work buffers; returns the elastic energy at `f`.
+    fn evaluate_fixed(&mut self, parts: &[Part], f: &[DVec2]) -> f64 {
+        if !self.cache_fits(parts.len()) {
+            self.rotations_at(parts, f);
+            self.edge_targets(parts);
+            return self.residuals_at(f);
+        }
+        self.evaluate(parts, f, chunks::Choice::Keep)
+    }
+
+    /// The local step at `f` with state switching (paper 4.3): as
+    /// [`Solver::evaluate_fixed`], and every part whose nearest state wins the hysteresis
+    /// switches to it (reported in part order).
+    fn evaluate_switching(
+        &mut self,
+        parts: &mut [Part],
+        f: &[DVec2],
+        switches: &mut Vec<StateSwitch>,
+    ) -> f64 {
+        let hysteresis = self.config.hysteresis;
+        if !self.cache_fits(parts.len()) {
+            self.local_step_switching(parts, f, hysteresis, switches);
+            self.edge_targets(parts);
+            return self.residuals_at(f);
+        }
+        let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
+        for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
+            if state != part.active {
+                switches.push(StateSwitch {
+                    part: i,
+                    from: part.active,
+                    to: state,
+                });
+                part.active = state;
+            }
+        }
+        elastic
+    }
+
+    /// [`chunks::evaluate`] into the work buffers (the rest cache fits).
+    fn evaluate(&mut self, parts: &[Part], f: &[DVec2], choice: chunks::Choice) -> f64 {
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let threads = self.config.thread_count();
+        let w = &mut self.work;
+        let Some(cache) = &w.rest else {
+            return 0.0;
+        };
+        let count = parts.len();
+        w.rotations.resize(count, DVec2::X);
+        w.chosen.resize(count, 0);
+        w.residuals.resize(count, 0.0);
+        // every slot is written: no clearing pass
+        w.targets.resize(cache.edges(), DVec2::ZERO);
+        let out = chunks::Outputs {
+            rotations: &mut w.rotations,
+            chosen: &mut w.chosen,
+            residuals: &mut w.residuals,
+            targets: &mut w.targets,
+        };
+        chunks::evaluate(cache, parts, f, choice, cos_cone, threads, out)
+    }
+
+    /// Per part, its squared stacked residual at `f` with `work.targets` (into
+    /// `work.residuals`); returns the elastic energy (the same sums as [`chunks::evaluate`]
+    /// for a model of one chunk).
+    fn residuals_at(&mut self, f: &[DVec2]) -> f64 {
+        let w = &mut self.work;
+        let edges = &self.pattern.edges;
+        w.residuals.clear();
+        w.residuals.resize(w.rotations.len(), 0.0);
+        let mut elastic = 0.0;
+        let mut k = 0;
+        while k < edges.len() {
+            let part = edges[k].part;
+            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+            let d2: f64 = (k..end)
+                .map(|j| {
+                    let r2 = (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared();
+                    elastic += r2;
+                    r2
+                })
+                .sum();
+            if let Some(r) = w.residuals.get_mut(part) {
+                *r = d2;
+            }
+            k = end;
+        }
+        elastic
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
@@ -684,19 +865,6 @@ impl Solver {
         }
     }
 
-    /// The pass-2 objective's terms at `f` for the given edge targets.
-    fn terms_at(&self, targets: &[DVec2], handles: &[Handle], f: &[DVec2]) -> Terms {
-        let hw = self.config.handle_weight;
-        // the compact edge ends of the rest cache instead of the wide edge slots
-        match self.work.rest.as_ref().and_then(|c| c.elastic(targets, f)) {
-            Some(elastic) => Terms {
-                elastic,
-                ..terms(&[], &[], handles, f, hw)
-            },
-            None => terms(&self.pattern.edges, targets, handles, f, hw),
-        }
-    }
-
     /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
     /// A component with no held vertex keeps its centroid: only the tiny proximal term fixes
     /// its position, so the solve's rounding, divided by that term's weight, would otherwise
@@ -711,7 +879,9 @@ impl Solver {
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
         self.solve_global_raw(f, next, mean_weight, pass, report)?;
+        let t = Instant::now();
         self.keep_free_centroids(f, next);
+        report.phases.bookkeeping += ms_since(t);
         Ok(())
     }
 
@@ -719,6 +889,10 @@ impl Solver {
     /// `f` (in exact arithmetic the solve already does: the Laplacian's rows of a component sum
     /// to zero, so the proximal term alone sets its centroid).
     fn keep_free_centroids(&mut self, f: &[DVec2], next: &mut [DVec2]) {
+        if !self.any_free {
+            // every component is held: nothing to shift
+            return;
+        }
         let c = &self.components;
         let k = c.count();
         let sums = &mut self.centroid_shift;
@@ -1036,18 +1210,8 @@ impl Terms {
     }
 }
 
-/// Pass-2 objective terms at `f` for the given edge targets.
-fn terms(
-    edges: &[global::EdgeSlot],
-    targets: &[DVec2],
-    handles: &[Handle],
-    f: &[DVec2],
-    handle_weight: f64,
-) -> Terms {
-    let mut elastic = 0.0;
-    for (e, &t) in edges.iter().zip(targets) {
-        elastic += (t - (f[e.x] - f[e.y])).length_squared();
-    }
+/// The handle term of the pass-2 objective at `f`.
+fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
     let mut handle = 0.0;
     for h in handles {
         for (k, &v) in h.vertices.iter().enumerate() {
@@ -1059,10 +1223,7 @@ fn terms(
             }
         }
     }
-    Terms {
-        elastic,
-        handle: handle_weight * handle,
-    }
+    handle_weight * handle
 }
 
 /// Per column, the norm of the right-hand side's edge terms (without the handle and proximal
