@@ -161,6 +161,27 @@ impl Chunks {
     }
 }
 
+/// Rows (vertices) per task of a gathered right-hand side ([`rows`]).
+const ROW_CHUNK: usize = 4096;
+
+/// Runs `work(first, rows)` over consecutive pieces of `rows` (each row computed on its own,
+/// so any cut gives the same rows): on the pool when `threads > 1` and there are at least
+/// four pieces, else on the calling thread.
+pub fn rows(threads: usize, rows: &mut [DVec2], work: &(dyn Fn(usize, &mut [DVec2]) + Sync)) {
+    if threads <= 1 || rows.len() < 4 * ROW_CHUNK {
+        work(0, rows);
+        return;
+    }
+    let mut run = move || {
+        let pieces = rows.par_chunks_mut(ROW_CHUNK).enumerate();
+        pieces.for_each(|(c, piece)| work(c * ROW_CHUNK, piece));
+    };
+    match pool() {
+        Some(pool) => pool.install(run),
+        None => run(),
+    }
+}
+
 /// The local step's thread pool (every core), started at the first parallel step; `None`
 /// when it cannot be started (rayon's global pool then runs the tasks).
 fn pool() -> Option<&'static rayon::ThreadPool> {

@@ -42,7 +42,6 @@ struct Work {
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
     weights: Vec<f64>,
-    ones: Vec<f64>,
     /// Per vertex: number of handle targets, and their sum.
     handle_count: Vec<f64>,
     handle_sum: Vec<DVec2>,
@@ -60,7 +59,8 @@ struct Work {
     part_sums: Vec<DVec2>,
     /// The displayed pose at the start of the frame (then moved by rigid following).
     warm: Vec<DVec2>,
-    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged.
+    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged,
+    /// and between steps those of [`Start`].
     kept_rotations: Vec<DVec2>,
     kept_targets: Vec<DVec2>,
     /// The positions the last frame displayed (pass 1 continues only from them).
@@ -74,17 +74,16 @@ struct Work {
     residuals: Vec<f64>,
 }
 
-/// Rotations, edge targets and elastic energy of the pose pass 2 starts from (the displayed
-/// pose after rigid following), when a step already computed them: the first IRLS
-/// iteration of this frame (it evaluates that pose, and its rotations are those of the
-/// states it chose), or the last accepted pass-2 iterate of the previous frame (the pose
-/// displayed since). Pass 2 takes them instead of evaluating the same pose again; they are
-/// the same numbers bit for bit, since the local step depends only on the pose, the active
-/// states and the settings.
+/// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
+/// when a step already computed it: the first IRLS iteration of this frame (it evaluates that
+/// pose, and its rotations are those of the states it chose), or the last accepted pass-2
+/// iterate of the previous frame (the pose displayed since). Pass 2 takes it instead of
+/// evaluating the same pose again; it is the same numbers bit for bit, since the local step
+/// depends only on the pose, the active states and the settings. Its rotations and targets
+/// are kept in `Work::kept_rotations` and `Work::kept_targets` (pass 2's scratch, unused
+/// until then).
 #[derive(Debug, Default)]
 struct Start {
-    rotations: Vec<DVec2>,
-    targets: Vec<DVec2>,
     elastic: f64,
     /// Valid for this assembly generation and settings while exactly this many state
     /// switches have been reported in the frame (a later switch changes the rest edges).
@@ -332,8 +331,8 @@ impl Solver {
         // the accepted iterate's evaluation is the next frame's start while `f` stays shown
         let w = &mut self.work;
         if cfg.l2_iterations > 0 && w.rotations.len() == asm.data().parts.len() {
-            std::mem::swap(&mut w.start.rotations, &mut w.rotations);
-            std::mem::swap(&mut w.start.targets, &mut w.targets);
+            std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+            std::mem::swap(&mut w.kept_targets, &mut w.targets);
             w.start.elastic = terms.elastic;
             w.start.valid = Some((generation, cfg, 0));
         } else {
@@ -421,8 +420,8 @@ impl Solver {
             if it == 0 && from_warm && cfg.pass1 == Pass1::Irls {
                 // this is the pose pass 2 starts from (`Start`)
                 let w = &mut self.work;
-                w.start.rotations.clone_from(&w.rotations);
-                w.start.targets.clone_from(&w.targets);
+                w.kept_rotations.clone_from(&w.rotations);
+                w.kept_targets.clone_from(&w.targets);
                 w.start.elastic = elastic;
                 let key = (
                     self.generation.unwrap_or(u64::MAX),
@@ -598,8 +597,8 @@ impl Solver {
         );
         let mut terms = if cfg.l2_iterations > 0 && w.start.valid == Some(key) {
             // the local step at `warm` was done already (`Start`)
-            std::mem::swap(&mut w.start.rotations, &mut w.rotations);
-            std::mem::swap(&mut w.start.targets, &mut w.targets);
+            std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+            std::mem::swap(&mut w.kept_targets, &mut w.targets);
             w.start.valid = None;
             Terms {
                 elastic: w.start.elastic,
@@ -940,6 +939,16 @@ impl Solver {
             w.extra.push(lambda * sum + mu * p);
         }
         let weights: &[f64] = match pass {
+            Pass::Irls if self.pattern.can_gather() => {
+                let threads = cfg.thread_count();
+                let rows = &mut w.vertex_rhs;
+                rows.clone_from(&w.extra);
+                (self.pattern).gather_rhs(Some(&w.weights), &w.targets, rows, threads);
+                w.rhs.clear();
+                w.rhs.extend(rows.iter().map(|p| p.x));
+                w.rhs.extend(rows.iter().map(|p| p.y));
+                &w.weights
+            }
             Pass::Irls => {
                 global::fill_rhs(
                     &self.pattern.edges,
@@ -1086,11 +1095,16 @@ impl Solver {
             *d = lambda * count + mu;
             *bi = lambda * sum + mu * p;
         }
-        for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
-            let (x, y) = (x as usize, y as usize);
-            if x != y {
-                b[x] += t;
-                b[y] -= t;
+        if self.pattern.can_gather() {
+            let threads = cfg.thread_count();
+            self.pattern.gather_rhs(None, &w.targets, b, threads);
+        } else {
+            for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
+                let (x, y) = (x as usize, y as usize);
+                if x != y {
+                    b[x] += t;
+                    b[y] -= t;
+                }
             }
         }
         let x = &mut self.ordered;
@@ -1153,11 +1167,7 @@ fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFa
     if w.l2_diagonal == w.diagonal && !w.l2_values.is_empty() {
         return;
     }
-    if w.ones.len() != pattern.edges.len() {
-        w.ones.clear();
-        w.ones.resize(pattern.edges.len(), 1.0);
-    }
-    pattern.fill_values(&w.ones, &w.diagonal, &mut w.l2_values);
+    pattern.fill_unit_values(&w.diagonal, &mut w.l2_values);
     w.l2_diagonal.clone_from(&w.diagonal);
     factor.invalidate();
 }
