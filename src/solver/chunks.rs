@@ -220,16 +220,17 @@ pub fn evaluate(
     let partials = if cos_cone >= 1.0 {
         let work = |c: usize, o: Outputs| {
             let (p0, e0) = chunks.bounds[c];
-            let mut pose = vec![DVec2::ZERO; scratch];
+            let (mut small, mut large) = ([DVec2::ZERO; SMALL], Vec::new());
+            let pose = scratch_of(&mut small, &mut large, scratch);
             let mut elastic = 0.0;
             for pi in chunks.parts(c) {
                 let part = &parts[pi];
-                let (active, own) = rotate(cache, pi, part, positions, choice, &mut pose);
+                let (active, own) = rotate(cache, pi, part, positions, choice, pose);
                 o.rotations[pi - p0] = own;
                 o.chosen[pi - p0] = active;
                 let first = cache.first_edge(pi) - e0;
                 let t = &mut o.targets[first..][..cache.part_edges(pi)];
-                cache.targets_with(pi, active, own, &[], cos_cone, t, &mut pose);
+                cache.targets_with(pi, active, own, &[], cos_cone, t, pose);
                 o.residuals[pi - p0] = cache.residual_of(pi, t, positions, &mut elastic);
             }
             elastic
@@ -287,9 +288,10 @@ fn within_cone(
     } = out;
     let states = |c: usize, o: Outputs| {
         let p0 = chunks.bounds[c].0;
-        let mut pose = vec![DVec2::ZERO; scratch];
+        let (mut small, mut large) = ([DVec2::ZERO; SMALL], Vec::new());
+        let pose = scratch_of(&mut small, &mut large, scratch);
         for pi in chunks.parts(c) {
-            let (active, own) = rotate(cache, pi, &parts[pi], positions, choice, &mut pose);
+            let (active, own) = rotate(cache, pi, &parts[pi], positions, choice, pose);
             o.rotations[pi - p0] = own;
             o.chosen[pi - p0] = active;
         }
@@ -307,13 +309,14 @@ fn within_cone(
     let (rotations, chosen) = (&*rotations, &*chosen);
     let work = |c: usize, o: Targets| {
         let (p0, e0) = chunks.bounds[c];
-        let mut sums = vec![DVec2::ZERO; scratch];
+        let (mut small, mut large) = ([DVec2::ZERO; SMALL], Vec::new());
+        let sums = scratch_of(&mut small, &mut large, scratch);
         let mut elastic = 0.0;
         for pi in chunks.parts(c) {
             let at = cache.first_edge(pi) - e0;
             let t = &mut o.targets[at..][..cache.part_edges(pi)];
             let own = rotations[pi];
-            cache.targets_with(pi, chosen[pi], own, rotations, cos_cone, t, &mut sums);
+            cache.targets_with(pi, chosen[pi], own, rotations, cos_cone, t, sums);
             o.residuals[pi - p0] = cache.residual_of(pi, t, positions, &mut elastic);
         }
         elastic
@@ -338,5 +341,23 @@ impl Split for PartsOnly<'_> {
         let (mut a, mut b) = (empty(), empty());
         (a.rotations, a.chosen, b.rotations, b.chosen) = (r0, c0, r1, c1);
         (PartsOnly(a), PartsOnly(b))
+    }
+}
+
+/// Parts up to this many vertices take their scratch from the stack.
+const SMALL: usize = 32;
+
+/// A chunk's scratch of `len` points: `small` when it fits, else `large` grown to it (a
+/// worker then allocates nothing for the usual parts).
+fn scratch_of<'a>(
+    small: &'a mut [DVec2; SMALL],
+    large: &'a mut Vec<DVec2>,
+    len: usize,
+) -> &'a mut [DVec2] {
+    if len <= SMALL {
+        &mut small[..len]
+    } else {
+        large.resize(len, DVec2::ZERO);
+        large
     }
 }

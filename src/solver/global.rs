@@ -105,7 +105,8 @@ impl Pattern {
         }
     }
 
-    /// Adds every edge's target (times its weight, when `weights` is given) to row `x` and
+    /// Adds every edge's target (times its part's weight, when `weights`, one per part, is
+    /// given) to row `x` and
     /// subtracts it from row `y` of `rows` (one `(x, y)` pair per vertex, holding the handle
     /// and proximal terms), each row's terms in edge order, as a serial scatter over the
     /// edges would: the same bits, on `threads` threads ([`chunks::rows`]).
@@ -123,7 +124,7 @@ impl Pattern {
                 for &k in &incident[start[v] as usize..start[v + 1] as usize] {
                     let e = (k >> 1) as usize;
                     let t = match weights {
-                        Some(w) => w[e] * targets[e],
+                        Some(w) => w[self.edges[e].part] * targets[e],
                         None => targets[e],
                     };
                     if k & 1 == 0 {
@@ -147,12 +148,14 @@ impl Pattern {
         self.row_idx.len()
     }
 
-    /// Fills `values` with the weighted Laplacian of the edges plus `diagonal`.
+    /// Fills `values` with the weighted Laplacian of the edges (`weights`: one per part, for
+    /// all its edges) plus `diagonal`.
     pub fn fill_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
         values.clear();
         values.resize(self.nnz(), 0.0);
-        for (e, &w) in self.edges.iter().zip(weights) {
+        for e in &self.edges {
             if let Some(slot) = e.slot {
+                let w = weights[e.part];
                 values[self.col_ptr[e.x]] += w;
                 values[self.col_ptr[e.y]] += w;
                 values[slot] -= w;
@@ -228,8 +231,9 @@ fn incidence(n: usize, edges: &[EdgeSlot]) -> (Vec<u32>, Vec<u32>) {
     (start, incident)
 }
 
-/// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` into row x and its negation
-/// into row y, plus `extra` (handle and proximal terms), for the x column then the y column.
+/// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` (`w` its part's weight in
+/// `weights`) into row x and its negation into row y, plus `extra` (handle and proximal
+/// terms), for the x column then the y column.
 pub fn fill_rhs(
     edges: &[EdgeSlot],
     weights: &[f64],
@@ -244,8 +248,9 @@ pub fn fill_rhs(
         rhs[i] = e.x;
         rhs[n + i] = e.y;
     }
-    for ((e, &w), &t) in edges.iter().zip(weights).zip(targets) {
+    for (e, &t) in edges.iter().zip(targets) {
         if e.slot.is_some() {
+            let w = weights[e.part];
             let c = w * t;
             rhs[e.x] += c.x;
             rhs[n + e.x] += c.y;

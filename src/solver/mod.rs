@@ -41,6 +41,7 @@ struct Work {
     rest: Option<local::RestCache>,
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
+    /// Per part: its IRLS weight (pass 1), for all its edges.
     weights: Vec<f64>,
     /// Per vertex: number of handle targets, and their sum.
     handle_count: Vec<f64>,
@@ -542,7 +543,7 @@ impl Solver {
         let w = &mut self.work;
         let edges = &self.pattern.edges;
         w.weights.clear();
-        w.weights.resize(edges.len(), 0.0);
+        w.weights.resize(w.residuals.len(), 0.0);
         // one weight per part, from its stacked residual (see the splitting's groups)
         let mut k = 0;
         while k < edges.len() {
@@ -555,10 +556,10 @@ impl Solver {
             } else {
                 eps.powf(p - 2.0)
             };
-            w.weights[k..end].fill(weight);
+            w.weights[part] = weight;
             k = end;
         }
-        let mean = mean_or_one(&w.weights);
+        let mean = mean_over_edges(edges, &w.weights);
         report.phases.assembly += ms_since(t);
         self.solve_global(f, next, mean, Pass::Irls, report)
     }
@@ -1266,11 +1267,13 @@ fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-fn mean_or_one(values: &[f64]) -> f64 {
-    if values.is_empty() {
+/// The mean over the edges of their parts' weights (1 when there are none or it is not a
+/// positive number): summed edge by edge, as one weight per edge would be.
+fn mean_over_edges(edges: &[global::EdgeSlot], part_weights: &[f64]) -> f64 {
+    if edges.is_empty() {
         return 1.0;
     }
-    let m = values.iter().sum::<f64>() / values.len() as f64;
+    let m = edges.iter().map(|e| part_weights[e.part]).sum::<f64>() / edges.len() as f64;
     if m.is_finite() && m > 0.0 { m } else { 1.0 }
 }
 
