@@ -361,3 +361,71 @@ fn scratch_of<'a>(
         large
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::local::{RestCache, VertexParts};
+
+    fn same(a: DVec2, b: DVec2) -> bool {
+        a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
+    }
+
+    /// The chunked step gives the reference step's states, rotations, targets and (for one
+    /// chunk) energy bit for bit, with and without a rotation cone, on a deformed city.
+    #[test]
+    fn chunked_step_matches_the_reference_step() {
+        let data = crate::synthetic::city(400).assembly;
+        let n = data.positions.len();
+        // a shear and a wave, so parts are rotated, strained and some switch
+        let positions: Vec<DVec2> = (data.positions.iter())
+            .map(|p| DVec2::new(p.x + 0.3 * p.y, p.y + (0.7 * p.x).sin()))
+            .collect();
+        for cos_cone in [1.0, 20f64.to_radians().cos()] {
+            for choice in [Choice::Keep, Choice::Switch { hysteresis: 0.15 }] {
+                let mut parts = data.parts.clone();
+                let vp = VertexParts::build(&parts, n);
+                let mut cache = RestCache::build(&parts, &vp).unwrap();
+                assert!(
+                    parts.len() <= CHUNK,
+                    "one chunk: the energy is one running sum"
+                );
+                let (count, edges) = (parts.len(), cache.edges());
+                let (mut rotations, mut chosen) = (vec![DVec2::X; count], vec![0; count]);
+                let (mut residuals, mut targets) = (vec![0.0; count], vec![DVec2::ZERO; edges]);
+                let out = Outputs {
+                    rotations: &mut rotations,
+                    chosen: &mut chosen,
+                    residuals: &mut residuals,
+                    targets: &mut targets,
+                };
+                let elastic = evaluate(&cache, &parts, &positions, choice, cos_cone, 2, out);
+                // the reference: state by state, then the targets, then the energy
+                let mut want_rotations = Vec::new();
+                for (pi, part) in parts.iter_mut().enumerate() {
+                    let (state, r) = match choice {
+                        Choice::Keep => (part.active, cache.part_rotation(pi, part, &positions)),
+                        Choice::Switch { hysteresis } => {
+                            cache.choose_state(pi, part, &positions, hysteresis)
+                        }
+                    };
+                    assert_eq!(chosen[pi], state, "part {pi}");
+                    part.active = state;
+                    want_rotations.push(r);
+                }
+                let mut want = Vec::new();
+                cache.edge_targets(&parts, &want_rotations, cos_cone, &mut want);
+                assert!(
+                    rotations
+                        .iter()
+                        .zip(&want_rotations)
+                        .all(|(a, b)| same(*a, *b))
+                );
+                assert_eq!(targets.len(), want.len());
+                assert!(targets.iter().zip(&want).all(|(a, b)| same(*a, *b)));
+                let energy = cache.elastic(&want, &positions).unwrap();
+                assert_eq!(elastic.to_bits(), energy.to_bits());
+            }
+        }
+    }
+}

@@ -91,6 +91,40 @@ struct Start {
     valid: Option<(u64, SolverConfig, usize)>,
 }
 
+impl Work {
+    /// Keeps the accepted pass-2 iterate's evaluation (in `rotations` and `targets`, with
+    /// energy `elastic`) as the next frame's [`Start`]: valid while that pose stays shown and
+    /// the parts keep their active states (noted in `chosen`: `Assembly::set_active_state`
+    /// changes them without a new generation).
+    fn keep_start(&mut self, cfg: SolverConfig, generation: u64, parts: &[Part], elastic: f64) {
+        if cfg.l2_iterations > 0 && self.rotations.len() == parts.len() {
+            std::mem::swap(&mut self.kept_rotations, &mut self.rotations);
+            std::mem::swap(&mut self.kept_targets, &mut self.targets);
+            self.chosen.clear();
+            self.chosen.extend(parts.iter().map(|p| p.active));
+            self.start.elastic = elastic;
+            self.start.valid = Some((generation, cfg, 0));
+        } else {
+            self.start.valid = None;
+        }
+    }
+
+    /// Whether the last frame's [`Start`] holds for this one: kept under `key`, for the pose
+    /// `warm` (the one it showed) and the parts' active states.
+    fn start_holds(
+        &self,
+        key: Option<(u64, SolverConfig, usize)>,
+        warm: &[DVec2],
+        parts: &[Part],
+    ) -> bool {
+        let states = || {
+            self.chosen.len() == parts.len()
+                && parts.iter().zip(&self.chosen).all(|(p, &c)| p.active == c)
+        };
+        self.start.valid == key && self.shown == warm && states()
+    }
+}
+
 /// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
 /// and all buffers between frames; rebuilds them when the assembly's generation changes.
 #[derive(Debug)]
@@ -288,7 +322,7 @@ impl Solver {
         self.follow_handles(&mut warm, &mut split, step_tolerance);
         let generation = self.generation.unwrap_or(u64::MAX);
         let start_key = Some((generation, cfg, 0));
-        if self.work.start.valid != start_key || self.work.shown != warm {
+        if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
             self.work.start.valid = None;
         }
         let from_warm = split.pose == warm;
@@ -329,16 +363,8 @@ impl Solver {
             rot.copy_from_slice(&self.work.rotations);
         }
         sync_instance_states(asm);
-        // the accepted iterate's evaluation is the next frame's start while `f` stays shown
-        let w = &mut self.work;
-        if cfg.l2_iterations > 0 && w.rotations.len() == asm.data().parts.len() {
-            std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
-            std::mem::swap(&mut w.kept_targets, &mut w.targets);
-            w.start.elastic = terms.elastic;
-            w.start.valid = Some((generation, cfg, 0));
-        } else {
-            w.start.valid = None;
-        }
+        self.work
+            .keep_start(cfg, generation, &asm.data().parts, terms.elastic);
         report.energy = terms.elastic;
         report.objective = terms.total();
         let settled = report.moved <= cfg.settle_tolerance * scale;
