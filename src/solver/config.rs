@@ -108,6 +108,9 @@ pub struct SolverConfig {
     /// Compute the relative residual of every linear solve into the report (one extra matrix
     /// product per solve).
     pub measure_residual: bool,
+    /// Threads of the local step (0: every core). The results are the same bit for bit
+    /// whatever the count (`solver/chunks.rs`); models under a few thousand parts use one.
+    pub threads: usize,
 }
 
 impl Default for SolverConfig {
@@ -141,6 +144,19 @@ impl SolverConfig {
             pcg_tolerance: 1e-6,
             settle_tolerance: 1e-6,
             measure_residual: false,
+            threads: 0,
+        }
+    }
+}
+
+impl SolverConfig {
+    /// The threads the local step runs on ([`SolverConfig::threads`], 0 resolved to the
+    /// machine's cores, asked once).
+    pub fn thread_count(&self) -> usize {
+        static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+        match self.threads {
+            0 => *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+            t => t,
         }
     }
 }

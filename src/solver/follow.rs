@@ -63,6 +63,18 @@ impl Components {
     pub fn count(&self) -> usize {
         self.count
     }
+
+    /// Whether some component has no vertex with a handle count above 0 (`handle_count`
+    /// per vertex).
+    pub fn any_free(&self, handle_count: &[f64]) -> bool {
+        let mut held = vec![false; self.count];
+        for (&c, &h) in self.of.iter().zip(handle_count) {
+            if h > 0.0 {
+                held[c as usize] = true;
+            }
+        }
+        held.contains(&false)
+    }
 }
 
 /// Per component, the rigid motion taking its held vertices from `positions` onto their

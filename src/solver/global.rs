@@ -7,6 +7,8 @@
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
+use super::chunks;
+
 /// One edge of one part, resolved to global vertices and its slot in the matrix values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EdgeSlot {
@@ -36,6 +38,13 @@ pub struct Pattern {
     /// with more vertices than `u32` counts): the per-iteration loops stream these instead
     /// of the whole slots.
     pub ends: Vec<[u32; 2]>,
+    /// Per vertex, the edges it ends (compressed rows, each vertex's in edge order; an edge
+    /// whose ends are one vertex is left out): `2 k` for the `x` end of edge `k`, `2 k + 1`
+    /// for its `y` end. The right-hand side is gathered from these vertex by vertex, so its
+    /// rows can be filled in parallel and still add their terms in the order of the serial
+    /// scatter. Empty when an entry would not fit `u32` (then the scatter runs).
+    pub incident_start: Vec<u32>,
+    pub incident: Vec<u32>,
 }
 
 impl Pattern {
@@ -84,28 +93,89 @@ impl Pattern {
         // the solver checks that every vertex index fits before it builds a pattern
         let compact = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
         let ends = edges.iter().map(|e| [compact(e.x), compact(e.y)]).collect();
+        let (incident_start, incident) = incidence(n, &edges);
         Self {
             n,
             col_ptr,
             row_idx,
             edges,
             ends,
+            incident_start,
+            incident,
         }
+    }
+
+    /// Adds every edge's target (times its part's weight, when `weights`, one per part, is
+    /// given) to row `x` and
+    /// subtracts it from row `y` of `rows` (one `(x, y)` pair per vertex, holding the handle
+    /// and proximal terms), each row's terms in edge order, as a serial scatter over the
+    /// edges would: the same bits, on `threads` threads ([`chunks::rows`]).
+    pub fn gather_rhs(
+        &self,
+        weights: Option<&[f64]>,
+        targets: &[DVec2],
+        rows: &mut [DVec2],
+        threads: usize,
+    ) {
+        let (start, incident) = (&self.incident_start, &self.incident);
+        let gather = |first: usize, chunk: &mut [DVec2]| {
+            for (v, row) in (first..).zip(chunk.iter_mut()) {
+                let mut acc = *row;
+                for &k in &incident[start[v] as usize..start[v + 1] as usize] {
+                    let e = (k >> 1) as usize;
+                    let t = match weights {
+                        Some(w) => w[self.edges[e].part] * targets[e],
+                        None => targets[e],
+                    };
+                    if k & 1 == 0 {
+                        acc += t;
+                    } else {
+                        acc -= t;
+                    }
+                }
+                *row = acc;
+            }
+        };
+        chunks::rows(threads, rows, &gather);
+    }
+
+    /// Whether [`Pattern::gather_rhs`] can run (the incidence was built).
+    pub fn can_gather(&self) -> bool {
+        self.incident_start.len() == self.n + 1
     }
 
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
     }
 
-    /// Fills `values` with the weighted Laplacian of the edges plus `diagonal`.
+    /// Fills `values` with the weighted Laplacian of the edges (`weights`: one per part, for
+    /// all its edges) plus `diagonal`.
     pub fn fill_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
         values.clear();
         values.resize(self.nnz(), 0.0);
-        for (e, &w) in self.edges.iter().zip(weights) {
+        for e in &self.edges {
             if let Some(slot) = e.slot {
+                let w = weights[e.part];
                 values[self.col_ptr[e.x]] += w;
                 values[self.col_ptr[e.y]] += w;
                 values[slot] -= w;
+            }
+        }
+        for (j, &d) in diagonal.iter().enumerate() {
+            values[self.col_ptr[j]] += d;
+        }
+    }
+
+    /// [`Pattern::fill_values`] with every weight 1 (the least-squares matrix), without a
+    /// slice of ones.
+    pub fn fill_unit_values(&self, diagonal: &[f64], values: &mut Vec<f64>) {
+        values.clear();
+        values.resize(self.nnz(), 0.0);
+        for e in &self.edges {
+            if let Some(slot) = e.slot {
+                values[self.col_ptr[e.x]] += 1.0;
+                values[self.col_ptr[e.y]] += 1.0;
+                values[slot] -= 1.0;
             }
         }
         for (j, &d) in diagonal.iter().enumerate() {
@@ -136,8 +206,34 @@ impl Pattern {
     }
 }
 
-/// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` into row x and its negation
-/// into row y, plus `extra` (handle and proximal terms), for the x column then the y column.
+/// Per vertex, the edge ends at it, in edge order ([`Pattern::incident`]); empty when an
+/// entry would not fit `u32`.
+fn incidence(n: usize, edges: &[EdgeSlot]) -> (Vec<u32>, Vec<u32>) {
+    if u32::try_from(2 * edges.len() + 1).is_err() {
+        return (Vec::new(), Vec::new());
+    }
+    let mut start = vec![0u32; n + 1];
+    for e in edges.iter().filter(|e| e.slot.is_some()) {
+        start[e.x + 1] += 1;
+        start[e.y + 1] += 1;
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut incident = vec![0u32; start[n] as usize];
+    for (k, e) in edges.iter().enumerate().filter(|(_, e)| e.slot.is_some()) {
+        for (v, end) in [(e.x, 0), (e.y, 1)] {
+            incident[fill[v] as usize] = (2 * k + end) as u32;
+            fill[v] += 1;
+        }
+    }
+    (start, incident)
+}
+
+/// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` (`w` its part's weight in
+/// `weights`) into row x and its negation into row y, plus `extra` (handle and proximal
+/// terms), for the x column then the y column.
 pub fn fill_rhs(
     edges: &[EdgeSlot],
     weights: &[f64],
@@ -152,8 +248,9 @@ pub fn fill_rhs(
         rhs[i] = e.x;
         rhs[n + i] = e.y;
     }
-    for ((e, &w), &t) in edges.iter().zip(weights).zip(targets) {
+    for (e, &t) in edges.iter().zip(targets) {
         if e.slot.is_some() {
+            let w = weights[e.part];
             let c = w * t;
             rhs[e.x] += c.x;
             rhs[n + e.x] += c.y;

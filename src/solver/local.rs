@@ -441,7 +441,9 @@ impl RestCache {
 
     /// The elastic energy `sum |t - (f_x - f_y)|^2` of `targets` (one per part-edge, in the
     /// solver's order) at `positions`, summed in edge order as the solver's `terms`; `None`
-    /// when `targets` is not one per cached edge.
+    /// when `targets` is not one per cached edge. (The solver sums these in
+    /// `chunks::evaluate`; this is the reference its tests compare with.)
+    #[cfg(test)]
     pub fn elastic(&self, targets: &[DVec2], positions: &[DVec2]) -> Option<f64> {
         if targets.len() != self.edge_ends.len() {
             return None;
@@ -466,12 +468,12 @@ impl RestCache {
 
     /// Gathers and centres the pose of the part with span `s` into `self.pose[..m]`;
     /// returns its squared norm. The same expressions, in the same order, as [`align`].
-    fn gather_pose(&mut self, s: Span, m: usize, positions: &[DVec2]) -> f64 {
+    fn gather_pose(&self, s: Span, m: usize, positions: &[DVec2], pose: &mut [DVec2]) -> f64 {
         let verts = &self.vertices[s.vertex as usize..][..m];
         let inv = 1.0 / m as f64;
         let centre = verts.iter().map(|&v| positions[v as usize]).sum::<DVec2>() * inv;
         let mut qq = 0.0;
-        for (q, &v) in self.pose[..m].iter_mut().zip(verts) {
+        for (q, &v) in pose[..m].iter_mut().zip(verts) {
             *q = positions[v as usize] - centre;
             qq += q.length_squared();
         }
@@ -510,6 +512,22 @@ impl RestCache {
         positions: &[DVec2],
         hysteresis: f64,
     ) -> (usize, DVec2) {
+        let mut pose = std::mem::take(&mut self.pose);
+        let chosen = self.choose_with(pi, part, positions, hysteresis, &mut pose);
+        self.pose = pose;
+        chosen
+    }
+
+    /// [`choose_state`] for part `pi` (which is `part`), with `pose` as scratch (at least as
+    /// long as the largest part).
+    pub fn choose_with(
+        &self,
+        pi: usize,
+        part: &Part,
+        positions: &[DVec2],
+        hysteresis: f64,
+        pose: &mut [DVec2],
+    ) -> (usize, DVec2) {
         let Some((s, shape)) = self.dense_span(pi, part) else {
             return choose_state(part, positions, hysteresis);
         };
@@ -519,8 +537,8 @@ impl RestCache {
         }
         let m = part.vertices.len();
         let active = part.active.min(count - 1);
-        let qq = self.gather_pose(s, m, positions);
-        let pose = &self.pose[..m];
+        let qq = self.gather_pose(s, m, positions, pose);
+        let pose = &pose[..m];
         let rest = &self.rest[shape.rest as usize..][..count * m];
         let pp = &self.pp[shape.pp as usize..][..count];
         // One pass over the pose for all states (each state's sums still run in vertex
@@ -561,6 +579,12 @@ impl RestCache {
     #[inline]
     pub fn part_rotation(&mut self, pi: usize, part: &Part, positions: &[DVec2]) -> DVec2 {
         self.note(pi, part.active);
+        self.rotation_of(pi, part, positions)
+    }
+
+    /// [`part_rotation`] for part `pi` (which is `part`), from the cached rest data.
+    #[inline]
+    pub fn rotation_of(&self, pi: usize, part: &Part, positions: &[DVec2]) -> DVec2 {
         let Some((s, shape)) = self.dense_span(pi, part) else {
             return part_rotation(part, positions);
         };
@@ -620,12 +644,52 @@ impl RestCache {
         cos_cone: f64,
         targets: &mut [DVec2],
     ) {
-        let own = rotations[pi];
+        let mut sums = std::mem::take(&mut self.sums);
+        let first = self.spans[pi].edge as usize;
+        let out = &mut targets[first..][..self.part_edges(pi)];
+        self.targets_with(
+            pi,
+            active,
+            rotations[pi],
+            rotations,
+            cos_cone,
+            out,
+            &mut sums,
+        );
+        self.sums = sums;
+    }
+
+    /// Number of edges of part `pi`.
+    #[inline]
+    pub fn part_edges(&self, pi: usize) -> usize {
+        self.shapes[self.spans[pi].shape as usize].edges as usize
+    }
+
+    /// Where part `pi`'s edges start in the solver's edge order.
+    #[inline]
+    pub fn first_edge(&self, pi: usize) -> usize {
+        self.spans[pi].edge as usize
+    }
+
+    /// The targets of part `pi`'s edges (`out`, [`RestCache::part_edges`] long), with its
+    /// active state `active` and rotation `own`; `rotations` (every part's) is read only
+    /// within a cone (`cos_cone < 1`), and `sums` is scratch as long as the largest part.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn targets_with(
+        &self,
+        pi: usize,
+        active: usize,
+        own: DVec2,
+        rotations: &[DVec2],
+        cos_cone: f64,
+        out: &mut [DVec2],
+        sums: &mut [DVec2],
+    ) {
         let (s, next) = (self.spans[pi], self.spans[pi + 1]);
         let shape = self.shapes[s.shape as usize];
         let count = shape.edges as usize;
         let edges = &self.edge_local[shape.edge_local as usize..][..count];
-        let out = &mut targets[s.edge as usize..][..count];
         // a part without its active state gets zero rest edges, as in the reference
         let rest = if active < shape.states as usize {
             &self.rest_edges[shape.rest_edges as usize + active * count..][..count]
@@ -646,11 +710,39 @@ impl RestCache {
         let sums = if m <= small.len() {
             &mut small[..m]
         } else {
-            let sums = &mut self.sums[..m];
+            let sums = &mut sums[..m];
             sums.fill(DVec2::ZERO);
             sums
         };
         part_targets(sums, neighbours, rotations, own, cos_cone, edges, rest, out);
+    }
+
+    /// The squared residuals `|t - (f_x - f_y)|^2` of part `pi`'s edges (`targets`, its
+    /// targets) at `positions`, each added to `elastic` in edge order; returns their sum
+    /// (the part's stacked residual, squared).
+    #[inline]
+    pub fn residual_of(
+        &self,
+        pi: usize,
+        targets: &[DVec2],
+        positions: &[DVec2],
+        elastic: &mut f64,
+    ) -> f64 {
+        let (s, next) = (self.spans[pi], self.spans[pi + 1]);
+        let ends = &self.edge_ends[s.edge as usize..next.edge as usize];
+        ends.iter()
+            .zip(targets)
+            .map(|(&[x, y], &t)| {
+                let r2 = (t - (positions[x as usize] - positions[y as usize])).length_squared();
+                *elastic += r2;
+                r2
+            })
+            .sum()
+    }
+
+    /// Scratch lengths a caller of the `&self` steps needs: the largest part's vertex count.
+    pub fn largest_part(&self) -> usize {
+        self.pose.len()
     }
 }
 

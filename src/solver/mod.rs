@@ -7,6 +7,7 @@
 mod admm;
 mod cg;
 mod cholesky;
+mod chunks;
 mod config;
 pub mod follow;
 mod global;
@@ -40,8 +41,8 @@ struct Work {
     rest: Option<local::RestCache>,
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
+    /// Per part: its IRLS weight (pass 1), for all its edges.
     weights: Vec<f64>,
-    ones: Vec<f64>,
     /// Per vertex: number of handle targets, and their sum.
     handle_count: Vec<f64>,
     handle_sum: Vec<DVec2>,
@@ -59,13 +60,69 @@ struct Work {
     part_sums: Vec<DVec2>,
     /// The displayed pose at the start of the frame (then moved by rigid following).
     warm: Vec<DVec2>,
-    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged.
+    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged,
+    /// and between steps those of [`Start`].
     kept_rotations: Vec<DVec2>,
     kept_targets: Vec<DVec2>,
     /// The positions the last frame displayed (pass 1 continues only from them).
     shown: Vec<DVec2>,
     f: Vec<DVec2>,
     next: Vec<DVec2>,
+    /// The local step already evaluated at the pose pass 2 starts from (see [`Start`]).
+    start: Start,
+    /// Per part: the state the last local step chose, and its squared stacked residual.
+    chosen: Vec<usize>,
+    residuals: Vec<f64>,
+}
+
+/// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
+/// when a step already computed it: the first IRLS iteration of this frame (it evaluates that
+/// pose, and its rotations are those of the states it chose), or the last accepted pass-2
+/// iterate of the previous frame (the pose displayed since). Pass 2 takes it instead of
+/// evaluating the same pose again; it is the same numbers bit for bit, since the local step
+/// depends only on the pose, the active states and the settings. Its rotations and targets
+/// are kept in `Work::kept_rotations` and `Work::kept_targets` (pass 2's scratch, unused
+/// until then).
+#[derive(Debug, Default)]
+struct Start {
+    elastic: f64,
+    /// Valid for this assembly generation and settings while exactly this many state
+    /// switches have been reported in the frame (a later switch changes the rest edges).
+    valid: Option<(u64, SolverConfig, usize)>,
+}
+
+impl Work {
+    /// Keeps the accepted pass-2 iterate's evaluation (in `rotations` and `targets`, with
+    /// energy `elastic`) as the next frame's [`Start`]: valid while that pose stays shown and
+    /// the parts keep their active states (noted in `chosen`: `Assembly::set_active_state`
+    /// changes them without a new generation).
+    fn keep_start(&mut self, cfg: SolverConfig, generation: u64, parts: &[Part], elastic: f64) {
+        if cfg.l2_iterations > 0 && self.rotations.len() == parts.len() {
+            std::mem::swap(&mut self.kept_rotations, &mut self.rotations);
+            std::mem::swap(&mut self.kept_targets, &mut self.targets);
+            self.chosen.clear();
+            self.chosen.extend(parts.iter().map(|p| p.active));
+            self.start.elastic = elastic;
+            self.start.valid = Some((generation, cfg, 0));
+        } else {
+            self.start.valid = None;
+        }
+    }
+
+    /// Whether the last frame's [`Start`] holds for this one: kept under `key`, for the pose
+    /// `warm` (the one it showed) and the parts' active states.
+    fn start_holds(
+        &self,
+        key: Option<(u64, SolverConfig, usize)>,
+        warm: &[DVec2],
+        parts: &[Part],
+    ) -> bool {
+        let states = || {
+            self.chosen.len() == parts.len()
+                && parts.iter().zip(&self.chosen).all(|(p, &c)| p.active == c)
+        };
+        self.start.valid == key && self.shown == warm && states()
+    }
 }
 
 /// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
@@ -90,6 +147,9 @@ pub struct Solver {
     /// The mean rest edge length of the active states when the generation was prepared (the
     /// splitting threshold's unit).
     mean_rest_edge: f64,
+    /// Whether some component has no held vertex this frame (only then do solves shift
+    /// centroids back).
+    any_free: bool,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
@@ -113,6 +173,7 @@ impl Solver {
             splitting: admm::Splitting::default(),
             components: follow::Components::default(),
             centroid_shift: Vec::new(),
+            any_free: true,
             mean_rest_edge: 1.0,
             shifted: Vec::new(),
             factor_slot: Vec::new(),
@@ -235,6 +296,7 @@ impl Solver {
         }
         let cfg = self.config;
         self.gather_handles(asm.handles(), n);
+        self.any_free = self.components.any_free(&self.work.handle_count);
         // Position buffers live in `work` between frames (taken here, put back at the end; an
         // error path just drops them and the next frame reallocates).
         let mut warm = std::mem::take(&mut self.work.warm);
@@ -258,24 +320,38 @@ impl Solver {
             split.reset(asm.generation(), m, &warm);
         }
         self.follow_handles(&mut warm, &mut split, step_tolerance);
+        let generation = self.generation.unwrap_or(u64::MAX);
+        let start_key = Some((generation, cfg, 0));
+        if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
+            self.work.start.valid = None;
+        }
+        let from_warm = split.pose == warm;
+        report.phases.bookkeeping += ms_since(start);
         let pass1 = self.pass1(
             &mut asm.data_mut().parts,
             &mut split,
+            from_warm,
             cfg.pass1_tolerance * scale,
             deadline,
             &mut report,
         );
         self.splitting = split;
+        // a frame that fails leaves no evaluation to reuse (its states may have switched)
+        self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
-        let (f, terms, pass2_converged) = self.pass2(
+        let pass2 = self.pass2(
             &asm.data().parts,
             asm.handles(),
             &warm,
             step_tolerance,
             deadline,
             &mut report,
-        )?;
+        );
+        self.work.start.valid.take_if(|_| pass2.is_err());
+        let (f, terms, pass2_converged) = pass2?;
+        let t = Instant::now();
         if f.iter().any(|p| !p.is_finite()) {
+            self.work.start.valid = None;
             return Err(SolverError(
                 "the solve produced non-finite positions".into(),
             ));
@@ -287,6 +363,8 @@ impl Solver {
             rot.copy_from_slice(&self.work.rotations);
         }
         sync_instance_states(asm);
+        self.work
+            .keep_start(cfg, generation, &asm.data().parts, terms.elastic);
         report.energy = terms.elastic;
         report.objective = terms.total();
         let settled = report.moved <= cfg.settle_tolerance * scale;
@@ -294,6 +372,7 @@ impl Solver {
             && report.switches.is_empty()
             && (settled || (pass1_converged && pass2_converged));
         self.work.shown.clone_from(&f);
+        report.phases.bookkeeping += ms_since(t);
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         (self.work.warm, self.work.f) = (warm, f);
         Ok(report)
@@ -333,10 +412,12 @@ impl Solver {
     /// vertex moves more than `tolerance` and no state switches, or the configured count, or
     /// (after [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns
     /// whether it converged.
+    #[allow(clippy::too_many_arguments)]
     fn pass1(
         &mut self,
         parts: &mut [Part],
         split: &mut admm::Splitting,
+        from_warm: bool,
         tolerance: f64,
         deadline: Option<Instant>,
         report: &mut FrameReport,
@@ -362,8 +443,20 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            self.local_step_switching(parts, &f, cfg.hysteresis, &mut report.switches);
-            self.edge_targets(parts);
+            let elastic = self.evaluate_switching(parts, &f, &mut report.switches);
+            if it == 0 && from_warm && cfg.pass1 == Pass1::Irls {
+                // this is the pose pass 2 starts from (`Start`)
+                let w = &mut self.work;
+                w.kept_rotations.clone_from(&w.rotations);
+                w.kept_targets.clone_from(&w.targets);
+                w.start.elastic = elastic;
+                let key = (
+                    self.generation.unwrap_or(u64::MAX),
+                    cfg,
+                    report.switches.len(),
+                );
+                w.start.valid = Some(key);
+            }
             report.phases.local += ms_since(t);
             let solved = match cfg.pass1 {
                 Pass1::Admm => {
@@ -463,7 +556,7 @@ impl Solver {
     }
 
     /// One IRLS iteration (paper 5.2): weights `1 / (|r| + eps)^(2 - p)` from the residuals
-    /// at `f`, then the weighted global step.
+    /// at `f` (the last local step's, per part), then the weighted global step.
     fn irls_iteration(
         &mut self,
         f: &[DVec2],
@@ -476,25 +569,23 @@ impl Solver {
         let w = &mut self.work;
         let edges = &self.pattern.edges;
         w.weights.clear();
-        w.weights.resize(edges.len(), 0.0);
+        w.weights.resize(w.residuals.len(), 0.0);
         // one weight per part, from its stacked residual (see the splitting's groups)
         let mut k = 0;
         while k < edges.len() {
             let part = edges[k].part;
             let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
-            let d2: f64 = (k..end)
-                .map(|j| (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared())
-                .sum();
+            let d2 = w.residuals[part];
             let weight = irls_weight(d2.sqrt() + eps, p);
             let weight = if weight.is_finite() {
                 weight
             } else {
                 eps.powf(p - 2.0)
             };
-            w.weights[k..end].fill(weight);
+            w.weights[part] = weight;
             k = end;
         }
-        let mean = mean_or_one(&w.weights);
+        let mean = mean_over_edges(edges, &w.weights);
         report.phases.assembly += ms_since(t);
         self.solve_global(f, next, mean, Pass::Irls, report)
     }
@@ -525,9 +616,27 @@ impl Solver {
         next.clear();
         next.resize(f.len(), DVec2::ZERO);
         let t = Instant::now();
-        self.rotations_at(parts, &f);
-        self.edge_targets(parts);
-        let mut terms = self.terms_at(&self.work.targets, handles, &f);
+        let w = &mut self.work;
+        let key = (
+            self.generation.unwrap_or(u64::MAX),
+            cfg,
+            report.switches.len(),
+        );
+        let mut terms = if cfg.l2_iterations > 0 && w.start.valid == Some(key) {
+            // the local step at `warm` was done already (`Start`)
+            std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+            std::mem::swap(&mut w.kept_targets, &mut w.targets);
+            w.start.valid = None;
+            Terms {
+                elastic: w.start.elastic,
+                handle: handle_term(handles, &f, cfg.handle_weight),
+            }
+        } else {
+            Terms {
+                elastic: self.evaluate_fixed(parts, &f),
+                handle: handle_term(handles, &f, cfg.handle_weight),
+            }
+        };
         report.warm_objective = terms.total();
         report.phases.local += ms_since(t);
         let mut converged = cfg.l2_iterations == 0;
@@ -545,9 +654,10 @@ impl Solver {
             let w = &mut self.work;
             std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
             std::mem::swap(&mut w.targets, &mut w.kept_targets);
-            self.rotations_at(parts, &next);
-            self.edge_targets(parts);
-            let next_terms = self.terms_at(&self.work.targets, handles, &next);
+            let next_terms = Terms {
+                elastic: self.evaluate_fixed(parts, &next),
+                handle: handle_term(handles, &next, cfg.handle_weight),
+            };
             report.phases.local += ms_since(t);
             // Only an iterate that lowers the objective is taken: a frame never ends worse
             // than it started, and a model at rest stays exactly where it is (a solve of a
@@ -584,6 +694,103 @@ impl Solver {
                     .extend(parts.iter().map(|part| local::part_rotation(part, f)));
             }
         }
+    }
+
+    /// Whether the rest cache fits the assembly (else the reference functions run).
+    fn cache_fits(&self, parts: usize) -> bool {
+        let edges = self.pattern.edges.len();
+        (self.work.rest.as_ref()).is_some_and(|c| c.parts() == parts && c.edges() == edges)
+    }
+
+    /// The local step at `f` with the states fixed: rotations, edge targets and per-part
+    /// residuals into the work buffers; returns the elastic energy at `f`.
+    fn evaluate_fixed(&mut self, parts: &[Part], f: &[DVec2]) -> f64 {
+        if !self.cache_fits(parts.len()) {
+            self.rotations_at(parts, f);
+            self.edge_targets(parts);
+            return self.residuals_at(f);
+        }
+        self.evaluate(parts, f, chunks::Choice::Keep)
+    }
+
+    /// The local step at `f` with state switching (paper 4.3): as
+    /// [`Solver::evaluate_fixed`], and every part whose nearest state wins the hysteresis
+    /// switches to it (reported in part order).
+    fn evaluate_switching(
+        &mut self,
+        parts: &mut [Part],
+        f: &[DVec2],
+        switches: &mut Vec<StateSwitch>,
+    ) -> f64 {
+        let hysteresis = self.config.hysteresis;
+        if !self.cache_fits(parts.len()) {
+            self.local_step_switching(parts, f, hysteresis, switches);
+            self.edge_targets(parts);
+            return self.residuals_at(f);
+        }
+        let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
+        for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
+            if state != part.active {
+                switches.push(StateSwitch {
+                    part: i,
+                    from: part.active,
+                    to: state,
+                });
+                part.active = state;
+            }
+        }
+        elastic
+    }
+
+    /// [`chunks::evaluate`] into the work buffers (the rest cache fits).
+    fn evaluate(&mut self, parts: &[Part], f: &[DVec2], choice: chunks::Choice) -> f64 {
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let threads = self.config.thread_count();
+        let w = &mut self.work;
+        let Some(cache) = &w.rest else {
+            return 0.0;
+        };
+        let count = parts.len();
+        w.rotations.resize(count, DVec2::X);
+        w.chosen.resize(count, 0);
+        w.residuals.resize(count, 0.0);
+        // every slot is written: no clearing pass
+        w.targets.resize(cache.edges(), DVec2::ZERO);
+        let out = chunks::Outputs {
+            rotations: &mut w.rotations,
+            chosen: &mut w.chosen,
+            residuals: &mut w.residuals,
+            targets: &mut w.targets,
+        };
+        chunks::evaluate(cache, parts, f, choice, cos_cone, threads, out)
+    }
+
+    /// Per part, its squared stacked residual at `f` with `work.targets` (into
+    /// `work.residuals`); returns the elastic energy (the same sums as [`chunks::evaluate`]
+    /// for a model of one chunk).
+    fn residuals_at(&mut self, f: &[DVec2]) -> f64 {
+        let w = &mut self.work;
+        let edges = &self.pattern.edges;
+        w.residuals.clear();
+        w.residuals.resize(w.rotations.len(), 0.0);
+        let mut elastic = 0.0;
+        let mut k = 0;
+        while k < edges.len() {
+            let part = edges[k].part;
+            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+            let d2: f64 = (k..end)
+                .map(|j| {
+                    let r2 = (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared();
+                    elastic += r2;
+                    r2
+                })
+                .sum();
+            if let Some(r) = w.residuals.get_mut(part) {
+                *r = d2;
+            }
+            k = end;
+        }
+        elastic
     }
 
     fn gather_handles(&mut self, handles: &[Handle], n: usize) {
@@ -684,19 +891,6 @@ impl Solver {
         }
     }
 
-    /// The pass-2 objective's terms at `f` for the given edge targets.
-    fn terms_at(&self, targets: &[DVec2], handles: &[Handle], f: &[DVec2]) -> Terms {
-        let hw = self.config.handle_weight;
-        // the compact edge ends of the rest cache instead of the wide edge slots
-        match self.work.rest.as_ref().and_then(|c| c.elastic(targets, f)) {
-            Some(elastic) => Terms {
-                elastic,
-                ..terms(&[], &[], handles, f, hw)
-            },
-            None => terms(&self.pattern.edges, targets, handles, f, hw),
-        }
-    }
-
     /// Global step: solves for `next` with the current edge targets and the weights of `pass`.
     /// A component with no held vertex keeps its centroid: only the tiny proximal term fixes
     /// its position, so the solve's rounding, divided by that term's weight, would otherwise
@@ -711,7 +905,9 @@ impl Solver {
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
         self.solve_global_raw(f, next, mean_weight, pass, report)?;
+        let t = Instant::now();
         self.keep_free_centroids(f, next);
+        report.phases.bookkeeping += ms_since(t);
         Ok(())
     }
 
@@ -719,6 +915,10 @@ impl Solver {
     /// `f` (in exact arithmetic the solve already does: the Laplacian's rows of a component sum
     /// to zero, so the proximal term alone sets its centroid).
     fn keep_free_centroids(&mut self, f: &[DVec2], next: &mut [DVec2]) {
+        if !self.any_free {
+            // every component is held: nothing to shift
+            return;
+        }
         let c = &self.components;
         let k = c.count();
         let sums = &mut self.centroid_shift;
@@ -766,6 +966,16 @@ impl Solver {
             w.extra.push(lambda * sum + mu * p);
         }
         let weights: &[f64] = match pass {
+            Pass::Irls if self.pattern.can_gather() => {
+                let threads = cfg.thread_count();
+                let rows = &mut w.vertex_rhs;
+                rows.clone_from(&w.extra);
+                (self.pattern).gather_rhs(Some(&w.weights), &w.targets, rows, threads);
+                w.rhs.clear();
+                w.rhs.extend(rows.iter().map(|p| p.x));
+                w.rhs.extend(rows.iter().map(|p| p.y));
+                &w.weights
+            }
             Pass::Irls => {
                 global::fill_rhs(
                     &self.pattern.edges,
@@ -912,11 +1122,16 @@ impl Solver {
             *d = lambda * count + mu;
             *bi = lambda * sum + mu * p;
         }
-        for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
-            let (x, y) = (x as usize, y as usize);
-            if x != y {
-                b[x] += t;
-                b[y] -= t;
+        if self.pattern.can_gather() {
+            let threads = cfg.thread_count();
+            self.pattern.gather_rhs(None, &w.targets, b, threads);
+        } else {
+            for (&[x, y], &t) in self.pattern.ends.iter().zip(&w.targets) {
+                let (x, y) = (x as usize, y as usize);
+                if x != y {
+                    b[x] += t;
+                    b[y] -= t;
+                }
             }
         }
         let x = &mut self.ordered;
@@ -979,11 +1194,7 @@ fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFa
     if w.l2_diagonal == w.diagonal && !w.l2_values.is_empty() {
         return;
     }
-    if w.ones.len() != pattern.edges.len() {
-        w.ones.clear();
-        w.ones.resize(pattern.edges.len(), 1.0);
-    }
-    pattern.fill_values(&w.ones, &w.diagonal, &mut w.l2_values);
+    pattern.fill_unit_values(&w.diagonal, &mut w.l2_values);
     w.l2_diagonal.clone_from(&w.diagonal);
     factor.invalidate();
 }
@@ -1036,18 +1247,8 @@ impl Terms {
     }
 }
 
-/// Pass-2 objective terms at `f` for the given edge targets.
-fn terms(
-    edges: &[global::EdgeSlot],
-    targets: &[DVec2],
-    handles: &[Handle],
-    f: &[DVec2],
-    handle_weight: f64,
-) -> Terms {
-    let mut elastic = 0.0;
-    for (e, &t) in edges.iter().zip(targets) {
-        elastic += (t - (f[e.x] - f[e.y])).length_squared();
-    }
+/// The handle term of the pass-2 objective at `f`.
+fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
     let mut handle = 0.0;
     for h in handles {
         for (k, &v) in h.vertices.iter().enumerate() {
@@ -1059,10 +1260,7 @@ fn terms(
             }
         }
     }
-    Terms {
-        elastic,
-        handle: handle_weight * handle,
-    }
+    handle_weight * handle
 }
 
 /// Per column, the norm of the right-hand side's edge terms (without the handle and proximal
@@ -1095,11 +1293,13 @@ fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-fn mean_or_one(values: &[f64]) -> f64 {
-    if values.is_empty() {
+/// The mean over the edges of their parts' weights (1 when there are none or it is not a
+/// positive number): summed edge by edge, as one weight per edge would be.
+fn mean_over_edges(edges: &[global::EdgeSlot], part_weights: &[f64]) -> f64 {
+    if edges.is_empty() {
         return 1.0;
     }
-    let m = values.iter().sum::<f64>() / values.len() as f64;
+    let m = edges.iter().map(|e| part_weights[e.part]).sum::<f64>() / edges.len() as f64;
     if m.is_finite() && m > 0.0 { m } else { 1.0 }
 }
 

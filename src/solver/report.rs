@@ -63,6 +63,9 @@ pub struct PhaseTimes {
     pub factorization: f64,
     /// Triangular solves and (preconditioned) CG.
     pub solve: f64,
+    /// The rest of the frame: handle targets, the warm start and rigid following, free
+    /// components' centroids, the displayed pose's copies.
+    pub bookkeeping: f64,
 }
 
 /// Why a frame could not be solved (left the positions unchanged).

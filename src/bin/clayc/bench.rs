@@ -42,6 +42,9 @@ pub struct BenchArgs {
     /// Most least-squares (pass 2) iterations per frame (default: the solver's).
     #[arg(long)]
     pub l2_iterations: Option<usize>,
+    /// Threads of the solver's local step (0: every core; the results are the same).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -91,11 +94,40 @@ struct BenchResult {
     #[serde(skip_serializing_if = "Option::is_none")]
     iteration_ms: Option<Ms>,
     converged_frames: usize,
+    /// Mean milliseconds per frame (after the first) by solver phase; `other` is what no
+    /// phase timer saw (the timers themselves, the pass loops).
+    phases_ms: Phases,
     /// The last frame's elastic energy and the sum of every vertex's coordinates at the end:
     /// two runs that give the same figures here computed the same frames (to compare
     /// builds).
     energy: f64,
     checksum: f64,
+}
+
+#[derive(Serialize)]
+struct Phases {
+    local: f64,
+    assembly: f64,
+    factorization: f64,
+    solve: f64,
+    bookkeeping: f64,
+    other: f64,
+}
+
+/// Mean phase times of `reports` (the frames after the first).
+fn phases(reports: &[FrameReport]) -> Phases {
+    let n = reports.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&FrameReport) -> f64| reports.iter().map(f).sum::<f64>() / n;
+    let p = |r: &FrameReport| r.phases;
+    let attributed = |r: &FrameReport| p(r).local + p(r).assembly + p(r).factorization + p(r).solve;
+    Phases {
+        local: mean(&|r| p(r).local),
+        assembly: mean(&|r| p(r).assembly),
+        factorization: mean(&|r| p(r).factorization),
+        solve: mean(&|r| p(r).solve),
+        bookkeeping: mean(&|r| p(r).bookkeeping),
+        other: mean(&|r| r.ms - attributed(r)),
+    }
 }
 
 fn stats(values: &[f64]) -> Ms {
@@ -135,6 +167,7 @@ pub fn bench(args: BenchArgs) -> u8 {
     if let Some(k) = args.l2_iterations {
         config.l2_iterations = k.min(1000);
     }
+    config.threads = args.threads.min(64);
     let (model, mut asm, drag) = match args.arap_grid {
         Some(k) => {
             if !(2..=2000).contains(&k) {
@@ -244,6 +277,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         rules_ms: stats(&rules_ms),
         rules_fired,
         converged_frames: reports.iter().filter(|r| r.converged).count(),
+        phases_ms: phases(reports.get(1..).unwrap_or(&reports)),
         energy: reports.last().map_or(0.0, |r| r.energy),
         checksum: asm.data().positions.iter().map(|p| p.x + p.y).sum(),
     };
