@@ -12,6 +12,8 @@ use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
+mod numeric;
+
 /// Supernode amalgamation: two adjacent supernodes of `n` columns in all merge when
 /// `n <= w` and less than a fraction `z` of the merged block would be explicit zeros, for
 /// the first `(w, z)` that holds. faer's default, `[(4, 1.0), (16, 0.8), (48, 0.1), ..]`,
@@ -39,6 +41,8 @@ pub struct SymbolicFactor {
     layout: Option<SupernodalLayout>,
     /// Both right-hand-side columns interleaved, in the fill-reducing order.
     pairs: Vec<[f64; 2]>,
+    /// Our numeric factorisation's map of the matrix into the factor (`None`: faer's).
+    scatter: Option<numeric::Scatter>,
 }
 
 /// Where each supernode's columns, row pattern and dense block live in the factor.
@@ -60,6 +64,8 @@ struct SupernodalLayout {
 /// Numeric values of an LLT factor belonging to a [`SymbolicFactor`].
 #[derive(Debug, Default, Clone)]
 pub struct NumericFactor {
+    /// faer's layout (supernodes column-major); empty when our factorisation made the factor
+    /// (then only `solve_order` is kept).
     values: Vec<f64>,
     /// The same values in the order [`SymbolicFactor::solve_in_place`] reads them: each
     /// supernode's diagonal block as faer stores it but with reciprocal diagonal entries
@@ -133,11 +139,13 @@ impl SymbolicFactor {
             }
             SymbolicCholeskyRaw::Simplicial(_) => None,
         };
+        let scatter = (layout.as_ref()).and_then(|l| numeric::Scatter::new(l, col_ptr, row_idx));
         Ok(Self {
             symbolic,
             scratch: MemBuffer::new(req),
             layout,
             pairs: Vec::new(),
+            scatter,
         })
     }
 
@@ -146,8 +154,28 @@ impl SymbolicFactor {
         self.symbolic.len_val()
     }
 
-    /// Numerically factorises the matrix (same pattern as analysed) into `factor`.
+    /// Numerically factorises the matrix (same pattern as analysed) into `factor`: by our
+    /// supernodal factorisation ([`numeric`]) when the factor is supernodal, else by faer's.
     pub fn factorize(
+        &mut self,
+        factor: &mut NumericFactor,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        values: &[f64],
+    ) -> Result<(), FactorError> {
+        factor.valid = false;
+        if let (Some(layout), Some(scatter)) = (&self.layout, &mut self.scatter) {
+            factor.values.clear();
+            let len = self.symbolic.len_val();
+            scatter.factorise(layout, values, &mut factor.solve_order, len)?;
+            factor.valid = true;
+            return Ok(());
+        }
+        self.factorize_with_faer(factor, col_ptr, row_idx, values)
+    }
+
+    /// [`SymbolicFactor::factorize`] by faer's numeric factorisation.
+    pub fn factorize_with_faer(
         &mut self,
         factor: &mut NumericFactor,
         col_ptr: &[usize],
@@ -220,7 +248,15 @@ impl SymbolicFactor {
     pub fn solve_with_faer(&mut self, factor: &NumericFactor, rhs: &mut [f64], ncols: usize) {
         let n = self.symbolic.nrows();
         debug_assert!(factor.valid);
-        let llt = LltRef::new(&self.symbolic, &factor.values);
+        let ours;
+        let values = match &self.layout {
+            Some(layout) if factor.values.is_empty() => {
+                ours = layout.faer_order(&factor.solve_order);
+                &ours
+            }
+            _ => &factor.values,
+        };
+        let llt = LltRef::new(&self.symbolic, values);
         let b = MatMut::from_column_major_slice_mut(rhs, n, ncols);
         llt.solve_in_place_with_conj(Conj::No, b, Par::Seq, MemStack::new(&mut self.scratch));
     }
@@ -257,6 +293,27 @@ impl SupernodalLayout {
                 }
             }
         }
+    }
+
+    /// The inverse of [`SupernodalLayout::reorder_for_solve`]: faer's layout of a factor in
+    /// solve order.
+    fn faer_order(&self, l: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; l.len()];
+        for s in 0..self.val_start.len() {
+            let (_, size, below, at) = self.supernode(s);
+            let rows = size + below.len();
+            let block = &l[at..][..rows * size];
+            let target = &mut out[at..][..rows * size];
+            let (diagonal, rest) = block.split_at(size * size);
+            for c in 0..size {
+                target[c * rows..][..size].copy_from_slice(&diagonal[c * size..][..size]);
+                target[c * rows + c] = 1.0 / diagonal[c * size + c];
+                for (b, row) in rest.chunks_exact(size).enumerate() {
+                    target[c * rows + size + b] = row[c];
+                }
+            }
+        }
+        out
     }
 
     /// `rhs` (two columns of length n) <- `A^-1 rhs` with `A = P^T L L^T P`; `l` in solve
@@ -455,6 +512,60 @@ mod tests {
         laplacian(n, 0.5, &edges)
     }
 
+    /// Our numeric factorisation gives faer's factor to rounding, on a grid with a clique
+    /// (supernodes of every width) and on the path with long edges.
+    #[test]
+    fn our_numeric_factor_matches_faers() {
+        for (col_ptr, row_idx, values) in [matrix(300), grid_with_clique(24)] {
+            let n = col_ptr.len() - 1;
+            let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
+            assert!(symbolic.scatter.is_some());
+            let (mut ours, mut theirs) = (NumericFactor::default(), NumericFactor::default());
+            symbolic
+                .factorize(&mut ours, &col_ptr, &row_idx, &values)
+                .unwrap();
+            (symbolic)
+                .factorize_with_faer(&mut theirs, &col_ptr, &row_idx, &values)
+                .unwrap();
+            assert!(ours.values.is_empty(), "ours keeps only the solve order");
+            let scale = theirs
+                .solve_order
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            let layout = symbolic.layout.as_ref().unwrap();
+            let mut compared = 0;
+            for s in 0..layout.val_start.len() {
+                let (_, size, below, at) = layout.supernode(s);
+                // faer leaves the diagonal block's upper triangle unspecified: not read
+                let lower = (0..size).flat_map(|c| (c..size).map(move |r| at + c * size + r));
+                let rows = at + size * size..at + (size + below.len()) * size;
+                for i in lower.chain(rows) {
+                    let (a, t) = (ours.solve_order[i], theirs.solve_order[i]);
+                    assert!((a - t).abs() <= 1e-12 * scale, "supernode {s}: {a} vs {t}");
+                    compared += 1;
+                }
+            }
+            assert!(compared > n, "{compared} values compared");
+        }
+    }
+
+    /// A matrix that is not positive definite is refused with the column, not factorised.
+    #[test]
+    fn an_indefinite_matrix_is_an_error() {
+        let (col_ptr, row_idx, mut values) = matrix(50);
+        values[col_ptr[20]] = -1.0; // a negative diagonal entry
+        let mut symbolic = SymbolicFactor::analyse(50, &col_ptr, &row_idx).unwrap();
+        let mut factor = NumericFactor::default();
+        let err = symbolic.factorize(&mut factor, &col_ptr, &row_idx, &values);
+        assert!(err.is_err() && !factor.is_valid(), "{err:?}");
+        values[col_ptr[20]] = f64::NAN;
+        assert!(
+            symbolic
+                .factorize(&mut factor, &col_ptr, &row_idx, &values)
+                .is_err()
+        );
+    }
+
     #[test]
     fn our_supernodal_solve_matches_faers() {
         let n = 300;
@@ -488,12 +599,9 @@ mod tests {
         (factor, ours)
     }
 
-    /// A grid Laplacian (the shape of the solver's matrices) with one dense clique, so that
-    /// the factor has narrow supernodes (the fixed-width substitutions) and at least one
-    /// wider than 8 columns (the any-width one).
-    #[test]
-    fn every_supernode_width_solves_as_faer_does() {
-        let side = 24;
+    /// A `side x side` grid Laplacian (the shape of the solver's matrices) with one dense
+    /// clique, so that the factor has narrow supernodes and at least one wider than 8.
+    fn grid_with_clique(side: usize) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
         let n = side * side;
         let mut edges = Vec::new();
         for i in 0..side {
@@ -513,7 +621,17 @@ mod tests {
                 edges.push((x, y, 0.25));
             }
         }
-        let (col_ptr, row_idx, values) = laplacian(n, 1e-3, &edges);
+        laplacian(n, 1e-3, &edges)
+    }
+
+    /// A grid Laplacian (the shape of the solver's matrices) with one dense clique, so that
+    /// the factor has narrow supernodes (the fixed-width substitutions) and at least one
+    /// wider than 8 columns (the any-width one).
+    #[test]
+    fn every_supernode_width_solves_as_faer_does() {
+        let side = 24;
+        let n = side * side;
+        let (col_ptr, row_idx, values) = grid_with_clique(side);
         let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
         let layout = symbolic.layout.as_ref().unwrap();
         let widths: Vec<usize> = layout.begin.windows(2).map(|w| w[1] - w[0]).collect();

@@ -1,0 +1,300 @@
+//! Our numeric supernodal Cholesky: the factor of faer's symbolic analysis (its ordering and
+//! supernodes), computed straight into the solve order of [`NumericFactor::solve_order`].
+//!
+//! Why not faer's numeric factorisation: the supernodes of these planar Laplacians are a few
+//! columns wide, and faer's per-supernode dense kernels (gemm plans, scratch matrices) cost
+//! more there than the arithmetic, as for the solves. Pass 1 factorises its matrix once per
+//! IRLS iteration, so this is most of a frame's factorisation time (docs/performance.md).
+//!
+//! The method is right-looking: supernodes in order (every update goes to a later one), each
+//! factorised densely (its diagonal block by Cholesky, the rows below it by substitution),
+//! then its rows below subtract their products from the supernodes of their columns. The
+//! order of every sum is fixed by the symbolic structure, so the result does not depend on
+//! anything but the matrix.
+
+use super::{FactorError, SupernodalLayout, by_width};
+
+/// Where each stored value of the matrix (lower triangle, original order) goes in the factor's
+/// values in solve order: built once per pattern.
+#[derive(Debug, Clone)]
+pub(super) struct Scatter {
+    /// `position[k]`: the place of the matrix's `k`-th stored value.
+    position: Vec<usize>,
+    /// `column_supernode[c]`: the supernode holding permuted column `c`.
+    column_supernode: Vec<u32>,
+    /// The rows of one update, as places among the rows below its target supernode.
+    relative: Vec<u32>,
+}
+
+impl Scatter {
+    /// The scatter map of the matrix (`col_ptr`, `row_idx`: lower triangle, original order)
+    /// into `layout`; `None` if an entry has no place in it (then faer factorises).
+    pub(super) fn new(
+        layout: &SupernodalLayout,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+    ) -> Option<Self> {
+        let n = layout.perm.len();
+        let mut inverse = vec![0usize; n];
+        for (i, &p) in layout.perm.iter().enumerate() {
+            *inverse.get_mut(p)? = i;
+        }
+        let mut column_supernode = vec![0u32; n];
+        for s in 0..layout.val_start.len() {
+            let (start, size, _, _) = layout.supernode(s);
+            column_supernode[start..start + size].fill(u32::try_from(s).ok()?);
+        }
+        let mut position = Vec::with_capacity(row_idx.len());
+        for c in 0..n {
+            for &r in &row_idx[*col_ptr.get(c)?..*col_ptr.get(c + 1)?] {
+                let (a, b) = (*inverse.get(r)?, inverse[c]);
+                let (col, row) = (a.min(b), a.max(b));
+                let (start, size, below, at) = layout.supernode(column_supernode[col] as usize);
+                let place = if row < start + size {
+                    at + (col - start) * size + (row - start)
+                } else {
+                    let k = below.binary_search(&u32::try_from(row).ok()?).ok()?;
+                    at + size * size + k * size + (col - start)
+                };
+                position.push(place);
+            }
+        }
+        if !nested(layout, &column_supernode) {
+            return None;
+        }
+        Some(Self {
+            position,
+            column_supernode,
+            relative: Vec::new(),
+        })
+    }
+
+    /// Factorises the matrix with stored values `values` into `out` (solve order: each
+    /// supernode's diagonal block column-major with reciprocal diagonal entries, then its rows
+    /// below row-major).
+    pub(super) fn factorise(
+        &mut self,
+        layout: &SupernodalLayout,
+        values: &[f64],
+        out: &mut Vec<f64>,
+        len: usize,
+    ) -> Result<(), FactorError> {
+        out.clear();
+        out.resize(len, 0.0);
+        for (&place, &v) in self.position.iter().zip(values) {
+            out[place] += v;
+        }
+        for s in 0..layout.val_start.len() {
+            let (start, size, below, at) = layout.supernode(s);
+            let end_of_block = at + (size + below.len()) * size;
+            let (head, later) = out.split_at_mut(end_of_block);
+            let block = &mut head[at..];
+            let (diagonal, rows) = block.split_at_mut(size * size);
+            factorise_diagonal(diagonal, size).map_err(|c| {
+                FactorError(format!(
+                    "numeric Cholesky failed: the matrix is not positive definite (column {})",
+                    start + c
+                ))
+            })?;
+            // the substitutions multiply by the reciprocals: a division per value sat on
+            // each row's dependency chain
+            for c in 0..size {
+                diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
+            }
+            for row in rows.chunks_exact_mut(size) {
+                substitute_row(diagonal, size, row);
+            }
+            self.update_later(layout, below, rows, size, later, end_of_block);
+        }
+        Ok(())
+    }
+
+    /// Subtracts the products of one supernode's rows below (`rows`, row-major, `size` wide,
+    /// at permuted rows `below`) from the supernodes of their columns; `later` is the factor's
+    /// values from `offset` on (every target lies there).
+    fn update_later(
+        &mut self,
+        layout: &SupernodalLayout,
+        below: &[u32],
+        rows: &[f64],
+        size: usize,
+        later: &mut [f64],
+        offset: usize,
+    ) {
+        let mut g = 0;
+        while g < below.len() {
+            let t = self.column_supernode[below[g] as usize] as usize;
+            let (start, width, target_below, at) = layout.supernode(t);
+            let end = start + width;
+            let group = below[g..]
+                .iter()
+                .take_while(|&&r| (r as usize) < end)
+                .count();
+            // the rows after the group are among the target's rows below (the supernodal
+            // structure): their places, by one merge of the two sorted lists
+            self.relative.clear();
+            let mut k = 0;
+            for &r in &below[g + group..] {
+                while target_below[k] != r {
+                    k += 1;
+                }
+                self.relative.push(k as u32);
+            }
+            let target = Target {
+                start,
+                width,
+                relative: &self.relative,
+            };
+            let values = &mut later[at - offset..];
+            by_width!(
+                size,
+                update,
+                update_wide,
+                target,
+                below,
+                rows,
+                g,
+                group,
+                values
+            );
+            g += group;
+        }
+    }
+}
+
+/// Whether every supernode's rows below, past the columns of the supernode they first fall
+/// in, are among that supernode's rows below: what the update's merge relies on (true of a
+/// supernodal Cholesky structure; checked once per pattern so a violation means faer's
+/// factorisation rather than a wrong factor).
+fn nested(layout: &SupernodalLayout, column_supernode: &[u32]) -> bool {
+    (0..layout.val_start.len()).all(|s| {
+        let (_, _, below, _) = layout.supernode(s);
+        let mut g = 0;
+        while g < below.len() {
+            let (start, width, target, _) =
+                layout.supernode(column_supernode[below[g] as usize] as usize);
+            let group = below[g..]
+                .iter()
+                .take_while(|&&r| (r as usize) < start + width)
+                .count();
+            let mut k = 0;
+            for &r in &below[g + group..] {
+                while k < target.len() && target[k] != r {
+                    k += 1;
+                }
+                if k == target.len() {
+                    return false;
+                }
+            }
+            g += group;
+        }
+        true
+    })
+}
+
+/// In-place dense Cholesky of the lower triangle of a `size x size` column-major block;
+/// `Err(c)` at the first column whose pivot is not positive and finite.
+fn factorise_diagonal(d: &mut [f64], size: usize) -> Result<(), usize> {
+    for j in 0..size {
+        let mut pivot = d[j * size + j];
+        for k in 0..j {
+            let l = d[k * size + j];
+            pivot -= l * l;
+        }
+        if !(pivot > 0.0 && pivot.is_finite()) {
+            return Err(j);
+        }
+        let ljj = pivot.sqrt();
+        d[j * size + j] = ljj;
+        for i in j + 1..size {
+            let mut v = d[j * size + i];
+            for k in 0..j {
+                v -= d[k * size + i] * d[k * size + j];
+            }
+            d[j * size + i] = v / ljj;
+        }
+    }
+    Ok(())
+}
+
+/// `row <- row L^-T` for one row below a factorised diagonal block `d` (its diagonal entries
+/// already replaced by their reciprocals).
+fn substitute_row(d: &[f64], size: usize, row: &mut [f64]) {
+    for c in 0..size {
+        let mut v = row[c];
+        for k in 0..c {
+            v -= row[k] * d[k * size + c];
+        }
+        row[c] = v * d[c * size + c];
+    }
+}
+
+/// The supernode an update goes to: its first column, its width, and the places among its
+/// rows below of the update's rows after those in its columns.
+struct Target<'a> {
+    start: usize,
+    width: usize,
+    relative: &'a [u32],
+}
+
+/// Subtracts from `values` (the target's, in solve order) the products of row `j` with the
+/// rows after it, for the `group` rows `j` from `g` that fall in the target's columns; rows
+/// `S` wide. Rows in the target's columns go to its diagonal block (column-major), the rest to
+/// its rows below (row-major).
+#[inline]
+fn update<const S: usize>(
+    target: Target,
+    below: &[u32],
+    rows: &[f64],
+    g: usize,
+    group: usize,
+    values: &mut [f64],
+) {
+    let rows: &[[f64; S]] = rows.as_chunks::<S>().0;
+    let w = target.width;
+    let (diagonal, lower) = values.split_at_mut(w * w);
+    let dot = |a: &[f64; S], b: &[f64; S]| {
+        let mut d = 0.0;
+        for k in 0..S {
+            d += a[k] * b[k];
+        }
+        d
+    };
+    for j in g..g + group {
+        let column = below[j] as usize - target.start;
+        let xj = &rows[j];
+        let col = &mut diagonal[column * w..][..w];
+        for (&r, xi) in below[j..g + group].iter().zip(&rows[j..g + group]) {
+            col[r as usize - target.start] -= dot(xi, xj);
+        }
+        for (&k, xi) in target.relative.iter().zip(&rows[g + group..]) {
+            lower[k as usize * w + column] -= dot(xi, xj);
+        }
+    }
+}
+
+/// [`update`] for rows of any width.
+fn update_wide(
+    size: usize,
+    target: Target,
+    below: &[u32],
+    rows: &[f64],
+    g: usize,
+    group: usize,
+    values: &mut [f64],
+) {
+    let w = target.width;
+    let (diagonal, lower) = values.split_at_mut(w * w);
+    let row = |i: usize| &rows[i * size..][..size];
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
+    for j in g..g + group {
+        let column = below[j] as usize - target.start;
+        let xj = row(j);
+        for (i, &r) in below.iter().enumerate().take(g + group).skip(j) {
+            diagonal[column * w + r as usize - target.start] -= dot(row(i), xj);
+        }
+        for (i, &k) in (g + group..).zip(target.relative) {
+            lower[k as usize * w + column] -= dot(row(i), xj);
+        }
+    }
+}
