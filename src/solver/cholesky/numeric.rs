@@ -150,17 +150,13 @@ impl Scatter {
                 relative: &self.relative,
             };
             let values = &mut later[at - offset..];
-            by_width!(
-                size,
-                update,
-                update_wide,
-                target,
+            let source = Source {
                 below,
                 rows,
                 g,
                 group,
-                values
-            );
+            };
+            by_width!(size, update, update_wide, target, source, values);
             g += group;
         }
     }
@@ -267,19 +263,27 @@ struct Target<'a> {
     relative: &'a [u32],
 }
 
+/// The supernode an update comes from: its rows below (`rows`, row-major, at permuted rows
+/// `below`) and the `group` of them from `g` that fall in the target's columns.
+struct Source<'a> {
+    below: &'a [u32],
+    rows: &'a [f64],
+    g: usize,
+    group: usize,
+}
+
 /// Subtracts from `values` (the target's, in solve order) the products of row `j` with the
 /// rows after it, for the `group` rows `j` from `g` that fall in the target's columns; rows
 /// `S` wide. Rows in the target's columns go to its diagonal block (column-major), the rest to
 /// its rows below (row-major).
 #[inline]
-fn update<const S: usize>(
-    target: Target,
-    below: &[u32],
-    rows: &[f64],
-    g: usize,
-    group: usize,
-    values: &mut [f64],
-) {
+fn update<const S: usize>(target: Target, source: Source, values: &mut [f64]) {
+    let Source {
+        below,
+        rows,
+        g,
+        group,
+    } = source;
     let rows: &[[f64; S]] = rows.as_chunks::<S>().0;
     let w = target.width;
     let (diagonal, lower) = values.split_at_mut(w * w);
@@ -304,15 +308,13 @@ fn update<const S: usize>(
 }
 
 /// [`update`] for rows of any width.
-fn update_wide(
-    size: usize,
-    target: Target,
-    below: &[u32],
-    rows: &[f64],
-    g: usize,
-    group: usize,
-    values: &mut [f64],
-) {
+fn update_wide(size: usize, target: Target, source: Source, values: &mut [f64]) {
+    let Source {
+        below,
+        rows,
+        g,
+        group,
+    } = source;
     let w = target.width;
     let (diagonal, lower) = values.split_at_mut(w * w);
     let row = |i: usize| &rows[i * size..][..size];
