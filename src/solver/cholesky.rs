@@ -1,7 +1,8 @@
-//! Sparse Cholesky (LLT) of the global step's normal matrix with faer: one symbolic analysis
-//! (AMD ordering, forced supernodal, sequential) per sparsity pattern, numeric factors
-//! recomputed whenever the weights change, and in-place solves for the two-column right-hand
-//! side. The matrix is passed as its lower triangle in compressed sparse column form.
+//! Sparse Cholesky (LLT) of the global step's normal matrix: one symbolic analysis by faer
+//! (AMD ordering, forced supernodal) per sparsity pattern, numeric factors recomputed whenever
+//! the weights change (ours, [`numeric`], where the supernodes are narrow; faer's otherwise),
+//! and our in-place solves for the two-column right-hand side. The matrix is passed as its
+//! lower triangle in compressed sparse column form.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::cholesky::{
