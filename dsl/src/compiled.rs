@@ -318,6 +318,12 @@ pub enum PartKind {
     Stretch { chain: usize, first: usize },
 }
 
+/// The rest states of a [`PartKind::Stretch`] part, by index (paper 5.1, Fig. 7b): its two
+/// elements squeezed into one element's length, at rest, and stretched to three's.
+pub const STRETCH_ONE: usize = 0;
+pub const STRETCH_TWO: usize = 1;
+pub const STRETCH_THREE: usize = 2;
+
 /// A named rest position set of a part.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PartState {

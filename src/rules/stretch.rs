@@ -24,9 +24,9 @@ use super::{
 use crate::fit::{self, PointMap};
 
 /// Index of the `one`, `two` and `three` states in a stretch part.
-pub const ONE: usize = 0;
-pub const TWO: usize = 1;
-pub const THREE: usize = 2;
+pub const ONE: usize = clay_dsl::compiled::STRETCH_ONE;
+pub const TWO: usize = clay_dsl::compiled::STRETCH_TWO;
+pub const THREE: usize = clay_dsl::compiled::STRETCH_THREE;
 
 /// Stretch parts that ask for a rewrite: `(chain, first)` of the first part in `three`, or in
 /// `one` when the chain is longer than the rule's `min`, at most one per chain. O(parts).

@@ -11,6 +11,7 @@ mod chunks;
 mod config;
 pub mod follow;
 mod global;
+mod growth;
 pub(crate) mod local;
 mod measure;
 mod report;
@@ -715,7 +716,8 @@ impl Solver {
 
     /// The local step at `f` with state switching (paper 4.3): as
     /// [`Solver::evaluate_fixed`], and every part whose nearest state wins the hysteresis
-    /// switches to it (reported in part order).
+    /// switches to it (reported in part order), except that a stretch chain grows or shrinks
+    /// by one part at a time ([`growth`]).
     fn evaluate_switching(
         &mut self,
         parts: &mut [Part],
@@ -723,10 +725,16 @@ impl Solver {
         switches: &mut Vec<StateSwitch>,
     ) -> f64 {
         let hysteresis = self.config.hysteresis;
+        let from = switches.len();
         if !self.cache_fits(parts.len()) {
             self.local_step_switching(parts, f, hysteresis, switches);
             self.edge_targets(parts);
-            return self.residuals_at(f);
+            let elastic = self.residuals_at(f);
+            if !growth::one_per_chain(parts, switches, from, &self.work.residuals) {
+                return elastic;
+            }
+            // the reverted parts' rotations and targets are their kept states'
+            return self.evaluate_fixed(parts, f);
         }
         let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
         for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
@@ -738,6 +746,9 @@ impl Solver {
                 });
                 part.active = state;
             }
+        }
+        if growth::one_per_chain(parts, switches, from, &self.work.residuals) {
+            return self.evaluate_fixed(parts, f);
         }
         elastic
     }
