@@ -209,6 +209,34 @@ fn fig8_least_squares_spreads_and_lags() {
     );
 }
 
+/// Fig. 8 and 5.1 with least squares: an evenly stretched chain lags (the paper: its elements
+/// stretch far before one goes in), but pulled to 5x (40 m) it never overfills: at every drag
+/// speed it ends with the same count, no more bricks than fit the length, no shrink, and
+/// the wall on its line (no buckle: the bounding box within 0.05 m of the rest height).
+#[test]
+fn fig8_least_squares_at_5x_stays_on_the_line() {
+    let rest = Session::new("wall", |_| {}).bbox();
+    let rest_height = rest[3] - rest[1];
+    let mut counts = Vec::new();
+    for frames in [30, 60, 120, 240] {
+        let s = wall_pull(2.0, 32.0, frames);
+        let b = s.bbox();
+        let (bricks, off) = (s.count("brick"), (b[3] - b[1] - rest_height).abs());
+        s.report(&format!("p = 2 at 5x over {frames} frames"));
+        assert!(
+            bricks <= 40 && off <= 0.05 && s.fired(RuleKind::Shrink) == 0,
+            "p = 2 at 5x over {frames} frames: {bricks} bricks (want <= 40), height {off:.4} m \
+             off the rest's (want <= 0.05), {}",
+            s.figures()
+        );
+        counts.push(bricks);
+    }
+    assert!(
+        counts.windows(2).all(|w| w[0] == w[1]),
+        "p = 2 at 5x: bricks {counts:?} over 30, 60, 120 and 240 frames (want one count)"
+    );
+}
+
 /// A steady drag of the 8 m wall by `by` metres over 240 frames with p = 0.5: it ends with
 /// `want` +- 1 bricks and no rule of kind `never` fired on the way.
 fn steady_drag(by: f64, want: usize, never: RuleKind, what: &str) {
