@@ -51,7 +51,9 @@ fn legend_width(grammar: &CompiledGrammar) -> f32 {
 
 /// Draws the sheet onto a canvas of [`sheet_size`].
 pub fn draw_sheet(canvas: &mut dyn Canvas, grammar: &CompiledGrammar) {
-    let title = format!("{}: {} pieces", grammar.source, grammar.pieces.len());
+    let count = grammar.pieces.len();
+    let noun = if count == 1 { "piece" } else { "pieces" };
+    let title = format!("{}: {count} {noun}", grammar.source);
     canvas.text([12.0, 24.0], 16.0, INK, &title);
     // Legend: one swatch per site type.
     let mut x = 12.0;
