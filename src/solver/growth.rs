@@ -1,6 +1,7 @@
 //! One growth per chain per frame (paper 5.1): of a stretch chain's parts, at most one
-//! switches into `three` and at most one into `one` in a frame. A part in `three` says "these two elements hold a
-//! third element's length"; the stretch rule then inserts one element per chain per frame.
+//! switches into `three` and at most one into `one` in a frame. A part in `three` says "these
+//! two elements hold a third element's length"; the stretch rule then inserts one element per
+//! chain per frame.
 //! When a chain is stretched evenly (least squares, p = 2), every part reaches the switching
 //! stretch together and all would enter `three` at once: each then claims an extra half
 //! element on both sides, the chain has room for far fewer, and the solve squeezes the parts
