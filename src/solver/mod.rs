@@ -716,8 +716,8 @@ impl Solver {
 
     /// The local step at `f` with state switching (paper 4.3): as
     /// [`Solver::evaluate_fixed`], and every part whose nearest state wins the hysteresis
-    /// switches to it (reported in part order), except that a stretch chain grows or shrinks
-    /// by one part at a time ([`growth`]).
+    /// switches to it (reported in part order), except that a stretch chain claims at most
+    /// one element per frame ([`growth`]).
     fn evaluate_switching(
         &mut self,
         parts: &mut [Part],
@@ -726,28 +726,26 @@ impl Solver {
     ) -> f64 {
         let hysteresis = self.config.hysteresis;
         let from = switches.len();
-        if !self.cache_fits(parts.len()) {
+        let elastic = if self.cache_fits(parts.len()) {
+            let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
+            for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
+                if state != part.active {
+                    switches.push(StateSwitch {
+                        part: i,
+                        from: part.active,
+                        to: state,
+                    });
+                    part.active = state;
+                }
+            }
+            elastic
+        } else {
             self.local_step_switching(parts, f, hysteresis, switches);
             self.edge_targets(parts);
-            let elastic = self.residuals_at(f);
-            if !growth::one_per_chain(parts, switches, from, &self.work.residuals) {
-                return elastic;
-            }
-            // the reverted parts' rotations and targets are their kept states'
-            return self.evaluate_fixed(parts, f);
-        }
-        let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
-        for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
-            if state != part.active {
-                switches.push(StateSwitch {
-                    part: i,
-                    from: part.active,
-                    to: state,
-                });
-                part.active = state;
-            }
-        }
+            self.residuals_at(f)
+        };
         if growth::one_per_chain(parts, switches, from, &self.work.residuals) {
+            // the reverted parts' rotations and targets are their kept states'
             return self.evaluate_fixed(parts, f);
         }
         elastic
