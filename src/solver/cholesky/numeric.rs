@@ -24,6 +24,8 @@ pub(super) struct Scatter {
     column_supernode: Vec<u32>,
     /// The rows of one update, as places among the rows below its target supernode.
     relative: Vec<u32>,
+    /// Scratch: a diagonal block row by row ([`substitute_rows`]).
+    transposed: Vec<f64>,
 }
 
 impl Scatter {
@@ -70,6 +72,7 @@ impl Scatter {
             position,
             column_supernode,
             relative: Vec::new(),
+            transposed: Vec::new(),
         })
     }
 
@@ -105,9 +108,7 @@ impl Scatter {
             for c in 0..size {
                 diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
             }
-            for row in rows.chunks_exact_mut(size) {
-                substitute_row(diagonal, size, row);
-            }
+            substitute_rows(diagonal, size, rows, &mut self.transposed);
             self.update_later(layout, below, rows, size, later, end_of_block);
         }
         Ok(())
@@ -220,38 +221,78 @@ fn nested(layout: &SupernodalLayout, column_supernode: &[u32]) -> bool {
 
 /// In-place dense Cholesky of the lower triangle of a `size x size` column-major block;
 /// `Err(c)` at the first column whose pivot is not positive and finite.
+///
+/// Column `j` below the diagonal takes `L_ij = (A_ij - sum_k L_ik L_jk) / L_jj` with the sum
+/// over `k` in increasing order, subtracted from the stored value one product at a time; the
+/// loop runs over `k` outside and `i` inside so the rows' chains are independent (they overlap
+/// in the pipeline and vectorise along the contiguous column) while every value sees the same
+/// operations in the same order as the textbook loop: the factor is the same to the bit.
 fn factorise_diagonal(d: &mut [f64], size: usize) -> Result<(), usize> {
     for j in 0..size {
-        let mut pivot = d[j * size + j];
+        let (done, rest) = d.split_at_mut(j * size);
+        let column = &mut rest[..size];
+        let mut pivot = column[j];
         for k in 0..j {
-            let l = d[k * size + j];
+            let l = done[k * size + j];
             pivot -= l * l;
         }
         if !(pivot > 0.0 && pivot.is_finite()) {
             return Err(j);
         }
         let ljj = pivot.sqrt();
-        d[j * size + j] = ljj;
-        for i in j + 1..size {
-            let mut v = d[j * size + i];
-            for k in 0..j {
-                v -= d[k * size + i] * d[k * size + j];
+        column[j] = ljj;
+        let below = &mut column[j + 1..];
+        for k in 0..j {
+            let l = done[k * size + j];
+            let source = &done[k * size + j + 1..][..below.len()];
+            for (v, &x) in below.iter_mut().zip(source) {
+                *v -= x * l;
             }
-            d[j * size + i] = v / ljj;
+        }
+        for v in below {
+            *v /= ljj;
         }
     }
     Ok(())
 }
 
-/// `row <- row L^-T` for one row below a factorised diagonal block `d` (its diagonal entries
-/// already replaced by their reciprocals).
-fn substitute_row(d: &[f64], size: usize, row: &mut [f64]) {
-    for c in 0..size {
-        let mut v = row[c];
-        for k in 0..c {
-            v -= row[k] * d[k * size + c];
+/// `row <- row L^-T` for every row below a factorised diagonal block `d` (its diagonal
+/// entries already replaced by their reciprocals), rows `size` wide and row-major.
+///
+/// Four rows at a time: each row's value is the same chain of operations as alone (so the
+/// result is the same to the bit), but four chains run side by side and each entry of `d` is
+/// loaded once for the four. `transposed` is scratch for `d` row by row (contiguous reads).
+fn substitute_rows(d: &[f64], size: usize, rows: &mut [f64], transposed: &mut Vec<f64>) {
+    transposed.clear();
+    transposed.extend((0..size * size).map(|at| d[(at % size) * size + at / size]));
+    let lt = &transposed[..];
+    let mut quads = rows.chunks_exact_mut(4 * size);
+    for quad in &mut quads {
+        let (r0, rest) = quad.split_at_mut(size);
+        let (r1, rest) = rest.split_at_mut(size);
+        let (r2, r3) = rest.split_at_mut(size);
+        for c in 0..size {
+            let l = &lt[c * size..][..c];
+            let (mut v0, mut v1, mut v2, mut v3) = (r0[c], r1[c], r2[c], r3[c]);
+            for k in 0..c {
+                v0 -= r0[k] * l[k];
+                v1 -= r1[k] * l[k];
+                v2 -= r2[k] * l[k];
+                v3 -= r3[k] * l[k];
+            }
+            let inv = lt[c * size + c];
+            (r0[c], r1[c], r2[c], r3[c]) = (v0 * inv, v1 * inv, v2 * inv, v3 * inv);
         }
-        row[c] = v * d[c * size + c];
+    }
+    for row in quads.into_remainder().chunks_exact_mut(size) {
+        for c in 0..size {
+            let l = &lt[c * size..][..c];
+            let mut v = row[c];
+            for k in 0..c {
+                v -= row[k] * l[k];
+            }
+            row[c] = v * lt[c * size + c];
+        }
     }
 }
 
@@ -307,7 +348,10 @@ fn update<const S: usize>(target: Target, source: Source, values: &mut [f64]) {
     }
 }
 
-/// [`update`] for rows of any width.
+/// [`update`] for rows of any width. The products of row `j` with four rows after it are
+/// summed side by side (four independent chains, each summed in the same order as one dot
+/// product alone: the same values to the bit), so each entry of row `j` is loaded once for
+/// four products and the additions overlap rather than wait on one another.
 fn update_wide(size: usize, target: Target, source: Source, values: &mut [f64]) {
     let Source {
         below,
@@ -318,15 +362,151 @@ fn update_wide(size: usize, target: Target, source: Source, values: &mut [f64]) 
     let w = target.width;
     let (diagonal, lower) = values.split_at_mut(w * w);
     let row = |i: usize| &rows[i * size..][..size];
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
     for j in g..g + group {
         let column = below[j] as usize - target.start;
         let xj = row(j);
-        for (i, &r) in below.iter().enumerate().take(g + group).skip(j) {
-            diagonal[column * w + r as usize - target.start] -= dot(row(i), xj);
+        // rows in the target's columns, then the rest: one list of (row, place) pairs
+        let in_block = (j..g + group).map(|i| (i, column * w + below[i] as usize - target.start));
+        dots_into(rows, size, xj, in_block, |place, d| diagonal[place] -= d);
+        let beyond = (g + group..)
+            .zip(target.relative)
+            .map(|(i, &k)| (i, k as usize * w + column));
+        dots_into(rows, size, xj, beyond, |place, d| lower[place] -= d);
+    }
+}
+
+/// For every `(i, place)` of `pairs`, `apply(place, row_i . x)` (rows `size` wide), four dot
+/// products at a time; each one sums its products from `k = 0` up, from `-0.0` as
+/// `Iterator::sum` does.
+#[inline]
+fn dots_into(
+    rows: &[f64],
+    size: usize,
+    x: &[f64],
+    pairs: impl Iterator<Item = (usize, usize)>,
+    mut apply: impl FnMut(usize, f64),
+) {
+    let row = |i: usize| &rows[i * size..][..size];
+    let mut pending = [(0usize, 0usize); 4];
+    let mut count = 0;
+    for pair in pairs {
+        pending[count] = pair;
+        count += 1;
+        if count == 4 {
+            let [a, b, c, e] = pending.map(|(i, _)| row(i));
+            let mut d = [-0.0f64; 4];
+            for k in 0..size {
+                let xk = x[k];
+                d[0] += a[k] * xk;
+                d[1] += b[k] * xk;
+                d[2] += c[k] * xk;
+                d[3] += e[k] * xk;
+            }
+            for (&(_, place), d) in pending.iter().zip(d) {
+                apply(place, d);
+            }
+            count = 0;
         }
-        for (i, &k) in (g + group..).zip(target.relative) {
-            lower[k as usize * w + column] -= dot(row(i), xj);
+    }
+    for &(i, place) in &pending[..count] {
+        let d = row(i).iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        apply(place, d);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic values in (-1, 1).
+    fn values(count: usize, seed: u64) -> Vec<f64> {
+        let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        (0..count)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+            })
+            .collect()
+    }
+
+    /// A positive definite `size x size` block, column-major.
+    fn spd(size: usize, seed: u64) -> Vec<f64> {
+        let a = values(size * size, seed);
+        let mut m = vec![0.0; size * size];
+        for i in 0..size {
+            for j in 0..size {
+                m[j * size + i] = (0..size).map(|k| a[k * size + i] * a[k * size + j]).sum();
+            }
+            m[i * size + i] += size as f64;
+        }
+        m
+    }
+
+    /// The kernels reorder loops, never sums: their results equal the textbook loops' to the
+    /// bit (the factor, and so every frame, does not depend on how they are scheduled).
+    #[test]
+    fn kernels_equal_the_textbook_loops_bit_for_bit() {
+        for size in [1, 3, 4, 5, 9, 17, 40] {
+            let mut ours = spd(size, size as u64);
+            let mut textbook = ours.clone();
+            factorise_diagonal(&mut ours, size).unwrap();
+            for j in 0..size {
+                let mut pivot = textbook[j * size + j];
+                for k in 0..j {
+                    pivot -= textbook[k * size + j] * textbook[k * size + j];
+                }
+                let ljj = pivot.sqrt();
+                textbook[j * size + j] = ljj;
+                for i in j + 1..size {
+                    let mut v = textbook[j * size + i];
+                    for k in 0..j {
+                        v -= textbook[k * size + i] * textbook[k * size + j];
+                    }
+                    textbook[j * size + i] = v / ljj;
+                }
+            }
+            let lower = |m: &[f64]| -> Vec<u64> {
+                (0..size)
+                    .flat_map(|c| (c..size).map(move |r| c * size + r))
+                    .map(|at| m[at].to_bits())
+                    .collect()
+            };
+            assert_eq!(lower(&ours), lower(&textbook), "diagonal block {size}");
+
+            for c in 0..size {
+                ours[c * size + c] = 1.0 / ours[c * size + c];
+            }
+            for count in [1, 4, 7] {
+                let mut rows = values(count * size, 7 + count as u64);
+                let mut reference = rows.clone();
+                substitute_rows(&ours, size, &mut rows, &mut Vec::new());
+                for row in reference.chunks_exact_mut(size) {
+                    for c in 0..size {
+                        let mut v = row[c];
+                        for k in 0..c {
+                            v -= row[k] * ours[k * size + c];
+                        }
+                        row[c] = v * ours[c * size + c];
+                    }
+                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&rows), bits(&reference), "{count} rows of {size}");
+
+                let x = values(size, 99);
+                let pairs = (0..count).map(|i| (i, count - 1 - i));
+                let mut got = vec![0.0; count];
+                dots_into(&rows, size, &x, pairs, |place, d| got[place] = d);
+                for (i, row) in rows.chunks_exact(size).enumerate() {
+                    let d = row.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>();
+                    assert_eq!(
+                        got[count - 1 - i].to_bits(),
+                        d.to_bits(),
+                        "dot {i} of {size}"
+                    );
+                }
+            }
         }
     }
 }
