@@ -1,6 +1,6 @@
 //! Sparse Cholesky (LLT) of the global step's normal matrix: one symbolic analysis by faer
 //! (AMD ordering, forced supernodal) per sparsity pattern, numeric factors recomputed whenever
-//! the weights change (ours, [`numeric`], where the supernodes are narrow; faer's otherwise),
+//! the weights change (ours, [`numeric`]; faer's where ours cannot lay the factor out),
 //! and our in-place solves for the two-column right-hand side. The matrix is passed as its
 //! lower triangle in compressed sparse column form.
 

@@ -1,10 +1,14 @@
 //! Our numeric supernodal Cholesky: the factor of faer's symbolic analysis (its ordering and
 //! supernodes), computed straight into the solve order of [`NumericFactor::solve_order`].
 //!
-//! Why not faer's numeric factorisation: the supernodes of these planar Laplacians are a few
+//! Why not faer's numeric factorisation: most supernodes of these planar Laplacians are a few
 //! columns wide, and faer's per-supernode dense kernels (gemm plans, scratch matrices) cost
-//! more there than the arithmetic, as for the solves. Pass 1 factorises its matrix once per
-//! IRLS iteration, so this is most of a frame's factorisation time (docs/performance.md).
+//! more there than the arithmetic, as for the solves; on the few wide separators our kernels
+//! run independent chains side by side and keep up with faer's (city, interleaved, factor
+//! time ours / faer's: under 0.5 at 10k parts, 0.96 at 100k, where 87% of the arithmetic is in
+//! supernodes wider than 16 columns), and the factor is made once, in solve order, with no
+//! second copy (peak memory at 100k 12% lower). Pass 1 factorises its matrix once per IRLS
+//! iteration, so this is most of a frame's factorisation time (docs/performance.md).
 //!
 //! The method is right-looking: supernodes in order (every update goes to a later one), each
 //! factorised densely (its diagonal block by Cholesky, the rows below it by substitution),
@@ -30,8 +34,7 @@ pub(super) struct Scatter {
 
 impl Scatter {
     /// The scatter map of the matrix (`col_ptr`, `row_idx`: lower triangle, original order)
-    /// into `layout`; `None` if an entry has no place in it or the factor's work is mostly
-    /// in wide supernodes (then faer factorises).
+    /// into `layout`; `None` if an entry has no place in it (then faer factorises).
     pub(super) fn new(
         layout: &SupernodalLayout,
         col_ptr: &[usize],
@@ -61,9 +64,6 @@ impl Scatter {
                 };
                 position.push(place);
             }
-        }
-        if wide_share(layout) > MAX_WIDE_SHARE {
-            return None;
         }
         if !nested(layout, &column_supernode) {
             return None;
@@ -161,32 +161,6 @@ impl Scatter {
             g += group;
         }
     }
-}
-
-/// The largest share of a factorisation's arithmetic that supernodes wider than
-/// [`WIDE`] columns may have for ours to be used. Ours runs plain loops, faer's blocked dense
-/// kernels win on wide blocks: measured on the city (interleaved, factor time ours / faer's):
-/// 0.44-0.48 at 10k parts (share 0.61), 0.78 at 30k (0.77), 1.07 at 100k (0.87).
-const MAX_WIDE_SHARE: f64 = 0.8;
-
-/// Supernodes wider than this are "wide" for [`MAX_WIDE_SHARE`].
-const WIDE: usize = 16;
-
-/// The share of the multiply-adds of a factorisation done in supernodes wider than [`WIDE`]:
-/// per supernode `w` wide with `b` rows below, `w^3 / 3` (its diagonal block), `b w^2` (its
-/// rows below) and `b^2 w / 2` (its updates).
-fn wide_share(layout: &SupernodalLayout) -> f64 {
-    let (mut all, mut wide) = (0.0, 0.0);
-    for s in 0..layout.val_start.len() {
-        let (_, size, below, _) = layout.supernode(s);
-        let (w, b) = (size as f64, below.len() as f64);
-        let work = w * w * w / 3.0 + b * w * w + b * b * w / 2.0;
-        all += work;
-        if size > WIDE {
-            wide += work;
-        }
-    }
-    if all > 0.0 { wide / all } else { 0.0 }
 }
 
 /// Whether every supernode's rows below, past the columns of the supernode they first fall
