@@ -14,6 +14,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 mod numeric;
+mod split;
 
 /// Supernode amalgamation: two adjacent supernodes of `n` columns in all merge when
 /// `n <= w` and less than a fraction `z` of the merged block would be explicit zeros, for
@@ -157,18 +158,21 @@ impl SymbolicFactor {
 
     /// Numerically factorises the matrix (same pattern as analysed) into `factor`: by our
     /// supernodal factorisation ([`numeric`]) when the factor is supernodal, else by faer's.
+    /// Ours runs two independent halves of the elimination tree on two threads when
+    /// `threads > 1`; the factor does not depend on `threads`.
     pub fn factorize(
         &mut self,
         factor: &mut NumericFactor,
         col_ptr: &[usize],
         row_idx: &[usize],
         values: &[f64],
+        threads: usize,
     ) -> Result<(), FactorError> {
         factor.valid = false;
         if let (Some(layout), Some(scatter)) = (&self.layout, &mut self.scatter) {
             factor.values.clear();
             let len = self.symbolic.len_val();
-            scatter.factorise(layout, values, &mut factor.solve_order, len)?;
+            scatter.factorise(layout, values, &mut factor.solve_order, len, threads)?;
             factor.valid = true;
             return Ok(());
         }
@@ -523,30 +527,85 @@ mod tests {
             assert!(symbolic.scatter.is_some());
             let (mut ours, mut theirs) = (NumericFactor::default(), NumericFactor::default());
             symbolic
-                .factorize(&mut ours, &col_ptr, &row_idx, &values)
+                .factorize(&mut ours, &col_ptr, &row_idx, &values, 2)
                 .unwrap();
             (symbolic)
                 .factorize_with_faer(&mut theirs, &col_ptr, &row_idx, &values)
                 .unwrap();
             assert!(ours.values.is_empty(), "ours keeps only the solve order");
-            let scale = theirs
-                .solve_order
-                .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            let layout = symbolic.layout.as_ref().unwrap();
-            let mut compared = 0;
-            for s in 0..layout.val_start.len() {
-                let (_, size, below, at) = layout.supernode(s);
-                // faer leaves the diagonal block's upper triangle unspecified: not read
-                let lower = (0..size).flat_map(|c| (c..size).map(move |r| at + c * size + r));
-                let rows = at + size * size..at + (size + below.len()) * size;
-                for i in lower.chain(rows) {
-                    let (a, t) = (ours.solve_order[i], theirs.solve_order[i]);
-                    assert!((a - t).abs() <= 1e-12 * scale, "supernode {s}: {a} vs {t}");
-                    compared += 1;
-                }
+            assert_same_factor(&symbolic, &ours, &theirs, n);
+        }
+    }
+
+    /// Asserts that our factor and faer's agree to rounding (every value faer specifies).
+    fn assert_same_factor(
+        symbolic: &SymbolicFactor,
+        ours: &NumericFactor,
+        theirs: &NumericFactor,
+        n: usize,
+    ) {
+        let scale = theirs
+            .solve_order
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let layout = symbolic.layout.as_ref().unwrap();
+        let mut compared = 0;
+        for s in 0..layout.val_start.len() {
+            let (_, size, below, at) = layout.supernode(s);
+            // faer leaves the diagonal block's upper triangle unspecified: not read
+            let lower = (0..size).flat_map(|c| (c..size).map(move |r| at + c * size + r));
+            let rows = at + size * size..at + (size + below.len()) * size;
+            for i in lower.chain(rows) {
+                let (a, t) = (ours.solve_order[i], theirs.solve_order[i]);
+                assert!((a - t).abs() <= 1e-12 * scale, "supernode {s}: {a} vs {t}");
+                compared += 1;
             }
-            assert!(compared > n, "{compared} values compared");
+        }
+        assert!(compared > n, "{compared} values compared");
+    }
+
+    /// A factorisation big enough to run as two halves on two threads (`cholesky/split.rs`)
+    /// gives faer's factor to rounding, and the same bits on one thread as on two.
+    #[test]
+    fn the_split_factorisation_is_faers_on_any_thread_count() {
+        let (col_ptr, row_idx, values) = grid_with_clique(60);
+        let n = col_ptr.len() - 1;
+        let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
+        let count = symbolic.layout.as_ref().unwrap().val_start.len();
+        let split = symbolic.scatter.as_ref().and_then(|s| s.split()).unwrap();
+        // the halves' subtrees and the top cover every supernode once
+        let mut covered = vec![0; count];
+        let runs = split.halves.iter().flatten().chain(&split.top);
+        runs.flat_map(Clone::clone).for_each(|s| covered[s] += 1);
+        assert!(covered.iter().all(|&c| c == 1), "{split:?}");
+        assert!(split.halves.iter().all(|h| !h.is_empty()), "{split:?}");
+        let mut factors = [(); 3].map(|()| NumericFactor::default());
+        for (factor, threads) in factors.iter_mut().zip([1, 2]) {
+            (symbolic)
+                .factorize(factor, &col_ptr, &row_idx, &values, threads)
+                .unwrap();
+        }
+        let [one, two, theirs] = &mut factors;
+        (symbolic)
+            .factorize_with_faer(theirs, &col_ptr, &row_idx, &values)
+            .unwrap();
+        let bits = |f: &NumericFactor| {
+            f.solve_order
+                .iter()
+                .map(|v| v.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert!(bits(one) == bits(two), "one thread and two differ");
+        assert_same_factor(&symbolic, one, theirs, n);
+        // a pivot that fails in either half is an error, not a factor
+        let mut indefinite = values.clone();
+        indefinite[col_ptr[n / 3]] = -1.0;
+        for threads in [1, 2] {
+            let err = symbolic.factorize(one, &col_ptr, &row_idx, &indefinite, threads);
+            assert!(
+                err.is_err() && !one.is_valid(),
+                "{threads} threads: {err:?}"
+            );
         }
     }
 
@@ -557,12 +616,12 @@ mod tests {
         values[col_ptr[20]] = -1.0; // a negative diagonal entry
         let mut symbolic = SymbolicFactor::analyse(50, &col_ptr, &row_idx).unwrap();
         let mut factor = NumericFactor::default();
-        let err = symbolic.factorize(&mut factor, &col_ptr, &row_idx, &values);
+        let err = symbolic.factorize(&mut factor, &col_ptr, &row_idx, &values, 1);
         assert!(err.is_err() && !factor.is_valid(), "{err:?}");
         values[col_ptr[20]] = f64::NAN;
         assert!(
             symbolic
-                .factorize(&mut factor, &col_ptr, &row_idx, &values)
+                .factorize(&mut factor, &col_ptr, &row_idx, &values, 2)
                 .is_err()
         );
     }
@@ -588,7 +647,7 @@ mod tests {
     ) -> (NumericFactor, Vec<f64>) {
         let mut factor = NumericFactor::default();
         symbolic
-            .factorize(&mut factor, col_ptr, row_idx, values)
+            .factorize(&mut factor, col_ptr, row_idx, values, 1)
             .unwrap();
         let (mut ours, mut theirs) = (b.to_vec(), b.to_vec());
         symbolic.solve_in_place(&factor, &mut ours, 2);

@@ -182,6 +182,24 @@ pub fn rows(threads: usize, rows: &mut [DVec2], work: &(dyn Fn(usize, &mut [DVec
     }
 }
 
+/// Runs `a` and `b`, side by side on the pool when `threads > 1` (the caller makes the
+/// result independent of which ran where).
+pub fn join<A, B, RA, RB>(threads: usize, a: A, b: B) -> (RA, RB)
+where
+    A: FnOnce() -> RA + Send,
+    B: FnOnce() -> RB + Send,
+    RA: Send,
+    RB: Send,
+{
+    if threads <= 1 {
+        return (a(), b());
+    }
+    match pool() {
+        Some(pool) => pool.install(|| rayon::join(a, b)),
+        None => rayon::join(a, b),
+    }
+}
+
 /// The local step's thread pool (every core), started at the first parallel step; `None`
 /// when it cannot be started (rayon's global pool then runs the tasks).
 fn pool() -> Option<&'static rayon::ThreadPool> {

@@ -1054,7 +1054,13 @@ impl Solver {
                     if pass == Pass::Irls || !factor.is_valid() {
                         let t = Instant::now();
                         symbolic
-                            .factorize(factor, &self.pattern.col_ptr, &self.pattern.row_idx, values)
+                            .factorize(
+                                factor,
+                                &self.pattern.col_ptr,
+                                &self.pattern.row_idx,
+                                values,
+                                cfg.thread_count(),
+                            )
                             .map_err(|e| SolverError(e.0))?;
                         report.factorizations += 1;
                         report.phases.factorization += ms_since(t);
@@ -1161,6 +1167,7 @@ impl Solver {
                     &self.pattern.col_ptr,
                     &self.pattern.row_idx,
                     &w.l2_values,
+                    self.config.thread_count(),
                 )
                 .map_err(|e| SolverError(e.0))?;
             report.factorizations += 1;

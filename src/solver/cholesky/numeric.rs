@@ -14,8 +14,13 @@
 //! factorised densely (its diagonal block by Cholesky, the rows below it by substitution),
 //! then its rows below subtract their products from the supernodes of their columns. The
 //! order of every sum is fixed by the symbolic structure, so the result does not depend on
-//! anything but the matrix.
+//! anything but the matrix. Where the elimination tree has two balanced halves under its top
+//! separators ([`split`]), they are factorised side by side (on two threads if asked, the
+//! same bits on one), then the top.
 
+use std::ops::Range;
+
+use super::split::{self, Split};
 use super::{FactorError, SupernodalLayout, by_width};
 
 /// Where each stored value of the matrix (lower triangle, original order) goes in the factor's
@@ -26,13 +31,52 @@ pub(super) struct Scatter {
     position: Vec<usize>,
     /// `column_supernode[c]`: the supernode holding permuted column `c`.
     column_supernode: Vec<u32>,
+    /// The two halves two threads factorise side by side, if the tree has them.
+    split: Option<Split>,
+    /// The second half's updates of the supernodes after both halves (added after both).
+    deferred: Vec<f64>,
+    /// Scratch of each half.
+    scratch: [Scratch; 2],
+}
+
+/// Scratch memory of one thread's factorisation.
+#[derive(Debug, Clone, Default)]
+struct Scratch {
     /// The rows of one update, as places among the rows below its target supernode.
     relative: Vec<u32>,
-    /// Scratch: a diagonal block row by row ([`substitute_rows`]).
+    /// A diagonal block row by row ([`substitute_rows`]).
     transposed: Vec<f64>,
 }
 
+/// Where a run of supernodes writes: its own values (`near`, the factor's values from
+/// `near_offset` on, up to the run's end) and the top's, when the run is a half's subtree
+/// (`far`: pieces of the factor, or of a buffer of updates added later, at their offsets).
+struct Sink<'a, 'b> {
+    near: &'a mut [f64],
+    near_offset: usize,
+    far: &'a mut [(usize, &'b mut [f64])],
+}
+
+impl Sink<'_, '_> {
+    /// The values of the supernode whose block starts at `at`, to the end of its slice.
+    fn at(&mut self, at: usize) -> &mut [f64] {
+        if at >= self.near_offset && at < self.near_offset + self.near.len() {
+            return &mut self.near[at - self.near_offset..];
+        }
+        // a target outside the run is in the top: the piece holding it
+        let k = self.far.partition_point(|(offset, _)| *offset <= at) - 1;
+        let (offset, piece) = &mut self.far[k];
+        &mut piece[at - *offset..]
+    }
+}
+
 impl Scatter {
+    /// The halves the factorisation runs side by side, if it is split.
+    #[cfg(test)]
+    pub(super) fn split(&self) -> Option<&Split> {
+        self.split.as_ref()
+    }
+
     /// The scatter map of the matrix (`col_ptr`, `row_idx`: lower triangle, original order)
     /// into `layout`; `None` if an entry has no place in it (then faer factorises).
     pub(super) fn new(
@@ -68,98 +112,211 @@ impl Scatter {
         if !nested(layout, &column_supernode) {
             return None;
         }
+        let split = split::find(layout, &column_supernode);
         Some(Self {
             position,
             column_supernode,
-            relative: Vec::new(),
-            transposed: Vec::new(),
+            split,
+            deferred: Vec::new(),
+            scratch: Default::default(),
         })
     }
 
     /// Factorises the matrix with stored values `values` into `out` (solve order: each
     /// supernode's diagonal block column-major with reciprocal diagonal entries, then its rows
-    /// below row-major).
+    /// below row-major); the two halves of the split on two threads when `threads > 1`, with
+    /// the same result.
     pub(super) fn factorise(
         &mut self,
         layout: &SupernodalLayout,
         values: &[f64],
         out: &mut Vec<f64>,
         len: usize,
+        threads: usize,
     ) -> Result<(), FactorError> {
         out.clear();
         out.resize(len, 0.0);
         for (&place, &v) in self.position.iter().zip(values) {
             out[place] += v;
         }
-        for s in 0..layout.val_start.len() {
-            let (start, size, below, at) = layout.supernode(s);
-            let end_of_block = at + (size + below.len()) * size;
-            let (head, later) = out.split_at_mut(end_of_block);
-            let block = &mut head[at..];
-            let (diagonal, rows) = block.split_at_mut(size * size);
-            factorise_diagonal(diagonal, size).map_err(|c| {
-                FactorError(format!(
-                    "numeric Cholesky failed: the matrix is not positive definite (column {})",
-                    start + c
-                ))
-            })?;
-            // the substitutions multiply by the reciprocals: a division per value sat on
-            // each row's dependency chain
-            for c in 0..size {
-                diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
+        let count = layout.val_start.len();
+        let columns = &self.column_supernode[..];
+        let [one, two] = &mut self.scratch;
+        let Some(split) = &self.split else {
+            return run(layout, columns, one, 0..count, whole(out));
+        };
+        // the factor's values cut at the groups' boundaries: each half's subtrees, and the
+        // top's runs (written directly by the first half, through `deferred` by the second)
+        let value_range = |r: &Range<usize>| {
+            let end = layout.val_start.get(r.end).copied().unwrap_or(len);
+            layout.val_start[r.start]..end
+        };
+        let mut groups: Vec<(usize, Range<usize>)> = (split.halves.iter().enumerate())
+            .flat_map(|(h, runs)| runs.iter().map(move |r| (h, r.clone())))
+            .chain(split.top.iter().map(|r| (2, r.clone())))
+            .collect();
+        groups.sort_by_key(|(_, r)| r.start);
+        let top_len: usize = split.top.iter().map(|r| value_range(r).len()).sum();
+        self.deferred.clear();
+        self.deferred.resize(top_len, 0.0);
+        let mut halves: [Vec<Subtree>; 2] = Default::default();
+        let (mut direct, mut through) = (Vec::new(), Vec::new());
+        let (mut rest, mut deferred) = (&mut out[..], &mut self.deferred[..]);
+        for (h, nodes) in groups {
+            let values = value_range(&nodes);
+            let piece;
+            (piece, rest) = std::mem::take(&mut rest).split_at_mut(values.len());
+            if h == 2 {
+                let buffer;
+                (buffer, deferred) = std::mem::take(&mut deferred).split_at_mut(values.len());
+                direct.push((values.start, piece));
+                through.push((values.start, buffer));
+            } else {
+                halves[h].push((nodes, values.start, piece));
             }
-            substitute_rows(diagonal, size, rows, &mut self.transposed);
-            self.update_later(layout, below, rows, size, later, end_of_block);
+        }
+        let [first, second] = halves;
+        let half = |scratch: &mut Scratch, runs: Vec<Subtree>, top: &mut Far| {
+            for (nodes, near_offset, near) in runs {
+                let sink = Sink {
+                    near,
+                    near_offset,
+                    far: &mut top[..],
+                };
+                run(layout, columns, scratch, nodes, sink)?;
+            }
+            Ok::<(), FactorError>(())
+        };
+        let (a, b) = super::super::chunks::join(
+            threads,
+            || half(one, first, &mut direct),
+            || half(two, second, &mut through),
+        );
+        a.and(b)?;
+        let mut added = 0;
+        for r in &split.top {
+            let values = value_range(r);
+            let buffer = &self.deferred[added..][..values.len()];
+            for (v, d) in out[values.clone()].iter_mut().zip(buffer) {
+                *v += d;
+            }
+            added += values.len();
+        }
+        for nodes in &split.top {
+            run(layout, columns, one, nodes.clone(), whole(out))?;
         }
         Ok(())
     }
+}
 
-    /// Subtracts the products of one supernode's rows below (`rows`, row-major, `size` wide,
-    /// at permuted rows `below`) from the supernodes of their columns; `later` is the factor's
-    /// values from `offset` on (every target lies there).
-    fn update_later(
-        &mut self,
-        layout: &SupernodalLayout,
-        below: &[u32],
-        rows: &[f64],
-        size: usize,
-        later: &mut [f64],
-        offset: usize,
-    ) {
-        let mut g = 0;
-        while g < below.len() {
-            let t = self.column_supernode[below[g] as usize] as usize;
-            let (start, width, target_below, at) = layout.supernode(t);
-            let end = start + width;
-            let group = below[g..]
-                .iter()
-                .take_while(|&&r| (r as usize) < end)
-                .count();
-            // the rows after the group are among the target's rows below (the supernodal
-            // structure): their places, by one merge of the two sorted lists
-            self.relative.clear();
-            let mut k = 0;
-            for &r in &below[g + group..] {
-                while target_below[k] != r {
-                    k += 1;
-                }
-                self.relative.push(k as u32);
-            }
-            let target = Target {
-                start,
-                width,
-                relative: &self.relative,
-            };
-            let values = &mut later[at - offset..];
-            let source = Source {
-                below,
-                rows,
-                g,
-                group,
-            };
-            by_width!(size, update, update_wide, target, source, values);
-            g += group;
+/// The top's pieces of the factor's values a half writes to: (offset, values), in order.
+type Far<'a> = Vec<(usize, &'a mut [f64])>;
+
+/// A half's subtree: its supernodes, and the factor's values they hold (offset, values).
+type Subtree<'a> = (Range<usize>, usize, &'a mut [f64]);
+
+/// A sink over all of the factor's values.
+fn whole(out: &mut [f64]) -> Sink<'_, 'static> {
+    Sink {
+        near: out,
+        near_offset: 0,
+        far: &mut [],
+    }
+}
+
+/// Factorises the supernodes `range` (each after every supernode below it), writing through
+/// `sink`.
+fn run(
+    layout: &SupernodalLayout,
+    column_supernode: &[u32],
+    scratch: &mut Scratch,
+    range: Range<usize>,
+    mut sink: Sink,
+) -> Result<(), FactorError> {
+    for s in range {
+        let (start, size, below, at) = layout.supernode(s);
+        let local = at - sink.near_offset;
+        let end_of_block = local + (size + below.len()) * size;
+        let (head, later) = std::mem::take(&mut sink.near).split_at_mut(end_of_block);
+        let block = &mut head[local..];
+        let (diagonal, rows) = block.split_at_mut(size * size);
+        factorise_diagonal(diagonal, size).map_err(|c| {
+            FactorError(format!(
+                "numeric Cholesky failed: the matrix is not positive definite (column {})",
+                start + c
+            ))
+        })?;
+        // the substitutions multiply by the reciprocals: a division per value sat on
+        // each row's dependency chain
+        for c in 0..size {
+            diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
         }
+        substitute_rows(diagonal, size, rows, &mut scratch.transposed);
+        let mut rest = Sink {
+            near: later,
+            near_offset: sink.near_offset + end_of_block,
+            far: std::mem::take(&mut sink.far),
+        };
+        update_later(
+            layout,
+            column_supernode,
+            scratch,
+            below,
+            rows,
+            size,
+            &mut rest,
+        );
+        sink = rest;
+    }
+    Ok(())
+}
+
+/// Subtracts the products of one supernode's rows below (`rows`, row-major, `size` wide,
+/// at permuted rows `below`) from the supernodes of their columns, through `sink` (every
+/// target lies after the supernode).
+#[allow(clippy::too_many_arguments)]
+fn update_later(
+    layout: &SupernodalLayout,
+    column_supernode: &[u32],
+    scratch: &mut Scratch,
+    below: &[u32],
+    rows: &[f64],
+    size: usize,
+    sink: &mut Sink,
+) {
+    let mut g = 0;
+    while g < below.len() {
+        let t = column_supernode[below[g] as usize] as usize;
+        let (start, width, target_below, at) = layout.supernode(t);
+        let end = start + width;
+        let group = below[g..]
+            .iter()
+            .take_while(|&&r| (r as usize) < end)
+            .count();
+        // the rows after the group are among the target's rows below (the supernodal
+        // structure): their places, by one merge of the two sorted lists
+        scratch.relative.clear();
+        let mut k = 0;
+        for &r in &below[g + group..] {
+            while target_below[k] != r {
+                k += 1;
+            }
+            scratch.relative.push(k as u32);
+        }
+        let target = Target {
+            start,
+            width,
+            relative: &scratch.relative,
+        };
+        let values = sink.at(at);
+        let source = Source {
+            below,
+            rows,
+            g,
+            group,
+        };
+        by_width!(size, update, update_wide, target, source, values);
+        g += group;
     }
 }
 
