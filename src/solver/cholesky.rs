@@ -4,6 +4,8 @@
 //! and our in-place solves for the two-column right-hand side. The matrix is passed as its
 //! lower triangle in compressed sparse column form.
 
+use std::ops::Range;
+
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -15,6 +17,9 @@ use faer::{Conj, MatMut, Par, Side};
 
 mod numeric;
 mod split;
+
+use super::chunks::join;
+use split::Split;
 
 /// Supernode amalgamation: two adjacent supernodes of `n` columns in all merge when
 /// `n <= w` and less than a fraction `z` of the merged block would be explicit zeros, for
@@ -43,6 +48,8 @@ pub struct SymbolicFactor {
     layout: Option<SupernodalLayout>,
     /// Both right-hand-side columns interleaved, in the fill-reducing order.
     pairs: Vec<[f64; 2]>,
+    /// The second half's copy of the pairs in a split substitution ([`Substitution`]).
+    spare: Vec<[f64; 2]>,
     /// Our numeric factorisation's map of the matrix into the factor (`None`: faer's).
     scatter: Option<numeric::Scatter>,
 }
@@ -147,6 +154,7 @@ impl SymbolicFactor {
             scratch: MemBuffer::new(req),
             layout,
             pairs: Vec::new(),
+            spare: Vec::new(),
             scatter,
         })
     }
@@ -215,13 +223,36 @@ impl SymbolicFactor {
     /// Two columns (the x and y of the global step) go through our own supernodal
     /// substitution: the supernodes of these planar Laplacians are a few columns wide, and
     /// faer's per-supernode dense kernels (gemm plans, scratch matrices) cost more there than
-    /// the arithmetic; plain loops over both columns at once are several times faster.
-    pub fn solve_in_place(&mut self, factor: &NumericFactor, rhs: &mut [f64], ncols: usize) {
+    /// the arithmetic; plain loops over both columns at once are several times faster. The
+    /// factorisation's two halves substitute side by side on two threads when `threads > 1`
+    /// (the same result on one).
+    pub fn solve_in_place(
+        &mut self,
+        factor: &NumericFactor,
+        rhs: &mut [f64],
+        ncols: usize,
+        threads: usize,
+    ) {
         debug_assert!(factor.valid);
         if ncols == 2
             && let Some(layout) = &self.layout
         {
-            layout.solve_pairs(&factor.solve_order, rhs, &mut self.pairs);
+            let n = layout.perm.len();
+            let x = &mut self.pairs;
+            x.clear();
+            x.extend(layout.perm.iter().map(|&p| [rhs[p], rhs[n + p]]));
+            let split = self.scatter.as_ref().and_then(|s| s.split());
+            let substitution = Substitution {
+                layout,
+                l: &factor.solve_order,
+                split,
+                threads,
+            };
+            substitution.run(x, &mut self.spare);
+            for (xi, &p) in x.iter().zip(&layout.perm) {
+                rhs[p] = xi[0];
+                rhs[n + p] = xi[1];
+            }
             return;
         }
         self.solve_with_faer(factor, rhs, ncols);
@@ -238,11 +269,23 @@ impl SymbolicFactor {
     /// [`SymbolicFactor::factor_order`], in place: the caller builds the right-hand side in
     /// that order and reads the solution from it, with no permuting copies. Returns `false`
     /// (and leaves `x` alone) when there is no such order or `x` is not one pair per row.
-    pub fn solve_in_factor_order(&self, factor: &NumericFactor, x: &mut [[f64; 2]]) -> bool {
+    pub fn solve_in_factor_order(
+        &mut self,
+        factor: &NumericFactor,
+        x: &mut [[f64; 2]],
+        threads: usize,
+    ) -> bool {
         debug_assert!(factor.valid);
         match &self.layout {
             Some(layout) if x.len() == layout.perm.len() => {
-                layout.substitute(&factor.solve_order, x);
+                let split = self.scatter.as_ref().and_then(|s| s.split());
+                let substitution = Substitution {
+                    layout,
+                    l: &factor.solve_order,
+                    split,
+                    threads,
+                };
+                substitution.run(x, &mut self.spare);
                 true
             }
             _ => false,
@@ -320,33 +363,87 @@ impl SupernodalLayout {
         }
         out
     }
+}
 
-    /// `rhs` (two columns of length n) <- `A^-1 rhs` with `A = P^T L L^T P`; `l` in solve
-    /// order (see [`SupernodalLayout::substitute`]).
-    fn solve_pairs(&self, l: &[f64], rhs: &mut [f64], x: &mut Vec<[f64; 2]>) {
-        let n = self.perm.len();
-        x.clear();
-        x.extend(self.perm.iter().map(|&p| [rhs[p], rhs[n + p]]));
-        self.substitute(l, x);
-        for (xi, &p) in x.iter().zip(&self.perm) {
-            rhs[p] = xi[0];
-            rhs[n + p] = xi[1];
+/// `x <- L^-T L^-1 x` for pairs in factor order; `l` in solve order. Supernodes up to 8 wide
+/// (nearly all of them in these planar Laplacians) run with their width known to the
+/// compiler, so a below row's update stays in registers.
+///
+/// With a [`Split`], the forward pass runs the two halves side by side (the second on a spare
+/// copy of its rows, its updates of the top's rows gathered there from zero and added after
+/// both), then the top; the backward pass runs the top, then the halves side by side (the
+/// second reading the top's rows from the spare copy). One thread runs the same steps.
+struct Substitution<'a> {
+    layout: &'a SupernodalLayout,
+    l: &'a [f64],
+    split: Option<&'a Split>,
+    threads: usize,
+}
+
+impl Substitution<'_> {
+    fn run(&self, x: &mut [[f64; 2]], spare: &mut Vec<[f64; 2]>) {
+        let count = self.layout.val_start.len();
+        let Some(split) = self.split else {
+            self.forward(0..count, x);
+            self.backward(0..count, x);
+            return;
+        };
+        let columns = |r: &Range<usize>| self.layout.begin[r.start]..self.layout.begin[r.end];
+        let [first, second] = &split.halves;
+        spare.resize(x.len(), [0.0; 2]);
+        for r in second {
+            spare[columns(r)].copy_from_slice(&x[columns(r)]);
+        }
+        for r in &split.top {
+            spare[columns(r)].fill([0.0; 2]);
+        }
+        let halves = |x: &mut [[f64; 2]], spare: &mut [[f64; 2]], forward: bool| {
+            let side = |runs: &[Range<usize>], x: &mut [[f64; 2]]| {
+                for r in runs {
+                    if forward {
+                        self.forward(r.clone(), x);
+                    } else {
+                        self.backward(r.clone(), x);
+                    }
+                }
+            };
+            join(self.threads, || side(first, x), || side(second, spare));
+            for r in second {
+                x[columns(r)].copy_from_slice(&spare[columns(r)]);
+            }
+        };
+        halves(x, spare, true);
+        for r in &split.top {
+            for c in columns(r) {
+                x[c] = [x[c][0] + spare[c][0], x[c][1] + spare[c][1]];
+            }
+        }
+        for r in &split.top {
+            self.forward(r.clone(), x);
+        }
+        for r in split.top.iter().rev() {
+            self.backward(r.clone(), x);
+        }
+        for r in &split.top {
+            spare[columns(r)].copy_from_slice(&x[columns(r)]);
+        }
+        halves(x, spare, false);
+    }
+
+    /// Forward substitution through the supernodes `range`, in order.
+    fn forward(&self, range: Range<usize>, x: &mut [[f64; 2]]) {
+        for s in range {
+            let (start, size, below, at) = self.layout.supernode(s);
+            let block = &self.l[at..][..(size + below.len()) * size];
+            by_width!(size, forward, forward_wide, block, start, below, x);
         }
     }
 
-    /// `x <- L^-T L^-1 x` for pairs in factor order; `l` in solve order. Supernodes up to 8
-    /// wide (nearly all of them in these planar Laplacians) run with their width known to
-    /// the compiler, so a below row's update stays in registers.
-    fn substitute(&self, l: &[f64], x: &mut [[f64; 2]]) {
-        let supernodes = self.val_start.len();
-        for s in 0..supernodes {
-            let (start, size, below, at) = self.supernode(s);
-            let block = &l[at..][..(size + below.len()) * size];
-            by_width!(size, forward, forward_wide, block, start, below, x);
-        }
-        for s in (0..supernodes).rev() {
-            let (start, size, below, at) = self.supernode(s);
-            let block = &l[at..][..(size + below.len()) * size];
+    /// Backward substitution through the supernodes `range`, in reverse order.
+    fn backward(&self, range: Range<usize>, x: &mut [[f64; 2]]) {
+        for s in range.rev() {
+            let (start, size, below, at) = self.layout.supernode(s);
+            let block = &self.l[at..][..(size + below.len()) * size];
             by_width!(size, backward, backward_wide, block, start, below, x);
         }
     }
@@ -565,9 +662,9 @@ mod tests {
     }
 
     /// A factorisation big enough to run as two halves on two threads (`cholesky/split.rs`)
-    /// gives faer's factor to rounding, and the same bits on one thread as on two.
+    /// gives faer's factor and solution to rounding, and the same bits on one thread as on two.
     #[test]
-    fn the_split_factorisation_is_faers_on_any_thread_count() {
+    fn the_split_factorisation_and_solve_are_faers_on_any_thread_count() {
         let (col_ptr, row_idx, values) = grid_with_clique(60);
         let n = col_ptr.len() - 1;
         let mut symbolic = SymbolicFactor::analyse(n, &col_ptr, &row_idx).unwrap();
@@ -597,6 +694,16 @@ mod tests {
         };
         assert!(bits(one) == bits(two), "one thread and two differ");
         assert_same_factor(&symbolic, one, theirs, n);
+        // the split substitution: faer's solution to rounding, the same bits on two threads
+        let b: Vec<f64> = (0..2 * n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+        let (_, ours) = solves_as_faer(&mut symbolic, (&col_ptr, &row_idx, &values), &b, 1e-12);
+        let mut on_two = b.clone();
+        symbolic.solve_in_place(one, &mut on_two, 2, 2);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert!(
+            bits(&on_two) == bits(&ours),
+            "the solve differs on two threads"
+        );
         // a pivot that fails in either half is an error, not a factor
         let mut indefinite = values.clone();
         indefinite[col_ptr[n / 3]] = -1.0;
@@ -650,7 +757,7 @@ mod tests {
             .factorize(&mut factor, col_ptr, row_idx, values, 1)
             .unwrap();
         let (mut ours, mut theirs) = (b.to_vec(), b.to_vec());
-        symbolic.solve_in_place(&factor, &mut ours, 2);
+        symbolic.solve_in_place(&factor, &mut ours, 2, 1);
         symbolic.solve_with_faer(&factor, &mut theirs, 2);
         let scale = theirs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for (a, t) in ours.iter().zip(&theirs) {
@@ -703,12 +810,12 @@ mod tests {
         // the same solve with the caller gathering into and reading from the factor's order
         let order = symbolic.factor_order().unwrap().to_vec();
         let mut pairs: Vec<[f64; 2]> = order.iter().map(|&v| [b[v], b[n + v]]).collect();
-        assert!(symbolic.solve_in_factor_order(&factor, &mut pairs));
+        assert!(symbolic.solve_in_factor_order(&factor, &mut pairs, 1));
         for (pair, &v) in pairs.iter().zip(&order) {
             assert_eq!(pair[0].to_bits(), ours[v].to_bits());
             assert_eq!(pair[1].to_bits(), ours[n + v].to_bits());
         }
         // a vector of the wrong length is refused, not solved
-        assert!(!symbolic.solve_in_factor_order(&factor, &mut pairs[1..]));
+        assert!(!symbolic.solve_in_factor_order(&factor, &mut pairs[1..], 1));
     }
 }

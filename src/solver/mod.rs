@@ -1030,8 +1030,9 @@ impl Solver {
                     let t = Instant::now();
                     let outcome = {
                         let factor = &*factor;
-                        let mut precondition =
-                            |z: &mut [f64]| symbolic.solve_in_place(factor, z, 2);
+                        let mut precondition = |z: &mut [f64]| {
+                            symbolic.solve_in_place(factor, z, 2, cfg.thread_count())
+                        };
                         cg::solve(
                             &self.pattern,
                             values,
@@ -1067,7 +1068,7 @@ impl Solver {
                     }
                     let t = Instant::now();
                     w.solution.copy_from_slice(&w.rhs);
-                    symbolic.solve_in_place(factor, &mut w.solution, 2);
+                    symbolic.solve_in_place(factor, &mut w.solution, 2, cfg.thread_count());
                     report.phases.solve += ms_since(t);
                 }
             }
@@ -1174,7 +1175,7 @@ impl Solver {
             report.phases.factorization += ms_since(t);
         }
         let t = Instant::now();
-        if !symbolic.solve_in_factor_order(&self.l2_factor, x) {
+        if !symbolic.solve_in_factor_order(&self.l2_factor, x, cfg.thread_count()) {
             return Err(SolverError("the factor has no supernodal order".into()));
         }
         report.phases.solve += ms_since(t);

@@ -1,5 +1,5 @@
 //! Our numeric supernodal Cholesky: the factor of faer's symbolic analysis (its ordering and
-//! supernodes), computed straight into the solve order of [`NumericFactor::solve_order`].
+//! supernodes), computed straight into the solve order of [`super::NumericFactor::solve_order`].
 //!
 //! Why not faer's numeric factorisation: most supernodes of these planar Laplacians are a few
 //! columns wide, and faer's per-supernode dense kernels (gemm plans, scratch matrices) cost
@@ -72,7 +72,6 @@ impl Sink<'_, '_> {
 
 impl Scatter {
     /// The halves the factorisation runs side by side, if it is split.
-    #[cfg(test)]
     pub(super) fn split(&self) -> Option<&Split> {
         self.split.as_ref()
     }
