@@ -676,6 +676,14 @@ mod tests {
         runs.flat_map(Clone::clone).for_each(|s| covered[s] += 1);
         assert!(covered.iter().all(|&c| c == 1), "{split:?}");
         assert!(split.halves.iter().all(|h| !h.is_empty()), "{split:?}");
+        // and a top supernode whose rows below two threads share
+        let layout = symbolic.layout.as_ref().unwrap();
+        let shared = split.top.iter().flat_map(Clone::clone).any(|s| {
+            let (_, size, below, _) = layout.supernode(s);
+            let (w, b) = (size as f64, below.len() as f64);
+            b * w * (w + b / 2.0) >= numeric::MIN_SHARED
+        });
+        assert!(shared, "no shared supernode");
         let mut factors = [(); 3].map(|()| NumericFactor::default());
         for (factor, threads) in factors.iter_mut().zip([1, 2]) {
             (symbolic)

@@ -21,7 +21,7 @@
 use std::ops::Range;
 
 use super::split::{self, Split};
-use super::{FactorError, SupernodalLayout, by_width};
+use super::{FactorError, SupernodalLayout, by_width, join};
 
 /// Where each stored value of the matrix (lower triangle, original order) goes in the factor's
 /// values in solve order: built once per pattern.
@@ -142,7 +142,14 @@ impl Scatter {
         let columns = &self.column_supernode[..];
         let [one, two] = &mut self.scratch;
         let Some(split) = &self.split else {
-            return run(layout, columns, one, 0..count, whole(out));
+            return run(
+                layout,
+                columns,
+                &mut self.scratch,
+                threads,
+                0..count,
+                whole(out),
+            );
         };
         // the factor's values cut at the groups' boundaries: each half's subtrees, and the
         // top's runs (written directly by the first half, through `deferred` by the second)
@@ -182,11 +189,18 @@ impl Scatter {
                     near_offset,
                     far: &mut top[..],
                 };
-                run(layout, columns, scratch, nodes, sink)?;
+                run(
+                    layout,
+                    columns,
+                    std::slice::from_mut(scratch),
+                    1,
+                    nodes,
+                    sink,
+                )?;
             }
             Ok::<(), FactorError>(())
         };
-        let (a, b) = super::super::chunks::join(
+        let (a, b) = join(
             threads,
             || half(one, first, &mut direct),
             || half(two, second, &mut through),
@@ -202,7 +216,8 @@ impl Scatter {
             added += values.len();
         }
         for nodes in &split.top {
-            run(layout, columns, one, nodes.clone(), whole(out))?;
+            let both = &mut self.scratch[..];
+            run(layout, columns, both, threads, nodes.clone(), whole(out))?;
         }
         Ok(())
     }
@@ -224,11 +239,14 @@ fn whole(out: &mut [f64]) -> Sink<'_, 'static> {
 }
 
 /// Factorises the supernodes `range` (each after every supernode below it), writing through
-/// `sink`.
+/// `sink`. With two scratches, `threads > 1` and no far pieces (the top, or a factor that is
+/// not split), a supernode with much work below its diagonal block shares it with a second
+/// thread ([`share_rows`]).
 fn run(
     layout: &SupernodalLayout,
     column_supernode: &[u32],
-    scratch: &mut Scratch,
+    scratch: &mut [Scratch],
+    threads: usize,
     range: Range<usize>,
     mut sink: Sink,
 ) -> Result<(), FactorError> {
@@ -250,24 +268,125 @@ fn run(
         for c in 0..size {
             diagonal[c * size + c] = 1.0 / diagonal[c * size + c];
         }
-        substitute_rows(diagonal, size, rows, &mut scratch.transposed);
         let mut rest = Sink {
             near: later,
             near_offset: sink.near_offset + end_of_block,
             far: std::mem::take(&mut sink.far),
         };
-        update_later(
-            layout,
-            column_supernode,
-            scratch,
-            below,
-            rows,
-            size,
-            &mut rest,
-        );
+        let (w, b) = (size as f64, below.len() as f64);
+        let shared = threads > 1 && rest.far.is_empty() && b * w * (w + b / 2.0) >= MIN_SHARED;
+        match scratch {
+            [one, two, ..] if shared => {
+                let rows = share_rows(diagonal, size, rows, [one, two], threads);
+                let s = Shared {
+                    layout,
+                    column_supernode,
+                    below,
+                    rows,
+                    size,
+                };
+                s.update_later([one, two], threads, rest.near, rest.near_offset);
+            }
+            [one, ..] => {
+                substitute_rows(diagonal, size, rows, &mut one.transposed);
+                let all = 0..below.len();
+                let (columns, rows) = (column_supernode, &*rows);
+                update_later(layout, columns, one, below, rows, size, all, &mut rest);
+            }
+            [] => unreachable!("run has a scratch"),
+        }
         sink = rest;
     }
     Ok(())
+}
+
+/// The work (multiply-adds) below a supernode's diagonal block from which [`run`] shares it
+/// between two threads: a thread's hand-over costs some microseconds.
+pub(super) const MIN_SHARED: f64 = 100_000.0;
+
+/// [`substitute_rows`] with the rows cut in two halves, one per thread (each row is computed
+/// alone, so the cut changes no bit); returns the rows.
+fn share_rows<'a>(
+    diagonal: &[f64],
+    size: usize,
+    rows: &'a mut [f64],
+    [one, two]: [&mut Scratch; 2],
+    threads: usize,
+) -> &'a [f64] {
+    let cut = rows.len() / size / 2 * size;
+    let (a, b) = rows.split_at_mut(cut);
+    join(
+        threads,
+        || substitute_rows(diagonal, size, a, &mut one.transposed),
+        || substitute_rows(diagonal, size, b, &mut two.transposed),
+    );
+    rows
+}
+
+/// One supernode's factorised rows below, for updates shared by two threads.
+struct Shared<'a> {
+    layout: &'a SupernodalLayout,
+    column_supernode: &'a [u32],
+    below: &'a [u32],
+    rows: &'a [f64],
+    size: usize,
+}
+
+impl Shared<'_> {
+    /// [`update_later`] with the targets cut in two runs of about equal work, one per thread:
+    /// each target receives one group of products, computed as on one thread, and the runs'
+    /// values are apart (`later`: the factor's values from `offset` on).
+    fn update_later(
+        &self,
+        [one, two]: [&mut Scratch; 2],
+        threads: usize,
+        later: &mut [f64],
+        offset: usize,
+    ) {
+        let (below, n) = (self.below, self.below.len());
+        // each group (rows in one target's columns) costs about its rows times the rows after
+        let mut groups = Vec::new();
+        let (mut g, mut total) = (0, 0.0);
+        while g < n {
+            let t = self.column_supernode[below[g] as usize] as usize;
+            let (start, width, _, at) = self.layout.supernode(t);
+            let group = below[g..]
+                .iter()
+                .take_while(|&&r| (r as usize) < start + width)
+                .count();
+            total += (group * (n - g)) as f64;
+            groups.push((g, at, total));
+            g += group;
+        }
+        // the second run starts after the group that reaches half the work
+        let k = groups.iter().position(|&(_, _, sum)| sum >= total / 2.0);
+        let (cut, split_at) = match k.and_then(|k| groups.get(k + 1)) {
+            Some(&(g, at, _)) => (g, at - offset),
+            None => (n, later.len()),
+        };
+        let (a, b) = later.split_at_mut(split_at);
+        let (layout, columns, rows, size) =
+            (self.layout, self.column_supernode, self.rows, self.size);
+        join(
+            threads,
+            || {
+                let mut sink = Sink {
+                    near: a,
+                    near_offset: offset,
+                    far: &mut [],
+                };
+                update_later(layout, columns, one, below, rows, size, 0..cut, &mut sink);
+            },
+            || {
+                let mut sink = Sink {
+                    near: b,
+                    near_offset: offset + split_at,
+                    far: &mut [],
+                };
+                update_later(layout, columns, two, below, rows, size, cut..n, &mut sink);
+            },
+        );
+    }
 }
 
 /// Subtracts the products of one supernode's rows below (`rows`, row-major, `size` wide,
@@ -281,10 +400,11 @@ fn update_later(
     below: &[u32],
     rows: &[f64],
     size: usize,
+    groups: Range<usize>,
     sink: &mut Sink,
 ) {
-    let mut g = 0;
-    while g < below.len() {
+    let mut g = groups.start;
+    while g < groups.end {
         let t = column_supernode[below[g] as usize] as usize;
         let (start, width, target_below, at) = layout.supernode(t);
         let end = start + width;
