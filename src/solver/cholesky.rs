@@ -237,22 +237,17 @@ impl SymbolicFactor {
         if ncols == 2
             && let Some(layout) = &self.layout
         {
-            let n = layout.perm.len();
-            let x = &mut self.pairs;
+            let (n, perm) = (layout.perm.len(), &layout.perm);
+            let mut x = std::mem::take(&mut self.pairs);
             x.clear();
-            x.extend(layout.perm.iter().map(|&p| [rhs[p], rhs[n + p]]));
-            let split = self.scatter.as_ref().and_then(|s| s.split());
-            let substitution = Substitution {
-                layout,
-                l: &factor.solve_order,
-                split,
-                threads,
-            };
-            substitution.run(x, &mut self.spare);
-            for (xi, &p) in x.iter().zip(&layout.perm) {
+            x.extend(perm.iter().map(|&p| [rhs[p], rhs[n + p]]));
+            self.solve_in_factor_order(factor, &mut x, threads);
+            let perm = &self.layout.as_ref().expect("checked above").perm;
+            for (xi, &p) in x.iter().zip(perm) {
                 rhs[p] = xi[0];
                 rhs[n + p] = xi[1];
             }
+            self.pairs = x;
             return;
         }
         self.solve_with_faer(factor, rhs, ncols);
