@@ -182,6 +182,40 @@ pub fn rows(threads: usize, rows: &mut [DVec2], work: &(dyn Fn(usize, &mut [DVec
     }
 }
 
+/// Runs `work(columns, values)` over consecutive runs of [`ROW_CHUNK`] columns of a
+/// compressed-column matrix (`col_ptr`), each with its columns' slice of `values` (each
+/// column computed on its own, so any cut gives the same values): on the pool when
+/// `threads > 1` and there are at least four runs, else on the calling thread.
+pub fn columns(
+    threads: usize,
+    col_ptr: &[usize],
+    values: &mut [f64],
+    work: &(dyn Fn(Range<usize>, &mut [f64]) + Sync),
+) {
+    let n = col_ptr.len().saturating_sub(1);
+    if threads <= 1 || n < 4 * ROW_CHUNK {
+        work(0..n, values);
+        return;
+    }
+    let mut pieces = Vec::with_capacity(n.div_ceil(ROW_CHUNK));
+    let mut rest = values;
+    for first in (0..n).step_by(ROW_CHUNK) {
+        let end = (first + ROW_CHUNK).min(n);
+        let (piece, tail) = rest.split_at_mut(col_ptr[end] - col_ptr[first]);
+        pieces.push((first..end, piece));
+        rest = tail;
+    }
+    let run = move || {
+        pieces
+            .into_par_iter()
+            .for_each(|(columns, piece)| work(columns, piece));
+    };
+    match pool() {
+        Some(pool) => pool.install(run),
+        None => run(),
+    }
+}
+
 /// Runs `a` and `b`, side by side on the pool when `threads > 1` (the caller makes the
 /// result independent of which ran where).
 pub fn join<A, B, RA, RB>(threads: usize, a: A, b: B) -> (RA, RB)

@@ -20,6 +20,10 @@ pub struct Components {
     /// Per vertex, its component.
     of: Vec<u32>,
     count: usize,
+    /// Per component, its vertices in ascending order (compressed: component `c`'s are
+    /// `members[start[c]..start[c + 1]]`).
+    start: Vec<u32>,
+    members: Vec<u32>,
 }
 
 impl Components {
@@ -52,7 +56,31 @@ impl Components {
             }
             of.push(index[r]);
         }
-        Self { of, count }
+        let mut start = vec![0u32; count + 1];
+        for &c in &of {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..count {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut members = vec![0u32; vertex_count];
+        for (v, &c) in of.iter().enumerate() {
+            // the solver takes no model with more vertices than `u32` counts
+            members[fill[c as usize] as usize] = v as u32;
+            fill[c as usize] += 1;
+        }
+        Self {
+            of,
+            count,
+            start,
+            members,
+        }
+    }
+
+    /// The vertices of component `c`, ascending.
+    pub fn members(&self, c: usize) -> &[u32] {
+        &self.members[self.start[c] as usize..self.start[c + 1] as usize]
     }
 
     /// The component of vertex `v`.
@@ -64,16 +92,17 @@ impl Components {
         self.count
     }
 
-    /// Whether some component has no vertex with a handle count above 0 (`handle_count`
-    /// per vertex).
-    pub fn any_free(&self, handle_count: &[f64]) -> bool {
+    /// Into `free`, the components (ascending) with no vertex whose handle count is above 0
+    /// (`handle_count` per vertex).
+    pub fn free(&self, handle_count: &[f64], free: &mut Vec<usize>) {
         let mut held = vec![false; self.count];
         for (&c, &h) in self.of.iter().zip(handle_count) {
             if h > 0.0 {
                 held[c as usize] = true;
             }
         }
-        held.contains(&false)
+        free.clear();
+        free.extend((0..self.count).filter(|&c| !held[c]));
     }
 }
 

@@ -4,6 +4,8 @@
 //! compressed sparse columns, built once per assembly generation), fills its values and the
 //! two-column right-hand side in place, and multiplies by the matrix.
 
+use std::ops::Range;
+
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
@@ -45,6 +47,14 @@ pub struct Pattern {
     /// scatter. Empty when an entry would not fit `u32` (then the scatter runs).
     pub incident_start: Vec<u32>,
     pub incident: Vec<u32>,
+    /// Beside `incident`: for an end at the edge's smaller vertex, the place of the edge's
+    /// entry within that vertex's column (the column holds it, below the diagonal); 0 (the
+    /// diagonal's place) at the larger vertex.
+    pub incident_entry: Vec<u32>,
+    /// Per edge, its part (packed: the weighted right-hand side reads one per edge end).
+    pub edge_part: Vec<u32>,
+    /// Per part, how many of `edges` are its (they are consecutive, part by part).
+    pub part_edges: Vec<usize>,
 }
 
 impl Pattern {
@@ -94,6 +104,14 @@ impl Pattern {
         let compact = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
         let ends = edges.iter().map(|e| [compact(e.x), compact(e.y)]).collect();
         let (incident_start, incident) = incidence(n, &edges);
+        let incident_entry = incident_entries(&col_ptr, &edges, &incident_start, &incident);
+        // packed only when every part index fits (else `can_gather` is false: the scatter runs)
+        let edge_part = if u32::try_from(parts.len()).is_ok() {
+            edges.iter().map(|e| compact(e.part)).collect()
+        } else {
+            Vec::new()
+        };
+        let part_edges = parts.iter().map(|p| p.edges.len()).collect();
         Self {
             n,
             col_ptr,
@@ -102,6 +120,9 @@ impl Pattern {
             ends,
             incident_start,
             incident,
+            incident_entry,
+            edge_part,
+            part_edges,
         }
     }
 
@@ -124,7 +145,7 @@ impl Pattern {
                 for &k in &incident[start[v] as usize..start[v + 1] as usize] {
                     let e = (k >> 1) as usize;
                     let t = match weights {
-                        Some(w) => w[self.edges[e].part] * targets[e],
+                        Some(w) => w[self.edge_part[e] as usize] * targets[e],
                         None => targets[e],
                     };
                     if k & 1 == 0 {
@@ -141,7 +162,7 @@ impl Pattern {
 
     /// Whether [`Pattern::gather_rhs`] can run (the incidence was built).
     pub fn can_gather(&self) -> bool {
-        self.incident_start.len() == self.n + 1
+        self.incident_start.len() == self.n + 1 && self.edge_part.len() == self.edges.len()
     }
 
     pub fn nnz(&self) -> usize {
@@ -149,8 +170,49 @@ impl Pattern {
     }
 
     /// Fills `values` with the weighted Laplacian of the edges (`weights`: one per part, for
-    /// all its edges) plus `diagonal`.
-    pub fn fill_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
+    /// all its edges) plus `diagonal`: column by column on `threads` threads
+    /// ([`chunks::columns`]) from the incidence, each entry's terms in edge order as the
+    /// serial scatter adds them (the same bits).
+    pub fn fill_values(
+        &self,
+        weights: &[f64],
+        diagonal: &[f64],
+        values: &mut Vec<f64>,
+        threads: usize,
+    ) {
+        if !self.can_gather() {
+            return self.scatter_values(weights, diagonal, values);
+        }
+        values.clear();
+        values.resize(self.nnz(), 0.0);
+        let (start, incident) = (&self.incident_start, &self.incident);
+        let fill = |columns: Range<usize>, out: &mut [f64]| {
+            let base = self.col_ptr[columns.start];
+            for j in columns {
+                let (lo, hi) = (self.col_ptr[j], self.col_ptr[j + 1]);
+                let column = &mut out[lo - base..hi - base];
+                // the diagonal: its edges' weights in edge order, then the diagonal term
+                let mut diag = 0.0;
+                let ends = start[j] as usize..start[j + 1] as usize;
+                for (&k, &entry) in incident[ends.clone()]
+                    .iter()
+                    .zip(&self.incident_entry[ends])
+                {
+                    let w = weights[self.edge_part[(k >> 1) as usize] as usize];
+                    diag += w;
+                    if entry > 0 {
+                        column[entry as usize] -= w;
+                    }
+                }
+                column[0] = diag + diagonal[j];
+            }
+        };
+        chunks::columns(threads, &self.col_ptr, values, &fill);
+    }
+
+    /// [`Pattern::fill_values`] as a serial scatter over the edges (when the incidence or the
+    /// packed parts are not built).
+    fn scatter_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
         values.clear();
         values.resize(self.nnz(), 0.0);
         for e in &self.edges {
@@ -229,6 +291,29 @@ fn incidence(n: usize, edges: &[EdgeSlot]) -> (Vec<u32>, Vec<u32>) {
         }
     }
     (start, incident)
+}
+
+/// Per entry of the incidence, [`Pattern::incident_entry`].
+fn incident_entries(
+    col_ptr: &[usize],
+    edges: &[EdgeSlot],
+    start: &[u32],
+    incident: &[u32],
+) -> Vec<u32> {
+    let mut entries = vec![0u32; incident.len()];
+    for (j, pair) in start.windows(2).enumerate() {
+        let range = pair[0] as usize..pair[1] as usize;
+        for (&k, entry) in incident[range.clone()].iter().zip(&mut entries[range]) {
+            let e = &edges[(k >> 1) as usize];
+            if let Some(slot) = e.slot
+                && e.x.min(e.y) == j
+            {
+                // within the column of a vertex index that fits u32 (the solver checks)
+                *entry = (slot - col_ptr[j]) as u32;
+            }
+        }
+    }
+    entries
 }
 
 /// Writes the right-hand side: for each edge, `w * R_xy (x0 - y0)` (`w` its part's weight in

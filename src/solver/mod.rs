@@ -142,15 +142,12 @@ pub struct Solver {
     splitting: admm::Splitting,
     /// The connected components of the vertex graph (rigid following, free centroids).
     components: follow::Components,
-    /// Scratch per component: the centroid shift a solve needs, vertex count, and whether
-    /// nothing in it is held.
-    centroid_shift: Vec<(DVec2, f64, bool)>,
     /// The mean rest edge length of the active states when the generation was prepared (the
     /// splitting threshold's unit).
     mean_rest_edge: f64,
-    /// Whether some component has no held vertex this frame (only then do solves shift
+    /// The components with no held vertex this frame, ascending (solves shift their
     /// centroids back).
-    any_free: bool,
+    free_components: Vec<usize>,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
@@ -173,8 +170,7 @@ impl Solver {
             work: Work::default(),
             splitting: admm::Splitting::default(),
             components: follow::Components::default(),
-            centroid_shift: Vec::new(),
-            any_free: true,
+            free_components: Vec::new(),
             mean_rest_edge: 1.0,
             shifted: Vec::new(),
             factor_slot: Vec::new(),
@@ -297,7 +293,8 @@ impl Solver {
         }
         let cfg = self.config;
         self.gather_handles(asm.handles(), n);
-        self.any_free = self.components.any_free(&self.work.handle_count);
+        self.components
+            .free(&self.work.handle_count, &mut self.free_components);
         // Position buffers live in `work` between frames (taken here, put back at the end; an
         // error path just drops them and the next frame reallocates).
         let mut warm = std::mem::take(&mut self.work.warm);
@@ -568,25 +565,22 @@ impl Solver {
         let t = Instant::now();
         let (p, eps) = (cfg.norm, cfg.irls_epsilon.max(1e-12));
         let w = &mut self.work;
-        let edges = &self.pattern.edges;
+        let part_edges = &self.pattern.part_edges;
         w.weights.clear();
         w.weights.resize(w.residuals.len(), 0.0);
-        // one weight per part, from its stacked residual (see the splitting's groups)
-        let mut k = 0;
-        while k < edges.len() {
-            let part = edges[k].part;
-            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
-            let d2 = w.residuals[part];
-            let weight = irls_weight(d2.sqrt() + eps, p);
-            let weight = if weight.is_finite() {
-                weight
-            } else {
-                eps.powf(p - 2.0)
-            };
-            w.weights[part] = weight;
-            k = end;
+        // one weight per part with edges, from its stacked residual (see the splitting's
+        // groups); a part without edges keeps 0
+        for ((weight, &d2), _) in w
+            .weights
+            .iter_mut()
+            .zip(&w.residuals)
+            .zip(part_edges)
+            .filter(|(_, count)| **count > 0)
+        {
+            let v = irls_weight(d2.sqrt() + eps, p);
+            *weight = if v.is_finite() { v } else { eps.powf(p - 2.0) };
         }
-        let mean = mean_over_edges(edges, &w.weights);
+        let mean = mean_over_edges(part_edges, &w.weights);
         report.phases.assembly += ms_since(t);
         self.solve_global(f, next, mean, Pass::Irls, report)
     }
@@ -923,26 +917,19 @@ impl Solver {
     /// Shifts every component without a held vertex so its centroid in `next` is the one in
     /// `f` (in exact arithmetic the solve already does: the Laplacian's rows of a component sum
     /// to zero, so the proximal term alone sets its centroid).
-    fn keep_free_centroids(&mut self, f: &[DVec2], next: &mut [DVec2]) {
-        if !self.any_free {
-            // every component is held: nothing to shift
-            return;
-        }
-        let c = &self.components;
-        let k = c.count();
-        let sums = &mut self.centroid_shift;
-        sums.clear();
-        sums.resize(k, (DVec2::ZERO, 0.0, true));
-        for (v, (&a, &b)) in f.iter().zip(next.iter()).enumerate() {
-            let s = &mut sums[c.of(v)];
-            s.0 += a - b;
-            s.1 += 1.0;
-            s.2 &= self.work.handle_count[v] == 0.0;
-        }
-        for (v, p) in next.iter_mut().enumerate() {
-            let (shift, count, free) = sums[c.of(v)];
-            if free {
-                *p += shift / count;
+    fn keep_free_centroids(&self, f: &[DVec2], next: &mut [DVec2]) {
+        // only the free components' vertices, each component's in ascending order (the sum
+        // a pass over every vertex would make, for a tenth of the reads in the bench's city)
+        for &c in &self.free_components {
+            let members = self.components.members(c);
+            let mut shift = DVec2::ZERO;
+            let mut count = 0.0;
+            for &v in members {
+                shift += f[v as usize] - next[v as usize];
+                count += 1.0;
+            }
+            for &v in members {
+                next[v as usize] += shift / count;
             }
         }
     }
@@ -1001,9 +988,10 @@ impl Solver {
             }
         };
         match pass {
-            Pass::Irls => self
-                .pattern
-                .fill_values(weights, &w.diagonal, &mut w.values),
+            Pass::Irls => {
+                let threads = cfg.thread_count();
+                (self.pattern).fill_values(weights, &w.diagonal, &mut w.values, threads);
+            }
             Pass::LeastSquares => refresh_least_squares(&self.pattern, w, &mut self.l2_factor),
         }
         let values = if pass == Pass::LeastSquares {
@@ -1311,12 +1299,21 @@ fn ms_since(t: Instant) -> f64 {
 }
 
 /// The mean over the edges of their parts' weights (1 when there are none or it is not a
-/// positive number): summed edge by edge, as one weight per edge would be.
-fn mean_over_edges(edges: &[global::EdgeSlot], part_weights: &[f64]) -> f64 {
-    if edges.is_empty() {
+/// positive number; `part_edges`: each part's edge count): summed edge by edge, as one weight
+/// per edge would be.
+fn mean_over_edges(part_edges: &[usize], part_weights: &[f64]) -> f64 {
+    let count: usize = part_edges.iter().sum();
+    if count == 0 {
         return 1.0;
     }
-    let m = edges.iter().map(|e| part_weights[e.part]).sum::<f64>() / edges.len() as f64;
+    let mut sum = 0.0;
+    for (&n, &w) in part_edges.iter().zip(part_weights) {
+        // added once per edge, in edge order (not `n * w`): the same bits as a sum over edges
+        for _ in 0..n {
+            sum += w;
+        }
+    }
+    let m = sum / count as f64;
     if m.is_finite() && m > 0.0 { m } else { 1.0 }
 }
 
