@@ -11,20 +11,28 @@ use glam::DVec2;
 
 use super::chunks;
 
-/// One edge of one part, resolved to global vertices and its slot in the matrix values.
+/// One edge of one part, resolved to global vertices and its slot in the matrix values
+/// (indices packed as `u32`: the solver takes no model with more vertices than `u32` counts,
+/// and a model's edges are kept once per rest state besides, so the slots are a fifth of the
+/// pattern's memory at 100k parts).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EdgeSlot {
-    pub part: usize,
-    /// Index of the edge within the part's edge list.
-    pub edge: usize,
+    pub part: u32,
     /// Part-local vertex indices of the edge's ends.
-    pub local: [usize; 2],
+    pub local: [u32; 2],
     /// Global vertex indices `x`, `y`.
-    pub x: usize,
-    pub y: usize,
+    pub x: u32,
+    pub y: u32,
     /// Index of the `(max(x, y), min(x, y))` entry in the values, or `None` for an edge whose
     /// ends are one global vertex (it contributes nothing to the matrix).
     pub slot: Option<usize>,
+}
+
+impl EdgeSlot {
+    /// The global ends `(x, y)`.
+    pub fn ends(&self) -> (usize, usize) {
+        (self.x as usize, self.y as usize)
+    }
 }
 
 /// The sparsity pattern of the normal matrix for one assembly generation.
@@ -80,9 +88,11 @@ impl Pattern {
             row_idx.extend_from_slice(rows);
             col_ptr.push(row_idx.len());
         }
+        // the solver checks that every vertex and part index fits before it builds a pattern
+        let compact = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
         let mut edges = Vec::new();
         for (pi, part) in parts.iter().enumerate() {
-            for (ei, e) in part.edges.iter().enumerate() {
+            for e in &part.edges {
                 let (x, y) = (part.vertices[e[0]], part.vertices[e[1]]);
                 let slot = (x != y).then(|| {
                     let (lo, hi) = (x.min(y), x.max(y));
@@ -91,26 +101,18 @@ impl Pattern {
                     col_ptr[lo] + col.binary_search(&hi).unwrap_or(0)
                 });
                 edges.push(EdgeSlot {
-                    part: pi,
-                    edge: ei,
-                    local: *e,
-                    x,
-                    y,
+                    part: compact(pi),
+                    local: e.map(compact),
+                    x: compact(x),
+                    y: compact(y),
                     slot,
                 });
             }
         }
-        // the solver checks that every vertex index fits before it builds a pattern
-        let compact = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
-        let ends = edges.iter().map(|e| [compact(e.x), compact(e.y)]).collect();
+        let ends = edges.iter().map(|e| [e.x, e.y]).collect();
         let (incident_start, incident) = incidence(n, &edges);
         let incident_entry = incident_entries(&col_ptr, &edges, &incident_start, &incident);
-        // packed only when every part index fits (else `can_gather` is false: the scatter runs)
-        let edge_part = if u32::try_from(parts.len()).is_ok() {
-            edges.iter().map(|e| compact(e.part)).collect()
-        } else {
-            Vec::new()
-        };
+        let edge_part = edges.iter().map(|e| e.part).collect();
         let part_edges = parts.iter().map(|p| p.edges.len()).collect();
         Self {
             n,
@@ -162,7 +164,7 @@ impl Pattern {
 
     /// Whether [`Pattern::gather_rhs`] can run (the incidence was built).
     pub fn can_gather(&self) -> bool {
-        self.incident_start.len() == self.n + 1 && self.edge_part.len() == self.edges.len()
+        self.incident_start.len() == self.n + 1
     }
 
     pub fn nnz(&self) -> usize {
@@ -217,9 +219,10 @@ impl Pattern {
         values.resize(self.nnz(), 0.0);
         for e in &self.edges {
             if let Some(slot) = e.slot {
-                let w = weights[e.part];
-                values[self.col_ptr[e.x]] += w;
-                values[self.col_ptr[e.y]] += w;
+                let w = weights[e.part as usize];
+                let (x, y) = e.ends();
+                values[self.col_ptr[x]] += w;
+                values[self.col_ptr[y]] += w;
                 values[slot] -= w;
             }
         }
@@ -235,8 +238,9 @@ impl Pattern {
         values.resize(self.nnz(), 0.0);
         for e in &self.edges {
             if let Some(slot) = e.slot {
-                values[self.col_ptr[e.x]] += 1.0;
-                values[self.col_ptr[e.y]] += 1.0;
+                let (x, y) = e.ends();
+                values[self.col_ptr[x]] += 1.0;
+                values[self.col_ptr[y]] += 1.0;
                 values[slot] -= 1.0;
             }
         }
@@ -276,8 +280,9 @@ fn incidence(n: usize, edges: &[EdgeSlot]) -> (Vec<u32>, Vec<u32>) {
     }
     let mut start = vec![0u32; n + 1];
     for e in edges.iter().filter(|e| e.slot.is_some()) {
-        start[e.x + 1] += 1;
-        start[e.y + 1] += 1;
+        let (x, y) = e.ends();
+        start[x + 1] += 1;
+        start[y + 1] += 1;
     }
     for v in 0..n {
         start[v + 1] += start[v];
@@ -285,7 +290,8 @@ fn incidence(n: usize, edges: &[EdgeSlot]) -> (Vec<u32>, Vec<u32>) {
     let mut fill = start.clone();
     let mut incident = vec![0u32; start[n] as usize];
     for (k, e) in edges.iter().enumerate().filter(|(_, e)| e.slot.is_some()) {
-        for (v, end) in [(e.x, 0), (e.y, 1)] {
+        let (x, y) = e.ends();
+        for (v, end) in [(x, 0), (y, 1)] {
             incident[fill[v] as usize] = (2 * k + end) as u32;
             fill[v] += 1;
         }
@@ -306,7 +312,7 @@ fn incident_entries(
         for (&k, entry) in incident[range.clone()].iter().zip(&mut entries[range]) {
             let e = &edges[(k >> 1) as usize];
             if let Some(slot) = e.slot
-                && e.x.min(e.y) == j
+                && e.x.min(e.y) as usize == j
             {
                 // within the column of a vertex index that fits u32 (the solver checks)
                 *entry = (slot - col_ptr[j]) as u32;
@@ -335,12 +341,13 @@ pub fn fill_rhs(
     }
     for (e, &t) in edges.iter().zip(targets) {
         if e.slot.is_some() {
-            let w = weights[e.part];
+            let w = weights[e.part as usize];
             let c = w * t;
-            rhs[e.x] += c.x;
-            rhs[n + e.x] += c.y;
-            rhs[e.y] -= c.x;
-            rhs[n + e.y] -= c.y;
+            let (x, y) = e.ends();
+            rhs[x] += c.x;
+            rhs[n + x] += c.y;
+            rhs[y] -= c.x;
+            rhs[n + y] -= c.y;
         }
     }
 }

@@ -210,10 +210,16 @@ impl Solver {
         if !stale {
             return Ok(());
         }
-        // the pattern and the rest cache keep vertex indices as u32
+        // the pattern and the rest cache keep vertex and part indices as u32
         if u32::try_from(n).is_err() {
             return Err(SolverError(format!(
                 "the model has {n} vertices, more than the solver can index"
+            )));
+        }
+        let part_count = asm.data().parts.len();
+        if u32::try_from(part_count).is_err() {
+            return Err(SolverError(format!(
+                "the model has {part_count} parts, more than the solver can index"
             )));
         }
         for (i, p) in asm.data().parts.iter().enumerate() {
@@ -496,10 +502,10 @@ impl Solver {
         let edges = &self.pattern.edges;
         for s in switched {
             // edges are listed part by part
-            let first = edges.partition_point(|e| e.part < s.part);
+            let first = edges.partition_point(|e| (e.part as usize) < s.part);
             let count = edges[first..]
                 .iter()
-                .take_while(|e| e.part == s.part)
+                .take_while(|e| e.part as usize == s.part)
                 .count();
             split.z[first..first + count].fill(DVec2::ZERO);
             split.u[first..first + count].fill(DVec2::ZERO);
@@ -525,14 +531,13 @@ impl Solver {
         let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
         let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
         let held = &self.work.handle_count;
-        let (edges, ends, targets) = (&self.pattern.edges, &self.pattern.ends, &self.work.targets);
+        let (ends, targets) = (&self.pattern.ends, &self.work.targets);
         // One group per part (paper Eq. 6: the shape distance is a part's): the part's
         // stacked edge residuals shrink together, so the sparse norm gathers deformation into
         // few parts and spreads it evenly within them (a bent segment, not a torn one).
         let mut k = 0;
-        while k < ends.len() {
-            let part = edges[k].part;
-            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+        for &count in self.pattern.part_edges.iter().filter(|&&c| c > 0) {
+            let end = k + count;
             let (mut n2, mut at_held) = (0.0, false);
             for j in k..end {
                 let [x, y] = ends[j].map(|i| i as usize);
@@ -783,12 +788,13 @@ impl Solver {
             let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
             let d2: f64 = (k..end)
                 .map(|j| {
-                    let r2 = (w.targets[j] - (f[edges[j].x] - f[edges[j].y])).length_squared();
+                    let (x, y) = edges[j].ends();
+                    let r2 = (w.targets[j] - (f[x] - f[y])).length_squared();
                     elastic += r2;
                     r2
                 })
                 .sum();
-            if let Some(r) = w.residuals.get_mut(part) {
+            if let Some(r) = w.residuals.get_mut(part as usize) {
                 *r = d2;
             }
             k = end;
@@ -877,14 +883,15 @@ impl Solver {
                 .get(part.active)
                 .map(|s| s.positions.as_slice())
                 .unwrap_or(&[]);
-            while k < edges.len() && edges[k].part == pi {
+            while k < edges.len() && edges[k].part as usize == pi {
                 let e = &edges[k];
-                let d0 = match (rest.get(e.local[0]), rest.get(e.local[1])) {
+                let [a, b] = e.local.map(|i| i as usize);
+                let d0 = match (rest.get(a), rest.get(b)) {
                     (Some(&a), Some(&b)) => a - b,
                     _ => DVec2::ZERO,
                 };
                 let r = if cos_cone < 1.0 {
-                    local::normalised_or(w.part_sums[e.local[0]] + w.part_sums[e.local[1]], own)
+                    local::normalised_or(w.part_sums[a] + w.part_sums[b], own)
                 } else {
                     own
                 };
