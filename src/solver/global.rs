@@ -396,3 +396,64 @@ pub fn relative_residual(
         num.sqrt()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clay_dsl::compiled::PartKind;
+
+    /// Parts over a strip of `n` vertices: quads of overlapping vertex runs (so neighbours
+    /// share edges and an entry gets several terms), a part whose two ends are one vertex (an
+    /// edge with no entry), and an edgeless part.
+    fn strip_parts(n: usize) -> Vec<Part> {
+        let part = |vertices: Vec<usize>, edges: Vec<[usize; 2]>| Part {
+            kind: PartKind::Piece { instance: 0 },
+            vertices,
+            edges,
+            states: Vec::new(),
+            active: 0,
+        };
+        let mut parts: Vec<Part> = (0..n - 3)
+            .step_by(2)
+            .map(|a| {
+                part(
+                    vec![a, a + 1, a + 2, a + 3],
+                    vec![[0, 1], [1, 2], [2, 3], [0, 3], [0, 2]],
+                )
+            })
+            .collect();
+        parts.push(part(vec![5, 5, 9], vec![[0, 1], [1, 2]]));
+        parts.push(part(vec![7], Vec::new()));
+        parts
+    }
+
+    #[test]
+    fn matrix_values_by_columns_equal_the_serial_scatter_bit_for_bit() {
+        // enough vertices for the columns to run as tasks on two threads
+        let n = 5 * 4096 + 3;
+        let parts = strip_parts(n);
+        let pattern = Pattern::build(n, &parts);
+        assert!(pattern.can_gather());
+        // weights with every bit pattern of rounding: sums in another order would differ
+        let weights: Vec<f64> = (0..parts.len())
+            .map(|i| 1.0 / (1.0 + (i as f64 * 0.618).fract() * 1e3) + (i % 7) as f64 * 1e-9)
+            .collect();
+        let diagonal: Vec<f64> = (0..n).map(|j| 1e-3 * (j % 11) as f64 + 1e-7).collect();
+        let mut serial = Vec::new();
+        pattern.scatter_values(&weights, &diagonal, &mut serial);
+        for threads in [1, 2] {
+            let mut by_columns = vec![f64::NAN; 3];
+            pattern.fill_values(&weights, &diagonal, &mut by_columns, threads);
+            assert_eq!(by_columns.len(), serial.len());
+            let differ =
+                (serial.iter().zip(&by_columns)).position(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ, None, "{threads} threads: first differing value");
+        }
+        // a shared edge (vertices 2-3 belong to two quads) sums both parts' weights
+        let slot = pattern.col_ptr[2]
+            + pattern.row_idx[pattern.col_ptr[2]..pattern.col_ptr[3]]
+                .binary_search(&3)
+                .unwrap();
+        assert_eq!(serial[slot], -weights[0] - weights[1]);
+    }
+}
