@@ -535,25 +535,31 @@ impl Solver {
         // One group per part (paper Eq. 6: the shape distance is a part's): the part's
         // stacked edge residuals shrink together, so the sparse norm gathers deformation into
         // few parts and spreads it evenly within them (a bent segment, not a torn one).
-        let mut k = 0;
-        for &count in self.pattern.part_edges.iter().filter(|&&c| c > 0) {
-            let end = k + count;
-            let (mut n2, mut at_held) = (0.0, false);
-            for j in k..end {
-                let [x, y] = ends[j].map(|i| i as usize);
-                let v = (next[x] - next[y]) - targets[j] + split.u[j];
-                split.z[j] = v;
-                n2 += v.length_squared();
-                at_held |= held[x] > 0.0 || held[y] > 0.0;
+        let next = &*next;
+        let shrink_parts = |first: usize, counts: &[usize], z: &mut [DVec2], u: &mut [DVec2]| {
+            let mut k = 0;
+            for &count in counts.iter().filter(|&&c| c > 0) {
+                let end = k + count;
+                let (mut n2, mut at_held) = (0.0, false);
+                for j in k..end {
+                    let [x, y] = ends[first + j].map(|i| i as usize);
+                    let v = (next[x] - next[y]) - targets[first + j] + u[j];
+                    z[j] = v;
+                    n2 += v.length_squared();
+                    at_held |= held[x] > 0.0 || held[y] > 0.0;
+                }
+                let scale = if at_held { &at_handle } else { &shrink }.factor(n2);
+                for j in k..end {
+                    let v = z[j];
+                    z[j] = v * scale;
+                    u[j] = v - z[j];
+                }
+                k = end;
             }
-            let scale = if at_held { &at_handle } else { &shrink }.factor(n2);
-            for j in k..end {
-                let v = split.z[j];
-                split.z[j] = v * scale;
-                split.u[j] = v - split.z[j];
-            }
-            k = end;
-        }
+        };
+        let threads = cfg.thread_count();
+        let counts = &self.pattern.part_edges;
+        chunks::part_edges(threads, counts, &mut split.z, &mut split.u, &shrink_parts);
         report.phases.local += ms_since(t);
         Ok(())
     }
