@@ -154,10 +154,7 @@ impl Chunks {
             let tasks = pieces.into_par_iter().enumerate().with_max_len(1);
             tasks.map(|(c, piece)| work(c, piece)).collect()
         };
-        match pool() {
-            Some(pool) => pool.install(run),
-            None => run(),
-        }
+        on_pool(run)
     }
 }
 
@@ -172,14 +169,11 @@ pub fn rows(threads: usize, rows: &mut [DVec2], work: &(dyn Fn(usize, &mut [DVec
         work(0, rows);
         return;
     }
-    let mut run = move || {
+    let run = move || {
         let pieces = rows.par_chunks_mut(ROW_CHUNK).enumerate();
         pieces.for_each(|(c, piece)| work(c * ROW_CHUNK, piece));
     };
-    match pool() {
-        Some(pool) => pool.install(run),
-        None => run(),
-    }
+    on_pool(run);
 }
 
 /// Runs `work(columns, values)` over consecutive runs of [`ROW_CHUNK`] columns of a
@@ -210,10 +204,7 @@ pub fn columns(
             .into_par_iter()
             .for_each(|(columns, piece)| work(columns, piece));
     };
-    match pool() {
-        Some(pool) => pool.install(run),
-        None => run(),
-    }
+    on_pool(run);
 }
 
 /// The work of [`part_edges`] on one run of parts: `(first edge, counts, z, u)`.
@@ -247,10 +238,7 @@ pub fn part_edges(
     let run = move || {
         (pieces.into_par_iter()).for_each(|(first, counts, z, u)| work(first, counts, z, u));
     };
-    match pool() {
-        Some(pool) => pool.install(run),
-        None => run(),
-    }
+    on_pool(run);
 }
 
 /// Runs `a` and `b`, side by side on the pool when `threads > 1` (the caller makes the
@@ -265,9 +253,14 @@ where
     if threads <= 1 {
         return (a(), b());
     }
+    on_pool(|| rayon::join(a, b))
+}
+
+/// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start.
+fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     match pool() {
-        Some(pool) => pool.install(|| rayon::join(a, b)),
-        None => rayon::join(a, b),
+        Some(pool) => pool.install(run),
+        None => run(),
     }
 }
 

@@ -12,9 +12,8 @@ use glam::DVec2;
 use super::chunks;
 
 /// One edge of one part, resolved to global vertices and its slot in the matrix values
-/// (indices packed as `u32`: the solver takes no model with more vertices than `u32` counts,
-/// and a model's edges are kept once per rest state besides, so the slots are a fifth of the
-/// pattern's memory at 100k parts).
+/// (indices packed as `u32`, 40 bytes where `usize` took 64: the solver takes no model with
+/// more vertices or parts than `u32` counts).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EdgeSlot {
     pub part: u32,
@@ -212,8 +211,8 @@ impl Pattern {
         chunks::columns(threads, &self.col_ptr, values, &fill);
     }
 
-    /// [`Pattern::fill_values`] as a serial scatter over the edges (when the incidence or the
-    /// packed parts are not built).
+    /// [`Pattern::fill_values`] as a serial scatter over the edges (when the incidence is not
+    /// built).
     fn scatter_values(&self, weights: &[f64], diagonal: &[f64], values: &mut Vec<f64>) {
         values.clear();
         values.resize(self.nnz(), 0.0);
@@ -434,7 +433,7 @@ mod tests {
         let parts = strip_parts(n);
         let pattern = Pattern::build(n, &parts);
         assert!(pattern.can_gather());
-        // weights with every bit pattern of rounding: sums in another order would differ
+        // weights whose sums round: added in another order they would differ in the last bits
         let weights: Vec<f64> = (0..parts.len())
             .map(|i| 1.0 / (1.0 + (i as f64 * 0.618).fract() * 1e3) + (i % 7) as f64 * 1e-9)
             .collect();
