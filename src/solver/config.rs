@@ -73,6 +73,9 @@ pub struct SolverConfig {
     pub irls_iterations: usize,
     /// Most least-squares (pass 2) iterations per frame.
     pub l2_iterations: usize,
+    /// Pass 2: how many past iterates Anderson acceleration mixes (0: the plain local/global
+    /// iteration); an accelerated iterate that does not lower the objective is dropped.
+    pub l2_anderson: usize,
     /// Handle weight relative to the mean edge weight (Eq. 3): large, so handles are hard.
     pub handle_weight: f64,
     /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
@@ -132,7 +135,8 @@ impl SolverConfig {
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
             irls_iterations: 20,
-            l2_iterations: 8,
+            l2_iterations: 5,
+            l2_anderson: 1,
             handle_weight: 1e6,
             rotation_cone_degrees: 0.0,
             proximal_weight: 1e-8,

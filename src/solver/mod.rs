@@ -5,6 +5,7 @@
 //! states fixed, and its positions are what the user sees.
 
 mod admm;
+mod anderson;
 mod cg;
 mod cholesky;
 mod chunks;
@@ -150,6 +151,8 @@ pub struct Solver {
     free_components: Vec<usize>,
     /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
     shifted: Vec<DVec2>,
+    /// Pass 2's mixing history ([`SolverConfig::l2_anderson`]).
+    anderson: anderson::Anderson,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
     /// [`SymbolicFactor::factor_order`]; empty when the factor has no such order): the
     /// least-squares solve reads its solution from there.
@@ -173,6 +176,7 @@ impl Solver {
             free_components: Vec::new(),
             mean_rest_edge: 1.0,
             shifted: Vec::new(),
+            anderson: anderson::Anderson::default(),
             factor_slot: Vec::new(),
             ordered: Vec::new(),
         }
@@ -647,6 +651,8 @@ impl Solver {
         report.phases.local += ms_since(t);
         let mut converged = cfg.l2_iterations == 0;
         let mut last_iteration = Duration::ZERO;
+        let mut anderson = std::mem::take(&mut self.anderson);
+        anderson.start(cfg.l2_anderson);
         for it in 0..cfg.l2_iterations {
             if it > 0 && out_of_time(deadline, last_iteration) {
                 report.complete = false;
@@ -656,14 +662,26 @@ impl Solver {
             report.l2_iterations += 1;
             self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, report)?;
             let t = Instant::now();
-            // f's rotations and targets aside while `next` is judged
+            // f's rotations and targets aside while the next iterate is judged
             let w = &mut self.work;
             std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
             std::mem::swap(&mut w.targets, &mut w.kept_targets);
-            let next_terms = Terms {
+            let mixed = anderson.mix(&f, &mut next);
+            let mut next_terms = Terms {
                 elastic: self.evaluate_fixed(parts, &next),
                 handle: handle_term(handles, &next, cfg.handle_weight),
             };
+            // NaN does not descend either
+            let descends = next_terms.total() < terms.total();
+            if mixed && !descends {
+                // the accelerated iterate does not descend: the plain one, a fresh history
+                anderson.plain(&mut next);
+                anderson.reset();
+                next_terms = Terms {
+                    elastic: self.evaluate_fixed(parts, &next),
+                    handle: handle_term(handles, &next, cfg.handle_weight),
+                };
+            }
             report.phases.local += ms_since(t);
             // Only an iterate that lowers the objective is taken: a frame never ends worse
             // than it started, and a model at rest stays exactly where it is (a solve of a
@@ -684,6 +702,7 @@ impl Solver {
                 break;
             }
         }
+        self.anderson = anderson;
         self.work.next = next;
         Ok((f, terms, converged))
     }

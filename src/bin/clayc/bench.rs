@@ -42,6 +42,9 @@ pub struct BenchArgs {
     /// Most least-squares (pass 2) iterations per frame (default: the solver's).
     #[arg(long)]
     pub l2_iterations: Option<usize>,
+    /// Pass 2's Anderson window (0: off).
+    #[arg(long)]
+    pub l2_anderson: Option<usize>,
     /// Threads of the solver's local step (0: every core; the results are the same).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -102,6 +105,9 @@ struct BenchResult {
     /// builds).
     energy: f64,
     checksum: f64,
+    /// The mean over frames of the displayed pose's objective (how close the frames come to
+    /// their least-squares minimum: lower is closer).
+    objective_mean: f64,
 }
 
 #[derive(Serialize)]
@@ -164,6 +170,9 @@ pub fn bench(args: BenchArgs) -> u8 {
     if let Some(k) = args.irls_iterations {
         config.irls_iterations = k.min(1000);
     }
+    if let Some(k) = args.l2_anderson {
+        config.l2_anderson = k.min(16);
+    }
     if let Some(k) = args.l2_iterations {
         config.l2_iterations = k.min(1000);
     }
@@ -175,9 +184,10 @@ pub fn bench(args: BenchArgs) -> u8 {
                 return 2;
             }
             // classic ARAP: least squares only, one local + global iteration per frame
+            // (unless asked for more)
             config.irls_iterations = 0;
             config.admm_iterations = 0;
-            config.l2_iterations = 1;
+            config.l2_iterations = args.l2_iterations.map_or(1, |k| k.min(1000));
             config.tolerance = 0.0;
             let mut asm = Assembly::new(Arc::new(synthetic::arap_grid(k)));
             let left: Vec<usize> = (0..k).map(|j| j * k).collect();
@@ -280,6 +290,7 @@ pub fn bench(args: BenchArgs) -> u8 {
         phases_ms: phases(reports.get(1..).unwrap_or(&reports)),
         energy: reports.last().map_or(0.0, |r| r.energy),
         checksum: asm.data().positions.iter().map(|p| p.x + p.y).sum(),
+        objective_mean: reports.iter().map(|r| r.objective).sum::<f64>() / n,
     };
     let text = if args.json {
         match serde_json::to_string_pretty(&result) {

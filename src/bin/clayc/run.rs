@@ -21,8 +21,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub json: bool,
     /// Override a solver parameter: hysteresis, norm, irls_epsilon, merge_distance,
-    /// pass1 (admm|irls), admm_iterations, irls_iterations, l2_iterations, handle_weight,
-    /// solver (cholesky|cg).
+    /// pass1 (admm|irls), admm_iterations, irls_iterations, l2_iterations, l2_anderson,
+    /// handle_weight, solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
@@ -104,13 +104,20 @@ pub fn apply_setting(
             check(count(number), "an integer from 0 to 1000")?;
             config.l2_iterations = number as usize;
         }
+        "l2_anderson" => {
+            check(
+                number.fract() == 0.0 && (0.0..=16.0).contains(&number),
+                "an integer from 0 to 16",
+            )?;
+            config.l2_anderson = number as usize;
+        }
         "handle_weight" => {
             check((1.0..=1e12).contains(&number), "in [1, 1e12]")?;
             config.handle_weight = number;
         }
         _ => {
             return Err(format!(
-                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, pass1, admm_iterations, irls_iterations, l2_iterations, handle_weight or solver)"
+                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, pass1, admm_iterations, irls_iterations, l2_iterations, l2_anderson, handle_weight or solver)"
             ));
         }
     }
