@@ -68,7 +68,6 @@ struct Work {
     kept_targets: Vec<DVec2>,
     /// The positions the last frame displayed (pass 1 continues only from them).
     shown: Vec<DVec2>,
-    f: Vec<DVec2>,
     next: Vec<DVec2>,
     /// The local step already evaluated at the pose pass 2 starts from (see [`Start`]).
     start: Start,
@@ -350,7 +349,7 @@ impl Solver {
         let pass2 = self.pass2(
             &asm.data().parts,
             asm.handles(),
-            &warm,
+            warm,
             step_tolerance,
             deadline,
             &mut report,
@@ -379,10 +378,10 @@ impl Solver {
         report.converged = report.complete
             && report.switches.is_empty()
             && (settled || (pass1_converged && pass2_converged));
-        self.work.shown.clone_from(&f);
+        // the shown pose is kept; the one shown before is the next frame's warm-start buffer
+        self.work.warm = std::mem::replace(&mut self.work.shown, f);
         report.phases.bookkeeping += ms_since(t);
         report.ms = start.elapsed().as_secs_f64() * 1e3;
-        (self.work.warm, self.work.f) = (warm, f);
         Ok(report)
     }
 
@@ -601,27 +600,25 @@ impl Solver {
     }
 
     /// Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose
-    /// `warm`, until no vertex moves more than `tolerance`, or the configured count, or (after
-    /// one iteration) the deadline. With no pass-2 iterations configured, shows the pass-1
-    /// pose. Returns the pose, its objective's terms (its rotations and edge targets left in
-    /// the work buffers) and whether it converged.
+    /// `warm` (iterated in place), until no vertex moves more than `tolerance`, or the
+    /// configured count, or (after one iteration) the deadline. With no pass-2 iterations
+    /// configured, shows the pass-1 pose. Returns the pose, its objective's terms (its
+    /// rotations and edge targets left in the work buffers) and whether it converged.
     fn pass2(
         &mut self,
         parts: &[Part],
         handles: &[Handle],
-        warm: &[DVec2],
+        warm: Vec<DVec2>,
         tolerance: f64,
         deadline: Option<Instant>,
         report: &mut FrameReport,
     ) -> Result<(Vec<DVec2>, Terms, bool), SolverError> {
         let cfg = self.config;
-        let mut f = std::mem::take(&mut self.work.f);
-        f.clear();
-        f.extend_from_slice(if cfg.l2_iterations == 0 {
-            &self.splitting.pose
-        } else {
-            warm
-        });
+        let mut f = warm;
+        if cfg.l2_iterations == 0 {
+            f.clear();
+            f.extend_from_slice(&self.splitting.pose);
+        }
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
         next.resize(f.len(), DVec2::ZERO);
