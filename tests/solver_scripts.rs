@@ -189,6 +189,8 @@ fn settings_are_validated_and_applied() {
         "norm",
         "irls_iterations=2.5",
         "admm_iterations=-1",
+        "l2_anderson=17",
+        "l2_anderson=0.5",
         "solver=lu",
         "pass1=newton",
     ] {
