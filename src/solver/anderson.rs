@@ -11,6 +11,8 @@
 
 use std::collections::VecDeque;
 
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
 use glam::DVec2;
 
 /// The mixing history: the last `window` differences of the residuals `F(x) = G(x) - x` and
@@ -120,10 +122,8 @@ impl Anderson {
     }
 
     /// `argmin |F(x) - dF gamma|` over the held differences, by the normal equations (a few
-    /// unknowns); `None` without differences, or when the equations are singular or not
-    /// finite.
-    // index loops: the normal equations read as their formula
-    #[allow(clippy::needless_range_loop)]
+    /// unknowns, symmetric positive definite with the ridge: faer's dense Cholesky); `None`
+    /// without differences, or when the equations are not positive definite or not finite.
     fn coefficients(&self, x: &[DVec2], g: &[DVec2]) -> Option<Vec<f64>> {
         let m = self.steps.len();
         if m == 0 {
@@ -132,52 +132,25 @@ impl Anderson {
         let df = |j: usize| &self.pairs[self.steps[j]][0];
         let dot =
             |a: &[DVec2], b: &[DVec2]| -> f64 { a.iter().zip(b).map(|(p, q)| p.dot(*q)).sum() };
-        let mut a = vec![vec![0.0; m + 1]; m];
-        for i in 0..m {
-            for j in 0..=i {
-                let v = dot(df(i), df(j));
-                a[i][j] = v;
-                a[j][i] = v;
-            }
-            a[i][m] = (df(i).iter().zip(x.iter().zip(g)))
+        let mut normal =
+            Mat::<f64>::from_fn(m, m, |i, j| if j <= i { dot(df(i), df(j)) } else { 0.0 });
+        let mut rhs = Mat::<f64>::from_fn(m, 1, |i, _| {
+            (df(i).iter().zip(x.iter().zip(g)))
                 .map(|(d, (&x, &g))| d.dot(g - x))
-                .sum();
-        }
+                .sum()
+        });
         // a relative ridge keeps nearly dependent differences from blowing the mix up
-        let trace: f64 = (0..m).map(|i| a[i][i]).sum();
+        let trace: f64 = (0..m).map(|i| normal[(i, i)]).sum();
         if !(trace > 0.0 && trace.is_finite()) {
             return None;
         }
-        for (i, row) in a.iter_mut().enumerate() {
-            row[i] += 1e-10 * trace;
+        for i in 0..m {
+            normal[(i, i)] += 1e-10 * trace;
         }
-        solve_dense(a)
+        normal.llt(Side::Lower).ok()?.solve_in_place(rhs.as_mut());
+        let gamma: Vec<f64> = (0..m).map(|i| rhs[(i, 0)]).collect();
+        gamma.iter().all(|v| v.is_finite()).then_some(gamma)
     }
-}
-
-/// Gaussian elimination with partial pivoting on an `m x (m + 1)` augmented system.
-#[allow(clippy::needless_range_loop)]
-fn solve_dense(mut a: Vec<Vec<f64>>) -> Option<Vec<f64>> {
-    let m = a.len();
-    for col in 0..m {
-        let pivot = (col..m).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() <= 1e-300 {
-            return None;
-        }
-        a.swap(col, pivot);
-        for row in col + 1..m {
-            let factor = a[row][col] / a[col][col];
-            for k in col..=m {
-                a[row][k] -= factor * a[col][k];
-            }
-        }
-    }
-    let mut x = vec![0.0; m];
-    for i in (0..m).rev() {
-        let s: f64 = (i + 1..m).map(|k| a[i][k] * x[k]).sum();
-        x[i] = (a[i][m] - s) / a[i][i];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 #[cfg(test)]
@@ -291,7 +264,13 @@ mod tests {
                 for (i, row) in a.iter_mut().enumerate() {
                     row[i] += 1e-10 * trace;
                 }
-                let gamma = solve_dense(a).unwrap();
+                let normal = Mat::<f64>::from_fn(d, d, |i, j| a[i][j]);
+                let mut gamma = Mat::<f64>::from_fn(d, 1, |i, _| a[i][d]);
+                normal
+                    .llt(Side::Lower)
+                    .unwrap()
+                    .solve_in_place(gamma.as_mut());
+                let gamma: Vec<f64> = (0..d).map(|i| gamma[(i, 0)]).collect();
                 for (j, c) in gamma.iter().enumerate() {
                     for (w, dg) in want.iter_mut().zip(&dgs[j]) {
                         *w -= *c * *dg;

@@ -639,10 +639,7 @@ impl Solver {
                 handle: handle_term(handles, &f, cfg.handle_weight),
             }
         } else {
-            Terms {
-                elastic: self.evaluate_fixed(parts, &f),
-                handle: handle_term(handles, &f, cfg.handle_weight),
-            }
+            self.terms_at(parts, handles, &f)
         };
         report.warm_objective = terms.total();
         report.phases.local += ms_since(t);
@@ -664,20 +661,14 @@ impl Solver {
             std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
             std::mem::swap(&mut w.targets, &mut w.kept_targets);
             let mixed = anderson.mix(&f, &mut next);
-            let mut next_terms = Terms {
-                elastic: self.evaluate_fixed(parts, &next),
-                handle: handle_term(handles, &next, cfg.handle_weight),
-            };
+            let mut next_terms = self.terms_at(parts, handles, &next);
             // NaN does not descend either
             let descends = next_terms.total() < terms.total();
             if mixed && !descends {
                 // the accelerated iterate does not descend: the plain one, a fresh history
                 anderson.plain(&mut next);
                 anderson.reset();
-                next_terms = Terms {
-                    elastic: self.evaluate_fixed(parts, &next),
-                    handle: handle_term(handles, &next, cfg.handle_weight),
-                };
+                next_terms = self.terms_at(parts, handles, &next);
             }
             report.phases.local += ms_since(t);
             // Only an iterate that lowers the objective is taken: a frame never ends worse
@@ -702,6 +693,14 @@ impl Solver {
         self.anderson = anderson;
         self.work.next = next;
         Ok((f, terms, converged))
+    }
+
+    /// Pass 2's objective at `f` (states fixed), its local step left in the work buffers.
+    fn terms_at(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
+        Terms {
+            elastic: self.evaluate_fixed(parts, f),
+            handle: handle_term(handles, f, self.config.handle_weight),
+        }
     }
 
     /// Each part's rotation onto `f` with its active state (states fixed), into
