@@ -164,6 +164,12 @@ impl SymbolicFactor {
         self.symbolic.len_val()
     }
 
+    /// Whether factorisations and substitutions run as two halves side by side (on two
+    /// threads when asked): the factor is big enough to be split ([`split`]).
+    pub fn is_split(&self) -> bool {
+        self.scatter.as_ref().is_some_and(|s| s.split().is_some())
+    }
+
     /// Numerically factorises the matrix (same pattern as analysed) into `factor`: by our
     /// supernodal factorisation ([`numeric`]) when the factor is supernodal, else by faer's.
     /// Ours runs two independent halves of the elimination tree on two threads when

@@ -161,11 +161,15 @@ impl Chunks {
 /// Rows (vertices) per task of a gathered right-hand side ([`rows`]).
 const ROW_CHUNK: usize = 4096;
 
+/// Below this many rows (vertices) a right-hand side or a matrix fill stays on the calling
+/// thread ([`rows`], [`columns`]).
+pub const PARALLEL_MIN_ROWS: usize = 4 * ROW_CHUNK;
+
 /// Runs `work(first, rows)` over consecutive pieces of `rows` (each row computed on its own,
 /// so any cut gives the same rows): on the pool when `threads > 1` and there are at least
 /// four pieces, else on the calling thread.
 pub fn rows(threads: usize, rows: &mut [DVec2], work: &(dyn Fn(usize, &mut [DVec2]) + Sync)) {
-    if threads <= 1 || rows.len() < 4 * ROW_CHUNK {
+    if threads <= 1 || rows.len() < PARALLEL_MIN_ROWS {
         work(0, rows);
         return;
     }
@@ -187,7 +191,7 @@ pub fn columns(
     work: &(dyn Fn(Range<usize>, &mut [f64]) + Sync),
 ) {
     let n = col_ptr.len().saturating_sub(1);
-    if threads <= 1 || n < 4 * ROW_CHUNK {
+    if threads <= 1 || n < PARALLEL_MIN_ROWS {
         work(0..n, values);
         return;
     }
@@ -257,7 +261,9 @@ where
 }
 
 /// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start.
-fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
+/// Called from a thread of the pool, `run` runs at once on that thread: a frame run as one
+/// task of the pool ([`super::Solver`]) hands no step over to a sleeping thread.
+pub fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     match pool() {
         Some(pool) => pool.install(run),
         None => run(),

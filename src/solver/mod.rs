@@ -290,6 +290,33 @@ impl Solver {
     ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
         self.prepare(asm)?;
+        // A frame whose steps go to both cores runs as one task of the pool: each step's
+        // parallel half then starts on a pool thread that is already awake, where handing
+        // every step from this thread to the pool woke and put to sleep a thread about 90
+        // times a frame at 10k parts (docs/performance.md). The steps, and so the bits, are
+        // the same wherever the frame runs.
+        if self.frame_uses_pool(asm) {
+            chunks::on_pool(|| self.frame_prepared(asm, deadline, start))
+        } else {
+            self.frame_prepared(asm, deadline, start)
+        }
+    }
+
+    /// Whether some step of a frame on `asm` (prepared) runs on both cores.
+    fn frame_uses_pool(&self, asm: &Assembly) -> bool {
+        self.config.thread_count() > 1
+            && (asm.data().parts.len() >= chunks::PARALLEL_MIN_PARTS
+                || asm.data().positions.len() >= chunks::PARALLEL_MIN_ROWS
+                || self.symbolic.as_ref().is_some_and(SymbolicFactor::is_split))
+    }
+
+    /// [`Solver::frame_within`] after [`Solver::prepare`] (`start`: when the frame began).
+    fn frame_prepared(
+        &mut self,
+        asm: &mut Assembly,
+        deadline: Option<Instant>,
+        start: Instant,
+    ) -> Result<FrameReport, SolverError> {
         let mut report = FrameReport {
             complete: true,
             ..FrameReport::default()
