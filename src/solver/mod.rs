@@ -1016,6 +1016,17 @@ impl Solver {
             w.diagonal.push(lambda * count + mu);
             w.extra.push(lambda * sum + mu * p);
         }
+        report.phases.assembly += ms_since(t);
+        if pass == Pass::Irls
+            && cfg.kind == SolverKind::Cholesky
+            && cfg.pcg_max_iterations == 0
+            && self.symbolic.is_some()
+            && self.pattern.can_gather()
+        {
+            return self.solve_irls_factored(next, report);
+        }
+        let t = Instant::now();
+        let w = &mut self.work;
         let weights: &[f64] = match pass {
             Pass::Irls if self.pattern.can_gather() => {
                 let threads = cfg.thread_count();
@@ -1152,6 +1163,67 @@ impl Solver {
 }
 
 impl Solver {
+    /// Pass 1's global step by Cholesky (the default path, `work.diagonal` and `work.extra`
+    /// filled): the weighted matrix is filled, then factorised while its right-hand side is
+    /// gathered beside it, then solved. The factorisation and the right-hand side read
+    /// disjoint data and write their own, so their results do not depend on which thread ran
+    /// what, or on one thread running both one after the other; the factorisation's phase
+    /// time includes the right-hand side it hides.
+    fn solve_irls_factored(
+        &mut self,
+        next: &mut [DVec2],
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let threads = cfg.thread_count();
+        let t = Instant::now();
+        let (w, pattern) = (&mut self.work, &self.pattern);
+        pattern.fill_values(&w.weights, &w.diagonal, &mut w.values, threads);
+        report.phases.assembly += ms_since(t);
+        let Some(symbolic) = self.symbolic.as_mut() else {
+            return Err(SolverError("no symbolic factorisation".into()));
+        };
+        let t = Instant::now();
+        let factor = &mut self.irls_factor;
+        let (factored, ()) = chunks::join(
+            threads,
+            || {
+                symbolic.factorize(
+                    factor,
+                    &pattern.col_ptr,
+                    &pattern.row_idx,
+                    &w.values,
+                    threads,
+                )
+            },
+            || {
+                let rows = &mut w.vertex_rhs;
+                rows.clone_from(&w.extra);
+                pattern.gather_rhs(Some(&w.weights), &w.targets, rows, threads);
+                w.rhs.clear();
+                w.rhs.extend(rows.iter().map(|p| p.x));
+                w.rhs.extend(rows.iter().map(|p| p.y));
+            },
+        );
+        factored.map_err(|e| SolverError(e.0))?;
+        report.factorizations += 1;
+        report.phases.factorization += ms_since(t);
+        let t = Instant::now();
+        w.solution.clone_from(&w.rhs);
+        symbolic.solve_in_place(factor, &mut w.solution, 2, threads);
+        report.phases.solve += ms_since(t);
+        if cfg.measure_residual {
+            let r =
+                global::relative_residual(pattern, &w.values, &w.solution, &w.rhs, &mut w.scratch);
+            report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
+        }
+        let n = next.len();
+        for (v, p) in next.iter_mut().enumerate() {
+            *p = DVec2::new(w.solution[v], w.solution[n + v]);
+        }
+        Ok(())
+    }
+
     /// The least-squares global step (unit weights) by Cholesky, with the right-hand side
     /// gathered into and solved in the factor's order
     /// ([`SymbolicFactor::solve_in_factor_order`]): the same numbers as the general path,
