@@ -289,20 +289,23 @@ impl Solver {
         deadline: Option<Instant>,
     ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
-        self.prepare(asm)?;
+        let on_pool = self.frame_uses_pool(asm);
+        let mut run = || {
+            self.prepare(asm)?;
+            self.frame_prepared(asm, deadline, start)
+        };
         // A frame whose steps go to both cores runs as one task of the pool: each step's
         // parallel half then starts on a pool thread that is already awake, where handing
         // every step from this thread to the pool woke and put to sleep a thread about 90
         // times a frame at 10k parts (docs/performance.md). The steps, and so the bits, are
-        // the same wherever the frame runs.
-        if self.frame_uses_pool(asm) {
-            chunks::on_pool(|| self.frame_prepared(asm, deadline, start))
-        } else {
-            self.frame_prepared(asm, deadline, start)
-        }
+        // the same wherever the frame runs. The preparation runs in the same task, so the
+        // frame's buffers reuse the memory its analysis frees (a thread allocates from its
+        // own arena: prepared on this thread, the 100k city peaked 5 MB higher).
+        if on_pool { chunks::on_pool(run) } else { run() }
     }
 
-    /// Whether some step of a frame on `asm` (prepared) runs on both cores.
+    /// Whether some step of a frame on `asm` runs on both cores (judged by the last
+    /// preparation's factor when the pattern is new: only where the frame runs depends on it).
     fn frame_uses_pool(&self, asm: &Assembly) -> bool {
         self.config.thread_count() > 1
             && (asm.data().parts.len() >= chunks::PARALLEL_MIN_PARTS
