@@ -161,6 +161,26 @@ impl Pattern {
         chunks::rows(threads, rows, &gather);
     }
 
+    /// Pass 1's right-hand side in columns (`rhs`: every row's x, then every y): `extra` (the
+    /// handle and proximal terms) plus the weighted edge targets, gathered row by row into
+    /// `rows` ([`Pattern::gather_rhs`]).
+    pub fn weighted_rhs(
+        &self,
+        weights: &[f64],
+        targets: &[DVec2],
+        extra: &[DVec2],
+        rows: &mut Vec<DVec2>,
+        rhs: &mut Vec<f64>,
+        threads: usize,
+    ) {
+        rows.clear();
+        rows.extend_from_slice(extra);
+        self.gather_rhs(Some(weights), targets, rows, threads);
+        rhs.clear();
+        rhs.extend(rows.iter().map(|p| p.x));
+        rhs.extend(rows.iter().map(|p| p.y));
+    }
+
     /// Whether [`Pattern::gather_rhs`] can run (the incidence was built).
     pub fn can_gather(&self) -> bool {
         self.incident_start.len() == self.n + 1

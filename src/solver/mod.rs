@@ -1032,13 +1032,9 @@ impl Solver {
         let w = &mut self.work;
         let weights: &[f64] = match pass {
             Pass::Irls if self.pattern.can_gather() => {
+                let (rows, rhs) = (&mut w.vertex_rhs, &mut w.rhs);
                 let threads = cfg.thread_count();
-                let rows = &mut w.vertex_rhs;
-                rows.clone_from(&w.extra);
-                (self.pattern).gather_rhs(Some(&w.weights), &w.targets, rows, threads);
-                w.rhs.clear();
-                w.rhs.extend(rows.iter().map(|p| p.x));
-                w.rhs.extend(rows.iter().map(|p| p.y));
+                (self.pattern).weighted_rhs(&w.weights, &w.targets, &w.extra, rows, rhs, threads);
                 &w.weights
             }
             Pass::Irls => {
@@ -1148,19 +1144,10 @@ impl Solver {
                 report.phases.solve += ms_since(t);
             }
         }
-        if cfg.measure_residual {
-            let r = global::relative_residual(
-                &self.pattern,
-                values,
-                &w.solution,
-                &w.rhs,
-                &mut w.scratch,
-            );
-            report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
-        }
-        for (v, p) in next.iter_mut().enumerate() {
-            *p = DVec2::new(w.solution[v], w.solution[n + v]);
-        }
+        let measure = cfg
+            .measure_residual
+            .then_some((&self.pattern, &values[..], &mut w.scratch));
+        take_solution(&w.solution, &w.rhs, measure, report, next);
         Ok(())
     }
 }
@@ -1188,8 +1175,11 @@ impl Solver {
         };
         let t = Instant::now();
         let factor = &mut self.irls_factor;
+        // side by side only where the frame runs on the pool (a split factor): elsewhere a
+        // hand-over to the pool per iteration costs more than the right-hand side
+        let beside = if symbolic.is_split() { threads } else { 1 };
         let (factored, ()) = chunks::join(
-            threads,
+            beside,
             || {
                 symbolic.factorize(
                     factor,
@@ -1200,12 +1190,8 @@ impl Solver {
                 )
             },
             || {
-                let rows = &mut w.vertex_rhs;
-                rows.clone_from(&w.extra);
-                pattern.gather_rhs(Some(&w.weights), &w.targets, rows, threads);
-                w.rhs.clear();
-                w.rhs.extend(rows.iter().map(|p| p.x));
-                w.rhs.extend(rows.iter().map(|p| p.y));
+                let (rows, rhs) = (&mut w.vertex_rhs, &mut w.rhs);
+                pattern.weighted_rhs(&w.weights, &w.targets, &w.extra, rows, rhs, threads);
             },
         );
         factored.map_err(|e| SolverError(e.0))?;
@@ -1215,15 +1201,10 @@ impl Solver {
         w.solution.clone_from(&w.rhs);
         symbolic.solve_in_place(factor, &mut w.solution, 2, threads);
         report.phases.solve += ms_since(t);
-        if cfg.measure_residual {
-            let r =
-                global::relative_residual(pattern, &w.values, &w.solution, &w.rhs, &mut w.scratch);
-            report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
-        }
-        let n = next.len();
-        for (v, p) in next.iter_mut().enumerate() {
-            *p = DVec2::new(w.solution[v], w.solution[n + v]);
-        }
+        let measure = cfg
+            .measure_residual
+            .then_some((pattern, &w.values[..], &mut w.scratch));
+        take_solution(&w.solution, &w.rhs, measure, report, next);
         Ok(())
     }
 
@@ -1319,6 +1300,26 @@ impl Solver {
             report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
         }
         Ok(())
+    }
+}
+
+/// The end of a global step solved into `solution` (every vertex's x, then every y) from
+/// `rhs`: with `measure` (the pattern and matrix values: tests ask for it), its relative
+/// residual into `report`; then the solution into `next`.
+fn take_solution(
+    solution: &[f64],
+    rhs: &[f64],
+    measure: Option<(&Pattern, &[f64], &mut Vec<f64>)>,
+    report: &mut FrameReport,
+    next: &mut [DVec2],
+) {
+    if let Some((pattern, values, scratch)) = measure {
+        let r = global::relative_residual(pattern, values, solution, rhs, scratch);
+        report.linear_residual = Some(report.linear_residual.map_or(r, |m| m.max(r)));
+    }
+    let n = next.len();
+    for (v, p) in next.iter_mut().enumerate() {
+        *p = DVec2::new(solution[v], solution[n + v]);
     }
 }
 
