@@ -5,40 +5,29 @@
 //! 2's factor: no numeric factorisation per iteration), shrinks every edge's residual with the
 //! proximal map of `|.|^p` (residuals below a threshold snap back to zero: those edges stay
 //! rigid; larger ones become free gaps) and accumulates the scaled dual `u`. This is the
-//! splitting Bouaziz et al. use for sparse ICP; IRLS and it minimise the same energy, but here
-//! the edges' splitting state carries over from frame to frame, so the solver converges
-//! across frames instead of re-weighting from scratch.
+//! splitting Bouaziz et al. use for sparse ICP; IRLS and it have the same stationary points.
+//! Like IRLS it starts every frame from the displayed pose (no gaps, no duals) and runs until
+//! its steps stop: it converges linearly, so it needs far more (cheaper) iterations than IRLS
+//! (`docs/solver.md`).
 //!
-//! This module holds the per-edge state and the shrink operator; `Solver` drives it.
+//! This module holds the per-edge variables and the shrink operator; `Solver` drives it.
 
 use glam::DVec2;
 
-/// Per part-edge splitting variables, valid for one assembly generation.
+/// Per part-edge splitting variables of one frame (kept between frames only as buffers).
 #[derive(Clone, Debug, Default)]
 pub struct Splitting {
-    /// The generation the variables belong to (`None`: not initialised).
-    pub generation: Option<u64>,
     /// Gaps `z_e`: the part of each residual the sub-quadratic norm leaves open.
     pub z: Vec<DVec2>,
     /// Scaled duals `u_e`.
     pub u: Vec<DVec2>,
-    /// The pass-1 pose the variables were last updated with.
+    /// The pass-1 pose (of either method).
     pub pose: Vec<DVec2>,
 }
 
 impl Splitting {
-    /// Whether the variables can continue for `generation` with `edges` part-edges and `n`
-    /// vertices.
-    pub fn is_valid(&self, generation: u64, edges: usize, n: usize) -> bool {
-        self.generation == Some(generation)
-            && self.z.len() == edges
-            && self.u.len() == edges
-            && self.pose.len() == n
-    }
-
-    /// Starts afresh: no gaps, no duals.
-    pub fn reset(&mut self, generation: u64, edges: usize, pose: &[DVec2]) {
-        self.generation = Some(generation);
+    /// Starts a frame's pass 1 at `pose`: no gaps, no duals.
+    pub fn reset(&mut self, edges: usize, pose: &[DVec2]) {
         self.z.clear();
         self.z.resize(edges, DVec2::ZERO);
         self.u.clear();

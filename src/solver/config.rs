@@ -22,8 +22,9 @@ pub enum Pass1 {
     #[default]
     Irls,
     /// Variable splitting (`admm.rs`): least-squares solves with the pass-2 factor, per-edge
-    /// gaps and duals carried from frame to frame. No factorisation while the assembly and
-    /// the held vertices stay the same.
+    /// gaps and duals, restarted from the displayed pose every frame. No factorisation while
+    /// the assembly and the held vertices stay the same, but it converges linearly: tens to
+    /// hundreds of iterations a frame where IRLS takes a few (`docs/solver.md`).
     Admm,
 }
 
@@ -60,8 +61,14 @@ pub struct SolverConfig {
     /// leave by itself.
     pub admm_handle_factor: f64,
     /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
-    /// the kept factor, a shrink and a dual update); the variables carry over between frames.
+    /// the kept factor, a shrink and a dual update).
     pub admm_iterations: usize,
+    /// [`Pass1::Admm`]: the splitting stops once no vertex moved more than this fraction of
+    /// the model's size and no state switched. Far below IRLS's [`SolverConfig::pass1_tolerance`]
+    /// because the splitting creeps: it gathers the wall's first gap by steps of about 3e-5
+    /// of the model's size over a hundred iterations, which IRLS's 1e-3 would take for
+    /// convergence at the second (`docs/solver.md`).
+    pub admm_tolerance: f64,
     /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
     pub hysteresis: f64,
     /// Exponent p of the IRLS pass (2 = least squares).
@@ -130,7 +137,8 @@ impl SolverConfig {
             pass1: Pass1::Irls,
             admm_threshold: 0.05,
             admm_handle_factor: 0.9,
-            admm_iterations: 20,
+            admm_iterations: 1000,
+            admm_tolerance: 1e-6,
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,

@@ -137,8 +137,8 @@ pub struct Solver {
     irls_factor: NumericFactor,
     l2_factor: NumericFactor,
     work: Work,
-    /// The pass-1 pose, and the splitting variables of [`Pass1::Admm`], carried between
-    /// frames.
+    /// The last frame's pass-1 pose, and the buffers of [`Pass1::Admm`]'s splitting
+    /// variables (each frame starts them afresh).
     splitting: admm::Splitting,
     /// The connected components of the vertex graph (rigid following, free centroids).
     components: follow::Components,
@@ -272,7 +272,7 @@ impl Solver {
     /// proper least-squares pose of the current states even when cut short. A further
     /// iteration is started only if the previous one of its pass fits in the time left. When
     /// cut short, the report has `complete == false` and `converged == false`; call again next
-    /// frame: the positions, active states and splitting variables carry the work over. A
+    /// frame: the positions and active states carry the work over. A
     /// budget of `Duration::MAX` behaves like [`Solver::frame`].
     pub fn frame_budgeted(
         &mut self,
@@ -346,29 +346,23 @@ impl Solver {
         }
         let scale = bbox_diagonal(&warm).max(1e-9);
         let step_tolerance = cfg.tolerance * scale;
-        // IRLS starts from the displayed least-squares pose every frame: reweighting it
-        // gathers the deformation into the parts the least-squares pose already strains most
-        // (`docs/solver.md`). The splitting continues its own pose and variables while the
-        // assembly is the one this solver last displayed (its gaps carry the history).
-        let m = self.pattern.edges.len();
+        self.follow_handles(&mut warm, step_tolerance);
+        // Pass 1 starts from the displayed least-squares pose every frame, by either method:
+        // descending from it gathers the deformation into the parts the least-squares pose
+        // already strains most (`docs/solver.md`). The splitting starts with no gaps and no
+        // duals (carried from frame to frame, its variables kept the first frame's gaps).
         let mut split = std::mem::take(&mut self.splitting);
-        let carry = cfg.pass1 == Pass1::Admm && self.work.shown == warm;
-        if !(carry && split.is_valid(asm.generation(), m, n)) {
-            split.reset(asm.generation(), m, &warm);
-        }
-        self.follow_handles(&mut warm, &mut split, step_tolerance);
+        split.reset(self.pattern.edges.len(), &warm);
         let generation = self.generation.unwrap_or(u64::MAX);
         let start_key = Some((generation, cfg, 0));
         if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
             self.work.start.valid = None;
         }
-        let from_warm = split.pose == warm;
         report.phases.bookkeeping += ms_since(start);
         let pass1 = self.pass1(
             &mut asm.data_mut().parts,
             &mut split,
-            from_warm,
-            cfg.pass1_tolerance * scale,
+            scale,
             deadline,
             &mut report,
         );
@@ -416,9 +410,8 @@ impl Solver {
     }
 
     /// Moves every component whose held vertices all moved by one rigid motion by that
-    /// motion ([`follow`]): the displayed pose `warm`, the pass-1 pose and the splitting
-    /// variables (world-frame edge vectors: turned with it).
-    fn follow_handles(&mut self, warm: &mut [DVec2], split: &mut admm::Splitting, tolerance: f64) {
+    /// motion ([`follow`]): the displayed pose `warm`.
+    fn follow_handles(&mut self, warm: &mut [DVec2], tolerance: f64) {
         let w = &self.work;
         let held: Vec<bool> = w.handle_count.iter().map(|&c| c > 0.0).collect();
         if !held.iter().any(|&h| h) {
@@ -435,34 +428,26 @@ impl Solver {
             return;
         }
         follow::move_points(&self.components, &motions, warm);
-        follow::move_points(&self.components, &motions, &mut split.pose);
-        for (k, &[x, _]) in self.pattern.ends.iter().enumerate() {
-            if let Some(motion) = &motions[self.components.of(x as usize)] {
-                split.z[k] = motion.apply_direction(split.z[k]);
-                split.u[k] = motion.apply_direction(split.u[k]);
-            }
-        }
     }
 
     /// Pass 1 (paper 5.2): the sub-quadratic norm, by splitting or by IRLS, from the pass-1
-    /// pose in `split`; its local steps decide the active rest states. Iterates until no
-    /// vertex moves more than `tolerance` and no state switches, or the configured count, or
-    /// (after [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns
-    /// whether it converged.
-    #[allow(clippy::too_many_arguments)]
+    /// pose in `split` (the displayed pose); its local steps decide the active rest states.
+    /// Iterates until no vertex moves more than the method's tolerance times `scale` (the
+    /// model's size) and no state switches, or the configured count, or (after
+    /// [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns whether it
+    /// converged.
     fn pass1(
         &mut self,
         parts: &mut [Part],
         split: &mut admm::Splitting,
-        from_warm: bool,
-        tolerance: f64,
+        scale: f64,
         deadline: Option<Instant>,
         report: &mut FrameReport,
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
-        let iterations = match cfg.pass1 {
-            Pass1::Irls => cfg.irls_iterations,
-            Pass1::Admm => cfg.admm_iterations,
+        let (iterations, tolerance) = match cfg.pass1 {
+            Pass1::Irls => (cfg.irls_iterations, cfg.pass1_tolerance * scale),
+            Pass1::Admm => (cfg.admm_iterations, cfg.admm_tolerance * scale),
         };
         let mut f = std::mem::take(&mut split.pose);
         let mut next = std::mem::take(&mut self.work.next);
@@ -481,7 +466,7 @@ impl Solver {
             let t = Instant::now();
             let switched_before = report.switches.len();
             let elastic = self.evaluate_switching(parts, &f, &mut report.switches);
-            if it == 0 && from_warm && cfg.pass1 == Pass1::Irls {
+            if it == 0 && cfg.pass1 == Pass1::Irls {
                 // this is the pose pass 2 starts from (`Start`)
                 let w = &mut self.work;
                 w.kept_rotations.clone_from(&w.rotations);
