@@ -66,8 +66,8 @@ pub struct SolverConfig {
     /// [`Pass1::Admm`]: the splitting stops once no vertex moved more than this fraction of
     /// the model's size and no state switched. Far below IRLS's [`SolverConfig::pass1_tolerance`]
     /// because the splitting creeps: it gathers the wall's first gap by steps of about 3e-5
-    /// of the model's size over a hundred iterations, which IRLS's 1e-3 would take for
-    /// convergence at the second (`docs/solver.md`).
+    /// of the model's size over a hundred iterations, and a step test at IRLS's 1e-3 stopped
+    /// it at its second iteration (`docs/solver.md`).
     pub admm_tolerance: f64,
     /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
     pub hysteresis: f64,
