@@ -27,8 +27,9 @@ use super::{FactorError, SupernodalLayout, by_width, join};
 /// values in solve order: built once per pattern.
 #[derive(Debug, Clone)]
 pub(super) struct Scatter {
-    /// `position[k]`: the place of the matrix's `k`-th stored value.
-    position: Vec<usize>,
+    /// `position[k]`: the place of the matrix's `k`-th stored value (`u32`: a factor of more
+    /// values is left to faer).
+    position: Vec<u32>,
     /// `column_supernode[c]`: the supernode holding permuted column `c`.
     column_supernode: Vec<u32>,
     /// The two halves two threads factorise side by side, if the tree has them.
@@ -105,7 +106,7 @@ impl Scatter {
                     let k = below.binary_search(&u32::try_from(row).ok()?).ok()?;
                     at + size * size + k * size + (col - start)
                 };
-                position.push(place);
+                position.push(u32::try_from(place).ok()?);
             }
         }
         if !nested(layout, &column_supernode) {
@@ -136,7 +137,7 @@ impl Scatter {
         out.clear();
         out.resize(len, 0.0);
         for (&place, &v) in self.position.iter().zip(values) {
-            out[place] += v;
+            out[place as usize] += v;
         }
         let count = layout.val_start.len();
         let columns = &self.column_supernode[..];
