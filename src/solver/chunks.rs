@@ -263,7 +263,7 @@ where
 
 /// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start.
 /// Called from a thread of the pool, `run` runs at once on that thread: a frame run as one
-/// task of the pool ([`super::Solver`]) hands no step over to a sleeping thread.
+/// task of the pool ([`on_pool_awake`]) hands no step over from a thread outside it.
 pub fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     match pool() {
         Some(pool) => pool.install(run),
