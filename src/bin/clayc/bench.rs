@@ -125,7 +125,10 @@ fn phases(reports: &[FrameReport]) -> Phases {
     let n = reports.len().max(1) as f64;
     let mean = |f: &dyn Fn(&FrameReport) -> f64| reports.iter().map(f).sum::<f64>() / n;
     let p = |r: &FrameReport| r.phases;
-    let attributed = |r: &FrameReport| p(r).local + p(r).assembly + p(r).factorization + p(r).solve;
+    // every timed phase, so `other` is only what no timer saw (it held the bookkeeping too)
+    let attributed = |r: &FrameReport| {
+        p(r).local + p(r).assembly + p(r).factorization + p(r).solve + p(r).bookkeeping
+    };
     Phases {
         local: mean(&|r| p(r).local),
         assembly: mean(&|r| p(r).assembly),
