@@ -142,6 +142,7 @@ fn brick_stretch_rule(piece: usize, length: f64, width: f64) -> StretchRule {
         from: 0,
         to: 1,
         min: 2,
+        max: None,
         part: StretchPart {
             vertices,
             edges,
@@ -238,6 +239,7 @@ pub fn wall(bricks: usize) -> CompiledGrammar {
     data.chains.push(Chain {
         rule: 0,
         instances: ids,
+        trend: 0,
     });
     data.parts = g.parts(&data);
     g.assembly = data;
@@ -508,6 +510,7 @@ pub fn city(parts: usize) -> CompiledGrammar {
     data.chains.push(Chain {
         rule: 0,
         instances: ids,
+        trend: 0,
     });
     data.parts = g.parts(&data);
     g.assembly = data;

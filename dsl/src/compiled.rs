@@ -176,6 +176,9 @@ pub struct StretchRule {
     pub to: usize,
     /// The chain never shrinks below this many elements (at least 2).
     pub min: usize,
+    /// The chain never grows beyond this many elements (`None`: no bound).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<usize>,
     /// The two-element part and its one-, two- and three-element rest states.
     pub part: StretchPart,
 }
@@ -292,6 +295,14 @@ pub struct InstanceSite {
 pub struct Chain {
     pub rule: usize,
     pub instances: Vec<usize>,
+    /// How the chain's element count last changed: +1 a stretch, -1 a shrink, 0 not yet
+    /// (the solver makes a reversal wait for most of an element: `docs/solver.md`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub trend: i8,
+}
+
+fn is_zero(x: &i8) -> bool {
+    *x == 0
 }
 
 /// A part (paper 4.1): vertices, edges, and the set of alternative rest states.

@@ -49,7 +49,8 @@ fn the_language_doc_example_compiles_to_a_wall_of_eight_bricks() {
         a.chains,
         vec![Chain {
             rule: 0,
-            instances: (0..8).collect()
+            instances: (0..8).collect(),
+            trend: 0,
         }]
     );
     assert_eq!(a.parts.len(), 7);
@@ -272,7 +273,8 @@ model {
         a.chains,
         vec![Chain {
             rule: 0,
-            instances: vec![1, 2, 3]
+            instances: vec![1, 2, 3],
+            trend: 0,
         }]
     );
     assert_eq!(

@@ -589,6 +589,7 @@ fn find_chains(
             chains.push(Chain {
                 rule: r,
                 instances: walk(i, &mut seen),
+                trend: 0,
             });
         }
     }
@@ -599,6 +600,7 @@ fn find_chains(
             chains.push(Chain {
                 rule: r,
                 instances: walk(i, &mut seen),
+                trend: 0,
             });
         }
     }

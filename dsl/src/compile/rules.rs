@@ -216,6 +216,7 @@ impl Compiler {
             from,
             to,
             min,
+            max: None,
             part,
         });
         self.stretch_spans.push(s.span);
