@@ -165,17 +165,25 @@ impl Session {
         budget: Option<Duration>,
     ) -> Result<Frame, SolverError> {
         let start = Instant::now();
-        let report = match budget {
-            Some(b) => self.solver.frame_budgeted(asm, b)?,
-            None => self.solver.frame(asm)?,
-        };
-        let events = match &mut self.rules {
-            Some(rules) => rules.after_frame(asm, &report),
-            None => {
-                let grammar = asm.grammar_arc().clone();
-                replace::replacement_events(&grammar, asm.data_mut(), &report.switches)
-            }
-        };
+        let deadline = budget.and_then(|b| start.checked_add(b));
+        let mut events = Vec::new();
+        // Paper 5.2: pass 1 decides the topology, the rules that change it run, and pass 2
+        // solves the new structure for display; merges act on the displayed pose after it.
+        let rules = &mut self.rules;
+        let report = self
+            .solver
+            .frame_with(asm, deadline, &mut |asm, report, pass1| {
+                events = match rules.as_mut() {
+                    Some(rules) => rules.after_pass1(asm, report, pass1),
+                    None => {
+                        let grammar = asm.grammar_arc().clone();
+                        replace::replacement_events(&grammar, asm.data_mut(), &report.switches)
+                    }
+                };
+            })?;
+        if let Some(rules) = &mut self.rules {
+            events.extend(rules.after_pass2(asm));
+        }
         for e in &events {
             *self.rules_fired.entry(e.kind).or_default() += 1;
         }

@@ -62,7 +62,7 @@ proptest! {
                     let (chain, first) = stretch_parts[k % stretch_parts.len()];
                     let state = if matches!(op, Op::Stretch(_)) { stretch::THREE } else { stretch::ONE };
                     d.parts.iter_mut().find(|p| p.kind == PartKind::Stretch { chain, first }).unwrap().active = state;
-                    let r = stretch::rewrite_part(&g, &mut d, chain, first);
+                    let r = rewrite(&g, &mut d, (chain, first));
                     // A refused shrink leaves the part in `one`: put it back.
                     if r.is_err() {
                         for p in &mut d.parts {
@@ -147,4 +147,26 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
     ];
     assert!(replace::replacement_events(&g, &mut d, &back).is_empty());
     d.check(&g).unwrap();
+}
+
+/// The paper's rewrite of a stretch part (two elements to three in `three`, to one in `one`),
+/// with no held element.
+fn rewrite(
+    g: &clay_dsl::compiled::CompiledGrammar,
+    d: &mut clay_dsl::compiled::AssemblyData,
+    at: (usize, usize),
+) -> Result<clay::rules::Rewrite, String> {
+    let state = d
+        .parts
+        .iter()
+        .find(|p| {
+            p.kind
+                == clay_dsl::compiled::PartKind::Stretch {
+                    chain: at.0,
+                    first: at.1,
+                }
+        })
+        .map(|p| p.active);
+    let elements = if state == Some(stretch::ONE) { 1 } else { 3 };
+    stretch::rewrite_part(g, d, at, elements, &Default::default())
 }

@@ -96,7 +96,7 @@ fn stretch_replaces_two_elements_by_three_over_the_same_span() {
     let b_to_centre = centre(&g, &d, ib, 1);
     let a_from_centre = centre(&g, &d, ia, 0);
 
-    let r = stretch::rewrite_part(&g, &mut d, 0, 2).unwrap();
+    let r = rewrite(&g, &mut d, (0, 2)).unwrap();
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Stretch);
     assert_eq!(
@@ -157,7 +157,7 @@ fn shrink_replaces_two_elements_by_one_and_drops_their_vertices() {
     let before_ids = ids(&d, 0);
     let (ia, ib) = (d.chains[0].instances[3], d.chains[0].instances[4]);
     let span = (centre(&g, &d, ia, 0), centre(&g, &d, ib, 1));
-    let r = stretch::rewrite_part(&g, &mut d, 0, 3).unwrap();
+    let r = rewrite(&g, &mut d, (0, 3)).unwrap();
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Shrink);
     assert_eq!(r.event.instances, vec![before_ids[3], before_ids[4]]);
@@ -178,7 +178,7 @@ fn shrink_stops_at_the_rules_minimum_and_leaves_the_data_alone() {
     set_state(&mut d, 0, 0, stretch::ONE);
     assert!(stretch::candidates(&g, &d).is_empty());
     let before = d.clone();
-    assert!(stretch::rewrite_part(&g, &mut d, 0, 0).is_err());
+    assert!(rewrite(&g, &mut d, (0, 0)).is_err());
     assert_eq!(d, before);
 }
 
@@ -187,10 +187,10 @@ fn stretch_then_shrink_round_trips_the_element_count() {
     let g = wall(4, 2);
     let mut d = data_of(&g);
     set_state(&mut d, 0, 1, stretch::THREE);
-    stretch::rewrite_part(&g, &mut d, 0, 1).unwrap();
+    rewrite(&g, &mut d, (0, 1)).unwrap();
     assert_eq!(d.chains[0].instances.len(), 5);
     set_state(&mut d, 0, 2, stretch::ONE);
-    stretch::rewrite_part(&g, &mut d, 0, 2).unwrap();
+    rewrite(&g, &mut d, (0, 2)).unwrap();
     d.check(&g).unwrap();
     assert_eq!(d.chains[0].instances.len(), 4);
     assert_eq!(d.positions.len(), 10);
@@ -206,7 +206,7 @@ fn inserted_variants_follow_the_rules_frequencies() {
     for _ in 0..24 {
         let n = d.chains[body].instances.len();
         set_state(&mut d, body, n / 2, stretch::THREE);
-        stretch::rewrite_part(&g, &mut d, body, n / 2).unwrap();
+        rewrite(&g, &mut d, (body, n / 2)).unwrap();
         d.check(&g).unwrap();
     }
     let rule = &g.stretch_rules[d.chains[body].rule];
@@ -371,4 +371,26 @@ model {
     assert_eq!(d.chains[0].instances.len(), 6);
     assert_eq!(d.parts.len(), 5);
     assert!(merge::find(&g, &d).is_none());
+}
+
+/// The paper's rewrite of a stretch part (two elements to three in `three`, to one in `one`),
+/// with no held element.
+fn rewrite(
+    g: &clay_dsl::compiled::CompiledGrammar,
+    d: &mut clay_dsl::compiled::AssemblyData,
+    at: (usize, usize),
+) -> Result<clay::rules::Rewrite, String> {
+    let state = d
+        .parts
+        .iter()
+        .find(|p| {
+            p.kind
+                == clay_dsl::compiled::PartKind::Stretch {
+                    chain: at.0,
+                    first: at.1,
+                }
+        })
+        .map(|p| p.active);
+    let elements = if state == Some(stretch::ONE) { 1 } else { 3 };
+    stretch::rewrite_part(g, d, at, elements, &Default::default())
 }

@@ -267,11 +267,11 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
         .collect();
     let k = stretch_part(&s.asm, 0);
     assert!(s.asm.set_active_state(k, clay::rules::stretch::THREE));
-    let events = s
-        .replay
-        .rules_mut()
-        .unwrap()
-        .after_frame(&mut s.asm, &clay::solver::FrameReport::default());
+    let events = s.replay.rules_mut().unwrap().after_frame(
+        &mut s.asm,
+        &clay::solver::FrameReport::default(),
+        &[],
+    );
     assert!(
         events
             .iter()
@@ -309,11 +309,11 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
     let east_id = s.asm.data().instances[s.asm.data().chains[0].instances[n - 1]].id;
     let k = stretch_part(&s.asm, n - 2);
     assert!(s.asm.set_active_state(k, clay::rules::stretch::ONE));
-    let events = s
-        .replay
-        .rules_mut()
-        .unwrap()
-        .after_frame(&mut s.asm, &clay::solver::FrameReport::default());
+    let events = s.replay.rules_mut().unwrap().after_frame(
+        &mut s.asm,
+        &clay::solver::FrameReport::default(),
+        &[],
+    );
     let shrink = events
         .iter()
         .find(|e| e.kind == clay::rules::RuleKind::Shrink)

@@ -303,6 +303,7 @@ pub(crate) fn derive_chains(grammar: &CompiledGrammar, data: &mut AssemblyData) 
             chains.push(Chain {
                 rule: r,
                 instances: list,
+                trend: 0,
             });
         }
     };
@@ -429,23 +430,93 @@ impl Rules {
         Self::default()
     }
 
-    /// Applies the rules after one solver frame: replacement events for the piece parts that
-    /// switched state, at most one stretch or shrink per chain (parts left in `three`/`one`),
-    /// and at most one merge. Bumps the assembly's generation if the structure changed, and
-    /// carries rotations and handles across the renumbering.
-    pub fn after_frame(&mut self, asm: &mut Assembly, report: &FrameReport) -> Vec<RuleEvent> {
+    /// Applies the rules after one solver frame ([`Rules::after_pass1`] with the frame's
+    /// pass-1 pose `pass1`, then [`Rules::after_pass2`]): for tests that drive the rules
+    /// around a frame of their own.
+    pub fn after_frame(
+        &mut self,
+        asm: &mut Assembly,
+        report: &FrameReport,
+        pass1: &[DVec2],
+    ) -> Vec<RuleEvent> {
+        let mut events = self.after_pass1(asm, report, pass1);
+        events.extend(self.after_pass2(asm));
+        events
+    }
+
+    /// The rules that decide the frame's topology, between the solver's passes (paper 5.2:
+    /// pass 2 runs on the topology pass 1 determined): replacement events for the piece parts
+    /// that switched state, and at most one stretch or shrink per chain (parts left in
+    /// `three`/`one`, by their claims). Counts the frame. Bumps the assembly's generation if
+    /// the structure changed, and carries rotations and handles across the renumbering.
+    ///
+    /// `pass1` is the frame's pass-1 pose (one position per vertex, or empty): a chain that
+    /// stretches is laid out in it first. There the sparse norm has gathered the chain's
+    /// stretch into the rewritten part and left the other elements at rest, so the elements
+    /// the rule lays into that part's span come out at rest too; in the displayed pose, where
+    /// least squares spreads the stretch over the whole chain, a part claiming many elements
+    /// would have them squeezed into two elements' length. A chain that shrinks stays in the
+    /// displayed pose: the sparse norm gathers a squeeze by folding the part onto itself, and
+    /// the elements beyond the fold lie back over those before it.
+    pub fn after_pass1(
+        &mut self,
+        asm: &mut Assembly,
+        report: &FrameReport,
+        pass1: &[DVec2],
+    ) -> Vec<RuleEvent> {
         self.frame += 1;
         let grammar = asm.grammar_arc().clone();
         let mut events = replace::replacement_events(&grammar, asm.data_mut(), &report.switches);
         let mut rewrites = Vec::new();
-        for (chain, first) in stretch::candidates(&grammar, asm.data()) {
+        let held: HashSet<u64> = asm
+            .handles()
+            .iter()
+            .filter_map(|h| h.held.as_ref().map(|x| x.id))
+            .collect();
+        let candidates = stretch::candidates(&grammar, asm.data());
+        if pass1.len() == asm.data().positions.len() {
+            let data = asm.data();
+            let mut laid = Vec::new();
+            let grows =
+                |part: usize| data.parts.get(part).map(|p| p.active) == Some(stretch::THREE);
+            for &(_, (chain, _)) in candidates.iter().filter(|c| grows(c.0)) {
+                for &i in data.chains.get(chain).map_or(&[][..], |c| &c.instances) {
+                    laid.extend(data.instances[i].vertices.iter().copied());
+                }
+            }
+            let positions = asm.positions_mut();
+            for v in laid {
+                if pass1[v].is_finite() {
+                    positions[v] = pass1[v];
+                }
+            }
+        }
+        for (part, at) in candidates {
             // Earlier rewrites in this loop never renumber chains, and elements only within
-            // their own chain, so (chain, first) is still valid here.
-            if let Ok(r) = stretch::rewrite_part(&grammar, asm.data_mut(), chain, first) {
+            // their own chain, so (chain, first) is still valid here; `part` indexes the
+            // parts the frame ran on.
+            let elements = report
+                .claims
+                .iter()
+                .find(|c| c.0 == part)
+                .map(|c| i64::from(c.1));
+            let elements = elements.unwrap_or_else(|| {
+                let active = asm.data().parts.get(part).map(|p| p.active);
+                if active == Some(stretch::ONE) { 1 } else { 3 }
+            });
+            if let Ok(r) = stretch::rewrite_part(&grammar, asm.data_mut(), at, elements, &held) {
                 self.carry(asm, &r);
                 rewrites.push(r.event);
             }
         }
+        events.extend(rewrites);
+        self.stamp(&grammar, asm, events)
+    }
+
+    /// The rules that act on the displayed pose, after the solver's frame: at most one merge.
+    pub fn after_pass2(&mut self, asm: &mut Assembly) -> Vec<RuleEvent> {
+        let grammar = asm.grammar_arc().clone();
+        let mut events = Vec::new();
         // a cut pair parts once no merge rule finds its sides within reach
         self.parted.retain(|&pair| {
             merge::find_in_reach(&grammar, asm.data(), |m, t| unordered(m, t) == pair).is_some()
@@ -456,16 +527,25 @@ impl Rules {
         }) && let Ok(r) = merge::apply(&grammar, asm.data_mut(), &found)
         {
             self.carry(asm, &r);
-            rewrites.push(r.event);
+            events.push(r.event);
         }
-        events.extend(rewrites);
+        self.stamp(&grammar, asm, events)
+    }
+
+    /// Stamps `events` with the frame and logs them.
+    fn stamp(
+        &mut self,
+        grammar: &CompiledGrammar,
+        asm: &Assembly,
+        mut events: Vec<RuleEvent>,
+    ) -> Vec<RuleEvent> {
         for e in &mut events {
             e.frame = self.frame;
         }
         debug_assert!(
-            asm.data().check(&grammar).is_ok(),
+            asm.data().check(grammar).is_ok(),
             "{:?}",
-            asm.data().check(&grammar)
+            asm.data().check(grammar)
         );
         self.log.extend(events.iter().cloned());
         events

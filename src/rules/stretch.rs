@@ -28,12 +28,13 @@ pub const ONE: usize = clay_dsl::compiled::STRETCH_ONE;
 pub const TWO: usize = clay_dsl::compiled::STRETCH_TWO;
 pub const THREE: usize = clay_dsl::compiled::STRETCH_THREE;
 
-/// Stretch parts that ask for a rewrite: `(chain, first)` of the first part in `three`, or in
-/// `one` when the chain is longer than the rule's `min`, at most one per chain. O(parts).
-pub fn candidates(grammar: &CompiledGrammar, data: &AssemblyData) -> Vec<(usize, usize)> {
+/// Stretch parts that ask for a rewrite: `(part, (chain, first))` of the first part in
+/// `three`, or in `one` when the chain is longer than the rule's `min`, at most one per chain.
+/// O(parts).
+pub fn candidates(grammar: &CompiledGrammar, data: &AssemblyData) -> Vec<(usize, (usize, usize))> {
     let mut seen = HashSet::new();
     let mut out = Vec::new();
-    for part in &data.parts {
+    for (pi, part) in data.parts.iter().enumerate() {
         let PartKind::Stretch { chain, first } = part.kind else {
             continue;
         };
@@ -49,7 +50,7 @@ pub fn candidates(grammar: &CompiledGrammar, data: &AssemblyData) -> Vec<(usize,
             _ => false,
         };
         if wants && seen.insert(chain) {
-            out.push((chain, first));
+            out.push((pi, (chain, first)));
         }
     }
     out
@@ -129,9 +130,11 @@ impl<'a> Layout<'a> {
     }
 }
 
-/// Positions of the `count`-element rest layout (count 1 or 3) for every piece vertex of
-/// every element, in the frame of the part's `one`/`three` state, and the blended affine map
-/// from that frame to the current pose of the two old elements.
+/// Positions of the `count`-element rest layout for every piece vertex of every element, in
+/// the frame of the part's state of that many elements' length (`one`, or `two` scaled along
+/// the axis to `count` elements), and the map from that frame to the current pose of the two
+/// old elements: each element's affine map, blended along the axis, or (`whole`) one affine
+/// map fitted to both.
 struct Placement {
     /// `rest[j][v]`: rest position of vertex v of new element j.
     rest: Vec<Vec<DVec2>>,
@@ -145,14 +148,14 @@ impl Placement {
     fn new(
         layout: &Layout,
         states: &[Vec<DVec2>],
-        reference: usize,
+        refs: &[DVec2],
         count: usize,
         old: [&[usize]; 2],
         positions: &[DVec2],
+        whole: bool,
     ) -> Option<Self> {
         let nv = old[0].len();
         let two = &states[TWO];
-        let refs = &states[reference];
         // Axis step from element 0 to element 1 in the `two` state.
         let mut d = DVec2::ZERO;
         let mut k = 0.0;
@@ -192,6 +195,22 @@ impl Placement {
             centres[e as usize] =
                 from.iter().map(|p| p.dot(axis)).sum::<f64>() / from.len().max(1) as f64;
         }
+        if whole {
+            // One map for the part, fitted to its two ends (the first element's `from` site,
+            // the second's `to` site): the new elements evenly over its span, however unevenly
+            // its two elements share it (pass 1 gathers a stretch into one of them).
+            let ends = (layout.from_site.iter().map(|&v| (0u8, v)))
+                .chain(layout.to_site.iter().map(|&v| (1u8, v)));
+            let (mut from, mut to) = (Vec::new(), Vec::new());
+            for (e, v) in ends {
+                from.push(refs[layout.index(e, v)?]);
+                to.push(positions[old[e as usize][v]]);
+            }
+            if from.len() >= 3 {
+                let map = fit::affine(&from, &to);
+                maps = [map, map];
+            }
+        }
         Some(Self {
             rest,
             maps,
@@ -213,22 +232,28 @@ impl Placement {
 }
 
 /// Rewrites the stretch part over elements `first`, `first + 1` of `chain` according to its
-/// active state (`three`: stretch, `one`: shrink). Errors (data unchanged) when the part does
-/// not exist, is in `two`, a shrink would go below `min`, or the result fails the check.
+/// active state and the solver's claim ([`crate::solver::FrameReport::claims`]: how many
+/// elements its span holds): `three` stretches it to that many elements (at least three),
+/// `one` shrinks it to one, or a longer run of the chain when the claim is below one, keeping
+/// an element in `held` (stable ids of the instances handles hold). Errors (data unchanged) when the part
+/// does not exist, is in `two`, a shrink would go below `min` or remove a held element, or the
+/// result fails the check.
 pub fn rewrite_part(
     grammar: &CompiledGrammar,
     data: &mut AssemblyData,
-    chain: usize,
-    first: usize,
+    at: (usize, usize),
+    elements: i64,
+    held: &HashSet<u64>,
 ) -> Result<Rewrite, String> {
+    let (chain, first) = at;
     let part = data
         .parts
         .iter()
         .find(|p| p.kind == PartKind::Stretch { chain, first })
         .ok_or_else(|| format!("no stretch part over chain {chain} element {first}"))?;
     match part.active {
-        THREE => stretch(grammar, data, chain, first),
-        ONE => shrink(grammar, data, chain, first),
+        THREE => stretch(grammar, data, chain, first, elements.max(3) as usize),
+        ONE => shrink(grammar, data, chain, first, elements.min(1), held),
         s => Err(format!(
             "chain {chain} element {first}: part is in state {s}, nothing to do"
         )),
@@ -252,20 +277,36 @@ fn find_dock(data: &AssemblyData, x: InstanceSite, y: InstanceSite) -> Option<us
         .position(|d| (d.a == x && d.b == y) || (d.a == y && d.b == x))
 }
 
-/// Two elements -> three. The first and last keep their ids and outer site vertices; the new
-/// one goes in the middle and is the variant that brings the chain's histogram closest to
-/// the rule's frequencies.
+/// Two elements -> `count` (at least three; no more than the rule's `max` lets the chain have,
+/// nor more new ones than the chain has elements). The first and last keep their ids and
+/// outer site vertices; the new ones go between them, each the variant that brings the
+/// chain's histogram closest to the rule's frequencies.
 // Long because: one transaction: every index it rewrites must change together.
 pub fn stretch(
     grammar: &CompiledGrammar,
     data: &mut AssemblyData,
     chain: usize,
     first: usize,
+    count: usize,
 ) -> Result<Rewrite, String> {
     let before = PartsBefore::record(data);
     transaction(grammar, data, |data| {
         let c = data.chains.get(chain).ok_or("no such chain")?;
         let rule = &grammar.stretch_rules[c.rule];
+        let room = rule
+            .max
+            .map_or(usize::MAX, |max| max.saturating_sub(c.instances.len()));
+        let room = room.min(clay_dsl::MAX_INSTANCES.saturating_sub(data.instances.len()));
+        // at most doubling the chain in one rewrite: a hand thrown a kilometre away fills the
+        // length over a few frames, each of them bounded, not in one that never ends
+        let inserted = count
+            .saturating_sub(2)
+            .clamp(1, c.instances.len().max(1))
+            .min(room);
+        if inserted == 0 {
+            return Err(format!("chain {chain} is at the rule's maximum"));
+        }
+        let count = inserted + 2;
         let (ia, ib) = element_pair(c, chain, first)?;
         let states =
             part_states(data, chain, first).ok_or("the stretch part has no three states")?;
@@ -274,20 +315,23 @@ pub fn stretch(
             data.instances[ia].vertices.clone(),
             data.instances[ib].vertices.clone(),
         );
-        let place = Placement::new(&layout, &states, THREE, 3, [&va, &vb], &data.positions)
-            .ok_or("the stretch rule's part does not describe an axis")?;
-        let pieces = chain_pieces(data, c);
-        let piece = variants(rule)
-            .into_iter()
-            .map(|(p, _)| p)
-            .min_by(|&p, &q| {
-                histogram_error(rule, &pieces, (p, 1)).total_cmp(&histogram_error(
-                    rule,
-                    &pieces,
-                    (q, 1),
-                ))
-            })
-            .unwrap_or(rule.piece);
+        // `two` scaled along the axis to `count` elements: `inserted` steps of `three - two`
+        let refs: Vec<DVec2> = states[TWO]
+            .iter()
+            .zip(&states[THREE])
+            .map(|(&two, &three)| two + (three - two) * inserted as f64)
+            .collect();
+        let place = Placement::new(
+            &layout,
+            &states,
+            &refs,
+            count,
+            [&va, &vb],
+            &data.positions,
+            true,
+        )
+        .ok_or("the stretch rule's part does not describe an axis")?;
+        let mut pieces = chain_pieces(data, c);
         let n = layout.from_site.len();
         let nv = va.len();
         let fresh = |data: &mut AssemblyData, p: DVec2| {
@@ -304,35 +348,13 @@ pub fn stretch(
                 data.positions[g] = place.place(place.rest[0][v]);
             }
         }
-        // N: from = A's new to, to = B's from (the old shared vertices), the rest fresh.
-        let mut n_vertices = vec![usize::MAX; nv];
-        for (v, slot) in n_vertices.iter_mut().enumerate() {
-            *slot = if let Some(i) = layout.from_site.iter().position(|&x| x == v) {
-                a_vertices[layout.to_site[n - 1 - i]]
-            } else if let Some(i) = layout.to_site.iter().position(|&x| x == v) {
-                vb[layout.from_site[n - 1 - i]]
-            } else {
-                fresh(data, place.place(place.rest[1][v]))
-            };
-        }
-        // B: same vertices; everything but its `to` site re-laid as element 2.
+        // B: same vertices; everything but its `to` site re-laid as the last element.
         for (v, &g) in vb.iter().enumerate() {
             if !layout.to_site.contains(&v) {
-                data.positions[g] = place.place(place.rest[2][v]);
+                data.positions[g] = place.place(place.rest[count - 1][v]);
             }
         }
         data.instances[ia].vertices = a_vertices;
-        let id = data.next_id;
-        data.next_id += 1;
-        let ni = data.instances.len();
-        let name = generated_name(&data.instances[ia].name, id);
-        data.instances.push(Instance {
-            id,
-            name: name.clone(),
-            piece,
-            vertices: n_vertices,
-            state: 0,
-        });
         let a_to = InstanceSite {
             instance: ia,
             site: rule.to,
@@ -342,37 +364,119 @@ pub fn stretch(
             site: rule.from,
         };
         let di = find_dock(data, a_to, b_from).ok_or("the two elements are not docked")?;
-        let n_to = InstanceSite {
-            instance: ni,
-            site: rule.to,
-        };
-        let n_from = InstanceSite {
-            instance: ni,
-            site: rule.from,
-        };
-        data.docks[di] = Dock { a: n_to, b: b_from };
-        data.docks.push(Dock { a: a_to, b: n_from });
-        data.chains[chain].instances.insert(first + 1, ni);
+        // The new elements 1..count-1: each `from` is the previous element's `to`, the last
+        // one's `to` is B's `from` (the old shared vertices), the rest fresh.
+        let mut previous = (ia, data.instances[ia].vertices.clone());
+        let mut names = Vec::new();
+        let mut ids = Vec::new();
+        for j in 1..count - 1 {
+            let mut vertices = vec![usize::MAX; nv];
+            for (v, slot) in vertices.iter_mut().enumerate() {
+                *slot = if let Some(i) = layout.from_site.iter().position(|&x| x == v) {
+                    previous.1[layout.to_site[n - 1 - i]]
+                } else if j == count - 2
+                    && let Some(i) = layout.to_site.iter().position(|&x| x == v)
+                {
+                    vb[layout.from_site[n - 1 - i]]
+                } else {
+                    fresh(data, place.place(place.rest[j][v]))
+                };
+            }
+            let piece = variants(rule)
+                .into_iter()
+                .map(|(p, _)| p)
+                .min_by(|&p, &q| {
+                    histogram_error(rule, &pieces, (p, 1)).total_cmp(&histogram_error(
+                        rule,
+                        &pieces,
+                        (q, 1),
+                    ))
+                })
+                .unwrap_or(rule.piece);
+            pieces.push(piece);
+            let id = data.next_id;
+            data.next_id += 1;
+            let ni = data.instances.len();
+            let name = generated_name(&data.instances[ia].name, id);
+            data.instances.push(Instance {
+                id,
+                name: name.clone(),
+                piece,
+                vertices: vertices.clone(),
+                state: 0,
+            });
+            let dock = Dock {
+                a: InstanceSite {
+                    instance: previous.0,
+                    site: rule.to,
+                },
+                b: InstanceSite {
+                    instance: ni,
+                    site: rule.from,
+                },
+            };
+            if j == 1 {
+                data.docks[di] = dock;
+            } else {
+                data.docks.push(dock);
+            }
+            data.chains[chain].instances.insert(first + j, ni);
+            previous = (ni, vertices);
+            names.push(name);
+            ids.push(id);
+        }
+        data.docks.push(Dock {
+            a: InstanceSite {
+                instance: previous.0,
+                site: rule.to,
+            },
+            b: b_from,
+        });
+        data.chains[chain].trend = 1;
         let (ida, idb) = (data.instances[ia].id, data.instances[ib].id);
-        let touched: HashSet<u64> = [ida, idb, id].into();
-        let count = data.chains[chain].instances.len();
-        let mid = &data.instances[ni].vertices;
+        let mut touched: HashSet<u64> = ids.iter().copied().collect();
+        touched.extend([ida, idb]);
+        let total = data.chains[chain].instances.len();
+        let middle = data.chains[chain].instances[first + count / 2];
+        let mid = &data.instances[middle].vertices;
         let at = mid.iter().map(|&v| data.positions[v]).sum::<DVec2>() / mid.len().max(1) as f64;
+        let piece_name = &grammar.pieces[data.instances[middle].piece].name;
         let event = RuleEvent {
             kind: RuleKind::Stretch,
             frame: 0,
             at,
-            instances: vec![ida, idb, id],
+            instances: [ida, idb].into_iter().chain(ids).collect(),
             detail: format!(
-                "`{}` and `{}` became three {}s: `{name}` inserted; {} has {count} now",
+                "`{}` and `{}` became {} {piece_name}s: {} inserted; {} has {total} now",
                 data.instances[ia].name,
                 data.instances[ib].name,
-                grammar.pieces[piece].name,
+                number_word(count),
+                listed(&names),
                 chain_name(&data.instances[ia].name, chain),
             ),
         };
         Ok(finish(grammar, data, &before, &touched, event))
     })
+}
+
+/// `three` for 3, and so on up to ten; digits beyond.
+fn number_word(n: usize) -> String {
+    const WORDS: [&str; 11] = [
+        "zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
+    ];
+    WORDS
+        .get(n)
+        .map_or_else(|| n.to_string(), |w| (*w).to_string())
+}
+
+/// Names in backticks, the first few and a count of the rest.
+fn listed(names: &[String]) -> String {
+    const SHOWN: usize = 3;
+    let mut out: Vec<String> = names.iter().take(SHOWN).map(|n| format!("`{n}`")).collect();
+    if names.len() > SHOWN {
+        out.push(format!("and {} more", names.len() - SHOWN));
+    }
+    out.join(", ")
 }
 
 /// What the user calls a chain in messages: the model's name for it (`wall` of `wall[3]` or
@@ -406,56 +510,106 @@ fn chain_pieces(data: &AssemblyData, c: &Chain) -> Vec<usize> {
         .collect()
 }
 
-/// Two elements -> one. The one kept (by the rule's frequencies; the first on ties) takes the
-/// outer sites of both; the other is removed with its unshared vertices.
+/// Two elements -> one, or a longer run of the chain -> one when the part was squeezed
+/// shorter than one element (`elements`, the solver's claim, says how many elements its span
+/// holds, 1 or fewer; the run loses `2 - elements` of them, never going below the rule's
+/// `min`). The run grows from the part's two elements to both sides, never over a held
+/// element; the element kept (the held one, else by the rule's frequencies, the first on
+/// ties) takes the run's outer sites, the others are removed with their unshared vertices.
+// Long because: one transaction: every index it rewrites must change together.
 pub fn shrink(
     grammar: &CompiledGrammar,
     data: &mut AssemblyData,
     chain: usize,
     first: usize,
+    elements: i64,
+    held: &HashSet<u64>,
 ) -> Result<Rewrite, String> {
     let before = PartsBefore::record(data);
     transaction(grammar, data, |data| {
         let c = data.chains.get(chain).ok_or("no such chain")?;
         let rule = &grammar.stretch_rules[c.rule];
-        if c.instances.len() <= rule.min.max(1) {
+        let len = c.instances.len();
+        if len <= rule.min.max(1) {
             return Err(format!(
-                "chain {chain} has {} elements, the rule's minimum",
-                c.instances.len()
+                "chain {chain} has {len} elements, the rule's minimum"
             ));
         }
-        let (ia, ib) = element_pair(c, chain, first)?;
+        element_pair(c, chain, first)?;
+        let is_held = |k: usize| held.contains(&data.instances[c.instances[k]].id);
+        if is_held(first) && is_held(first + 1) {
+            return Err("both elements are held; not shrinking".into());
+        }
+        let remove = (2 - elements.min(1)).clamp(1, (len - rule.min.max(1)) as i64) as usize;
+        // the run [lo, hi]: the part's two elements, then one more at a time on either side
+        let (mut lo, mut hi) = (first, first + 1);
+        let mut side = 0;
+        while hi - lo < remove {
+            let can_left = lo > 0 && !is_held(lo - 1) && !(is_held(lo) && is_held(hi));
+            let can_right = hi + 1 < len && !is_held(hi + 1) && !(is_held(lo) && is_held(hi));
+            match (can_left, can_right) {
+                (true, true) if side == 0 => lo -= 1,
+                (true, true) => hi += 1,
+                (true, false) => lo -= 1,
+                (false, true) => hi += 1,
+                (false, false) => break,
+            }
+            side ^= 1;
+        }
+        let run: Vec<usize> = c.instances[lo..=hi].to_vec();
         let states = part_states(data, chain, first).ok_or("the stretch part has no one state")?;
         let layout = Layout::new(grammar, rule);
+        let (ia, ib) = (run[0], run[run.len() - 1]);
         let (va, vb) = (
             data.instances[ia].vertices.clone(),
             data.instances[ib].vertices.clone(),
         );
-        let place = Placement::new(&layout, &states, ONE, 1, [&va, &vb], &data.positions)
-            .ok_or("the stretch rule's part does not describe an axis")?;
+        let place = Placement::new(
+            &layout,
+            &states,
+            &states[ONE],
+            1,
+            [&va, &vb],
+            &data.positions,
+            false,
+        )
+        .ok_or("the stretch rule's part does not describe an axis")?;
         let pieces = chain_pieces(data, c);
-        let (pa, pb) = (data.instances[ia].piece, data.instances[ib].piece);
-        let keep_b = histogram_error(rule, &pieces, (pa, -1))
-            < histogram_error(rule, &pieces, (pb, -1)) - 1e-12;
-        let (keep, gone) = if keep_b { (ib, ia) } else { (ia, ib) };
-        // Only the chain docks may touch the removed element: anything else would be lost.
-        let a_to = InstanceSite {
-            instance: ia,
-            site: rule.to,
-        };
-        let b_from = InstanceSite {
-            instance: ib,
-            site: rule.from,
-        };
-        let inner = find_dock(data, a_to, b_from).ok_or("the two elements are not docked")?;
-        let gone_site_ok =
-            |s: InstanceSite| s.instance != gone || s.site == rule.from || s.site == rule.to;
-        if data
-            .docks
+        let keep = match run
             .iter()
-            .any(|d| !gone_site_ok(d.a) || !gone_site_ok(d.b))
+            .position(|&i| held.contains(&data.instances[i].id))
         {
-            return Err("the element to remove is docked at a side site; not shrinking".into());
+            Some(k) => run[k],
+            None => {
+                // the first element whose removal of the others fits the frequencies best
+                let error = |keep: usize| {
+                    let mut rest = pieces.clone();
+                    for &i in &run {
+                        if i != keep
+                            && let Some(at) =
+                                rest.iter().position(|&p| p == data.instances[i].piece)
+                        {
+                            rest.remove(at);
+                        }
+                    }
+                    histogram_error(rule, &rest, (rule.piece, 0))
+                };
+                let mut best = run[0];
+                for &i in &run[1..] {
+                    if error(i) < error(best) - 1e-12 {
+                        best = i;
+                    }
+                }
+                best
+            }
+        };
+        let gone: Vec<usize> = run.iter().copied().filter(|&i| i != keep).collect();
+        // Only the chain docks may touch a removed element: anything else would be lost.
+        let site_ok = |s: InstanceSite| {
+            !gone.contains(&s.instance) || s.site == rule.from || s.site == rule.to
+        };
+        if data.docks.iter().any(|d| !site_ok(d.a) || !site_ok(d.b)) {
+            return Err("an element to remove is docked at a side site; not shrinking".into());
         }
         let mut k_vertices = data.instances[keep].vertices.clone();
         for (v, slot) in k_vertices.iter_mut().enumerate() {
@@ -468,19 +622,32 @@ pub fn shrink(
             }
         }
         data.instances[keep].vertices = k_vertices;
-        data.docks.remove(inner);
-        // The removed element's outer dock now belongs to the kept one.
+        // the docks inside the run go; its outer docks (the run's first `from`, its last
+        // `to`) now belong to the kept element
+        let inside = |s: InstanceSite| run.contains(&s.instance);
+        data.docks.retain(|d| !(inside(d.a) && inside(d.b)));
         for d in &mut data.docks {
             for s in [&mut d.a, &mut d.b] {
-                if s.instance == gone {
+                if gone.contains(&s.instance) {
                     s.instance = keep;
                 }
             }
         }
-        let (kid, gid) = (data.instances[keep].id, data.instances[gone].id);
-        let gone_name = data.instances[gone].name.clone();
-        remove_instances(data, &HashSet::from([gone]));
-        let touched: HashSet<u64> = [kid, gid].into();
+        let kid = data.instances[keep].id;
+        let gone_ids: Vec<u64> = gone.iter().map(|&i| data.instances[i].id).collect();
+        let gone_names: Vec<String> = gone
+            .iter()
+            .map(|&i| data.instances[i].name.clone())
+            .collect();
+        let kept_name = data.instances[keep].name.clone();
+        let run_names: Vec<String> = run
+            .iter()
+            .map(|&i| data.instances[i].name.clone())
+            .collect();
+        data.chains[chain].trend = -1;
+        remove_instances(data, &gone.iter().copied().collect());
+        let mut touched: HashSet<u64> = gone_ids.iter().copied().collect();
+        touched.insert(kid);
         let ki = data
             .instances
             .iter()
@@ -489,16 +656,27 @@ pub fn shrink(
         let kv = &data.instances[ki].vertices;
         let at = kv.iter().map(|&v| data.positions[v]).sum::<DVec2>() / kv.len().max(1) as f64;
         let count = data.chains.get(chain).map_or(0, |c| c.instances.len());
+        let became = if run_names.len() == 2 {
+            format!("`{}` and `{}`", run_names[0], run_names[1])
+        } else {
+            format!(
+                "{} {}s from `{}` to `{}`",
+                number_word(run_names.len()),
+                grammar.pieces[data.instances[ki].piece].name,
+                run_names[0],
+                run_names[run_names.len() - 1]
+            )
+        };
         let event = RuleEvent {
             kind: RuleKind::Shrink,
             frame: 0,
             at,
-            instances: vec![kid, gid],
+            instances: std::iter::once(kid).chain(gone_ids).collect(),
             detail: format!(
-                "`{}` and `{gone_name}` became one {}: `{gone_name}` removed; {} has {count} now",
-                data.instances[ki].name,
+                "{became} became one {}: {} removed; {} has {count} now",
                 grammar.pieces[data.instances[ki].piece].name,
-                chain_name(&data.instances[ki].name, chain),
+                listed(&gone_names),
+                chain_name(&kept_name, chain),
             ),
         };
         Ok(finish(grammar, data, &before, &touched, event))

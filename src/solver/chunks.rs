@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
-use super::local::RestCache;
+use super::local::{RestCache, Switching};
 
 /// Parts per chunk (fixed: the chunks, and so every sum, do not depend on the thread count).
 pub const CHUNK: usize = 512;
@@ -29,12 +29,13 @@ pub const CHUNK: usize = 512;
 pub const PARALLEL_MIN_PARTS: usize = 8 * CHUNK;
 
 /// Whether the local step may switch rest states (pass 1) or keeps them (pass 2).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Choice {
+#[derive(Clone, Copy, Debug)]
+pub enum Choice<'a> {
     /// Rotations of the active states.
     Keep,
-    /// Each part's nearest rest state, with hysteresis (paper 4.3).
-    Switch { hysteresis: f64 },
+    /// Each part's nearest rest state, with hysteresis (paper 4.3), a stretch part's by its
+    /// length ([`super::local::decide_stretch`]).
+    Switch(Switching<'a>),
 }
 
 /// One evaluation's outputs: per part its rotation, its (chosen) active state and its squared
@@ -42,6 +43,8 @@ pub enum Choice {
 pub struct Outputs<'a> {
     pub rotations: &'a mut [DVec2],
     pub chosen: &'a mut [usize],
+    /// Per part: its claim ([`super::local::Chosen::claim`]; 0 when the states are kept).
+    pub claims: &'a mut [i32],
     pub residuals: &'a mut [f64],
     pub targets: &'a mut [DVec2],
 }
@@ -55,18 +58,21 @@ impl Split for Outputs<'_> {
     fn split(self, parts: usize, edges: usize) -> (Self, Self) {
         let (r0, r1) = self.rotations.split_at_mut(parts);
         let (c0, c1) = self.chosen.split_at_mut(parts);
+        let (k0, k1) = self.claims.split_at_mut(parts);
         let (s0, s1) = self.residuals.split_at_mut(parts);
         let (t0, t1) = self.targets.split_at_mut(edges);
         (
             Outputs {
                 rotations: r0,
                 chosen: c0,
+                claims: k0,
                 residuals: s0,
                 targets: t0,
             },
             Outputs {
                 rotations: r1,
                 chosen: c1,
+                claims: k1,
                 residuals: s1,
                 targets: t1,
             },
@@ -347,9 +353,10 @@ pub fn evaluate(
             let mut elastic = 0.0;
             for pi in chunks.parts(c) {
                 let part = &parts[pi];
-                let (active, own) = rotate(cache, pi, part, positions, choice, pose);
+                let (active, own, claim) = rotate(cache, pi, part, positions, choice, pose);
                 o.rotations[pi - p0] = own;
                 o.chosen[pi - p0] = active;
+                o.claims[pi - p0] = claim;
                 let first = cache.first_edge(pi) - e0;
                 let t = &mut o.targets[first..][..cache.part_edges(pi)];
                 cache.targets_with(pi, active, own, &[], cos_cone, t, pose);
@@ -371,7 +378,7 @@ pub fn evaluate(
     elastic
 }
 
-/// Part `pi`'s active state after the step and its rotation onto `positions`.
+/// Part `pi`'s active state after the step, its rotation onto `positions` and its claim.
 #[inline]
 fn rotate(
     cache: &RestCache,
@@ -380,10 +387,13 @@ fn rotate(
     positions: &[DVec2],
     choice: Choice,
     pose: &mut [DVec2],
-) -> (usize, DVec2) {
+) -> (usize, DVec2, i32) {
     match choice {
-        Choice::Keep => (part.active, cache.rotation_of(pi, part, positions)),
-        Choice::Switch { hysteresis } => cache.choose_with(pi, part, positions, hysteresis, pose),
+        Choice::Keep => (part.active, cache.rotation_of(pi, part, positions), 0),
+        Choice::Switch(how) => {
+            let c = cache.choose_with(pi, part, positions, how, pose);
+            (c.state, c.rotation, c.claim)
+        }
     }
 }
 
@@ -405,6 +415,7 @@ fn within_cone(
     let Outputs {
         rotations,
         chosen,
+        claims,
         residuals,
         targets,
     } = out;
@@ -413,14 +424,16 @@ fn within_cone(
         let (mut small, mut large) = ([DVec2::ZERO; SMALL], Vec::new());
         let pose = scratch_of(&mut small, &mut large, scratch);
         for pi in chunks.parts(c) {
-            let (active, own) = rotate(cache, pi, &parts[pi], positions, choice, pose);
+            let (active, own, claim) = rotate(cache, pi, &parts[pi], positions, choice, pose);
             o.rotations[pi - p0] = own;
             o.chosen[pi - p0] = active;
+            o.claims[pi - p0] = claim;
         }
     };
     let no_targets = Outputs {
         rotations: &mut *rotations,
         chosen: &mut *chosen,
+        claims,
         residuals: &mut [],
         targets: &mut [],
     };
@@ -454,14 +467,17 @@ impl Split for PartsOnly<'_> {
         let o = self.0;
         let (r0, r1) = o.rotations.split_at_mut(parts);
         let (c0, c1) = o.chosen.split_at_mut(parts);
+        let (k0, k1) = o.claims.split_at_mut(parts);
         let empty = || Outputs {
             rotations: &mut [],
             chosen: &mut [],
+            claims: &mut [],
             residuals: &mut [],
             targets: &mut [],
         };
         let (mut a, mut b) = (empty(), empty());
         (a.rotations, a.chosen, b.rotations, b.chosen) = (r0, c0, r1, c1);
+        (a.claims, b.claims) = (k0, k1);
         (PartsOnly(a), PartsOnly(b))
     }
 }
@@ -527,7 +543,7 @@ mod tests {
             .map(|p| DVec2::new(p.x + 0.3 * p.y, p.y + (0.7 * p.x).sin()))
             .collect();
         for cos_cone in [1.0, 20f64.to_radians().cos()] {
-            for choice in [Choice::Keep, Choice::Switch { hysteresis: 0.15 }] {
+            for choice in [Choice::Keep, Choice::Switch(Switching::plain(0.15))] {
                 let mut parts = data.parts.clone();
                 let vp = VertexParts::build(&parts, n);
                 let mut cache = RestCache::build(&parts, &vp).unwrap();
@@ -538,9 +554,11 @@ mod tests {
                 let (count, edges) = (parts.len(), cache.edges());
                 let (mut rotations, mut chosen) = (vec![DVec2::X; count], vec![0; count]);
                 let (mut residuals, mut targets) = (vec![0.0; count], vec![DVec2::ZERO; edges]);
+                let mut claims = vec![0; count];
                 let out = Outputs {
                     rotations: &mut rotations,
                     chosen: &mut chosen,
+                    claims: &mut claims,
                     residuals: &mut residuals,
                     targets: &mut targets,
                 };
@@ -550,8 +568,9 @@ mod tests {
                 for (pi, part) in parts.iter_mut().enumerate() {
                     let (state, r) = match choice {
                         Choice::Keep => (part.active, cache.part_rotation(pi, part, &positions)),
-                        Choice::Switch { hysteresis } => {
-                            cache.choose_state(pi, part, &positions, hysteresis)
+                        Choice::Switch(how) => {
+                            let c = cache.choose_state(pi, part, &positions, how);
+                            (c.state, c.rotation)
                         }
                     };
                     assert_eq!(chosen[pi], state, "part {pi}");

@@ -73,6 +73,20 @@ pub struct SolverConfig {
     pub hysteresis: f64,
     /// Exponent p of the IRLS pass (2 = least squares).
     pub norm: f64,
+    /// Pass 1 (paper 5.2: "the constraint handles are considered as outliers"): a stretch
+    /// part that holds a held vertex weighs `handle_outlier^(2 - p)` in the sparse norm
+    /// (least squares, p = 2, is unchanged). An evenly stretched chain is a stationary point
+    /// of the sparse norm, equally far from gathering its stretch into any one part; next to
+    /// the handles a gap is cheaper, so that is where it opens.
+    pub handle_outlier: f64,
+    /// A chain whose last change of element count went one way changes the other way only
+    /// once its length is off by this many elements (a stretch after a shrink: longer than
+    /// its elements at rest by this much; a shrink after a stretch: shorter). The sparse norm
+    /// gathers a chain's whole leftover length into one part, where the hysteresis of paper
+    /// 4.3 switches at about half an element, so right after a switch the chain is within a
+    /// few hundredths of an element of switching back; a hand that wavers by a third of an
+    /// element would add and remove an element every time (`docs/solver.md`).
+    pub reversal: f64,
     /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
     pub irls_epsilon: f64,
     /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
@@ -142,6 +156,8 @@ impl SolverConfig {
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,
+            handle_outlier: 0.5,
+            reversal: 0.95,
             irls_iterations: 20,
             l2_iterations: 5,
             l2_anderson: 1,

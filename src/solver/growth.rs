@@ -1,16 +1,20 @@
-//! One growth per chain per frame (paper 5.1): of a stretch chain's parts, at most one
-//! switches into `three` and at most one into `one` in a frame. A part in `three` says "these
-//! two elements hold a third element's length"; the stretch rule then inserts one element per
-//! chain per frame.
+//! One claim per chain per frame (paper 5.1): of a stretch chain's parts, at most one enters
+//! `three` and at most one enters `one` in a frame. A part in `three` says "these two elements
+//! span this many elements' length" (its claim); the stretch rule then inserts the difference,
+//! and the shrink rule removes it for a part in `one`.
+//!
 //! When a chain is stretched evenly (least squares, p = 2), every part reaches the switching
-//! stretch together and all would enter `three` at once: each then claims an extra half
-//! element on both sides, the chain has room for far fewer, and the solve squeezes the parts
-//! still in `two` to keep the claimed ones at rest. The rule then inserts one element for
-//! every claimed pair, and the chain ends overfull and buckles (41 bricks in a 40 m wall
-//! pulled to 5x). So in a frame a switch into `three` (`one`) is kept only for the part that
-//! fits that state best: the rest of the chain waits for the rewrite and the solve after it,
-//! which is when the chain's length is known again. Parts that entered the state in earlier
-//! frames keep it (with the rules off, a chain may hold many parts in `three`).
+//! stretch together and all would enter `three` at once: each then claims room on both sides,
+//! the chain has room for far fewer, and the solve squeezes the parts still in `two` to keep
+//! the claimed ones at rest. The rule would insert for every claim, and the chain would end
+//! overfull and buckle (41 bricks in a 40 m wall pulled to 5x). So in a frame only the part
+//! with the largest claim (the farthest from two elements; among equal claims, the one that
+//! fits its state best) keeps its switch: the rest of the chain waits for the rewrite and the
+//! solve after it, which is when the chain's length is known again. A claim made earlier in
+//! the frame gives way to a larger one later (pass 1 gathers the deformation as it iterates:
+//! the first part to pass the threshold is seldom where the whole of it ends up). Parts that
+//! entered the state in earlier frames keep it (with the rules off, a chain may hold many
+//! parts in `three`).
 
 use std::collections::BTreeMap;
 
@@ -18,67 +22,85 @@ use clay_dsl::compiled::{Part, PartKind, STRETCH_ONE, STRETCH_THREE};
 
 use super::StateSwitch;
 
-/// Undoes the switches in `switches[from..]` (this local step's; `switches[..from]` are the
-/// frame's earlier ones) that would let a chain claim a second element in one frame (see the
-/// module doc): among a chain's new switches into `three` (or `one`), the part with the
-/// smallest squared stacked residual in it (`residuals`, per part) keeps its switch, unless
-/// an earlier step of the frame already switched a part of the chain into that state. The
-/// reverted parts get their previous state back and their entries leave `switches`. Returns
-/// whether any was reverted (their rotations and targets are then stale: the caller
-/// evaluates again keeping the states).
+/// Keeps, for every chain and each of `three` and `one`, only the best of the parts that
+/// entered that state during the frame and are still in it (see the module doc): `claims` and
+/// `residuals` are this local step's, per part. The switches of this step
+/// (`switches[from..]`) that lose are undone and leave the list; an earlier switch of the frame
+/// that loses is undone by a switch back, appended. Returns whether any was undone (their
+/// rotations and targets are then stale: the caller evaluates again keeping the states).
 pub fn one_per_chain(
     parts: &mut [Part],
     switches: &mut Vec<StateSwitch>,
     from: usize,
     residuals: &[f64],
+    claims: &[i32],
 ) -> bool {
-    let growth = |state: usize| state == STRETCH_THREE || state == STRETCH_ONE;
-    let chain_of = |part: &Part| match part.kind {
-        PartKind::Stretch { chain, .. } => Some(chain),
-        PartKind::Piece { .. } => None,
+    let claim = |parts: &[Part], s: &StateSwitch| match parts[s.part].kind {
+        PartKind::Stretch { chain, .. }
+            if (s.to == STRETCH_THREE || s.to == STRETCH_ONE) && parts[s.part].active == s.to =>
+        {
+            Some((chain, s.to))
+        }
+        _ => None,
     };
-    let claim = |s: &StateSwitch| {
-        chain_of(&parts[s.part])
-            .filter(|_| growth(s.to))
-            .map(|chain| (chain, s.to))
-    };
-    if !switches[from..].iter().any(|s| claim(s).is_some()) {
+    if !switches[from..].iter().any(|s| claim(parts, s).is_some()) {
         return false;
     }
-    // (chain, state) -> the part whose claim stands (`None`: claimed earlier this frame);
-    // ties go to the lower part index, so the choice is deterministic
-    let mut keep: BTreeMap<(usize, usize), Option<(f64, usize)>> = BTreeMap::new();
+    // (chain, state) -> the standing claim: the most elements claimed (the farthest from
+    // two), then the smaller residual, then the lower part index (deterministic)
+    let rank = |part: usize| {
+        let change = claims.get(part).map_or(1, |&c| (i64::from(c) - 2).abs());
+        let r = residuals.get(part).copied().unwrap_or(f64::INFINITY);
+        (-change, r, part)
+    };
+    let mut best: BTreeMap<(usize, usize), (i64, f64, usize)> = BTreeMap::new();
+    for s in switches.iter() {
+        let Some(key) = claim(parts, s) else { continue };
+        let r = rank(s.part);
+        let slot = best.entry(key).or_insert(r);
+        if r.0 < slot.0 || (r.0 == slot.0 && (r.1 < slot.1 || (r.1 == slot.1 && r.2 < slot.2))) {
+            *slot = r;
+        }
+    }
+    let loses =
+        |parts: &[Part], s: &StateSwitch| claim(parts, s).is_some_and(|key| best[&key].2 != s.part);
+    // earlier switches that lose are switched back (in the order of their first switch);
+    // a part that also switched in this step is undone with this step's switches below
+    let mut back = Vec::new();
+    let now: Vec<usize> = switches[from..].iter().map(|s| s.part).collect();
     for s in &switches[..from] {
-        if let Some(key) = claim(s) {
-            keep.insert(key, None);
-        }
-    }
-    for s in &switches[from..] {
-        let Some(key) = claim(s) else { continue };
-        let r = residuals.get(s.part).copied().unwrap_or(f64::INFINITY);
-        let slot = keep.entry(key).or_insert(Some((r, s.part)));
-        if let Some(best) = slot
-            && r < best.0
+        if loses(parts, s)
+            && !now.contains(&s.part)
+            && !back.iter().any(|b: &StateSwitch| b.part == s.part)
         {
-            *best = (r, s.part);
+            back.push(StateSwitch {
+                part: s.part,
+                from: s.to,
+                to: s.from,
+            });
         }
     }
-    let stands: Vec<bool> = switches[from..]
-        .iter()
-        .map(|s| claim(s).is_none_or(|key| keep[&key].is_some_and(|(_, p)| p == s.part)))
-        .collect();
+    // this step's switches that lose never happened
     let before = switches.len();
-    let mut stands = stands.into_iter();
     let mut k = 0;
+    let mut undone = Vec::new();
     switches.retain(|s| {
         k += 1;
-        if k <= from || stands.next() == Some(true) {
+        if k <= from || !loses(parts, s) {
             return true;
         }
-        parts[s.part].active = s.from;
+        undone.push((s.part, s.from));
         false
     });
-    switches.len() != before
+    for (part, state) in undone {
+        parts[part].active = state;
+    }
+    for b in &back {
+        parts[b.part].active = b.to;
+    }
+    let changed = switches.len() != before || !back.is_empty();
+    switches.extend(back);
+    changed
 }
 
 #[cfg(test)]
@@ -113,19 +135,24 @@ mod tests {
             .collect()
     }
 
+    fn active(parts: &[Part]) -> Vec<usize> {
+        parts.iter().map(|p| p.active).collect()
+    }
+
     #[test]
-    fn only_the_best_fitting_part_of_a_chain_grows() {
+    fn only_the_best_fitting_part_of_an_evenly_claiming_chain_grows() {
         let mut parts = chain_parts(4);
         let mut switches = switch_all(&mut parts, STRETCH_THREE);
+        let residuals = [0.3, 0.1, 0.2, 0.1];
         assert!(one_per_chain(
             &mut parts,
             &mut switches,
             0,
-            &[0.3, 0.1, 0.2, 0.1]
+            &residuals,
+            &[3; 4]
         ));
-        let active: Vec<usize> = parts.iter().map(|p| p.active).collect();
         assert_eq!(
-            active,
+            active(&parts),
             [STRETCH_TWO, STRETCH_THREE, STRETCH_TWO, STRETCH_TWO]
         );
         assert_eq!(switches.len(), 1);
@@ -133,7 +160,23 @@ mod tests {
     }
 
     #[test]
-    fn a_claim_earlier_in_the_frame_holds_the_chain_and_chains_are_apart() {
+    fn the_largest_claim_stands() {
+        let mut parts = chain_parts(3);
+        let mut switches = switch_all(&mut parts, STRETCH_THREE);
+        // part 2 claims 7 elements: it stands although it fits its state worst
+        let residuals = [0.1, 0.1, 5.0];
+        assert!(one_per_chain(
+            &mut parts,
+            &mut switches,
+            0,
+            &residuals,
+            &[3, 4, 7]
+        ));
+        assert_eq!(active(&parts), [STRETCH_TWO, STRETCH_TWO, STRETCH_THREE]);
+    }
+
+    #[test]
+    fn an_earlier_claim_gives_way_to_a_larger_one_and_chains_are_apart() {
         let mut parts = chain_parts(3);
         parts[2].kind = PartKind::Stretch { chain: 1, first: 0 };
         for p in &mut parts {
@@ -144,18 +187,50 @@ mod tests {
             from: STRETCH_TWO,
             to: STRETCH_THREE,
         };
-        // part 0 switched in an earlier iteration of the frame
+        // part 0 switched in an earlier iteration of the frame and now claims 3; part 1
+        // claims 5 in this step: part 0 switches back
         let mut switches = vec![switch(0), switch(1), switch(2)];
         assert!(one_per_chain(
             &mut parts,
             &mut switches,
             1,
-            &[0.5, 0.0, 0.0]
+            &[0.0; 3],
+            &[3, 5, 3]
         ));
-        let active: Vec<usize> = parts.iter().map(|p| p.active).collect();
-        assert_eq!(active, [STRETCH_THREE, STRETCH_TWO, STRETCH_THREE]);
-        let left: Vec<usize> = switches.iter().map(|s| s.part).collect();
-        assert_eq!(left, [0, 2]);
+        assert_eq!(active(&parts), [STRETCH_TWO, STRETCH_THREE, STRETCH_THREE]);
+        let left: Vec<(usize, usize)> = switches.iter().map(|s| (s.part, s.to)).collect();
+        assert_eq!(
+            left,
+            [
+                (0, STRETCH_THREE),
+                (1, STRETCH_THREE),
+                (2, STRETCH_THREE),
+                (0, STRETCH_TWO)
+            ]
+        );
+    }
+
+    #[test]
+    fn an_earlier_claim_as_large_holds_the_chain() {
+        let mut parts = chain_parts(2);
+        for p in &mut parts {
+            p.active = STRETCH_THREE;
+        }
+        let switch = |part| StateSwitch {
+            part,
+            from: STRETCH_TWO,
+            to: STRETCH_THREE,
+        };
+        let mut switches = vec![switch(0), switch(1)];
+        assert!(one_per_chain(
+            &mut parts,
+            &mut switches,
+            1,
+            &[0.0, 0.0],
+            &[3, 3]
+        ));
+        assert_eq!(active(&parts), [STRETCH_THREE, STRETCH_TWO]);
+        assert_eq!(switches.len(), 1);
     }
 
     #[test]
@@ -172,7 +247,8 @@ mod tests {
             &mut parts,
             &mut switches,
             0,
-            &[0.0, 0.0, 0.1]
+            &[0.0, 0.0, 0.1],
+            &[3; 3]
         ));
         assert_eq!(parts[2].active, STRETCH_THREE);
     }
@@ -194,7 +270,13 @@ mod tests {
                 to: STRETCH_THREE,
             },
         ];
-        assert!(!one_per_chain(&mut parts, &mut switches, 0, &[0.1, 0.1]));
+        assert!(!one_per_chain(
+            &mut parts,
+            &mut switches,
+            0,
+            &[0.1, 0.1],
+            &[1, 3]
+        ));
         assert_eq!(switches.len(), 2);
     }
 }

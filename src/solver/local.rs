@@ -16,6 +16,78 @@ pub struct Alignment {
     pub distance: f64,
 }
 
+/// What the local step knows of a stretch part besides its rest states (paper 5.1): the
+/// direction its chain ran in when the frame started, and which of its states the stretch
+/// rule can honour now.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StretchContext {
+    /// The part's rotation in the pose the frame started from (the displayed one): the
+    /// direction along which its length is measured. The pass-1 pose may fold a squeezed
+    /// part onto itself, and the best rotation of a folded part turns it round, so a squeeze
+    /// would read as a stretch.
+    pub reference: DVec2,
+    /// Bit `j` set: state `j` may become active. A state the rule cannot apply (`one` at the
+    /// chain's `min` or between two held elements, `three` at its `max`) is unavailable
+    /// rather than chosen: a part left in it would hold a shape its chain never gets.
+    pub allowed: u8,
+}
+
+impl StretchContext {
+    fn allows(&self, state: usize) -> bool {
+        state < 8 && self.allowed & (1 << state) != 0
+    }
+}
+
+/// How a switching local step decides (paper 4.3, 5.1).
+#[derive(Clone, Copy, Debug)]
+pub struct Switching<'a> {
+    /// A part switches to a nearer state only when it is closer by this fraction.
+    pub hysteresis: f64,
+    /// Per part, in part order: the stretch parts' contexts (`None` for other parts; an
+    /// empty slice decides every part by its distances alone).
+    pub stretch: &'a [Option<StretchContext>],
+    /// The parts around every vertex: with it, a piece part's rest state is judged by the
+    /// vertices it shares with other parts ([`boundary_of`]); without, by all its vertices.
+    pub shared: Option<&'a VertexParts>,
+}
+
+impl<'a> Switching<'a> {
+    /// Every part by its distances alone, with `hysteresis`.
+    #[cfg(test)]
+    pub fn plain(hysteresis: f64) -> Self {
+        Self {
+            hysteresis,
+            stretch: &[],
+            shared: None,
+        }
+    }
+
+    fn context(&self, pi: usize, part: &Part) -> Option<StretchContext> {
+        let stretch = matches!(part.kind, clay_dsl::compiled::PartKind::Stretch { .. })
+            && part.states.len() == 3;
+        if stretch {
+            self.stretch.get(pi).copied().flatten()
+        } else {
+            None
+        }
+    }
+}
+
+/// A switching local step's choice for one part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Chosen {
+    pub state: usize,
+    /// The rotation of that state onto the pose.
+    pub rotation: DVec2,
+    /// For a stretch part, how many elements its two span in the pose: at least 3 in
+    /// `three`, 2 in `two`, 1 or fewer in `one` (a part squeezed past one element's length,
+    /// folded onto itself, spans fewer than none); 0 for other parts.
+    pub claim: i32,
+}
+
+/// The most elements a stretch part may claim or give up (far beyond any model).
+pub const MAX_CLAIM: i32 = 1 << 20;
+
 /// Aligns `rest` (one position per vertex) to the current positions of `vertices`.
 /// Degenerate poses (all coincident) give the identity rotation, never NaN.
 pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignment {
@@ -75,29 +147,296 @@ fn distance_of(pp: f64, qq: f64, len: f64) -> f64 {
     }
 }
 
-/// Picks the active state of `part` for the current positions: the nearest rest state, but
-/// only when it is closer than `(1 - hysteresis)` times the active one (paper 4.3). Returns
-/// the (possibly new) active state and the rotation of that state onto the pose.
-pub fn choose_state(part: &Part, positions: &[DVec2], hysteresis: f64) -> (usize, DVec2) {
+/// Picks the active state of part `pi` (`part`) for the current positions: the nearest rest
+/// state, but only when it is closer than `(1 - hysteresis)` times the active one (paper
+/// 4.3); a stretch part with a context decides by [`decide_stretch`]. Returns the (possibly
+/// new) active state, the rotation of that state onto the pose and the part's claim.
+pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Chosen {
+    let hysteresis = how.hysteresis;
     let active = part.active.min(part.states.len().saturating_sub(1));
     let Some(current) = part.states.get(active) else {
-        return (0, DVec2::X);
+        return Chosen {
+            state: 0,
+            rotation: DVec2::X,
+            claim: 0,
+        };
     };
+    if let Some(ctx) = how.context(pi, part)
+        && let Some(sums) = state_sums(part, positions)
+    {
+        return decide_stretch(sums, active, hysteresis, ctx);
+    }
     let here = align(&current.positions, &part.vertices, positions);
     if part.states.len() < 2 {
-        return (active, here.rotation);
+        return Chosen {
+            state: active,
+            rotation: here.rotation,
+            claim: 0,
+        };
     }
-    let mut best = (active, here);
+    // judged on the shared vertices when the part has enough of them, else on all
+    let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
+    let judge = |rest: &[DVec2]| match &boundary {
+        Some(ks) => {
+            let r: Vec<DVec2> = ks.iter().map(|&k| rest[k]).collect();
+            let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
+            align(&r, &vs, positions)
+        }
+        None => align(rest, &part.vertices, positions),
+    };
+    let mut best = (active, judge(&current.positions));
+    let judged_here = best.1;
     for (j, state) in part.states.iter().enumerate() {
         if j == active {
             continue;
         }
-        let a = align(&state.positions, &part.vertices, positions);
+        let a = judge(&state.positions);
         if a.distance < best.1.distance {
             best = (j, a);
         }
     }
-    with_hysteresis(active, here, best, hysteresis)
+    let (state, _) = with_hysteresis(active, judged_here, best, hysteresis);
+    let rotation = if state == active {
+        here.rotation
+    } else {
+        align(&part.states[state].positions, &part.vertices, positions).rotation
+    };
+    Chosen {
+        state,
+        rotation,
+        claim: 0,
+    }
+}
+
+/// The local indices of the vertices of a piece part with alternative rest states that it
+/// shares with other parts, when there are at least two and fewer than all (paper 5.1,
+/// replacement: "the shape of the boundary vertices determines which piece to insert"). The
+/// others belong to the part alone and take whichever state it takes, so they decide nothing:
+/// judged with them, a segment whose ends are where its bent state puts them reads as
+/// no nearer that state than its straight one, its middle still where the straight state's
+/// elasticity holds it.
+pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Vec<usize>> {
+    if !matches!(part.kind, clay_dsl::compiled::PartKind::Piece { .. }) || part.states.len() < 2 {
+        return None;
+    }
+    let ks: Vec<usize> = (0..part.vertices.len())
+        .filter(|&k| shared.of(part.vertices[k]).len() >= 2)
+        .collect();
+    if ks.len() < 2 || ks.len() == part.vertices.len() {
+        return None;
+    }
+    // the states must differ there: a part docked by one site has that site's shape in
+    // every state, and its distances would all be rounding
+    let at = |j: usize| -> Option<Vec<DVec2>> {
+        ks.iter()
+            .map(|&k| part.states[j].positions.get(k).copied())
+            .collect()
+    };
+    let first = at(0)?;
+    let scale: f64 = {
+        let c = first.iter().copied().sum::<DVec2>() / first.len() as f64;
+        first.iter().map(|p| (*p - c).length_squared()).sum()
+    };
+    let differ = (1..part.states.len()).any(|j| {
+        at(j).is_some_and(|other| {
+            let indices: Vec<usize> = (0..other.len()).collect();
+            align(&first, &indices, &other).distance > 1e-9 * scale
+        })
+    });
+    differ.then_some(ks)
+}
+
+/// A stretch part's sums over its centred pose for its three states (as [`align`] forms
+/// them): `(dot, cross, pp)` per state and the pose's squared norm. `None` when a state has
+/// fewer positions than the part has vertices.
+fn state_sums(part: &Part, positions: &[DVec2]) -> Option<StateSums> {
+    let m = part.vertices.len();
+    if m == 0 || part.states.iter().any(|s| s.positions.len() < m) {
+        return None;
+    }
+    let inv = 1.0 / m as f64;
+    let pose_centre = part.vertices.iter().map(|&v| positions[v]).sum::<DVec2>() * inv;
+    let mut sums = StateSums::default();
+    for (j, state) in part.states.iter().take(3).enumerate() {
+        let rest = &state.positions[..m];
+        let rest_centre = rest.iter().copied().sum::<DVec2>() * inv;
+        let (mut dot, mut cross, mut pp, mut qq) = (0.0, 0.0, 0.0, 0.0);
+        for (k, &v) in part.vertices.iter().enumerate() {
+            let p = rest[k] - rest_centre;
+            let q = positions[v] - pose_centre;
+            dot += p.dot(q);
+            cross += p.perp_dot(q);
+            pp += p.length_squared();
+            qq += q.length_squared();
+        }
+        sums.dot[j] = dot;
+        sums.cross[j] = cross;
+        sums.pp[j] = pp;
+        sums.qq = qq;
+    }
+    let ends = StretchEnds::find(
+        &part.states[0].positions[..m],
+        &part.states[2].positions[..m],
+    )?;
+    sums.span = ends.span(|k| positions[part.vertices[k]]);
+    sums.element = ends.element;
+    sums.axis = ends.axis;
+    Some(sums)
+}
+
+/// The sums a stretch part's decision reads (see [`state_sums`]), and its span: where its
+/// far end (the second element's `to` site) is from its near end (the first element's `from`
+/// site) in the pose, `span`, against `ends.element`, one element's length at rest.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StateSums {
+    pub dot: [f64; 3],
+    pub cross: [f64; 3],
+    pub pp: [f64; 3],
+    pub qq: f64,
+    pub span: DVec2,
+    pub element: f64,
+    /// The chain's direction in the part's rest frame (unit).
+    pub axis: DVec2,
+}
+
+/// A stretch part's ends, found from its rest states: its `one`, `two` and `three` states
+/// differ only along the axis, by the vertex's distance from the near end, so the vertices
+/// that do not move between `one` and `three` are the near end (the first element's `from`
+/// site) and those that move most are the far end (the second element's `to` site).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StretchEnds {
+    pub near: Vec<usize>,
+    /// The first element's `to` site (the second's `from`): half way in `three - one`.
+    pub middle: Vec<usize>,
+    pub far: Vec<usize>,
+    /// The chain's direction in the part's rest frame (unit), and one element's length.
+    pub axis: DVec2,
+    pub element: f64,
+}
+
+impl StretchEnds {
+    /// From the `one` and `three` rest positions (one per vertex of the part).
+    pub fn find(one: &[DVec2], three: &[DVec2]) -> Option<Self> {
+        let moved: Vec<DVec2> = one.iter().zip(three).map(|(&a, &b)| b - a).collect();
+        let longest = moved.iter().map(|d| d.length()).fold(0.0, f64::max);
+        if !(longest > 0.0 && longest.is_finite()) {
+            return None;
+        }
+        let tolerance = 1e-9 * longest;
+        let near: Vec<usize> = (0..moved.len())
+            .filter(|&k| moved[k].length() <= tolerance)
+            .collect();
+        let far: Vec<usize> = (0..moved.len())
+            .filter(|&k| moved[k].length() >= longest - tolerance)
+            .collect();
+        let middle: Vec<usize> = (0..moved.len())
+            .filter(|&k| (moved[k].length() - longest / 2.0).abs() <= tolerance)
+            .collect();
+        // `three - one` moves the far end by two elements' length (3/2 - 1/2 of the two)
+        let axis = moved[far[0]] / longest;
+        (!near.is_empty() && !middle.is_empty()).then_some(Self {
+            near,
+            middle,
+            far,
+            axis,
+            element: longest / 2.0,
+        })
+    }
+
+    /// The far end's centre less the near end's, in `pose` (the part's vertices' positions).
+    pub fn span(&self, pose: impl Fn(usize) -> DVec2) -> DVec2 {
+        let centre = |ks: &[usize]| ks.iter().map(|&k| pose(k)).sum::<DVec2>() / ks.len() as f64;
+        centre(&self.far) - centre(&self.near)
+    }
+
+    /// The spans of the part's two elements (from their `from` site's centre to their `to`
+    /// site's), in `pose`.
+    pub fn element_spans(&self, pose: impl Fn(usize) -> DVec2) -> [DVec2; 2] {
+        let centre = |ks: &[usize]| ks.iter().map(|&k| pose(k)).sum::<DVec2>() / ks.len() as f64;
+        let (near, middle, far) = (centre(&self.near), centre(&self.middle), centre(&self.far));
+        [middle - near, far - middle]
+    }
+}
+
+/// A stretch part's state (paper 5.1, the stretch rule's `one`, `two`, `three`). Its three
+/// rest states are its two elements scaled along the chain's axis by 1/2, 1 and 3/2, so the
+/// rest shape of its two elements stretched to span `c` elements is the same affine family at
+/// scale `c / 2`, and every sum the shape distance needs is an affine (the rest norm: a
+/// quadratic) function of the scale, known from the three states' sums.
+///
+/// The part is measured in the frame of its rotation when the frame began
+/// ([`StretchContext::reference`]), not in its best rotation: pass 1 may fold a squeezed part
+/// onto itself, and the best rotation of a folded part turns it round, so a squeeze would
+/// read as a stretch. Its length `c` in elements is its span, from the near end to the far
+/// end along the chain's direction in that frame (the sparse norm gathers a stretch into one
+/// of the two elements, so the scale that fits all its vertices best would mislead). The state the length calls for is the candidate: `three` from 2.5 elements on
+/// (claiming the nearest count, however many: a part stretched far beyond three fits the
+/// three-element shape no better, by the hysteresis's margin, than two), `one` up to 1.5,
+/// else `two`. The candidate replaces the active state when its shape distance (for a claim
+/// of `c` elements, the distance to the `c`-element shape) is below `(1 - hysteresis)` times
+/// the active state's (paper 4.3); at once when the part is no longer than `one` (beyond
+/// the states' range both distances grow alike, and the margin would never be met) or when
+/// the active state has become unavailable.
+pub fn decide_stretch(
+    sums: StateSums,
+    active: usize,
+    hysteresis: f64,
+    ctx: StretchContext,
+) -> Chosen {
+    use clay_dsl::compiled::{STRETCH_ONE as ONE, STRETCH_THREE as THREE, STRETCH_TWO as TWO};
+    let StateSums {
+        dot, cross, pp, qq, ..
+    } = sums;
+    let r = ctx.reference;
+    // the squared distance to a rest shape with these sums, turned by the reference
+    let distance =
+        |dot: f64, cross: f64, pp: f64| (pp + qq - 2.0 * (r.x * dot + r.y * cross)).max(0.0);
+    let fixed: [f64; 3] = std::array::from_fn(|j| distance(dot[j], cross[j], pp[j]));
+    // the span along the chain's direction, in elements
+    let length = sums.span.dot(r.rotate(sums.axis)) / sums.element;
+    let length = if length.is_finite() { length } else { 2.0 };
+    let elements = length
+        .round()
+        .clamp(-f64::from(MAX_CLAIM), f64::from(MAX_CLAIM)) as i32;
+    let count = elements.max(1);
+    let mut candidate = match count {
+        1 => ONE,
+        2 => TWO,
+        _ => THREE,
+    };
+    if !ctx.allows(candidate) {
+        candidate = TWO;
+    }
+    let candidate_distance = if candidate == THREE && count > 3 {
+        // the `count`-element shape: t = count - 2 steps of `three - two` from `two`
+        let t = f64::from(count - 2);
+        let d = dot[TWO] + t * (dot[THREE] - dot[TWO]);
+        let c = cross[TWO] + t * (cross[THREE] - cross[TWO]);
+        let linear = (pp[THREE] - pp[ONE]) / 4.0;
+        let quadratic = (pp[ONE] + pp[THREE]) / 2.0 - pp[TWO];
+        distance(d, c, pp[TWO] + 2.0 * t * linear + t * t * quadratic)
+    } else {
+        fixed[candidate]
+    };
+    let beyond_one = candidate == ONE && length <= 1.0;
+    let switch = candidate != active
+        && (!ctx.allows(active)
+            || beyond_one
+            || candidate_distance < (1.0 - hysteresis) * fixed[active]);
+    let state = if switch { candidate } else { active };
+    let claim = match state {
+        ONE if candidate == ONE => elements.min(1),
+        ONE => 1,
+        TWO => 2,
+        _ if candidate == THREE => count.max(3),
+        _ => 3,
+    };
+    let len = (dot[state] * dot[state] + cross[state] * cross[state]).sqrt();
+    Chosen {
+        state,
+        rotation: rotation_of(dot[state], cross[state], len),
+        claim,
+    }
 }
 
 /// Paper 4.3: the nearest state `best` replaces the active one only when it is closer than
@@ -272,6 +611,11 @@ const SHORT: u32 = u32::MAX;
 pub struct RestCache {
     spans: Vec<Span>,
     shapes: Vec<Shape>,
+    /// Per shape: a stretch part's ends ([`StretchEnds`]), `None` for other shapes.
+    ends: Vec<Option<StretchEnds>>,
+    /// Per part: its index into `boundaries` ([`SHORT`]: none; see [`boundary_of`]).
+    boundary_at: Vec<u32>,
+    boundaries: Vec<Boundary>,
     vertices: Vec<u32>,
     rest: Vec<DVec2>,
     /// Per shape and state: the squared norm of its centred positions.
@@ -296,6 +640,36 @@ pub struct RestCache {
     /// read the parts again.
     active: Vec<usize>,
     noted: usize,
+}
+
+/// The vertices a piece part shares with other parts ([`boundary_of`]), with every state's
+/// positions of them centred, and their squared norms.
+#[derive(Clone, Debug, Default)]
+struct Boundary {
+    local: Vec<usize>,
+    /// State `j`'s centred positions at `j * local.len()`.
+    rest: Vec<DVec2>,
+    pp: Vec<f64>,
+}
+
+impl Boundary {
+    fn new(part: &Part, local: Vec<usize>) -> Self {
+        let b = local.len();
+        let mut rest = Vec::with_capacity(b * part.states.len());
+        let mut pp = Vec::with_capacity(part.states.len());
+        for state in &part.states {
+            let r: Vec<DVec2> = local.iter().map(|&k| state.positions[k]).collect();
+            let centre = r.iter().copied().sum::<DVec2>() / b as f64;
+            let mut norm = 0.0;
+            for p in r {
+                let c = p - centre;
+                norm += c.length_squared();
+                rest.push(c);
+            }
+            pp.push(norm);
+        }
+        Self { local, rest, pp }
+    }
 }
 
 /// Converts an index into the cache's compact form (`None` when it does not fit).
@@ -362,6 +736,17 @@ impl RestCache {
                 let end = |k: usize| part.vertices.get(k).copied().and_then(compact);
                 c.edge_ends.push([end(e[0])?, end(e[1])?]);
             }
+            let dense = part
+                .states
+                .iter()
+                .all(|st| st.positions.len() >= part.vertices.len());
+            match boundary_of(part, vertex_parts).filter(|_| dense) {
+                Some(local) => {
+                    c.boundary_at.push(compact(c.boundaries.len())?);
+                    c.boundaries.push(Boundary::new(part, local));
+                }
+                None => c.boundary_at.push(SHORT),
+            }
         }
         c.spans.push(Span {
             vertex: compact(c.vertices.len())?,
@@ -420,7 +805,37 @@ impl RestCache {
         }
         let index = compact(self.shapes.len())?;
         self.shapes.push(shape);
+        let stretch = matches!(part.kind, clay_dsl::compiled::PartKind::Stretch { .. })
+            && part.states.len() == 3
+            && dense;
+        self.ends.push(
+            stretch
+                .then(|| {
+                    StretchEnds::find(
+                        &part.states[0].positions[..m],
+                        &part.states[2].positions[..m],
+                    )
+                })
+                .flatten(),
+        );
         Some(index)
+    }
+
+    /// A stretch part's two elements' lengths in elements at `positions`, each measured
+    /// along its chain's direction turned by `reference`; `None` for other parts.
+    pub fn element_lengths(
+        &self,
+        pi: usize,
+        part: &Part,
+        positions: &[DVec2],
+        reference: DVec2,
+    ) -> Option<[f64; 2]> {
+        let (s, _) = self.dense_span(pi, part)?;
+        let ends = self.ends[s.shape as usize].as_ref()?;
+        let verts = &self.vertices[s.vertex as usize..];
+        let axis = reference.rotate(ends.axis);
+        let spans = ends.element_spans(|k| positions[verts[k] as usize]);
+        Some(spans.map(|d| d.dot(axis) / ends.element))
     }
 
     /// Number of parts the cache was built for.
@@ -486,12 +901,14 @@ impl RestCache {
         pi: usize,
         part: &Part,
         positions: &[DVec2],
-        hysteresis: f64,
-    ) -> (usize, DVec2) {
-        let (state, rotation) = self.choose_state_of(pi, part, positions, hysteresis);
-        // the caller makes `state` the part's active state
-        self.note(pi, state);
-        (state, rotation)
+        how: Switching,
+    ) -> Chosen {
+        let mut pose = std::mem::take(&mut self.pose);
+        let chosen = self.choose_with(pi, part, positions, how, &mut pose);
+        self.pose = pose;
+        // the caller makes `chosen.state` the part's active state
+        self.note(pi, chosen.state);
+        chosen
     }
 
     /// Records part `pi`'s active state; `noted` counts the parts noted in order from 0.
@@ -505,19 +922,6 @@ impl RestCache {
         self.noted = if pi == self.noted { pi + 1 } else { usize::MAX };
     }
 
-    fn choose_state_of(
-        &mut self,
-        pi: usize,
-        part: &Part,
-        positions: &[DVec2],
-        hysteresis: f64,
-    ) -> (usize, DVec2) {
-        let mut pose = std::mem::take(&mut self.pose);
-        let chosen = self.choose_with(pi, part, positions, hysteresis, &mut pose);
-        self.pose = pose;
-        chosen
-    }
-
     /// [`choose_state`] for part `pi` (which is `part`), with `pose` as scratch (at least as
     /// long as the largest part).
     pub fn choose_with(
@@ -525,25 +929,52 @@ impl RestCache {
         pi: usize,
         part: &Part,
         positions: &[DVec2],
-        hysteresis: f64,
+        how: Switching,
         pose: &mut [DVec2],
-    ) -> (usize, DVec2) {
+    ) -> Chosen {
         let Some((s, shape)) = self.dense_span(pi, part) else {
-            return choose_state(part, positions, hysteresis);
+            return choose_state(pi, part, positions, how);
         };
         let count = shape.states as usize;
         if count == 0 {
-            return choose_state(part, positions, hysteresis);
+            return choose_state(pi, part, positions, how);
         }
+        let hysteresis = how.hysteresis;
         let m = part.vertices.len();
         let active = part.active.min(count - 1);
         let qq = self.gather_pose(s, m, positions, pose);
         let pose = &pose[..m];
         let rest = &self.rest[shape.rest as usize..][..count * m];
         let pp = &self.pp[shape.pp as usize..][..count];
+        if let Some(ctx) = how.context(pi, part)
+            && let Some(ends) = &self.ends[s.shape as usize]
+        {
+            let mut sums = StateSums {
+                qq,
+                span: ends.span(|k| pose[k]),
+                element: ends.element,
+                axis: ends.axis,
+                ..StateSums::default()
+            };
+            for j in 0..3 {
+                (sums.dot[j], sums.cross[j]) = products(&rest[j * m..][..m], pose);
+                sums.pp[j] = pp[j];
+            }
+            return decide_stretch(sums, active, hysteresis, ctx);
+        }
+        if how.shared.is_some()
+            && let Some(b) = self
+                .boundary_at
+                .get(pi)
+                .and_then(|&i| self.boundaries.get(i as usize))
+            && b.pp.len() == count
+        {
+            return self
+                .decide_on_boundary(b, s, pose, positions, rest, pp, qq, active, hysteresis);
+        }
         // One pass over the pose for all states (each state's sums still run in vertex
         // order), then the reference's comparisons on the distances.
-        match count {
+        let (state, rotation) = match count {
             1 => decide::<1>(pose, rest, pp, qq, active, hysteresis),
             2 => decide::<2>(pose, rest, pp, qq, active, hysteresis),
             3 => decide::<3>(pose, rest, pp, qq, active, hysteresis),
@@ -563,6 +994,62 @@ impl RestCache {
                 }
                 with_hysteresis(active, here, best, hysteresis)
             }
+        };
+        Chosen {
+            state,
+            rotation,
+            claim: 0,
+        }
+    }
+
+    /// [`choose_state`]'s decision for a part judged on its boundary `b` (see
+    /// [`boundary_of`]): the states' distances over the boundary vertices, the chosen
+    /// state's rotation over all of them (`pose`, `rest`, `pp`, `qq`: the whole part's, as
+    /// [`RestCache::choose_with`] gathered them).
+    #[allow(clippy::too_many_arguments)]
+    fn decide_on_boundary(
+        &self,
+        b: &Boundary,
+        s: Span,
+        pose: &[DVec2],
+        positions: &[DVec2],
+        rest: &[DVec2],
+        pp: &[f64],
+        qq: f64,
+        active: usize,
+        hysteresis: f64,
+    ) -> Chosen {
+        let verts = &self.vertices[s.vertex as usize..];
+        let n = b.local.len();
+        let centre = b
+            .local
+            .iter()
+            .map(|&k| positions[verts[k] as usize])
+            .sum::<DVec2>()
+            / n as f64;
+        let q: Vec<DVec2> = (b.local.iter())
+            .map(|&k| positions[verts[k] as usize] - centre)
+            .collect();
+        let qq_b: f64 = q.iter().map(|p| p.length_squared()).sum();
+        let judge = |j: usize| {
+            let (dot, cross) = products(&b.rest[j * n..][..n], &q);
+            finish(dot, cross, b.pp[j], qq_b)
+        };
+        let here = judge(active);
+        let mut best = (active, here);
+        for j in (0..b.pp.len()).filter(|&j| j != active) {
+            let a = judge(j);
+            if a.distance < best.1.distance {
+                best = (j, a);
+            }
+        }
+        let (state, _) = with_hysteresis(active, here, best, hysteresis);
+        let m = pose.len();
+        let (dot, cross) = products(&rest[state * m..][..m], pose);
+        Chosen {
+            state,
+            rotation: finish(dot, cross, pp[state], qq).rotation,
+            claim: 0,
         }
     }
 
@@ -991,12 +1478,13 @@ mod tests {
             // the switching step, then the states-fixed step, as the solver runs them
             let mut rotations = Vec::new();
             for (pi, part) in parts.iter_mut().enumerate() {
-                let want = choose_state(part, &positions, hysteresis);
-                let got = cache.choose_state(pi, part, &positions, hysteresis);
-                proptest::prop_assert_eq!(want.0, got.0);
-                proptest::prop_assert!(same(want.1, got.1), "{:?} vs {:?}", want.1, got.1);
-                part.active = got.0;
-                rotations.push(got.1);
+                let how = Switching::plain(hysteresis);
+                let want = choose_state(pi, part, &positions, how);
+                let got = cache.choose_state(pi, part, &positions, how);
+                proptest::prop_assert_eq!(want.state, got.state);
+                proptest::prop_assert!(same(want.rotation, got.rotation), "{:?} vs {:?}", want.rotation, got.rotation);
+                part.active = got.state;
+                rotations.push(got.rotation);
             }
             for round in 0..2 {
                 let mut targets = Vec::new();

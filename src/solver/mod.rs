@@ -29,9 +29,13 @@ use std::time::{Duration, Instant};
 use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
-use crate::assembly::{Assembly, Handle};
+use crate::assembly::{Assembly, Handle, HandleKind};
 use cholesky::{NumericFactor, SymbolicFactor};
 use global::Pattern;
+
+/// What runs between a frame's two passes ([`Solver::frame_with`]): the assembly, the report
+/// so far and the pass-1 pose.
+pub type Between<'a> = dyn FnMut(&mut Assembly, &FrameReport, &[DVec2]) + Send + 'a;
 
 /// Buffers sized once per generation and reused every frame.
 #[derive(Debug, Default)]
@@ -74,6 +78,16 @@ struct Work {
     /// Per part: the state the last local step chose, and its squared stacked residual.
     chosen: Vec<usize>,
     residuals: Vec<f64>,
+    /// Per part: the factor of its term in the sparse norm (the handles as outliers:
+    /// [`SolverConfig::handle_outlier`]).
+    outlier: Vec<f64>,
+    /// Per part: a stretch part's context for this frame's switching steps.
+    stretch: Vec<Option<local::StretchContext>>,
+    /// Per part: the claim of the last local step, and of pass 1's last switching step.
+    claims: Vec<i32>,
+    pass1_claims: Vec<i32>,
+    /// Per chain: its length in elements where pass 1 starts (`None`: not measured).
+    chain_lengths: Vec<Option<f64>>,
 }
 
 /// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
@@ -262,7 +276,23 @@ impl Solver {
 
     /// Runs one frame on `asm`: moves its positions, active states and rotations.
     pub fn frame(&mut self, asm: &mut Assembly) -> Result<FrameReport, SolverError> {
-        self.frame_within(asm, None)
+        self.frame_within(asm, None, &mut |_, _, _| {})
+    }
+
+    /// Runs one frame with `between` called after pass 1 (paper 5.2: "after having
+    /// determined the topology, we run a second optimization pass with the ordinary
+    /// least-squares energy, the result of which will be displayed"): it gets the assembly, the
+    /// frame's report so far (switches, claims) and the pass-1 pose, and may rewrite the
+    /// assembly's structure (the stretch and shrink rules); pass 2 then runs on the rewritten
+    /// assembly, from its positions, so what is displayed is the least-squares pose of the
+    /// new structure. `deadline` as for [`Solver::frame_budgeted`] (`None`: no deadline).
+    pub fn frame_with(
+        &mut self,
+        asm: &mut Assembly,
+        deadline: Option<Instant>,
+        between: &mut Between,
+    ) -> Result<FrameReport, SolverError> {
+        self.frame_within(asm, deadline, between)
     }
 
     /// Runs one frame that stops early once `budget` is (about to be) spent, for an editor
@@ -280,19 +310,20 @@ impl Solver {
         budget: Duration,
     ) -> Result<FrameReport, SolverError> {
         let deadline = Instant::now().checked_add(budget);
-        self.frame_within(asm, deadline)
+        self.frame_within(asm, deadline, &mut |_, _, _| {})
     }
 
     fn frame_within(
         &mut self,
         asm: &mut Assembly,
         deadline: Option<Instant>,
+        between: &mut Between,
     ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
         let on_pool = self.frame_uses_pool(asm);
         let mut run = || {
             self.prepare(asm)?;
-            self.frame_prepared(asm, deadline, start)
+            self.frame_prepared(asm, deadline, start, between)
         };
         // A frame whose steps go to both cores runs as one task of the pool, with the pool's
         // second thread kept awake for it: each step's parallel half then starts at once,
@@ -319,11 +350,13 @@ impl Solver {
     }
 
     /// [`Solver::frame_within`] after [`Solver::prepare`] (`start`: when the frame began).
+    // Long because: the frame's steps in order, with the hand-over between its passes.
     fn frame_prepared(
         &mut self,
         asm: &mut Assembly,
         deadline: Option<Instant>,
         start: Instant,
+        between: &mut Between,
     ) -> Result<FrameReport, SolverError> {
         let mut report = FrameReport {
             complete: true,
@@ -352,16 +385,28 @@ impl Solver {
         let scale = bbox_diagonal(&warm).max(1e-9);
         let step_tolerance = cfg.tolerance * scale;
         self.follow_handles(&mut warm, step_tolerance);
-        // Pass 1 starts from the displayed least-squares pose every frame, by either method:
-        // descending from it gathers the deformation into the parts the least-squares pose
-        // already strains most (`docs/solver.md`). The splitting starts with no gaps and no
-        // duals (carried from frame to frame, its variables kept the first frame's gaps).
-        let mut split = std::mem::take(&mut self.splitting);
-        split.reset(self.pattern.edges.len(), &warm);
         let generation = self.generation.unwrap_or(u64::MAX);
         let start_key = Some((generation, cfg, 0));
         if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
             self.work.start.valid = None;
+        }
+        // Pass 1 starts from the displayed least-squares pose with the held vertices where the
+        // handles now put them, by either method: the gesture's new step is where the
+        // deformation starts, so the sparse norm gathers it next to the handle that moved,
+        // and elsewhere into the parts the least-squares pose already strains most
+        // (`docs/solver.md`). The splitting starts with no gaps and no duals (carried from
+        // frame to frame, its variables kept the first frame's gaps).
+        let mut split = std::mem::take(&mut self.splitting);
+        split.reset(self.pattern.edges.len(), &warm);
+        self.snap_held(&mut split.pose);
+        if self.pass1_runs() {
+            // the evaluation at the displayed pose: pass 2 starts there (`Start`), and its
+            // rotations are the directions the stretch parts' lengths are measured along
+            if self.work.start.valid.is_none() {
+                self.start_at(&asm.data().parts, asm.handles(), &warm, start_key);
+            }
+            self.stretch_contexts(asm, &split.pose);
+            self.outlier_factors(&asm.data().parts, asm.handles());
         }
         report.phases.bookkeeping += ms_since(start);
         let pass1 = self.pass1(
@@ -372,9 +417,29 @@ impl Solver {
             &mut report,
         );
         self.splitting = split;
+        self.collect_claims(asm, &mut report);
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
+        let t = Instant::now();
+        let before = asm.generation();
+        between(asm, &report, &self.splitting.pose);
+        if asm.generation() != before {
+            // the structure changed: pass 2 runs on the new one, from the rules' layout
+            self.prepare(asm)?;
+            let n = asm.data().positions.len();
+            self.gather_handles(asm.handles(), n);
+            self.components
+                .free(&self.work.handle_count, &mut self.free_components);
+            warm.clear();
+            warm.extend_from_slice(&asm.data().positions);
+            if warm.iter().any(|p| !p.is_finite()) {
+                return Err(SolverError("a rule laid out non-finite positions".into()));
+            }
+            self.work.start.valid = None;
+        }
+        report.phases.bookkeeping += ms_since(t);
+        let generation = self.generation.unwrap_or(u64::MAX);
         let pass2 = self.pass2(
             &asm.data().parts,
             asm.handles(),
@@ -414,6 +479,238 @@ impl Solver {
         Ok(report)
     }
 
+    /// The claims of the stretch parts pass 1 left in `three` or `one`
+    /// ([`FrameReport::claims`]). With a sub-L1 norm they are sized by their chains' lengths
+    /// where pass 1 started (`work.chain_lengths`): the part's own claim says where the chain
+    /// grows or shrinks, the chain's length (its elements' lengths summed along its
+    /// direction) how many elements it gains or loses. The sparse pass gathers a fast
+    /// gesture's change of length into one part only as far as its iterations got, and a part
+    /// claiming too few would leave the rest to the displayed pose: a chain squeezed in one
+    /// frame to a third of its length then buckles before the rules catch up. With p >= 1
+    /// nothing gathers: a part claims one element (the paper's rule).
+    fn collect_claims(&self, asm: &Assembly, report: &mut FrameReport) {
+        use clay_dsl::compiled::{STRETCH_ONE, STRETCH_THREE};
+        let parts = &asm.data().parts;
+        let claims = &self.work.pass1_claims;
+        let standing: Vec<(usize, usize, i32)> = (parts.iter().enumerate())
+            .filter_map(|(pi, part)| {
+                let PartKind::Stretch { chain, .. } = part.kind else {
+                    return None;
+                };
+                let claim = claims.get(pi).copied();
+                match part.active {
+                    STRETCH_THREE => Some((pi, chain, claim.unwrap_or(3).max(3))),
+                    STRETCH_ONE => Some((pi, chain, claim.unwrap_or(1).min(1))),
+                    _ => None,
+                }
+            })
+            .collect();
+        if standing.is_empty() {
+            return;
+        }
+        let lengths = &self.work.chain_lengths;
+        // only a sub-L1 norm gathers: with p >= 1 every part holds a share of the chain's
+        // change of length, and a part claims one element at a time (paper 5.2)
+        let gathers = self.config.norm < 1.0;
+        for (pi, chain, claim) in standing {
+            let count = asm
+                .data()
+                .chains
+                .get(chain)
+                .map_or(0, |c| c.instances.len()) as f64;
+            let change = lengths
+                .get(chain)
+                .copied()
+                .flatten()
+                .map(|l| l.round() - count);
+            let change = change.filter(|_| gathers);
+            let limit = f64::from(local::MAX_CLAIM);
+            let claim = match change {
+                Some(d) if claim >= 3 && d >= 1.0 => 2 + d.min(limit) as i32,
+                Some(d) if claim <= 1 && d <= -1.0 => 2 + d.max(-limit) as i32,
+                _ if claim >= 3 => 3,
+                _ => 1,
+            };
+            report.claims.push((pi, claim));
+        }
+    }
+
+    /// Per chain, its length in elements at `pose`: every element's span from its `from`
+    /// site to its `to` site along its part's direction (`work.kept_rotations`), summed.
+    /// `None` for a chain some part of which cannot be measured.
+    fn chain_lengths(&self, asm: &Assembly, pose: &[DVec2]) -> Vec<Option<f64>> {
+        let data = asm.data();
+        let mut lengths = vec![Some(0.0); data.chains.len()];
+        let w = &self.work;
+        for (pi, part) in data.parts.iter().enumerate() {
+            let PartKind::Stretch { chain, first } = part.kind else {
+                continue;
+            };
+            let Some(slot) = lengths.get_mut(chain) else {
+                continue;
+            };
+            let count = data.chains[chain].instances.len();
+            let measured = match (&w.rest, w.kept_rotations.get(pi)) {
+                (Some(cache), Some(&r)) => cache.element_lengths(pi, part, pose, r),
+                _ => None,
+            };
+            *slot = match (*slot, measured) {
+                // each element counted once: as its part's first, and the last as the second
+                (Some(sum), Some([a, b])) if first + 2 == count => Some(sum + a + b),
+                (Some(sum), Some([a, _])) => Some(sum + a),
+                _ => None,
+            };
+        }
+        lengths
+    }
+
+    /// Whether pass 1 runs at all (the configured method with any iterations).
+    fn pass1_runs(&self) -> bool {
+        match self.config.pass1 {
+            Pass1::Irls => self.config.irls_iterations > 0,
+            Pass1::Admm => self.config.admm_iterations > 0,
+        }
+    }
+
+    /// Evaluates the local step at the displayed pose `warm` with the states kept and keeps
+    /// it as [`Start`] under `key` (its rotations in `work.kept_rotations`).
+    fn start_at(
+        &mut self,
+        parts: &[Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        key: Option<(u64, SolverConfig, usize)>,
+    ) {
+        let elastic = self.terms_at(parts, handles, warm).elastic;
+        let w = &mut self.work;
+        std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+        std::mem::swap(&mut w.kept_targets, &mut w.targets);
+        w.start.elastic = elastic;
+        w.start.valid = key;
+    }
+
+    /// Every stretch part's context for this frame ([`local::StretchContext`]): its rotation
+    /// at the displayed pose `warm` (`work.kept_rotations`, from [`Solver::start_at`] or the
+    /// last frame), and the states the stretch rule can honour: `three` below the rule's
+    /// `max`, `one` above its `min` unless both elements are held (a shrink would remove one).
+    /// A chain claims elements only in the direction its length has moved: `three` only
+    /// while it is longer than its elements at rest, `one` only while it is shorter, judged
+    /// by its length in `start` (pass 1's first pose: the displayed one with the handles' new
+    /// step; [`Solver::chain_lengths`], kept in `work.chain_lengths` to size the claims). The
+    /// sparse pass gathers the change into a few parts, and a chain squeezed below its `min`
+    /// folds, where a part beside a fold may span more than two elements though the chain as a
+    /// whole is short.
+    fn stretch_contexts(&mut self, asm: &Assembly, start: &[DVec2]) {
+        use clay_dsl::compiled::{STRETCH_ONE, STRETCH_THREE, STRETCH_TWO};
+        let data = asm.data();
+        let grammar = asm.grammar();
+        self.work.stretch.clear();
+        if !data
+            .parts
+            .iter()
+            .any(|p| matches!(p.kind, PartKind::Stretch { .. }))
+        {
+            return;
+        }
+        let lengths = self.chain_lengths(asm, start);
+        let reversal = self.config.reversal;
+        let w = &mut self.work;
+        let held_ids: Vec<u64> = asm
+            .handles()
+            .iter()
+            .filter_map(|h| h.held.as_ref().map(|x| x.id))
+            .collect();
+        let held = |instance: usize| {
+            data.instances
+                .get(instance)
+                .is_some_and(|i| held_ids.contains(&i.id))
+        };
+        for (pi, part) in data.parts.iter().enumerate() {
+            let PartKind::Stretch { chain, first } = part.kind else {
+                w.stretch.push(None);
+                continue;
+            };
+            let (Some(c), Some(&reference)) = (data.chains.get(chain), w.kept_rotations.get(pi))
+            else {
+                w.stretch.push(None);
+                continue;
+            };
+            let Some(rule) = grammar.stretch_rules.get(c.rule) else {
+                w.stretch.push(None);
+                continue;
+            };
+            let count = c.instances.len();
+            let both_held = [first, first + 1]
+                .iter()
+                .all(|&k| c.instances.get(k).is_some_and(|&i| held(i)));
+            let length = lengths
+                .get(chain)
+                .copied()
+                .flatten()
+                .unwrap_or(count as f64);
+            // a change that reverses the chain's last one waits for `reversal` elements
+            let shrink_below = count as f64 - if c.trend > 0 { reversal } else { 0.0 };
+            let grow_above = count as f64 + if c.trend < 0 { reversal } else { 0.0 };
+            let mut allowed = 1 << STRETCH_TWO;
+            if count > rule.min.max(1) && !both_held && !(length > shrink_below) {
+                allowed |= 1 << STRETCH_ONE;
+            }
+            if rule.max.is_none_or(|max| count < max) && !(length < grow_above) {
+                allowed |= 1 << STRETCH_THREE;
+            }
+            w.stretch
+                .push(Some(local::StretchContext { reference, allowed }));
+        }
+        w.chain_lengths = lengths;
+    }
+
+    /// Per part, the factor of its term in the sparse norm: for a stretch part holding a
+    /// vertex of a grab, [`SolverConfig::handle_outlier`] to the power `2 - p`; of a pin only,
+    /// the square root of that (the handle the user moves is the likelier place for the gap:
+    /// with a pin at one end and a grab at the other, an evenly stretched chain would
+    /// otherwise split its stretch between the two ends, where neither half switches); 1 for
+    /// every other part.
+    fn outlier_factors(&mut self, parts: &[Part], handles: &[Handle]) {
+        let cfg = self.config;
+        let grab = cfg.handle_outlier.clamp(1e-3, 1.0).powf(2.0 - cfg.norm);
+        let pin = grab.sqrt();
+        let w = &mut self.work;
+        // per vertex, the smallest factor of the handles holding it (the `rhs` buffer is
+        // free until the first solve)
+        let at = &mut w.rhs;
+        at.clear();
+        at.resize(w.handle_count.len(), 1.0);
+        for h in handles {
+            let factor = match h.kind {
+                HandleKind::Grab => grab,
+                HandleKind::Pin => pin,
+            };
+            for &v in &h.vertices {
+                if let Some(a) = at.get_mut(v) {
+                    *a = a.min(factor);
+                }
+            }
+        }
+        w.outlier.clear();
+        w.outlier.extend(parts.iter().map(|part| {
+            if matches!(part.kind, PartKind::Stretch { .. }) {
+                part.vertices.iter().map(|&v| at[v]).fold(1.0, f64::min)
+            } else {
+                1.0
+            }
+        }));
+    }
+
+    /// Puts every held vertex of `pose` where its handles now want it (their mean target).
+    fn snap_held(&self, pose: &mut [DVec2]) {
+        let w = &self.work;
+        for ((p, &count), &sum) in pose.iter_mut().zip(&w.handle_count).zip(&w.handle_sum) {
+            if count > 0.0 {
+                *p = sum / count;
+            }
+        }
+    }
+
     /// Moves every component whose held vertices all moved by one rigid motion by that
     /// motion ([`follow`]): the displayed pose `warm`.
     fn follow_handles(&mut self, warm: &mut [DVec2], tolerance: f64) {
@@ -451,7 +748,10 @@ impl Solver {
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
         let (iterations, tolerance) = match cfg.pass1 {
-            Pass1::Irls => (cfg.irls_iterations, cfg.pass1_tolerance * scale),
+            Pass1::Irls => (
+                cfg.irls_iterations,
+                cfg.pass1_tolerance * self.mean_rest_edge,
+            ),
             Pass1::Admm => (cfg.admm_iterations, cfg.admm_tolerance * scale),
         };
         let mut f = std::mem::take(&mut split.pose);
@@ -470,19 +770,14 @@ impl Solver {
             report.pass1_iterations += 1;
             let t = Instant::now();
             let switched_before = report.switches.len();
-            let elastic = self.evaluate_switching(parts, &f, &mut report.switches);
-            if it == 0 && cfg.pass1 == Pass1::Irls {
-                // this is the pose pass 2 starts from (`Start`)
-                let w = &mut self.work;
-                w.kept_rotations.clone_from(&w.rotations);
-                w.kept_targets.clone_from(&w.targets);
-                w.start.elastic = elastic;
-                let key = (
-                    self.generation.unwrap_or(u64::MAX),
-                    cfg,
-                    report.switches.len(),
-                );
-                w.start.valid = Some(key);
+            // The first iteration judges the pose pass 1 starts from, the least-squares one
+            // (with the handles moved): it only weighs the parts. States switch from the
+            // second on, judged by the sub-quadratic norm's pose (paper 5.2): on an evenly
+            // stretched chain every part would claim an element at once.
+            if it > 0 || iterations == 1 {
+                self.evaluate_switching(parts, &f, &mut report.switches);
+            } else {
+                self.evaluate_fixed(parts, &f);
             }
             report.phases.local += ms_since(t);
             let solved = match cfg.pass1 {
@@ -499,7 +794,10 @@ impl Solver {
             let delta = max_move(&f, &next);
             std::mem::swap(&mut f, &mut next);
             last_iteration = iteration_start.elapsed();
-            if delta <= tolerance && report.switches.len() == switched_before {
+            if (it > 0 || iterations == 1)
+                && delta <= tolerance
+                && report.switches.len() == switched_before
+            {
                 converged = true;
                 break;
             }
@@ -604,15 +902,16 @@ impl Solver {
         w.weights.resize(w.residuals.len(), 0.0);
         // one weight per part with edges, from its stacked residual (see the splitting's
         // groups); a part without edges keeps 0
-        for ((weight, &d2), _) in w
+        for (((weight, &d2), _), &c) in w
             .weights
             .iter_mut()
             .zip(&w.residuals)
             .zip(part_edges)
-            .filter(|(_, count)| **count > 0)
+            .zip(&w.outlier)
+            .filter(|((_, count), _)| **count > 0)
         {
             let v = irls_weight(d2.sqrt() + eps, p);
-            *weight = if v.is_finite() { v } else { eps.powf(p - 2.0) };
+            *weight = c * if v.is_finite() { v } else { eps.powf(p - 2.0) };
         }
         let mean = mean_over_edges(part_edges, &w.weights);
         report.phases.assembly += ms_since(t);
@@ -763,11 +1062,17 @@ impl Solver {
         parts: &mut [Part],
         f: &[DVec2],
         switches: &mut Vec<StateSwitch>,
-    ) -> f64 {
-        let hysteresis = self.config.hysteresis;
+    ) {
+        let stretch = std::mem::take(&mut self.work.stretch);
+        let shared = std::mem::take(&mut self.work.vertex_parts);
+        let how = local::Switching {
+            hysteresis: self.config.hysteresis,
+            stretch: &stretch,
+            shared: Some(&shared),
+        };
         let from = switches.len();
-        let elastic = if self.cache_fits(parts.len()) {
-            let elastic = self.evaluate(parts, f, chunks::Choice::Switch { hysteresis });
+        if self.cache_fits(parts.len()) {
+            self.evaluate(parts, f, chunks::Choice::Switch(how));
             for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
                 if state != part.active {
                     switches.push(StateSwitch {
@@ -778,17 +1083,19 @@ impl Solver {
                     part.active = state;
                 }
             }
-            elastic
         } else {
-            self.local_step_switching(parts, f, hysteresis, switches);
+            self.local_step_switching(parts, f, how, switches);
             self.edge_targets(parts);
-            self.residuals_at(f)
-        };
-        if growth::one_per_chain(parts, switches, from, &self.work.residuals) {
-            // the reverted parts' rotations and targets are their kept states'
-            return self.evaluate_fixed(parts, f);
+            self.residuals_at(f);
         }
-        elastic
+        self.work.stretch = stretch;
+        self.work.vertex_parts = shared;
+        let w = &mut self.work;
+        std::mem::swap(&mut w.pass1_claims, &mut w.claims);
+        if growth::one_per_chain(parts, switches, from, &w.residuals, &w.pass1_claims) {
+            // the reverted parts' rotations and targets are their kept states'
+            self.evaluate_fixed(parts, f);
+        }
     }
 
     /// [`chunks::evaluate`] into the work buffers (the rest cache fits).
@@ -802,12 +1109,14 @@ impl Solver {
         let count = parts.len();
         w.rotations.resize(count, DVec2::X);
         w.chosen.resize(count, 0);
+        w.claims.resize(count, 0);
         w.residuals.resize(count, 0.0);
         // every slot is written: no clearing pass
         w.targets.resize(cache.edges(), DVec2::ZERO);
         let out = chunks::Outputs {
             rotations: &mut w.rotations,
             chosen: &mut w.chosen,
+            claims: &mut w.claims,
             residuals: &mut w.residuals,
             targets: &mut w.targets,
         };
@@ -862,30 +1171,32 @@ impl Solver {
         }
     }
 
-    /// Local step with state switching; fills `work.rotations`.
+    /// Local step with state switching; fills `work.rotations` and `work.claims`.
     fn local_step_switching(
         &mut self,
         parts: &mut [Part],
         f: &[DVec2],
-        hysteresis: f64,
+        how: local::Switching,
         switches: &mut Vec<StateSwitch>,
     ) {
         let w = &mut self.work;
         w.rotations.clear();
+        w.claims.clear();
         for (i, part) in parts.iter_mut().enumerate() {
-            let (state, r) = match &mut w.rest {
-                Some(cache) => cache.choose_state(i, part, f, hysteresis),
-                None => local::choose_state(part, f, hysteresis),
+            let chosen = match &mut w.rest {
+                Some(cache) => cache.choose_state(i, part, f, how),
+                None => local::choose_state(i, part, f, how),
             };
-            if state != part.active {
+            if chosen.state != part.active {
                 switches.push(StateSwitch {
                     part: i,
                     from: part.active,
-                    to: state,
+                    to: chosen.state,
                 });
-                part.active = state;
+                part.active = chosen.state;
             }
-            w.rotations.push(r);
+            w.rotations.push(chosen.rotation);
+            w.claims.push(chosen.claim);
         }
     }
 

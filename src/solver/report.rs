@@ -26,6 +26,10 @@ pub struct FrameReport {
     pub warm_objective: f64,
     /// Rest-state switches, in the order they happened.
     pub switches: Vec<StateSwitch>,
+    /// `(part, elements)` for every stretch part pass 1 left in `three` or `one`: how many
+    /// elements its two span in the pass-1 pose (at least 3 in `three`: the stretch rule
+    /// inserts the difference; 1 or fewer in `one`: the shrink rule removes the difference).
+    pub claims: Vec<(usize, i32)>,
     /// Wall time of the frame in milliseconds.
     pub ms: f64,
     /// The frame left the model at rest: the frame was complete, no rest state switched, and
