@@ -94,6 +94,11 @@ pub struct SolverConfig {
     pub irls_iterations: usize,
     /// Most least-squares (pass 2) iterations per frame.
     pub l2_iterations: usize,
+    /// Most pass-2 iterations per frame while nothing is held: a model let go relaxes along
+    /// its softest modes (a long, thin chain unbending), which least squares crosses slowly;
+    /// with 5 a frame, a buckled chain of 113 thin bricks took 600 frames to come to rest, with
+    /// 20 under 200 (`docs/solver.md`).
+    pub l2_iterations_free: usize,
     /// Pass 2: how many past iterates Anderson acceleration mixes (0: the plain local/global
     /// iteration); an accelerated iterate that does not lower the objective is dropped.
     pub l2_anderson: usize,
@@ -160,6 +165,7 @@ impl SolverConfig {
             reversal: 0.95,
             irls_iterations: 20,
             l2_iterations: 5,
+            l2_iterations_free: 20,
             l2_anderson: 1,
             handle_weight: 1e6,
             rotation_cone_degrees: 0.0,

@@ -299,6 +299,18 @@ pub struct StateSums {
     pub axis: DVec2,
 }
 
+/// A stretch part measured in a pose ([`RestCache::measure_stretch`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PartMeasure {
+    /// Each element's length, in elements at rest.
+    pub lengths: [f64; 2],
+    /// The first element's `from` site's centre and the second's `to` site's.
+    pub near: DVec2,
+    pub far: DVec2,
+    /// One element's length at rest.
+    pub element: f64,
+}
+
 /// A stretch part's ends, found from its rest states: its `one`, `two` and `three` states
 /// differ only along the axis, by the vertex's distance from the near end, so the vertices
 /// that do not move between `one` and `three` are the near end (the first element's `from`
@@ -821,21 +833,28 @@ impl RestCache {
         Some(index)
     }
 
-    /// A stretch part's two elements' lengths in elements at `positions`, each measured
-    /// along its chain's direction turned by `reference`; `None` for other parts.
-    pub fn element_lengths(
+    /// A stretch part at `positions` ([`PartMeasure`]), its lengths measured along its
+    /// chain's direction turned by `reference`; `None` for other parts.
+    pub fn measure_stretch(
         &self,
         pi: usize,
         part: &Part,
         positions: &[DVec2],
         reference: DVec2,
-    ) -> Option<[f64; 2]> {
+    ) -> Option<PartMeasure> {
         let (s, _) = self.dense_span(pi, part)?;
         let ends = self.ends[s.shape as usize].as_ref()?;
         let verts = &self.vertices[s.vertex as usize..];
+        let at = |k: usize| positions[verts[k] as usize];
+        let centre = |ks: &[usize]| ks.iter().map(|&k| at(k)).sum::<DVec2>() / ks.len() as f64;
         let axis = reference.rotate(ends.axis);
-        let spans = ends.element_spans(|k| positions[verts[k] as usize]);
-        Some(spans.map(|d| d.dot(axis) / ends.element))
+        let spans = ends.element_spans(at);
+        Some(PartMeasure {
+            lengths: spans.map(|d| d.dot(axis) / ends.element),
+            near: centre(&ends.near),
+            far: centre(&ends.far),
+            element: ends.element,
+        })
     }
 
     /// Number of parts the cache was built for.

@@ -86,8 +86,17 @@ struct Work {
     /// Per part: the claim of the last local step, and of pass 1's last switching step.
     claims: Vec<i32>,
     pass1_claims: Vec<i32>,
-    /// Per chain: its length in elements where pass 1 starts (`None`: not measured).
-    chain_lengths: Vec<Option<f64>>,
+    /// Per chain: its lengths where pass 1 starts (`None`: not measured).
+    chain_lengths: Vec<Option<ChainLength>>,
+    /// How far the handles moved the held vertices at the frame's start.
+    snapped_moved: f64,
+    /// The handle targets (`handle_sum`) of the last frame: still when equal.
+    last_targets: Vec<DVec2>,
+    /// How far the last frame moved the displayed pose.
+    last_moved: f64,
+    /// Other rest states were tried since the handles, the states or the structure last
+    /// changed, and none helped ([`Solver::try_states`]).
+    tried: bool,
 }
 
 /// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
@@ -271,6 +280,7 @@ impl Solver {
         self.l2_factor.invalidate();
         self.work.l2_diagonal.clear();
         self.generation = Some(asm.generation());
+        self.work.tried = false;
         Ok(())
     }
 
@@ -421,6 +431,12 @@ impl Solver {
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
+        let settling = self.settling(&report);
+        self.work.last_targets.clone_from(&self.work.handle_sum);
+        if settling && !out_of_time(deadline, Duration::ZERO) {
+            let handles = asm.handles().to_vec();
+            self.try_states(&mut asm.data_mut().parts, &handles, &warm, &mut report)?;
+        }
         let t = Instant::now();
         let before = asm.generation();
         between(asm, &report, &self.splitting.pose);
@@ -458,6 +474,7 @@ impl Solver {
             ));
         }
         report.moved = max_move(&asm.data().positions, &f);
+        self.work.last_moved = report.moved;
         asm.positions_mut().copy_from_slice(&f);
         let rot = asm.rotations_mut();
         if rot.len() == self.work.rotations.len() {
@@ -477,6 +494,162 @@ impl Solver {
         report.phases.bookkeeping += ms_since(t);
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(report)
+    }
+
+    /// Whether this frame tries other rest states ([`Solver::try_states`]): the handles
+    /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
+    /// pose all but still and yet not at rest, and no try since the handles, the states or
+    /// the structure last changed.
+    fn settling(&mut self, report: &FrameReport) -> bool {
+        let w = &mut self.work;
+        let still = w.last_targets == w.handle_sum && report.switches.is_empty();
+        if !still {
+            w.tried = false;
+        }
+        let e = self.mean_rest_edge;
+        let stopped = w.last_moved <= 1e-3 * e;
+        let strained = w.start.elastic > 1e-6 * e * e;
+        still && stopped && strained && !w.tried
+    }
+
+    /// A held model that does not come to rest tries other rest states (a move): the few
+    /// piece parts whose best alternative state is nearest (by its shape distance against
+    /// the active one's) switch, and a part out of its first state hands that state to a
+    /// neighbour of its piece (the sparse pass gathered a bend into the part next to the one
+    /// the gesture bends). For each move, least squares and the other parts' state choices
+    /// settle for a few iterations with the moved parts held in their states; the assignment
+    /// with the lowest energy is kept when it is below `(1 - hysteresis)` times the energy
+    /// without a move.
+    fn try_states(
+        &mut self,
+        parts: &mut [Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        const CANDIDATES: usize = 4;
+        const ITERATIONS: usize = 3;
+        let hysteresis = self.config.hysteresis;
+        let multi = |p: &Part| matches!(p.kind, PartKind::Piece { .. }) && p.states.len() >= 2;
+        let mut singles: Vec<(f64, usize, usize)> = Vec::new();
+        for (pi, part) in parts.iter().enumerate().filter(|(_, p)| multi(p)) {
+            let d: Vec<f64> = (part.states.iter())
+                .map(|st| local::align(&st.positions, &part.vertices, warm).distance)
+                .collect();
+            let here = d[part.active.min(d.len() - 1)];
+            if here > 0.0 {
+                for (j, &dj) in d.iter().enumerate().filter(|(j, _)| *j != part.active) {
+                    singles.push((dj / here, pi, j));
+                }
+            }
+        }
+        singles.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut moves: Vec<Vec<(usize, usize)>> = singles
+            .iter()
+            .take(CANDIDATES)
+            .map(|&(_, pi, j)| vec![(pi, j)])
+            .collect();
+        let vp = &self.work.vertex_parts;
+        for (pi, part) in parts
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| multi(p) && p.active != 0)
+        {
+            let mut neighbours: Vec<usize> = (part.vertices.iter())
+                .flat_map(|&v| vp.of(v).iter().copied())
+                .filter(|&q| q != pi && multi(&parts[q]) && parts[q].active == 0)
+                .filter(|&q| parts[q].states.len() == part.states.len())
+                .collect();
+            neighbours.sort_unstable();
+            neighbours.dedup();
+            for q in neighbours {
+                moves.push(vec![(pi, 0), (q, part.active)]);
+            }
+        }
+        if moves.is_empty() {
+            return Ok(());
+        }
+        let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
+        let baseline = self.settle(parts, handles, warm, ITERATIONS, &actives, &[])?;
+        let mut best: Option<(f64, Vec<usize>)> = None;
+        for m in &moves {
+            for (p, &a) in parts.iter_mut().zip(&actives) {
+                p.active = a;
+            }
+            for &(pi, j) in m {
+                parts[pi].active = j;
+            }
+            let forced: Vec<usize> = m.iter().map(|x| x.0).collect();
+            let e = self.settle(parts, handles, warm, ITERATIONS, &actives, &forced)?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+            }
+        }
+        self.work.tried = best.is_none();
+        let chosen = best.map_or(actives.clone(), |b| b.1);
+        for (pi, (p, (&from, &to))) in parts
+            .iter_mut()
+            .zip(actives.iter().zip(&chosen))
+            .enumerate()
+        {
+            p.active = to;
+            if from != to {
+                report.switches.push(StateSwitch { part: pi, from, to });
+            }
+        }
+        self.work.start.valid = None;
+        Ok(())
+    }
+
+    /// Settles a trial assignment from `warm`: `iterations` least-squares iterations in which
+    /// the piece parts but `forced` choose their states (hysteresis; the stretch parts keep
+    /// those in `keep`), then pass 2 with the states fixed, to convergence (at most
+    /// [`SETTLE_ITERATIONS`], accelerated like every pass 2). Returns its objective.
+    fn settle(
+        &mut self,
+        parts: &mut [Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        iterations: usize,
+        keep: &[usize],
+        forced: &[usize],
+    ) -> Result<f64, SolverError> {
+        let mut f = warm.to_vec();
+        let mut next = vec![DVec2::ZERO; f.len()];
+        let shared = std::mem::take(&mut self.work.vertex_parts);
+        let mut report = FrameReport::default();
+        for _ in 0..iterations {
+            let how = local::Switching {
+                hysteresis: self.config.hysteresis,
+                stretch: &[],
+                shared: Some(&shared),
+            };
+            if self.cache_fits(parts.len()) {
+                self.evaluate(parts, &f, chunks::Choice::Switch(how));
+                for (i, p) in parts.iter_mut().enumerate() {
+                    if forced.contains(&i) {
+                        continue;
+                    }
+                    if matches!(p.kind, PartKind::Piece { .. }) {
+                        p.active = self.work.chosen[i];
+                    } else {
+                        p.active = keep[i];
+                    }
+                }
+            }
+            self.evaluate_fixed(parts, &f);
+            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
+            std::mem::swap(&mut f, &mut next);
+        }
+        self.work.vertex_parts = shared;
+        let cfg = self.config;
+        self.config.l2_iterations = SETTLE_ITERATIONS;
+        self.work.start.valid = None;
+        let scale = bbox_diagonal(&f).max(1e-9);
+        let settled = self.pass2(parts, handles, f, cfg.tolerance * scale, None, &mut report);
+        self.config = cfg;
+        let (_, terms, _) = settled?;
+        Ok(terms.total())
     }
 
     /// The claims of the stretch parts pass 1 left in `three` or `one`
@@ -518,16 +691,18 @@ impl Solver {
                 .chains
                 .get(chain)
                 .map_or(0, |c| c.instances.len()) as f64;
-            let change = lengths
-                .get(chain)
-                .copied()
-                .flatten()
-                .map(|l| l.round() - count);
-            let change = change.filter(|_| gathers);
+            let length = lengths.get(chain).copied().flatten().filter(|_| gathers);
             let limit = f64::from(local::MAX_CLAIM);
-            let claim = match change {
-                Some(d) if claim >= 3 && d >= 1.0 => 2 + d.min(limit) as i32,
-                Some(d) if claim <= 1 && d <= -1.0 => 2 + d.max(-limit) as i32,
+            let claim = match length {
+                // a chain grows by what its ends are apart beyond its elements, too: a slack
+                // (buckled) chain pulled straightens before it stretches
+                Some(l) if claim >= 3 && l.path.round() - count >= 1.0 => {
+                    let grow = (l.path.round() - count).min((l.chord.round() - count).max(1.0));
+                    2 + grow.min(limit) as i32
+                }
+                Some(l) if claim <= 1 && l.path.round() - count <= -1.0 => {
+                    2 + (l.path.round() - count).max(-limit) as i32
+                }
                 _ if claim >= 3 => 3,
                 _ => 1,
             };
@@ -535,12 +710,13 @@ impl Solver {
         }
     }
 
-    /// Per chain, its length in elements at `pose`: every element's span from its `from`
-    /// site to its `to` site along its part's direction (`work.kept_rotations`), summed.
-    /// `None` for a chain some part of which cannot be measured.
-    fn chain_lengths(&self, asm: &Assembly, pose: &[DVec2]) -> Vec<Option<f64>> {
+    /// Per chain, at `pose` ([`ChainLength`]): every element's span from its `from` site to
+    /// its `to` site along its part's direction (`work.kept_rotations`), summed, and the
+    /// straight distance between the chain's ends. `None` for a chain some part of which
+    /// cannot be measured.
+    fn chain_lengths(&self, asm: &Assembly, pose: &[DVec2]) -> Vec<Option<ChainLength>> {
         let data = asm.data();
-        let mut lengths = vec![Some(0.0); data.chains.len()];
+        let mut lengths = vec![Some(ChainLength::default()); data.chains.len()];
         let w = &self.work;
         for (pi, part) in data.parts.iter().enumerate() {
             let PartKind::Stretch { chain, first } = part.kind else {
@@ -551,15 +727,22 @@ impl Solver {
             };
             let count = data.chains[chain].instances.len();
             let measured = match (&w.rest, w.kept_rotations.get(pi)) {
-                (Some(cache), Some(&r)) => cache.element_lengths(pi, part, pose, r),
+                (Some(cache), Some(&r)) => cache.measure_stretch(pi, part, pose, r),
                 _ => None,
             };
-            *slot = match (*slot, measured) {
-                // each element counted once: as its part's first, and the last as the second
-                (Some(sum), Some([a, b])) if first + 2 == count => Some(sum + a + b),
-                (Some(sum), Some([a, _])) => Some(sum + a),
-                _ => None,
+            let (Some(length), Some(m)) = (slot.as_mut(), measured) else {
+                *slot = None;
+                continue;
             };
+            // each element counted once: as its part's first, and the last as the second
+            length.path += m.lengths[0];
+            if first == 0 {
+                length.near = m.near;
+            }
+            if first + 2 == count {
+                length.path += m.lengths[1];
+                length.chord = (m.far - length.near).length() / m.element;
+            }
         }
         lengths
     }
@@ -643,19 +826,15 @@ impl Solver {
             let both_held = [first, first + 1]
                 .iter()
                 .all(|&k| c.instances.get(k).is_some_and(|&i| held(i)));
-            let length = lengths
-                .get(chain)
-                .copied()
-                .flatten()
-                .unwrap_or(count as f64);
+            let length = (lengths.get(chain).copied().flatten()).map_or(count as f64, |l| l.path);
             // a change that reverses the chain's last one waits for `reversal` elements
             let shrink_below = count as f64 - if c.trend > 0 { reversal } else { 0.0 };
             let grow_above = count as f64 + if c.trend < 0 { reversal } else { 0.0 };
             let mut allowed = 1 << STRETCH_TWO;
-            if count > rule.min.max(1) && !both_held && !(length > shrink_below) {
+            if count > rule.min.max(1) && !both_held && length <= shrink_below {
                 allowed |= 1 << STRETCH_ONE;
             }
-            if rule.max.is_none_or(|max| count < max) && !(length < grow_above) {
+            if rule.max.is_none_or(|max| count < max) && length >= grow_above {
                 allowed |= 1 << STRETCH_THREE;
             }
             w.stretch
@@ -701,14 +880,19 @@ impl Solver {
         }));
     }
 
-    /// Puts every held vertex of `pose` where its handles now want it (their mean target).
-    fn snap_held(&self, pose: &mut [DVec2]) {
-        let w = &self.work;
+    /// Puts every held vertex of `pose` where its handles now want it (their mean target);
+    /// notes the largest move in `work.snapped_moved`.
+    fn snap_held(&mut self, pose: &mut [DVec2]) {
+        let w = &mut self.work;
+        let mut moved: f64 = 0.0;
         for ((p, &count), &sum) in pose.iter_mut().zip(&w.handle_count).zip(&w.handle_sum) {
             if count > 0.0 {
-                *p = sum / count;
+                let t = sum / count;
+                moved = moved.max((t - *p).length());
+                *p = t;
             }
         }
+        w.snapped_moved = moved;
     }
 
     /// Moves every component whose held vertices all moved by one rigid motion by that
@@ -966,7 +1150,14 @@ impl Solver {
         let mut last_iteration = Duration::ZERO;
         let mut anderson = std::mem::take(&mut self.anderson);
         anderson.start(cfg.l2_anderson);
-        for it in 0..cfg.l2_iterations {
+        // a model nothing holds relaxes along its softest modes (a long chain unbending), which
+        // least squares takes many iterations over: more of them then
+        let iterations = if handles.is_empty() && cfg.l2_iterations > 0 {
+            cfg.l2_iterations.max(cfg.l2_iterations_free)
+        } else {
+            cfg.l2_iterations
+        };
+        for it in 0..iterations {
             if it > 0 && out_of_time(deadline, last_iteration) {
                 report.complete = false;
                 break;
@@ -1636,6 +1827,11 @@ fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFa
     factor.invalidate();
 }
 
+/// Most pass-2 iterations that settle one trial assignment of rest states
+/// ([`Solver::try_states`]): a bend moved to the neighbouring segment moves every segment
+/// between it and the handle, which least squares settles slowly.
+const SETTLE_ITERATIONS: usize = 60;
+
 /// Pass-1 iterations a budgeted frame always runs (when configured to run that many): the
 /// first judges the pose the last frame left, the second the pose with the handles moved.
 const MIN_PASS1_ITERATIONS: usize = 2;
@@ -1682,6 +1878,17 @@ impl Terms {
     fn total(self) -> f64 {
         self.elastic + self.handle
     }
+}
+
+/// A stretch chain measured in a pose, in elements at rest ([`Solver::chain_lengths`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ChainLength {
+    /// Along the chain: its elements' lengths summed.
+    path: f64,
+    /// Straight from its first element's `from` site to its last element's `to` site.
+    chord: f64,
+    /// Where the chain starts (its first element's `from` site's centre).
+    near: DVec2,
 }
 
 /// The handle term of the pass-2 objective at `f`.
