@@ -90,7 +90,11 @@ pub struct SolverConfig {
     /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
     pub irls_epsilon: f64,
     /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
-    /// per part, and a global step with a fresh numeric factorisation.
+    /// per part, and a global step with a fresh numeric factorisation. Six pass every claim
+    /// of both claims suites (300 generated cases of each property; four fail two of them);
+    /// a large model seldom converges to the tolerance below in a frame of a brisk drag (the
+    /// 10,000-part city took 19 iterations a frame with 20 allowed), and the next frame
+    /// starts where this one left the displayed pose (`docs/solver.md`).
     pub irls_iterations: usize,
     /// Most least-squares (pass 2) iterations per frame.
     pub l2_iterations: usize,
@@ -114,10 +118,12 @@ pub struct SolverConfig {
     pub rotation_cone_degrees: f64,
     /// Pass 2 stops early once no vertex moved more than this fraction of the model's size.
     pub tolerance: f64,
-    /// Pass 1 stops early once no vertex moved more than this fraction of the model's size
-    /// and no state switched. Pass 1 only decides the rest states, so its pose need not be as
-    /// exact as the displayed one: 1e-3 decides the same states on every claim of
-    /// `tests/paper_claims.rs` as 1e-6, in a sixth of the iterations on a brisk drag.
+    /// Pass 1 stops early once no vertex moved more than this fraction of the mean rest edge
+    /// and no state switched (from its second iteration on). Pass 1 only decides the rest
+    /// states, so its pose need not be as exact as the displayed one. Relative to the parts,
+    /// not to the model's size: a claim must not depend on how large the rest of the model
+    /// is (with 1e-3 of the size, a 50-brick wall stopped at its evenly stretched pose, 5 cm
+    /// steps being converged).
     pub pass1_tolerance: f64,
     /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
     /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
@@ -163,7 +169,7 @@ impl SolverConfig {
             irls_epsilon: params.irls_epsilon,
             handle_outlier: 0.5,
             reversal: 0.95,
-            irls_iterations: 20,
+            irls_iterations: 6,
             l2_iterations: 5,
             l2_iterations_free: 20,
             l2_anderson: 1,
