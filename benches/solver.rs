@@ -80,12 +80,6 @@ fn phases(parts: usize) {
     if let Some(k) = env("CLAY_IRLS") {
         config.irls_iterations = k;
     }
-    if let Some(k) = env("CLAY_ADMM") {
-        config.admm_iterations = k;
-    }
-    if std::env::var("CLAY_PASS1").is_ok_and(|v| v == "irls") {
-        config.pass1 = clay::solver::Pass1::Irls;
-    }
     if let Some(k) = env("CLAY_L2") {
         config.l2_iterations = k;
     }

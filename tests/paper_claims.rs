@@ -12,7 +12,7 @@ use clay::assembly::Assembly;
 use clay::rules::RuleKind;
 use clay::script::Script;
 use clay::solver::follow::Components;
-use clay::solver::{Pass1, SolverConfig, bbox, max_edge_strain};
+use clay::solver::{SolverConfig, bbox, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
@@ -22,7 +22,6 @@ struct Session {
     asm: Assembly,
     replay: clay::session::Session,
     steps: usize,
-    pass1: Pass1,
 }
 
 fn grammar(name: &str) -> CompiledGrammar {
@@ -32,19 +31,16 @@ fn grammar(name: &str) -> CompiledGrammar {
 }
 
 impl Session {
-    /// `name`'s grammar with its own solver settings and the pass-1 method `pass1`, changed
-    /// by `tune`.
-    fn new(name: &str, pass1: Pass1, tune: impl FnOnce(&mut SolverConfig)) -> Self {
+    /// `name`'s grammar with its own solver settings, changed by `tune`.
+    fn new(name: &str, tune: impl FnOnce(&mut SolverConfig)) -> Self {
         let g = grammar(name);
         let mut config = SolverConfig::from_params(&g.solver);
-        config.pass1 = pass1;
         tune(&mut config);
         Self {
             asm: Assembly::new(Arc::new(g.clone())),
             grammar: g,
             replay: clay::session::Session::new(config),
             steps: 0,
-            pass1,
         }
     }
 
@@ -118,8 +114,7 @@ impl Session {
             .map(|(k, &n)| (k.name(), n))
             .collect();
         format!(
-            "pass 1 {}, instances {}, max |strain| {:.4}, energy {:.3e}, bbox {:.4?}, fired {fired:?}",
-            self.pass1.name(),
+            "instances {}, max |strain| {:.4}, energy {:.3e}, bbox {:.4?}, fired {fired:?}",
             self.asm.data().instances.len(),
             self.strain(),
             self.energy(),
@@ -152,9 +147,9 @@ fn hold(frames: u64) -> String {
 /// Paper 5.1 (stretching and shrinking) and the README: the 8-brick wall pulled to twice its
 /// length grows bricks instead of stretching them, and pushed back it has its 8 bricks back,
 /// at rest, whatever the speed of the drag.
-fn sec5_1_wall_round_trip_has_its_bricks_back(pass1: Pass1) {
+fn sec5_1_wall_round_trip_has_its_bricks_back() {
     for frames in [60, 120, 240] {
-        let mut s = Session::new("wall", pass1, |_| {});
+        let mut s = Session::new("wall", |_| {});
         s.run(PIN_WEST_GRAB_EAST)
             .run(&drag(8.0, 0.0, frames))
             .run(&hold(60));
@@ -178,8 +173,8 @@ fn sec5_1_wall_round_trip_has_its_bricks_back(pass1: Pass1) {
 
 /// A wall session: pin the west end, drag the east end by `by` metres over `frames` frames,
 /// hold 30, with the given norm.
-fn wall_pull(pass1: Pass1, norm: f64, by: f64, frames: u64) -> Session {
-    let mut s = Session::new("wall", pass1, |c| c.norm = norm);
+fn wall_pull(norm: f64, by: f64, frames: u64) -> Session {
+    let mut s = Session::new("wall", |c| c.norm = norm);
     s.run(PIN_WEST_GRAB_EAST)
         .run(&drag(by, 0.0, frames))
         .run(&hold(30));
@@ -188,8 +183,8 @@ fn wall_pull(pass1: Pass1, norm: f64, by: f64, frames: u64) -> Session {
 
 /// Fig. 8 and 5.2: with the square-root norm the stretch gathers in one gap, so a brick goes
 /// in early (one brick in eight fits at about 1.06x; by 1.10x it must have).
-fn fig8_sub_l1_inserts_early(pass1: Pass1) {
-    let s = wall_pull(pass1, 0.5, 0.8, 60);
+fn fig8_sub_l1_inserts_early() {
+    let s = wall_pull(0.5, 0.8, 60);
     s.report("p = 0.5 at 1.10x");
     assert!(
         s.count("brick") >= 9,
@@ -200,8 +195,8 @@ fn fig8_sub_l1_inserts_early(pass1: Pass1) {
 }
 
 /// Fig. 8: least squares spreads the stretch evenly, so at 1.15x no gap is big enough yet.
-fn fig8_least_squares_spreads_and_lags(pass1: Pass1) {
-    let s = wall_pull(pass1, 2.0, 1.2, 60);
+fn fig8_least_squares_spreads_and_lags() {
+    let s = wall_pull(2.0, 1.2, 60);
     s.report("p = 2 at 1.15x");
     assert!(
         s.count("brick") == 8,
@@ -215,12 +210,12 @@ fn fig8_least_squares_spreads_and_lags(pass1: Pass1) {
 /// stretch far before one goes in), but pulled to 5x (40 m) it never overfills: at every drag
 /// speed it ends with the same count, no more bricks than fit the length, no shrink, and
 /// the wall on its line (no buckle: the bounding box within 0.05 m of the rest height).
-fn fig8_least_squares_at_5x_stays_on_the_line(pass1: Pass1) {
-    let rest = Session::new("wall", pass1, |_| {}).bbox();
+fn fig8_least_squares_at_5x_stays_on_the_line() {
+    let rest = Session::new("wall", |_| {}).bbox();
     let rest_height = rest[3] - rest[1];
     let mut counts = Vec::new();
     for frames in [30, 60, 120, 240] {
-        let s = wall_pull(pass1, 2.0, 32.0, frames);
+        let s = wall_pull(2.0, 32.0, frames);
         let b = s.bbox();
         let (bricks, off) = (s.count("brick"), (b[3] - b[1] - rest_height).abs());
         s.report(&format!("p = 2 at 5x over {frames} frames"));
@@ -240,8 +235,8 @@ fn fig8_least_squares_at_5x_stays_on_the_line(pass1: Pass1) {
 
 /// A steady drag of the 8 m wall by `by` metres over 240 frames with p = 0.5: it ends with
 /// `want` +- 1 bricks and no rule of kind `never` fired on the way.
-fn steady_drag(pass1: Pass1, by: f64, want: usize, never: RuleKind, what: &str) {
-    let s = wall_pull(pass1, 0.5, by, 240);
+fn steady_drag(by: f64, want: usize, never: RuleKind, what: &str) {
+    let s = wall_pull(0.5, by, 240);
     s.report(what);
     let bricks = s.count("brick");
     assert!(
@@ -254,14 +249,14 @@ fn steady_drag(pass1: Pass1, by: f64, want: usize, never: RuleKind, what: &str) 
 
 /// Fig. 8: a steady pull to three times the length fills it with bricks (24 +- 1) and never
 /// drops one on the way.
-fn fig8_monotonic_pull_to_3x_fills_the_length(pass1: Pass1) {
-    steady_drag(pass1, 16.0, 24, RuleKind::Shrink, "p = 0.5 pulled to 3x");
+fn fig8_monotonic_pull_to_3x_fills_the_length() {
+    steady_drag(16.0, 24, RuleKind::Shrink, "p = 0.5 pulled to 3x");
 }
 
 /// Fig. 8 ("reducing overlap, respectively"): a steady push to half the length drops bricks
 /// (4 +- 1) and never adds one.
-fn fig8_monotonic_push_to_half_drops_bricks(pass1: Pass1) {
-    steady_drag(pass1, -4.0, 4, RuleKind::Stretch, "p = 0.5 pushed to 0.5x");
+fn fig8_monotonic_push_to_half_drops_bricks() {
+    steady_drag(-4.0, 4, RuleKind::Stretch, "p = 0.5 pushed to 0.5x");
 }
 
 /// The path of `bend.clay`'s east end when only segment `k` (of six, 2 m each, along +x from
@@ -305,8 +300,8 @@ fn segment_start(k: usize) -> (DVec2, f64) {
 /// Fig. 4: a street bent round a corner prefers a straight run and a quarter turn over a
 /// continuous bend: segment 3's end is led along the path on which it alone would bend
 /// evenly to 90 degrees; the street ends with one `left`, the rest straight, at rest.
-fn fig4_bend_snaps_to_a_quarter_turn(pass1: Pass1) {
-    let mut s = Session::new("bend", pass1, |_| {});
+fn fig4_bend_snaps_to_a_quarter_turn() {
+    let mut s = Session::new("bend", |_| {});
     s.run(PIN_WEST_GRAB_EAST)
         .run(&bend_steps(3, segment_start(3)))
         .run(&hold(60));
@@ -323,8 +318,8 @@ fn fig4_bend_snaps_to_a_quarter_turn(pass1: Pass1) {
 /// quarter turn (the one-segment path to 180 degrees cannot be two quarter turns: two
 /// quarter turns of 2 m segments span 2.55 m, the half circle of one segment 1.27 m). The
 /// street ends with two `left`, the rest straight.
-fn fig4_u_turn_snaps_to_two_quarter_turns(pass1: Pass1) {
-    let mut s = Session::new("bend", pass1, |_| {});
+fn fig4_u_turn_snaps_to_two_quarter_turns() {
+    let mut s = Session::new("bend", |_| {});
     let r = 4.0 / PI;
     // segment 4 starts where segment 3's quarter turn ends, heading north
     let after_first = (DVec2::new(6.0 + r, r), PI / 2.0);
@@ -384,10 +379,10 @@ fn bbox_off(got: [f64; 4], want: [f64; 4]) -> (f64, f64) {
 /// Paper 4.1 (as rigid as possible): with nothing pinned, a model turned by one part turns
 /// rigidly: the grabbed part's component ends as its rest pose turned about the handle (the
 /// other components stay), at rest, and no rule fires.
-fn sec4_1_free_rotation_is_rigid(pass1: Pass1) {
+fn sec4_1_free_rotation_is_rigid() {
     for name in GRAMMARS {
         for degrees in [90.0, 180.0] {
-            let mut s = Session::new(name, pass1, |_| {});
+            let mut s = Session::new(name, |_| {});
             let turn = DVec2::from_angle(f64::to_radians(degrees));
             let want = grab_north(&mut s, |p, centre| centre + turn.rotate(p - centre));
             s.run(&rotate(degrees, 30)).run(&hold(60));
@@ -407,9 +402,9 @@ fn sec4_1_free_rotation_is_rigid(pass1: Pass1) {
 
 /// Paper 4.1: a translation of the model by one part is exact: the grabbed part's component
 /// moves by the drag (the other components stay), at rest, and no rule fires.
-fn sec4_1_free_translation_is_exact(pass1: Pass1) {
+fn sec4_1_free_translation_is_exact() {
     for name in GRAMMARS {
-        let mut s = Session::new(name, pass1, |_| {});
+        let mut s = Session::new(name, |_| {});
         let by = DVec2::new(-5.0, 3.0);
         let want = grab_north(&mut s, |p, _| p + by);
         s.run(&drag(by.x, by.y, 30)).run(&hold(10));
@@ -426,12 +421,12 @@ fn sec4_1_free_translation_is_exact(pass1: Pass1) {
 
 /// Paper 4.3: with 15% hysteresis a jittering hand makes no part flip back and forth:
 /// +-3% jitter at a held stretch adds at most 2 rule events to those of the plain drag.
-fn sec4_3_hysteresis_stops_oscillation(pass1: Pass1) {
+fn sec4_3_hysteresis_stops_oscillation() {
     for stretch in [1.1, 1.2, 1.3] {
         let by = 8.0 * (stretch - 1.0);
         let amplitude = 0.03 * 8.0 * stretch;
         let session = |jitter: bool| {
-            let mut s = Session::new("wall", pass1, |_| {});
+            let mut s = Session::new("wall", |_| {});
             s.run(PIN_WEST_GRAB_EAST)
                 .run(&drag(by, 0.0, 60))
                 .run(&hold(30));
@@ -445,12 +440,12 @@ fn sec4_3_hysteresis_stops_oscillation(pass1: Pass1) {
         };
         let (plain, jittered) = (session(false), session(true));
         jittered.report(&format!(
-            "{pass1:?} jittered at {stretch}x ({} events plain)",
+            "jittered at {stretch}x ({} events plain)",
             plain.events()
         ));
         assert!(
             jittered.events() <= plain.events() + 2,
-            "{pass1:?} at {stretch}x: {} events jittered, {} plain; jittered {}",
+            "at {stretch}x: {} events jittered, {} plain; jittered {}",
             jittered.events(),
             plain.events(),
             jittered.figures()
@@ -460,8 +455,8 @@ fn sec4_3_hysteresis_stops_oscillation(pass1: Pass1) {
 
 /// Paper 5.1 (merging, cutting): after a cut, the connection does not weld again while its
 /// sites stay near; only once they have moved apart beyond the merge distance and come back.
-fn sec5_1_cut_connection_rewelds_only_after_parting(pass1: Pass1) {
-    let mut s = Session::new("junction", pass1, |_| {});
+fn sec5_1_cut_connection_rewelds_only_after_parting() {
+    let mut s = Session::new("junction", |_| {});
     // the side street's free end onto the main street: it welds
     s.run(r#"{"pin": {"extreme": "west"}}, {"pin": {"at": [15, 0]}}, {"grab": {"at": [9, 3]}}"#)
         .run(&drag(0.0, -1.3, 40))
@@ -491,8 +486,8 @@ fn sec5_1_cut_connection_rewelds_only_after_parting(pass1: Pass1) {
 }
 
 /// `docs/scripts.md`: `max_edge_strain` is max |length / rest - 1|, so a squeeze counts.
-fn max_edge_strain_counts_compression(pass1: Pass1) {
-    let mut s = Session::new("wall", pass1, |_| {});
+fn max_edge_strain_counts_compression() {
+    let mut s = Session::new("wall", |_| {});
     s.run(PIN_WEST_GRAB_EAST).run(&drag(-0.48, 0.0, 2));
     s.report("a quick 6% squeeze");
     assert!(
@@ -503,26 +498,19 @@ fn max_edge_strain_counts_compression(pass1: Pass1) {
     );
 }
 
-/// Every claim holds for both pass-1 methods (issue 15): each runs once per method, as
-/// `irls::<claim>` and `admm::<claim>`.
-macro_rules! for_both_pass1_methods {
+/// Every claim as a test, `claim::<name>`.
+macro_rules! claims {
     ($($claim:ident),* $(,)?) => {
-        mod irls {
+        mod claim {
             $(#[test]
             fn $claim() {
-                super::$claim(clay::solver::Pass1::Irls)
-            })*
-        }
-        mod admm {
-            $(#[test]
-            fn $claim() {
-                super::$claim(clay::solver::Pass1::Admm)
+                super::$claim()
             })*
         }
     };
 }
 
-for_both_pass1_methods!(
+claims!(
     sec5_1_wall_round_trip_has_its_bricks_back,
     fig8_sub_l1_inserts_early,
     fig8_least_squares_spreads_and_lags,

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use clay::assembly::{Assembly, Compass, HandleKind};
 use clay::script::Script;
 use clay::session::{Session, replay};
-use clay::solver::{Pass1, Solver, SolverConfig, SolverKind};
+use clay::solver::{Solver, SolverConfig, SolverKind};
 use clay::synthetic;
 use glam::DVec2;
 
@@ -339,7 +339,6 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
         measure_residual: true,
         // more than a zero budget allows: 2 of the 3 pass-1 iterations, 1 of the 2
         // least-squares ones
-        admm_iterations: 3,
         irls_iterations: 3,
         l2_iterations: 2,
         ..SolverConfig::default()
@@ -380,11 +379,10 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
 }
 
 #[test]
-fn the_splitting_pass_reuses_one_factor_while_irls_refactors_every_iteration() {
-    // A 1k-part city dragged for 20 frames with the same handles: the splitting pass 1 solves
-    // with the least-squares factor (factorised on the first frame only), the paper's IRLS
-    // factorises once per pass-1 iteration. Both end with the same displayed-pose guarantees.
-    for pass1 in [Pass1::Admm, Pass1::Irls] {
+fn irls_refactors_every_iteration_and_keeps_the_displayed_pose_exact() {
+    // A 1k-part city dragged for 20 frames with the same handles: the paper's IRLS factorises
+    // once per pass-1 iteration, and every frame ends with the displayed-pose guarantees.
+    {
         let mut asm = Assembly::new(Arc::new(synthetic::city(1_000)));
         let (lo, hi) = clay::solver::bbox(&asm.data().positions).unwrap();
         asm.hold_part(asm.part_nearest(lo).unwrap(), HandleKind::Pin);
@@ -392,7 +390,6 @@ fn the_splitting_pass_reuses_one_factor_while_irls_refactors_every_iteration() {
             .hold_part(asm.part_nearest(hi).unwrap(), HandleKind::Grab)
             .unwrap();
         let mut solver = Solver::new(SolverConfig {
-            pass1,
             measure_residual: true,
             ..SolverConfig::default()
         });
@@ -401,7 +398,7 @@ fn the_splitting_pass_reuses_one_factor_while_irls_refactors_every_iteration() {
         for k in 0..20 {
             asm.handle_mut(h).unwrap().translation = DVec2::new(0.4, 0.25) * k as f64;
             let r = solver.frame(&mut asm).unwrap();
-            assert!(r.linear_residual.unwrap() < 1e-9, "{pass1:?}: {r:?}");
+            assert!(r.linear_residual.unwrap() < 1e-9, "{r:?}");
             assert!(r.objective <= r.warm_objective * (1.0 + 1e-12) + 1e-12);
             if k > 0 {
                 later += r.factorizations;
@@ -409,10 +406,7 @@ fn the_splitting_pass_reuses_one_factor_while_irls_refactors_every_iteration() {
             }
         }
         assert!(iterations > 0);
-        match pass1 {
-            Pass1::Admm => assert_eq!(later, 0, "the splitting pass refactorised"),
-            Pass1::Irls => assert!(later >= iterations, "{later} factorisations"),
-        }
+        assert!(later >= iterations, "{later} factorisations");
     }
 }
 
@@ -427,7 +421,6 @@ fn grid_drag_objective(k: usize, tune: impl FnOnce(&mut SolverConfig)) -> f64 {
         .unwrap();
     let mut config = SolverConfig {
         irls_iterations: 0,
-        admm_iterations: 0,
         ..SolverConfig::default()
     };
     tune(&mut config);

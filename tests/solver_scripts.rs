@@ -188,11 +188,11 @@ fn settings_are_validated_and_applied() {
         "colour=red",
         "norm",
         "irls_iterations=2.5",
-        "admm_iterations=-1",
+        "irls_iterations=-1",
         "l2_anderson=17",
         "l2_anderson=0.5",
         "solver=lu",
-        "pass1=newton",
+        "pass1=irls",
     ] {
         let (code, _, err) = clayc(&["run", &g, "--set", bad]);
         assert_eq!(code, 2, "--set {bad}: {err}");

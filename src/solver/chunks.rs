@@ -218,40 +218,6 @@ pub fn columns(
     on_pool(run);
 }
 
-/// The work of [`part_edges`] on one run of parts: `(first edge, counts, z, u)`.
-pub type PartEdgesWork<'a> = dyn Fn(usize, &[usize], &mut [DVec2], &mut [DVec2]) + Sync + 'a;
-
-/// Runs `work(first, counts, z, u)` over runs of [`CHUNK`] parts (`part_edges`: each part's
-/// edge count; `z`, `u`: one value per part-edge, part by part), each with its parts' counts,
-/// the index of its first edge and its edges' slices of `z` and `u` (each part computed on its
-/// own, so any cut gives the same values): on the pool when `threads > 1` and there are at
-/// least [`PARALLEL_MIN_PARTS`] parts, else on the calling thread.
-pub fn part_edges(
-    threads: usize,
-    part_edges: &[usize],
-    z: &mut [DVec2],
-    u: &mut [DVec2],
-    work: &PartEdgesWork<'_>,
-) {
-    if threads <= 1 || part_edges.len() < PARALLEL_MIN_PARTS {
-        work(0, part_edges, z, u);
-        return;
-    }
-    let mut pieces = Vec::with_capacity(part_edges.len().div_ceil(CHUNK));
-    let (mut z, mut u, mut first) = (z, u, 0);
-    for counts in part_edges.chunks(CHUNK) {
-        let len: usize = counts.iter().sum();
-        let (z0, z1) = std::mem::take(&mut z).split_at_mut(len);
-        let (u0, u1) = std::mem::take(&mut u).split_at_mut(len);
-        pieces.push((first, counts, z0, u0));
-        (z, u, first) = (z1, u1, first + len);
-    }
-    let run = move || {
-        (pieces.into_par_iter()).for_each(|(first, counts, z, u)| work(first, counts, z, u));
-    };
-    on_pool(run);
-}
-
 /// Runs `a` and `b`, side by side on the pool when `threads > 1` (the caller makes the
 /// result independent of which ran where).
 pub fn join<A, B, RA, RB>(threads: usize, a: A, b: B) -> (RA, RB)

@@ -1,4 +1,4 @@
-//! The solver's settings: which linear solver, which pass-1 method, iteration counts and
+//! The solver's settings: which linear solver, iteration counts and
 //! tolerances, hysteresis and the norm exponent, taken from a grammar's `solver` block.
 
 use clay_dsl::compiled::SolverParams;
@@ -14,64 +14,13 @@ pub enum SolverKind {
     Cg,
 }
 
-/// How pass 1 minimises the sub-quadratic energy (both decide the active rest states).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Pass1 {
-    /// Iteratively reweighted least squares (the paper's 5.2), restarted from the displayed
-    /// pose every frame, one weight per part: a numeric factorisation per iteration.
-    #[default]
-    Irls,
-    /// Variable splitting (`admm.rs`): least-squares solves with the pass-2 factor, per-edge
-    /// gaps and duals, restarted from the displayed pose every frame. No factorisation while
-    /// the assembly and the held vertices stay the same, but it converges linearly: tens to
-    /// hundreds of iterations a frame where IRLS takes a few (`docs/solver.md`).
-    Admm,
-}
-
-impl Pass1 {
-    pub fn name(self) -> &'static str {
-        match self {
-            Pass1::Irls => "irls",
-            Pass1::Admm => "admm",
-        }
-    }
-
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "irls" => Some(Pass1::Irls),
-            "admm" => Some(Pass1::Admm),
-            _ => None,
-        }
-    }
-}
-
 /// Solver parameters. The first four mirror the grammar's [`SolverParams`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverConfig {
     pub kind: SolverKind,
-    /// The pass-1 method.
-    pub pass1: Pass1,
-    /// [`Pass1::Admm`]: a part whose stacked residual is shorter than this fraction of the
-    /// mean rest edge length closes (stays rigid); a longer one opens as a gap.
-    pub admm_threshold: f64,
-    /// [`Pass1::Admm`]: parts with a held vertex close below this fraction of the threshold,
-    /// i.e. weigh `factor^(2 - p)` in the sparse norm. Among equally strained parts the gaps
-    /// then open at the handles first (paper 5.2: the handles are the outliers); without it a
-    /// chain pulled evenly stays evenly stretched, a stationary point the splitting cannot
-    /// leave by itself.
-    pub admm_handle_factor: f64,
-    /// [`Pass1::Admm`]: most splitting iterations per frame (each a local step, a solve with
-    /// the kept factor, a shrink and a dual update).
-    pub admm_iterations: usize,
-    /// [`Pass1::Admm`]: the splitting stops once no vertex moved more than this fraction of
-    /// the model's size and no state switched. Far below IRLS's [`SolverConfig::pass1_tolerance`]
-    /// because the splitting creeps: it gathers the wall's first gap by steps of about 3e-5
-    /// of the model's size over a hundred iterations, and a step test at IRLS's 1e-3 stopped
-    /// it at its second iteration (`docs/solver.md`).
-    pub admm_tolerance: f64,
     /// A part switches to a nearer rest state only when `d_new < (1 - hysteresis) d_active`.
     pub hysteresis: f64,
-    /// Exponent p of the IRLS pass (2 = least squares).
+    /// Exponent p of pass 1's sub-quadratic norm (2 = least squares).
     pub norm: f64,
     /// Pass 1 (paper 5.2: "the constraint handles are considered as outliers"): a stretch
     /// part that holds a held vertex weighs `handle_outlier^(2 - p)` in the sparse norm
@@ -159,11 +108,6 @@ impl SolverConfig {
     pub fn from_params(params: &SolverParams) -> Self {
         Self {
             kind: SolverKind::Cholesky,
-            pass1: Pass1::Irls,
-            admm_threshold: 0.05,
-            admm_handle_factor: 0.9,
-            admm_iterations: 1000,
-            admm_tolerance: 1e-6,
             hysteresis: params.hysteresis,
             norm: params.norm,
             irls_epsilon: params.irls_epsilon,

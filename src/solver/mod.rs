@@ -4,7 +4,6 @@
 //! norm (IRLS) and decides the active rest states; pass 2 is plain least squares with the
 //! states fixed, and its positions are what the user sees.
 
-mod admm;
 mod anderson;
 mod cg;
 mod cholesky;
@@ -18,7 +17,7 @@ mod measure;
 mod report;
 
 use config::cone_cosine;
-pub use config::{Pass1, SolverConfig, SolverKind};
+pub use config::{SolverConfig, SolverKind};
 pub use measure::{
     bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
 };
@@ -160,19 +159,16 @@ pub struct Solver {
     irls_factor: NumericFactor,
     l2_factor: NumericFactor,
     work: Work,
-    /// The last frame's pass-1 pose, and the buffers of [`Pass1::Admm`]'s splitting
-    /// variables (each frame starts them afresh).
-    splitting: admm::Splitting,
+    /// The last frame's pass-1 pose.
+    pass1_pose: Vec<DVec2>,
     /// The connected components of the vertex graph (rigid following, free centroids).
     components: follow::Components,
     /// The mean rest edge length of the active states when the generation was prepared (the
-    /// splitting threshold's unit).
+    /// unit of pass 1's tolerance and of the rest test of [`Solver::try_states`]).
     mean_rest_edge: f64,
     /// The components with no held vertex this frame, ascending (solves shift their
     /// centroids back).
     free_components: Vec<usize>,
-    /// Scratch: the shifted edge targets `t + z - u` of a splitting solve.
-    shifted: Vec<DVec2>,
     /// Pass 2's mixing history ([`SolverConfig::l2_anderson`]).
     anderson: anderson::Anderson,
     /// Per vertex, its row in the factor's fill-reducing order (the inverse of
@@ -193,11 +189,10 @@ impl Solver {
             irls_factor: NumericFactor::default(),
             l2_factor: NumericFactor::default(),
             work: Work::default(),
-            splitting: admm::Splitting::default(),
+            pass1_pose: Vec::new(),
             components: follow::Components::default(),
             free_components: Vec::new(),
             mean_rest_edge: 1.0,
-            shifted: Vec::new(),
             anderson: anderson::Anderson::default(),
             factor_slot: Vec::new(),
             ordered: Vec::new(),
@@ -207,7 +202,7 @@ impl Solver {
     /// The pass-1 (sub-quadratic) pose of the last frame, from which the active rest states
     /// were decided; empty before the first frame.
     pub fn pass1_pose(&self) -> &[DVec2] {
-        &self.splitting.pose
+        &self.pass1_pose
     }
 
     /// Number of stored entries of the normal matrix's lower triangle (after the first frame).
@@ -307,8 +302,8 @@ impl Solver {
 
     /// Runs one frame that stops early once `budget` is (about to be) spent, for an editor
     /// that must draw at a fixed rate. It always runs the pass-1 iterations that decide states
-    /// (two splitting iterations, or one IRLS iteration; fewer if the configuration asks for
-    /// fewer) and ends with at least one least-squares solve, so the displayed positions are a
+    /// (two: the first only weighs the parts; fewer if the configuration asks for fewer) and
+    /// ends with at least one least-squares solve, so the displayed positions are a
     /// proper least-squares pose of the current states even when cut short. A further
     /// iteration is started only if the previous one of its pass fits in the time left. When
     /// cut short, the report has `complete == false` and `converged == false`; call again next
@@ -404,29 +399,22 @@ impl Solver {
         // handles now put them, by either method: the gesture's new step is where the
         // deformation starts, so the sparse norm gathers it next to the handle that moved,
         // and elsewhere into the parts the least-squares pose already strains most
-        // (`docs/solver.md`). The splitting starts with no gaps and no duals (carried from
-        // frame to frame, its variables kept the first frame's gaps).
-        let mut split = std::mem::take(&mut self.splitting);
-        split.reset(self.pattern.edges.len(), &warm);
-        self.snap_held(&mut split.pose);
+        // (`docs/solver.md`).
+        let mut pose = std::mem::take(&mut self.pass1_pose);
+        pose.clone_from(&warm);
+        self.snap_held(&mut pose);
         if self.pass1_runs() {
             // the evaluation at the displayed pose: pass 2 starts there (`Start`), and its
             // rotations are the directions the stretch parts' lengths are measured along
             if self.work.start.valid.is_none() {
                 self.start_at(&asm.data().parts, asm.handles(), &warm, start_key);
             }
-            self.stretch_contexts(asm, &split.pose);
+            self.stretch_contexts(asm, &pose);
             self.outlier_factors(&asm.data().parts, asm.handles());
         }
         report.phases.bookkeeping += ms_since(start);
-        let pass1 = self.pass1(
-            &mut asm.data_mut().parts,
-            &mut split,
-            scale,
-            deadline,
-            &mut report,
-        );
-        self.splitting = split;
+        let pass1 = self.pass1(&mut asm.data_mut().parts, &mut pose, deadline, &mut report);
+        self.pass1_pose = pose;
         self.collect_claims(asm, &mut report);
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());
@@ -439,7 +427,7 @@ impl Solver {
         }
         let t = Instant::now();
         let before = asm.generation();
-        between(asm, &report, &self.splitting.pose);
+        between(asm, &report, &self.pass1_pose);
         if asm.generation() != before {
             // the structure changed: pass 2 runs on the new one, from the rules' layout
             self.prepare(asm)?;
@@ -747,12 +735,9 @@ impl Solver {
         lengths
     }
 
-    /// Whether pass 1 runs at all (the configured method with any iterations).
+    /// Whether pass 1 runs at all.
     fn pass1_runs(&self) -> bool {
-        match self.config.pass1 {
-            Pass1::Irls => self.config.irls_iterations > 0,
-            Pass1::Admm => self.config.admm_iterations > 0,
-        }
+        self.config.irls_iterations > 0
     }
 
     /// Evaluates the local step at the displayed pose `warm` with the states kept and keeps
@@ -916,29 +901,23 @@ impl Solver {
         follow::move_points(&self.components, &motions, warm);
     }
 
-    /// Pass 1 (paper 5.2): the sub-quadratic norm, by splitting or by IRLS, from the pass-1
-    /// pose in `split` (the displayed pose); its local steps decide the active rest states.
-    /// Iterates until no vertex moves more than the method's tolerance times `scale` (the
-    /// model's size) and no state switches, or the configured count, or (after
-    /// [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `split`; returns whether it
+    /// Pass 1 (paper 5.2): the sub-quadratic norm by IRLS, from the pass-1 pose `pose` (the
+    /// displayed pose, the handles moved); its local steps decide the active rest states.
+    /// Iterates until no vertex moves more than [`SolverConfig::pass1_tolerance`] times the
+    /// mean rest edge and no state switches, or the configured count, or (after
+    /// [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `pose`; returns whether it
     /// converged.
     fn pass1(
         &mut self,
         parts: &mut [Part],
-        split: &mut admm::Splitting,
-        scale: f64,
+        pose: &mut Vec<DVec2>,
         deadline: Option<Instant>,
         report: &mut FrameReport,
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
-        let (iterations, tolerance) = match cfg.pass1 {
-            Pass1::Irls => (
-                cfg.irls_iterations,
-                cfg.pass1_tolerance * self.mean_rest_edge,
-            ),
-            Pass1::Admm => (cfg.admm_iterations, cfg.admm_tolerance * scale),
-        };
-        let mut f = std::mem::take(&mut split.pose);
+        let iterations = cfg.irls_iterations;
+        let tolerance = cfg.pass1_tolerance * self.mean_rest_edge;
+        let mut f = std::mem::take(pose);
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
         next.resize(f.len(), DVec2::ZERO);
@@ -964,13 +943,7 @@ impl Solver {
                 self.evaluate_fixed(parts, &f);
             }
             report.phases.local += ms_since(t);
-            let solved = match cfg.pass1 {
-                Pass1::Admm => {
-                    let switched = report.switches[switched_before..].to_vec();
-                    self.split_iteration(split, &switched, &f, &mut next, report)
-                }
-                Pass1::Irls => self.irls_iteration(&f, &mut next, report),
-            };
+            let solved = self.irls_iteration(&f, &mut next, report);
             if let Err(e) = solved {
                 result = Err(e);
                 break;
@@ -986,87 +959,9 @@ impl Solver {
                 break;
             }
         }
-        split.pose = f;
+        *pose = f;
         self.work.next = next;
         result.map(|()| converged)
-    }
-
-    /// One splitting iteration ([`admm`]): a least-squares solve with the edge targets shifted
-    /// by `z - u` (pass 2's factor), the shrink, the dual update. The edges of parts that
-    /// just switched state have new rest edges: their gaps and duals start over.
-    fn split_iteration(
-        &mut self,
-        split: &mut admm::Splitting,
-        switched: &[StateSwitch],
-        f: &[DVec2],
-        next: &mut [DVec2],
-        report: &mut FrameReport,
-    ) -> Result<(), SolverError> {
-        let cfg = self.config;
-        let t = Instant::now();
-        let edges = &self.pattern.edges;
-        for s in switched {
-            // edges are listed part by part
-            let first = edges.partition_point(|e| (e.part as usize) < s.part);
-            let count = edges[first..]
-                .iter()
-                .take_while(|e| e.part as usize == s.part)
-                .count();
-            split.z[first..first + count].fill(DVec2::ZERO);
-            split.u[first..first + count].fill(DVec2::ZERO);
-        }
-        self.shifted.clear();
-        self.shifted.extend(
-            self.work
-                .targets
-                .iter()
-                .zip(split.z.iter().zip(&split.u))
-                .map(|(&t, (&z, &u))| t + z - u),
-        );
-        report.phases.local += ms_since(t);
-        std::mem::swap(&mut self.work.targets, &mut self.shifted);
-        let solved = self.solve_global(f, next, 1.0, Pass::LeastSquares, report);
-        std::mem::swap(&mut self.work.targets, &mut self.shifted);
-        solved?;
-        let t = Instant::now();
-        let p = cfg.norm;
-        let rho = admm::penalty(cfg.admm_threshold * self.mean_rest_edge, p);
-        let shrink = admm::Shrink::new(rho, p);
-        // weight c = factor^(2 - p) in the norm: the penalty seen by the shrink is rho / c
-        let factor = cfg.admm_handle_factor.clamp(1e-3, 1.0);
-        let at_handle = admm::Shrink::new(rho / factor.powf(2.0 - p), p);
-        let held = &self.work.handle_count;
-        let (ends, targets) = (&self.pattern.ends, &self.work.targets);
-        // One group per part (paper Eq. 6: the shape distance is a part's): the part's
-        // stacked edge residuals shrink together, so the sparse norm gathers deformation into
-        // few parts and spreads it evenly within them (a bent segment, not a torn one).
-        let next = &*next;
-        let shrink_parts = |first: usize, counts: &[usize], z: &mut [DVec2], u: &mut [DVec2]| {
-            let mut k = 0;
-            for &count in counts.iter().filter(|&&c| c > 0) {
-                let end = k + count;
-                let (mut n2, mut at_held) = (0.0, false);
-                for j in k..end {
-                    let [x, y] = ends[first + j].map(|i| i as usize);
-                    let v = (next[x] - next[y]) - targets[first + j] + u[j];
-                    z[j] = v;
-                    n2 += v.length_squared();
-                    at_held |= held[x] > 0.0 || held[y] > 0.0;
-                }
-                let scale = if at_held { &at_handle } else { &shrink }.factor(n2);
-                for j in k..end {
-                    let v = z[j];
-                    z[j] = v * scale;
-                    u[j] = v - z[j];
-                }
-                k = end;
-            }
-        };
-        let threads = cfg.thread_count();
-        let counts = &self.pattern.part_edges;
-        chunks::part_edges(threads, counts, &mut split.z, &mut split.u, &shrink_parts);
-        report.phases.local += ms_since(t);
-        Ok(())
     }
 
     /// One IRLS iteration (paper 5.2): weights `1 / (|r| + eps)^(2 - p)` from the residuals
@@ -1084,8 +979,8 @@ impl Solver {
         let part_edges = &self.pattern.part_edges;
         w.weights.clear();
         w.weights.resize(w.residuals.len(), 0.0);
-        // one weight per part with edges, from its stacked residual (see the splitting's
-        // groups); a part without edges keeps 0
+        // one weight per part with edges, from its stacked residual (paper Eq. 6: the shape
+        // distance is a part's); a part without edges keeps 0
         for (((weight, &d2), _), &c) in w
             .weights
             .iter_mut()
@@ -1120,7 +1015,7 @@ impl Solver {
         let mut f = warm;
         if cfg.l2_iterations == 0 {
             f.clear();
-            f.extend_from_slice(&self.splitting.pose);
+            f.extend_from_slice(&self.pass1_pose);
         }
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();

@@ -12,7 +12,7 @@ pub struct StateSwitch {
 /// What one frame did.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct FrameReport {
-    /// Pass-1 iterations run (splitting or IRLS, per [`SolverConfig::pass1`](super::SolverConfig::pass1)).
+    /// Pass-1 (IRLS) iterations run.
     pub pass1_iterations: usize,
     /// Least-squares (pass 2) iterations run.
     pub l2_iterations: usize,

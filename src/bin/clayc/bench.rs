@@ -8,7 +8,7 @@ use std::sync::Arc;
 use crate::out;
 use clay::assembly::{Assembly, HandleKind};
 use clay::session::Session;
-use clay::solver::{FrameReport, Pass1, SolverConfig, SolverKind};
+use clay::solver::{FrameReport, SolverConfig, SolverKind};
 use clay::synthetic;
 use glam::DVec2;
 use serde::Serialize;
@@ -30,13 +30,7 @@ pub struct BenchArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
-    /// How pass 1 minimises the sub-quadratic energy.
-    #[arg(long, value_enum, default_value_t = Pass1Arg::Irls)]
-    pub pass1: Pass1Arg,
-    /// Most splitting (pass 1, `--pass1 admm`) iterations per frame (default: the solver's).
-    #[arg(long)]
-    pub admm_iterations: Option<usize>,
-    /// Most IRLS (pass 1, `--pass1 irls`) iterations per frame (default: the solver's).
+    /// Most IRLS (pass 1) iterations per frame (default: the solver's).
     #[arg(long)]
     pub irls_iterations: Option<usize>,
     /// Most least-squares (pass 2) iterations per frame (default: the solver's).
@@ -48,12 +42,6 @@ pub struct BenchArgs {
     /// Threads of the solver's local step (0: every core; the results are the same).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Pass1Arg {
-    Admm,
-    Irls,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -77,9 +65,8 @@ struct BenchResult {
     /// Values stored by the Cholesky factor (0 with `--solver cg`).
     factor_values: usize,
     solver: &'static str,
-    pass1: &'static str,
     frames: usize,
-    /// Mean pass-1 (splitting or IRLS) and least-squares (pass 2) iterations per frame.
+    /// Mean pass-1 (IRLS) and least-squares (pass 2) iterations per frame.
     pass1_iterations: f64,
     l2_iterations: f64,
     factorizations_per_frame: f64,
@@ -161,15 +148,8 @@ pub fn bench(args: BenchArgs) -> u8 {
     };
     let mut config = SolverConfig {
         kind,
-        pass1: match args.pass1 {
-            Pass1Arg::Admm => Pass1::Admm,
-            Pass1Arg::Irls => Pass1::Irls,
-        },
         ..SolverConfig::default()
     };
-    if let Some(k) = args.admm_iterations {
-        config.admm_iterations = k.min(1000);
-    }
     if let Some(k) = args.irls_iterations {
         config.irls_iterations = k.min(1000);
     }
@@ -189,7 +169,6 @@ pub fn bench(args: BenchArgs) -> u8 {
             // classic ARAP: least squares only, one local + global iteration per frame
             // (unless asked for more)
             config.irls_iterations = 0;
-            config.admm_iterations = 0;
             config.l2_iterations = args.l2_iterations.map_or(1, |k| k.min(1000));
             config.tolerance = 0.0;
             let mut asm = Assembly::new(Arc::new(synthetic::arap_grid(k)));
@@ -267,7 +246,6 @@ pub fn bench(args: BenchArgs) -> u8 {
             SolverKind::Cholesky => "cholesky",
             SolverKind::Cg => "cg",
         },
-        pass1: config.pass1.name(),
         frames: reports.len(),
         pass1_iterations: reports
             .iter()
@@ -305,12 +283,11 @@ pub fn bench(args: BenchArgs) -> u8 {
         }
     } else {
         format!(
-            "{}: {} parts, {} vertices, solver {}, pass 1 {}, {} frames\niterations per frame: {:.2} pass-1 + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
+            "{}: {} parts, {} vertices, solver {}, {} frames\niterations per frame: {:.2} pass-1 + {:.2} L2, {:.2} factorisations, {:.1} CG iterations\nfirst frame {:.2} ms; frame_ms median {:.2}, max {:.2}\nrules_ms median {:.3}, max {:.3} ({} fired){}",
             result.model,
             result.parts,
             result.vertices,
             result.solver,
-            result.pass1,
             result.frames,
             result.pass1_iterations,
             result.l2_iterations,

@@ -8,7 +8,7 @@ use crate::out;
 use clay::assembly::Assembly;
 use clay::script::{Script, ScriptError};
 use clay::session::{Session, replay};
-use clay::solver::{Pass1, SolverConfig, SolverKind};
+use clay::solver::{SolverConfig, SolverKind};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
@@ -21,8 +21,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub json: bool,
     /// Override a solver parameter: hysteresis, norm, irls_epsilon, merge_distance,
-    /// pass1 (admm|irls), admm_iterations, irls_iterations, l2_iterations, l2_anderson,
-    /// handle_weight, solver (cholesky|cg).
+    /// irls_iterations, l2_iterations, l2_anderson, handle_weight, solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
@@ -57,11 +56,6 @@ pub fn apply_setting(
         };
         return Ok(());
     }
-    if name == "pass1" {
-        config.pass1 = Pass1::parse(value)
-            .ok_or_else(|| format!("--set pass1={value}: expected admm or irls"))?;
-        return Ok(());
-    }
     let number: f64 = value
         .parse()
         .ok()
@@ -92,10 +86,6 @@ pub fn apply_setting(
             check(number >= 0.0, "at least 0")?;
             *merge_distance = number;
         }
-        "admm_iterations" => {
-            check(count(number), "an integer from 0 to 1000")?;
-            config.admm_iterations = number as usize;
-        }
         "irls_iterations" => {
             check(count(number), "an integer from 0 to 1000")?;
             config.irls_iterations = number as usize;
@@ -117,7 +107,7 @@ pub fn apply_setting(
         }
         _ => {
             return Err(format!(
-                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, pass1, admm_iterations, irls_iterations, l2_iterations, l2_anderson, handle_weight or solver)"
+                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, irls_iterations, l2_iterations, l2_anderson, handle_weight or solver)"
             ));
         }
     }
