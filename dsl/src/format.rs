@@ -620,10 +620,11 @@ impl<'s> Printer<'s> {
         self.close(indent, s.span);
     }
 
-    /// Whether the stretch rule's body is written `{ min N }` on its line (or has no body).
+    /// Whether the stretch rule's body is written `{ min N }` or `{ max N }` on its line (or
+    /// has no body): one statement at most. `min` and `max` together take a line each.
     fn stretch_inline(&self, s: &StretchDecl) -> bool {
         s.variants.is_empty()
-            && s.min.len() <= 1
+            && s.min.len() + s.max.len() <= 1
             && !self.comment_within(Span::new(s.to.span.end, s.span.end))
     }
 
@@ -633,28 +634,37 @@ impl<'s> Printer<'s> {
             s.piece.name, s.from.name, s.to.name
         );
         if self.stretch_inline(s) {
-            let t = match s.min.first() {
-                Some(m) => format!("{header} {{ min {} }}", self.num(m)),
-                None => header,
+            let t = match (s.min.first(), s.max.first()) {
+                (Some(m), _) => format!("{header} {{ min {} }}", self.num(m)),
+                (None, Some(m)) => format!("{header} {{ max {} }}", self.num(m)),
+                (None, None) => header,
             };
             return self.stmt(0, &t, s.span);
         }
         self.open(0, &header, s.span.start, s.to.span.end);
-        let mut body: Vec<(usize, Option<&Expr>, Option<&VariantsDecl>)> = Vec::new();
-        body.extend(s.min.iter().map(|m| (m.span.start, Some(m), None)));
-        body.extend(s.variants.iter().map(|v| (v.span.start, None, Some(v))));
+        // A statement of the body: `min N` / `max N` (the keyword and N), or `variants`.
+        enum Stmt<'a> {
+            Bound(&'static str, &'a Expr),
+            Variants(&'a VariantsDecl),
+        }
+        // Without the source: `min`, `max`, then `variants`.
+        let mut body: Vec<(usize, Stmt)> = Vec::new();
+        body.extend(s.min.iter().map(|m| (m.span.start, Stmt::Bound("min", m))));
+        body.extend(s.max.iter().map(|m| (m.span.start, Stmt::Bound("max", m))));
+        body.extend(s.variants.iter().map(|v| (v.span.start, Stmt::Variants(v))));
         if self.src.is_some() {
             body.sort_by_key(|b| b.0);
         }
-        for (_, min, variants) in body {
-            if let Some(m) = min {
-                // The span of a `min` statement is not kept; `min` is 4 bytes before a number
-                // written after one space, and a comment in between is printed before it.
-                let span = Span::new(m.span.start.saturating_sub(4), m.span.end);
-                self.stmt(1, &format!("min {}", self.num(m)), span);
-            }
-            if let Some(v) = variants {
-                self.variants(1, v);
+        for (_, stmt) in body {
+            match stmt {
+                Stmt::Bound(keyword, m) => {
+                    // The span of a `min`/`max` statement is not kept; the keyword is 4 bytes
+                    // before a number written after one space, and a comment in between is
+                    // printed before it.
+                    let span = Span::new(m.span.start.saturating_sub(4), m.span.end);
+                    self.stmt(1, &format!("{keyword} {}", self.num(m)), span);
+                }
+                Stmt::Variants(v) => self.variants(1, v),
             }
         }
         // Only a rule with a body is printed as a block, so its span ends with `}`.

@@ -66,7 +66,7 @@ pub fn describe(rule: Rule) -> &'static str {
         }
         Rule::piece_stmt => "a piece statement",
         Rule::state_stmt => "a state statement",
-        Rule::stretch_stmt => "`min` or `variants`",
+        Rule::stretch_stmt => "`min`, `max` or `variants`",
         Rule::model_stmt => "an instance or a `dock`",
         Rule::name => "a name",
         Rule::number | Rule::plain => "a number",
@@ -105,6 +105,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::kw_from => "`from`",
         Rule::kw_to => "`to`",
         Rule::kw_min => "`min`",
+        Rule::kw_max => "`max`",
         Rule::kw_variants => "`variants`",
         Rule::kw_merge => "`merge`",
         Rule::kw_onto => "`onto`",
@@ -167,6 +168,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::derived_stmt => "a `polygon` or `polyline`",
         Rule::stretch_decl => "a `stretch` rule",
         Rule::min_decl => "`min`",
+        Rule::max_decl => "`max`",
         Rule::variants_decl => "`variants`",
         Rule::variant => "a variant `PIECE FREQUENCY`",
         Rule::merge_decl => "a `merge` rule",
@@ -1125,6 +1127,11 @@ impl Lower {
             .filter_map(|m| first(&kids(m), Rule::expr))
             .map(|n| self.expr(n).0)
             .collect();
+        let max = of(&ch, Rule::max_decl)
+            .into_iter()
+            .filter_map(|m| first(&kids(m), Rule::expr))
+            .map(|n| self.expr(n).0)
+            .collect();
         let variants = of(&ch, Rule::variants_decl)
             .into_iter()
             .map(|v| {
@@ -1154,6 +1161,7 @@ impl Lower {
             from: names.get(1).cloned().unwrap_or(empty.clone()),
             to: names.get(2).cloned().unwrap_or(empty),
             min,
+            max,
             variants,
             span,
         }

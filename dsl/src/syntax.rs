@@ -354,6 +354,8 @@ pub struct StretchDecl {
     pub to: Ident,
     /// Every `min N` written (more than one is reported).
     pub min: Vec<Expr>,
+    /// Every `max N` written (more than one is reported).
+    pub max: Vec<Expr>,
     /// Every `variants { ... }` written (more than one is reported).
     pub variants: Vec<VariantsDecl>,
     pub span: Span,

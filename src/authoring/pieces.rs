@@ -627,6 +627,7 @@ impl Design {
                     from: ident(&p.sites[from].name),
                     to: ident(&p.sites[to].name),
                     min: vec![number(2.0)],
+                    max: Vec::new(),
                     variants: Vec::new(),
                     span: Span::default(),
                 }));

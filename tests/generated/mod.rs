@@ -388,7 +388,6 @@ pub mod strategy {
             .prop_flat_map(|(element, count, angle, (x, y))| {
                 let min = prop_oneof![4 => Just(2usize), 1 => 2..=count.max(2)];
                 let max = prop_oneof![3 => Just(None), 1 => (count..=4 * count).prop_map(Some)];
-                let max = max.prop_map(|_| None::<usize>); // TODO(max): until `max` parses
                 (
                     Just(element),
                     Just(count),
@@ -1143,8 +1142,10 @@ pub mod norm {
     pub fn sub_l1_inserts_early(g: &ChainGrammar, frames: u64) -> Result<(), String> {
         let n = g.count as f64;
         let pull = Pull {
+            // the property is the norm's: no `max` to stop the insertion
             grammar: ChainGrammar {
                 norm: 0.5,
+                max: None,
                 ..g.clone()
             },
             factor: (n + 1.0) / n,
@@ -1170,6 +1171,7 @@ pub mod norm {
         let pull = Pull {
             grammar: ChainGrammar {
                 norm: 1.0,
+                max: None,
                 ..g.clone()
             },
             factor: 2.0,

@@ -185,7 +185,9 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
             Some("solver") => PARAMETERS
                 .iter()
                 .for_each(|p| out.push(p, CompletionKind::Parameter, None)),
-            Some("stretch") => ["min", "variants"].iter().for_each(|k| out.keyword(k)),
+            Some("stretch") => ["min", "max", "variants"]
+                .iter()
+                .for_each(|k| out.keyword(k)),
             Some("polygon") => out.keyword("hole"),
             _ => {}
         }
@@ -202,7 +204,7 @@ fn expression_context(before: &str, first: &str, inner: Option<&str>) -> bool {
         || before
             .split_whitespace()
             .last()
-            .is_some_and(|w| matches!(w, "rotate" | "width" | "within" | "min" | "x"))
+            .is_some_and(|w| matches!(w, "rotate" | "width" | "within" | "min" | "max" | "x"))
 }
 
 /// Collects completions without duplicates.

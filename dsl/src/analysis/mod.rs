@@ -40,9 +40,9 @@ use imports::Imported;
 pub const KEYWORDS: &[&str] = &[
     "let", "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
-    "min", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x", "along",
-    "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude", "above",
-    "mesh",
+    "min", "max", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x",
+    "along", "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude",
+    "above", "mesh",
 ];
 
 /// Words that start a top-level item, where a parsed prefix may end.

@@ -303,7 +303,7 @@ impl Symbols {
                 self.use_of(&r.piece, pi.as_ref());
                 self.member(scope, pi, &r.from, SymbolKind::Site);
                 self.member(scope, pi, &r.to, SymbolKind::Site);
-                for m in &r.min {
+                for m in r.min.iter().chain(&r.max) {
                     self.expr(m, scope);
                 }
                 for v in r.variants.iter().flat_map(|v| &v.entries) {

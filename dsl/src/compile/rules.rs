@@ -113,6 +113,32 @@ impl Compiler {
                 self.whole(m, "`min`", 2).map(|v| v as usize)
             }
         };
+        // `Some(None)`: no `max` written; `None`: a `max` that failed (reported).
+        let max = match s.max.as_slice() {
+            [] => Some(None),
+            [m, rest @ ..] => {
+                for r in rest {
+                    let id = syntax::Ident {
+                        name: "max".into(),
+                        span: r.span,
+                    };
+                    self.duplicate("setting", &id, m.span);
+                }
+                match (self.whole(m, "`max`", 2), min, s.min.first()) {
+                    (None, ..) => None,
+                    // Below a written `min` (the default 2 is the least `whole` accepts).
+                    (Some(v), Some(lo), Some(written)) if v < lo as u64 => {
+                        self.error(
+                            Diagnostic::error(codes::OUT_OF_RANGE, format!("`max` {v} is below `min` {lo}"), m.span, format!("must be at least {lo}"))
+                                .with_secondary(written.span, "the `min` of this rule")
+                                .with_hint("a chain never grows beyond `max` elements nor shrinks below `min`: raise `max` to at least `min`, or lower `min`"),
+                        );
+                        None
+                    }
+                    (Some(v), ..) => Some(Some(v as usize)),
+                }
+            }
+        };
         let mut variants = Vec::new();
         let mut ok = true;
         if let Some((first, rest)) = s.variants.split_first() {
@@ -188,7 +214,7 @@ impl Compiler {
                 self.no_element_states(v.piece, head);
             }
         }
-        let (Some(from), Some(to), Some(min)) = (from, to, min) else {
+        let (Some(from), Some(to), Some(min), Some(max)) = (from, to, min, max) else {
             return;
         };
         let piece = self.pieces[pi].clone();
@@ -216,7 +242,7 @@ impl Compiler {
             from,
             to,
             min,
-            max: None,
+            max,
             part,
         });
         self.stretch_spans.push(s.span);

@@ -41,7 +41,7 @@ const grammar = await registry.loadGrammar("source.clay");
 // Keywords that begin a statement (or a block).
 const STATEMENT_KEYWORDS = new Set([
   "import", "let", "solver", "site", "piece", "vertex", "edges", "axis", "polygon", "polyline",
-  "mesh", "hole", "state", "stretch", "min", "variants", "merge", "cut", "model", "dock",
+  "mesh", "hole", "state", "stretch", "min", "max", "variants", "merge", "cut", "model", "dock",
 ]);
 // Keywords inside a statement, by the statement's first keyword ("=" for `NAME = ...`).
 const INNER_KEYWORDS = {
@@ -416,6 +416,10 @@ test("expressions: built-ins, pi, operators, points and groups", () => {
   expectScope("let a = min(1, 2)\nstretch s from a to b { min 2 }\n", "stretch", "min", "keyword.other.min.clay");
   expectScope("let a = min(1, 2)\n", "let", "min", "support.function.builtin.clay");
   expectScope("let a = min (1, 2)\n", "let", "min", "support.function.builtin.clay");
+  expectScope(fixture, "    max max(", "max", "keyword.other.max.clay");
+  expectScope(fixture, "    max max(", "max", "support.function.builtin.clay", { nth: 1 });
+  expectScope(fixture, "    max max(", "max", "keyword", { nth: 1, not: true });
+  expectScope("let a = max(1, 2)\nstretch s from a to b { max 2 }\n", "stretch", "max", "keyword.other.max.clay");
   expectScope("let a = sinus(1)\n", "let", "sinus", "support.function", { not: true });
   expectScope("let a = pi(1)\n", "let", "pi", "constant.language", { not: true });
 });
