@@ -18,7 +18,6 @@ use crate::assembly::{Assembly, HandleId, HandleKind};
 use crate::rules::cut::CUT_REACH;
 use crate::rules::{RuleEvent, RuleKind, Rules, replace};
 use crate::script::{Motion, Script, Selector, Step};
-use crate::solver::local::align;
 use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
 use crate::summary::{Summary, summarize};
 
@@ -31,19 +30,30 @@ pub struct Frame {
     pub events: Vec<RuleEvent>,
 }
 
-/// Why a part is in the rest state it is in (the editor's inspector shows this).
+/// Why a part is in the rest state it is in (the editor's inspector shows this): what the
+/// solver's state choice compares.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartReport {
     pub part: usize,
     /// The active state's index in `states`.
     pub active: usize,
-    /// Every rest state's name with its shape-space distance (squared, after the best
-    /// rotation) to the current pose.
+    /// Every rest state's name with the shape-space distance the state choice compares
+    /// (squared: a piece part's over the vertices it shares with other parts, a stretch
+    /// part's in its chain's frame) to the current pose.
     pub states: Vec<(String, f64)>,
+    /// Per rest state: whether it may become active now (a stretch part's `one` at its
+    /// chain's `min`, say, may not).
+    pub available: Vec<bool>,
+    /// For a stretch part: the state its length calls for, and its length in elements.
+    pub candidate: Option<(usize, f64)>,
     pub hysteresis: f64,
-    /// Another state becomes active once its distance drops below this (paper 4.2's
+    /// Another state becomes active once its distance drops below this (paper 4.3's
     /// hysteresis: `(1 - hysteresis)` times the active state's distance).
     pub switch_below: f64,
+    /// Whether the part rests in its active state: its distance to it is within a millionth
+    /// of the part's size squared (a part may also hold still under strain, held by handles
+    /// or its neighbours).
+    pub at_rest: bool,
 }
 
 /// A sculpting session over an assembly.
@@ -283,26 +293,42 @@ impl Session {
             .collect()
     }
 
+    /// Whether the model rests after the last frame: its energy is within a millionth of the
+    /// model's size squared (the claims suites' rest). A model may also hold still under
+    /// strain: held by handles, or in states its chains cannot leave.
+    pub fn at_rest(&self, asm: &Assembly) -> bool {
+        let size = crate::solver::bbox_diagonal(&asm.data().positions);
+        self.last_report()
+            .is_some_and(|r| r.energy <= 1e-6 * size * size)
+    }
+
     /// Why `part` is in the state it is in, under the solver's hysteresis.
     pub fn inspect(&self, asm: &Assembly, part: usize) -> Option<PartReport> {
         let data = &asm.data();
         let p = data.parts.get(part)?;
-        let states: Vec<(String, f64)> = p
-            .states
-            .iter()
-            .map(|s| {
-                let d = align(&s.positions, &p.vertices, &data.positions).distance;
-                (s.name.clone(), d)
-            })
+        let judged = self.solver.judge(asm, part)?;
+        let states: Vec<(String, f64)> = (p.states.iter())
+            .zip(&judged.distances)
+            .map(|(s, &d)| (s.name.clone(), d))
             .collect();
         let active = p.active.min(states.len().saturating_sub(1));
         let d_active = states.get(active).map_or(0.0, |s| s.1);
         let hysteresis = self.solver.config.hysteresis;
+        // at rest: within a millionth of the part's size squared (the claims suite's rest)
+        let size = crate::solver::bbox_diagonal(
+            &p.vertices
+                .iter()
+                .map(|&v| data.positions[v])
+                .collect::<Vec<_>>(),
+        );
         Some(PartReport {
             part,
             active,
             hysteresis,
             switch_below: (1.0 - hysteresis) * d_active,
+            available: judged.available,
+            candidate: judged.candidate,
+            at_rest: d_active <= 1e-6 * size * size,
             states,
         })
     }

@@ -38,7 +38,7 @@ pub struct SolverConfig {
     pub reversal: f64,
     /// Epsilon in the IRLS weight `1 / (|r| + eps)^(2 - p)`.
     pub irls_epsilon: f64,
-    /// [`Pass1::Irls`]: most IRLS iterations per frame; each is a local step, one weight
+    /// Pass 1: most IRLS iterations per frame; each is a local step, one weight
     /// per part, and a global step with a fresh numeric factorisation. Six pass every claim
     /// of both claims suites (300 generated cases of each property; four fail two of them);
     /// a large model seldom converges to the tolerance below in a frame of a brisk drag (the

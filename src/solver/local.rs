@@ -396,46 +396,21 @@ pub fn decide_stretch(
     ctx: StretchContext,
 ) -> Chosen {
     use clay_dsl::compiled::{STRETCH_ONE as ONE, STRETCH_THREE as THREE, STRETCH_TWO as TWO};
-    let StateSums {
-        dot, cross, pp, qq, ..
-    } = sums;
-    let r = ctx.reference;
-    // the squared distance to a rest shape with these sums, turned by the reference
-    let distance =
-        |dot: f64, cross: f64, pp: f64| (pp + qq - 2.0 * (r.x * dot + r.y * cross)).max(0.0);
-    let fixed: [f64; 3] = std::array::from_fn(|j| distance(dot[j], cross[j], pp[j]));
-    // the span along the chain's direction, in elements
-    let length = sums.span.dot(r.rotate(sums.axis)) / sums.element;
-    let length = if length.is_finite() { length } else { 2.0 };
-    let elements = length
-        .round()
-        .clamp(-f64::from(MAX_CLAIM), f64::from(MAX_CLAIM)) as i32;
-    let count = elements.max(1);
-    let mut candidate = match count {
-        1 => ONE,
-        2 => TWO,
-        _ => THREE,
-    };
-    if !ctx.allows(candidate) {
-        candidate = TWO;
-    }
-    let candidate_distance = if candidate == THREE && count > 3 {
-        // the `count`-element shape: t = count - 2 steps of `three - two` from `two`
-        let t = f64::from(count - 2);
-        let d = dot[TWO] + t * (dot[THREE] - dot[TWO]);
-        let c = cross[TWO] + t * (cross[THREE] - cross[TWO]);
-        let linear = (pp[THREE] - pp[ONE]) / 4.0;
-        let quadratic = (pp[ONE] + pp[THREE]) / 2.0 - pp[TWO];
-        distance(d, c, pp[TWO] + 2.0 * t * linear + t * t * quadratic)
-    } else {
-        fixed[candidate]
-    };
+    let view = StretchView::of(&sums, ctx);
+    let StretchView {
+        distances,
+        length,
+        elements,
+        candidate,
+        candidate_distance,
+    } = view;
     let beyond_one = candidate == ONE && length <= 1.0;
     let switch = candidate != active
         && (!ctx.allows(active)
             || beyond_one
-            || candidate_distance < (1.0 - hysteresis) * fixed[active]);
+            || candidate_distance < (1.0 - hysteresis) * distances[active]);
     let state = if switch { candidate } else { active };
+    let count = elements.max(1);
     let claim = match state {
         ONE if candidate == ONE => elements.min(1),
         ONE => 1,
@@ -443,11 +418,118 @@ pub fn decide_stretch(
         _ if candidate == THREE => count.max(3),
         _ => 3,
     };
-    let len = (dot[state] * dot[state] + cross[state] * cross[state]).sqrt();
+    let (dot, cross) = (sums.dot[state], sums.cross[state]);
+    let len = (dot * dot + cross * cross).sqrt();
     Chosen {
         state,
-        rotation: rotation_of(dot[state], cross[state], len),
+        rotation: rotation_of(dot, cross, len),
         claim,
+    }
+}
+
+/// What a stretch part's decision ([`decide_stretch`]) sees of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StretchView {
+    /// The squared distances to `one`, `two` and `three`, turned by the reference.
+    pub distances: [f64; 3],
+    /// Its span in elements along the chain's direction, and that rounded (however far).
+    pub length: f64,
+    pub elements: i32,
+    /// The state its length calls for (`two` when that one is unavailable), and the distance
+    /// to its shape (for `three`, to the shape of `elements` elements).
+    pub candidate: usize,
+    pub candidate_distance: f64,
+}
+
+impl StretchView {
+    pub fn of(sums: &StateSums, ctx: StretchContext) -> Self {
+        use clay_dsl::compiled::{STRETCH_ONE as ONE, STRETCH_THREE as THREE, STRETCH_TWO as TWO};
+        let StateSums {
+            dot, cross, pp, qq, ..
+        } = *sums;
+        let r = ctx.reference;
+        // the squared distance to a rest shape with these sums, turned by the reference
+        let distance =
+            |dot: f64, cross: f64, pp: f64| (pp + qq - 2.0 * (r.x * dot + r.y * cross)).max(0.0);
+        let distances: [f64; 3] = std::array::from_fn(|j| distance(dot[j], cross[j], pp[j]));
+        // the span along the chain's direction, in elements
+        let length = sums.span.dot(r.rotate(sums.axis)) / sums.element;
+        let length = if length.is_finite() { length } else { 2.0 };
+        let elements = length
+            .round()
+            .clamp(-f64::from(MAX_CLAIM), f64::from(MAX_CLAIM)) as i32;
+        let count = elements.max(1);
+        let mut candidate = match count {
+            1 => ONE,
+            2 => TWO,
+            _ => THREE,
+        };
+        if !ctx.allows(candidate) {
+            candidate = TWO;
+        }
+        let candidate_distance = if candidate == THREE && count > 3 {
+            // the `count`-element shape: t = count - 2 steps of `three - two` from `two`
+            let t = f64::from(count - 2);
+            let d = dot[TWO] + t * (dot[THREE] - dot[TWO]);
+            let c = cross[TWO] + t * (cross[THREE] - cross[TWO]);
+            let linear = (pp[THREE] - pp[ONE]) / 4.0;
+            let quadratic = (pp[ONE] + pp[THREE]) / 2.0 - pp[TWO];
+            distance(d, c, pp[TWO] + 2.0 * t * linear + t * t * quadratic)
+        } else {
+            distances[candidate]
+        };
+        Self {
+            distances,
+            length,
+            elements,
+            candidate,
+            candidate_distance,
+        }
+    }
+}
+
+/// What the local step sees of a part when it chooses its state ([`choose_state`]): the
+/// distances it compares, per rest state, and which states may become active. For the
+/// inspector, which must say what the solver does.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judgement {
+    /// Per rest state: the squared shape distance the choice compares (a piece part's over
+    /// its shared vertices, a stretch part's in its chain's frame).
+    pub distances: Vec<f64>,
+    /// Per rest state: whether it may become active.
+    pub available: Vec<bool>,
+    /// For a stretch part: the state its length calls for, and its length in elements.
+    pub candidate: Option<(usize, f64)>,
+}
+
+/// The [`Judgement`] of part `pi` (`part`) at `positions`, as [`choose_state`] makes it.
+pub fn judge(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Judgement {
+    let n = part.states.len();
+    if let Some(ctx) = how.context(pi, part)
+        && let Some(sums) = state_sums(part, positions)
+    {
+        let view = StretchView::of(&sums, ctx);
+        return Judgement {
+            distances: view.distances.to_vec(),
+            available: (0..n).map(|j| ctx.allows(j)).collect(),
+            candidate: Some((view.candidate, view.length)),
+        };
+    }
+    let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
+    let distances = (part.states.iter())
+        .map(|st| match &boundary {
+            Some(ks) => {
+                let r: Vec<DVec2> = ks.iter().map(|&k| st.positions[k]).collect();
+                let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
+                align(&r, &vs, positions).distance
+            }
+            None => align(&st.positions, &part.vertices, positions).distance,
+        })
+        .collect();
+    Judgement {
+        distances,
+        available: vec![true; n],
+        candidate: None,
     }
 }
 

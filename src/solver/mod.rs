@@ -205,6 +205,32 @@ impl Solver {
         &self.pass1_pose
     }
 
+    /// What the local step sees of `part` at `asm`'s pose when it chooses the part's state
+    /// ([`local::Judgement`]), with this solver's last frame's view of the chains (the
+    /// directions their parts are measured along, the states the rules can honour) when the
+    /// assembly has not changed since. For the inspector.
+    pub(crate) fn judge(&self, asm: &Assembly, part: usize) -> Option<local::Judgement> {
+        let data = asm.data();
+        let p = data.parts.get(part)?;
+        let current = self.generation == Some(asm.generation())
+            && self.work.stretch.len() == data.parts.len();
+        let fresh;
+        let shared = if current {
+            &self.work.vertex_parts
+        } else {
+            fresh = local::VertexParts::build(&data.parts, data.positions.len());
+            &fresh
+        };
+        let stretch: &[Option<local::StretchContext>] =
+            if current { &self.work.stretch } else { &[] };
+        let how = local::Switching {
+            hysteresis: self.config.hysteresis,
+            stretch,
+            shared: Some(shared),
+        };
+        Some(local::judge(part, p, &data.positions, how))
+    }
+
     /// Number of stored entries of the normal matrix's lower triangle (after the first frame).
     pub fn matrix_nonzeros(&self) -> usize {
         self.pattern.nnz()
@@ -474,8 +500,14 @@ impl Solver {
         report.energy = terms.elastic;
         report.objective = terms.total();
         let settled = report.moved <= cfg.settle_tolerance * scale;
+        // still and strained, other states not yet tried: the next frame tries them
+        // (`settling`), so this one is not the last (a host that stops at convergence, as the
+        // editor does, would never run it)
+        let e = self.mean_rest_edge;
+        let trial_due = !self.work.tried && terms.elastic > 1e-6 * e * e;
         report.converged = report.complete
             && report.switches.is_empty()
+            && !trial_due
             && (settled || (pass1_converged && pass2_converged));
         // the shown pose is kept; the one shown before is the next frame's warm-start buffer
         self.work.warm = std::mem::replace(&mut self.work.shown, f);
@@ -517,6 +549,8 @@ impl Solver {
     ) -> Result<(), SolverError> {
         const CANDIDATES: usize = 4;
         const ITERATIONS: usize = 3;
+        // more parts out of their first state than this: no reverting moves (each is a settle)
+        const REVERT_LIMIT: usize = 8;
         let hysteresis = self.config.hysteresis;
         let multi = |p: &Part| matches!(p.kind, PartKind::Piece { .. }) && p.states.len() >= 2;
         let mut singles: Vec<(f64, usize, usize)> = Vec::new();
@@ -554,7 +588,27 @@ impl Solver {
                 moves.push(vec![(pi, 0), (q, part.active)]);
             }
         }
+        // the bends gathered in the wrong parts (a pause on the way, say): all but one of
+        // the parts out of their first state back in it, and all of them
+        let bent: Vec<usize> = (0..parts.len())
+            .filter(|&pi| multi(&parts[pi]) && parts[pi].active != 0)
+            .collect();
+        if (2..=REVERT_LIMIT).contains(&bent.len()) {
+            for &keep in &bent {
+                let revert = bent.iter().filter(|&&q| q != keep).map(|&q| (q, 0));
+                moves.push(
+                    std::iter::once((keep, parts[keep].active))
+                        .chain(revert)
+                        .collect(),
+                );
+            }
+        }
+        if (1..=REVERT_LIMIT).contains(&bent.len()) {
+            moves.push(bent.iter().map(|&q| (q, 0)).collect());
+        }
         if moves.is_empty() {
+            // nothing to try is a try that found nothing
+            self.work.tried = true;
             return Ok(());
         }
         let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
