@@ -12,7 +12,7 @@
 
 mod generated;
 
-use generated::{BendGrammar, ChainGrammar, Pull, Run, claims, family, more, norm, step, strategy};
+use generated::{ChainGrammar, Pull, Run, claims, family, more, norm, step, strategy};
 
 use glam::DVec2;
 use proptest::prelude::*;
@@ -116,20 +116,6 @@ proptest! {
     }
 }
 
-/// One or two segments of a street (not its ends, which are held) and the way each bends.
-fn turns(g: &BendGrammar, picks: (usize, usize, bool, bool, bool)) -> Vec<(usize, f64)> {
-    let (a, b, two, left_a, left_b) = picks;
-    let inner = g.count - 2;
-    let first = 1 + a % inner;
-    let angle = |left: bool| if left { g.angle } else { -g.angle };
-    if two && first < inner {
-        let second = first + 1 + b % (inner - first);
-        vec![(first, angle(left_a)), (second, angle(left_b))]
-    } else {
-        vec![(first, angle(left_a))]
-    }
-}
-
 proptest! {
     #![proptest_config(config(48, 5))]
 
@@ -143,7 +129,7 @@ proptest! {
         g in family::bend(),
         picks in (0usize..64, 0usize..64, any::<bool>(), any::<bool>(), any::<bool>()),
     ) {
-        let turns = turns(&g, picks);
+        let turns = more::turns(&g, picks);
         holds(more::reachability(&g, &turns))?;
     }
 }

@@ -784,8 +784,10 @@ impl EditorApp {
                     "solving: frame over its time budget, continuing next frame".to_string()
                 } else if self.sculpt.needs_work() {
                     "solving: not converged yet, continuing next frame".to_string()
+                } else if self.sculpt.at_rest() {
+                    "at rest".to_string()
                 } else {
-                    "settled".to_string()
+                    "still, under strain".to_string()
                 };
                 ui.label(state);
                 if let Some(r) = self.sculpt.last_report() {

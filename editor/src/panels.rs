@@ -133,26 +133,36 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         .states
         .get(report.active)
         .map_or("?", |s| s.0.as_str());
-    ui.label(format!("rests as `{active_name}`"));
+    if report.at_rest {
+        ui.label(format!("rests as `{active_name}`"));
+    } else {
+        ui.label(format!("in `{active_name}`, strained (not at rest)"));
+    }
+    if let Some((_, length)) = report.candidate {
+        ui.label(format!("its two elements span {length:.2} elements"));
+    }
     if report.states.len() > 1 {
         let best_other = report
             .states
             .iter()
             .enumerate()
-            .filter(|(i, _)| *i != report.active)
+            .filter(|(i, _)| *i != report.active && report.available.get(*i) != Some(&false))
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
         if let Some((_, (name, d))) = best_other {
-            let d_active = report.states.get(report.active).map_or(0.0, |s| s.1);
-            let gap = if *d > 0.0 {
-                format!("{:.0}%", 100.0 * (1.0 - d_active / d))
-            } else {
-                "0%".to_string()
-            };
             ui.label(format!(
-                "`{name}` would take over once it fits {:.0}% better than `{active_name}` \
-                 (now `{active_name}` fits {gap} better)",
+                "`{name}` takes over once its misfit drops below {:.4} ({:.0}% under \
+                 `{active_name}`'s); it is {d:.4} now",
+                report.switch_below,
                 100.0 * report.hysteresis
             ));
+        }
+        for (i, (name, _)) in report.states.iter().enumerate() {
+            if report.available.get(i) == Some(&false) {
+                ui.label(format!(
+                    "`{name}` is ruled out now: the chain's length or its `min`/`max` does \
+                     not call for it"
+                ));
+            }
         }
     }
     egui::Grid::new("states").striped(true).show(ui, |ui| {

@@ -78,12 +78,18 @@ pub struct PartReport {
     /// "`t1`", or "`wall[3]` and `wall[4]`" for a stretch part.
     pub covers: String,
     pub active: usize,
-    /// Every rest state with its shape-space distance (squared, after the best rotation) to the
-    /// current pose.
+    /// Every rest state with the shape-space distance (squared) the solver's state choice
+    /// compares to the current pose (`clay::session::PartReport`).
     pub states: Vec<(String, f64)>,
+    /// Per rest state: whether it may become active now.
+    pub available: Vec<bool>,
+    /// For a stretch part: the state its length calls for, and its length in elements.
+    pub candidate: Option<(usize, f64)>,
     pub hysteresis: f64,
     /// Another state becomes active once its distance drops below this.
     pub switch_below: f64,
+    /// The part rests in its active state (else it holds still under strain, or moves).
+    pub at_rest: bool,
     pub pinned: bool,
 }
 
@@ -304,6 +310,13 @@ impl Sculpt {
     /// Whether the solver has work left; the app keeps repainting while it has.
     pub fn needs_work(&self) -> bool {
         (self.unsettled || self.job.is_some()) && self.error.is_none()
+    }
+
+    /// Whether the model rests: the solver has nothing left to do and the last frame's energy
+    /// is within a millionth of the model's size squared (the claims suite's rest). A model
+    /// may also hold still under strain: held by handles, or a state its chain cannot leave.
+    pub fn at_rest(&self) -> bool {
+        !self.needs_work() && self.session.at_rest(&self.assembly)
     }
 
     /// The pins, with where they hold their vertices.
@@ -715,6 +728,9 @@ impl Sculpt {
             hysteresis: why.hysteresis,
             switch_below: why.switch_below,
             states: why.states,
+            available: why.available,
+            candidate: why.candidate,
+            at_rest: why.at_rest,
             pinned: self.is_pinned(part),
         })
     }

@@ -955,23 +955,45 @@ pub mod more {
         })
     }
 
+    /// One or two segments of a street (not its ends, which are held) and the way each bends.
+    pub fn turns(g: &BendGrammar, picks: (usize, usize, bool, bool, bool)) -> Vec<(usize, f64)> {
+        let (a, b, two, left_a, left_b) = picks;
+        let inner = g.count - 2;
+        let first = 1 + a % inner;
+        let angle = |left: bool| if left { g.angle } else { -g.angle };
+        if two && first < inner {
+            let second = first + 1 + b % (inner - first);
+            vec![(first, angle(left_a)), (second, angle(left_b))]
+        } else {
+            vec![(first, angle(left_a))]
+        }
+    }
+
+    /// The script of [`reachability`]: the street's first segment pinned, its last grabbed,
+    /// each of `turns` bent in turn (held 30 frames after each), then held 60 frames.
+    pub fn reach_script(g: &BendGrammar, turns: &[(usize, f64)]) -> Vec<String> {
+        let mut steps = vec![
+            step::pin_at(g.centre(0)),
+            step::grab_at(g.centre(g.count - 1)),
+        ];
+        let mut done: Vec<(usize, f64)> = Vec::new();
+        for &(k, degrees) in turns {
+            let before = g.start_of(k, &done);
+            steps.extend(g.bend_steps(k, degrees, before));
+            steps.push(step::hold(30));
+            done.push((k, degrees.to_radians()));
+        }
+        steps.push(step::hold(60));
+        steps
+    }
+
     /// Reachability (Fig. 4): segment `turns[0].0` led along the path on which it bends evenly
     /// by `turns[0].1` degrees, then (if any) `turns[1]` from where the first left the street:
     /// held, the model is at rest in some assignment of states (energy at most
     /// 1e-4 x size^2, max |strain| at most 0.02).
     pub fn reachability(g: &BendGrammar, turns: &[(usize, f64)]) -> Result<(), String> {
         let mut run = Run::new(&g.text());
-        let last = g.count - 1;
-        run.step(&step::pin_at(g.centre(0)))
-            .step(&step::grab_at(g.centre(last)));
-        let mut done: Vec<(usize, f64)> = Vec::new();
-        for &(k, degrees) in turns {
-            let before = g.start_of(k, &done);
-            run.steps(&g.bend_steps(k, degrees, before));
-            run.step(&step::hold(30));
-            done.push((k, degrees.to_radians()));
-        }
-        run.step(&step::hold(60));
+        run.steps(&reach_script(g, turns));
         let (e, size, strain) = (run.energy(), run.size(), run.max_strain());
         if e <= 1e-4 * size * size && strain <= 0.02 {
             Ok(())
