@@ -26,4 +26,8 @@ pub enum Action {
     TryAuthored,
     /// Show a message in the status bar.
     Report(String),
+    /// Restore the sculpt a crashed editor left in the recovery file.
+    RestoreRecovery,
+    /// Forget the sculpt a crashed editor left (the recovery file is removed).
+    DiscardRecovery,
 }

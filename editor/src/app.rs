@@ -20,6 +20,7 @@ use crate::files::{Desktop, FileKind, NativeDialog, Recent};
 use crate::help;
 use crate::overlay::ViewOverlays;
 use crate::panels;
+use crate::recovery::Recovery;
 use crate::sculpt::{Command, Sculpt};
 use crate::session::{self, Session};
 use crate::watch::FileWatch;
@@ -76,6 +77,10 @@ pub struct EditorApp {
     /// The files the last good compile imported: hot reload watches them too.
     imports: Vec<String>,
     session_path: Option<PathBuf>,
+    /// Drawing the model panicked at this revision of the sculpt, and why.
+    draw_failed: Option<(u64, String)>,
+    /// Crash recovery (`None`: off, as in tests that do not ask for it).
+    recovery: Option<Recovery>,
     dialog: Option<PathDialog>,
     /// An action that discards unsaved work, waiting for the user's yes.
     confirm: Option<Action>,
@@ -207,6 +212,8 @@ impl EditorApp {
             dialog: None,
             confirm: None,
             quitting: false,
+            draw_failed: None,
+            recovery: None,
             message: None,
             waker: None,
             commands: Vec::new(),
@@ -477,6 +484,7 @@ impl EditorApp {
         } else {
             self.sculpt.step(SOLVER_BUDGET)
         };
+        self.keep_recovery();
         if more {
             ctx.request_repaint();
         }
@@ -514,12 +522,7 @@ impl EditorApp {
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
             .show(ui, |ui| match self.mode {
-                Mode::Sculpt => {
-                    self.canvas
-                        .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
-                    let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
-                    crate::follow::paint(ui, &self.canvas, grammar, data, &self.followed());
-                }
+                Mode::Sculpt => self.sculpt_canvas(ui),
                 Mode::Author => {
                     self.author_canvas
                         .show(ui, &self.author, &mut self.author_commands)
@@ -527,6 +530,36 @@ impl EditorApp {
             });
         self.dialogs(ui.ctx());
         self.apply();
+    }
+
+    /// The model's canvas. A panic while drawing (tessellating a proxy, say) is caught: the
+    /// canvas shows what went wrong instead of the model until the model changes, and the
+    /// editor, its sculpt and the file stay.
+    fn sculpt_canvas(&mut self, ui: &mut egui::Ui) {
+        let revision = self.sculpt.revision();
+        if let Some((at, why)) = &self.draw_failed {
+            if *at == revision {
+                ui.centered_and_justified(|ui| {
+                    ui.colored_label(
+                        egui::Color32::from_rgb(200, 60, 40),
+                        format!("the model cannot be drawn: {why}"),
+                    )
+                });
+                return;
+            }
+            self.draw_failed = None;
+        }
+        let drawn = crate::guard::catching(|| {
+            self.canvas
+                .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
+            let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
+            crate::follow::paint(ui, &self.canvas, grammar, data, &self.followed());
+        });
+        if let Err(why) = drawn {
+            let why = format!("internal error while drawing ({why})");
+            self.message = Some(format!("{why}; the sculpt is kept: save it"));
+            self.draw_failed = Some((revision, why));
+        }
     }
 
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
@@ -862,10 +895,91 @@ impl EditorApp {
     fn dialogs(&mut self, ctx: &egui::Context) {
         self.path_dialog(ctx);
         self.unsaved_prompt(ctx);
+        self.recovery_prompt(ctx);
         help::show(ctx, &mut self.help_open);
         if self.quitting && self.confirm.is_none() {
+            // a clean exit: nothing to recover
+            if let Some(r) = &mut self.recovery {
+                r.clear();
+            }
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
+    }
+
+    /// Crash recovery into `path` (`recovery::default_path`): from now on the unsaved sculpt
+    /// is kept there, and work a crashed editor left there is offered for restoring.
+    pub fn use_recovery(&mut self, path: PathBuf) {
+        self.recovery = Some(Recovery::at(path));
+    }
+
+    /// The recovery file, if crash recovery is on.
+    pub fn recovery(&self) -> Option<&Recovery> {
+        self.recovery.as_ref()
+    }
+
+    /// Writes the unsaved sculpt to the recovery file when it is due (`Recovery::keep`).
+    fn keep_recovery(&mut self) {
+        let Some(mut r) = self.recovery.take() else {
+            return;
+        };
+        let stamp = (self.sculpt.history(), self.sculpt.revision());
+        let unsaved = self.sculpt.dirty && !self.quitting;
+        let savable = self.grammar_path.is_some() || self.sculpt.grammar().source == CASTLE_PATH;
+        if let Some(m) = r.keep(stamp, unsaved, || savable.then(|| self.session())) {
+            self.message = Some(m);
+        }
+        self.recovery = Some(r);
+    }
+
+    /// Offers to restore the work a crashed editor left (Restore or Discard).
+    fn recovery_prompt(&mut self, ctx: &egui::Context) {
+        let Some(offer) = self.recovery.as_ref().and_then(Recovery::offer).cloned() else {
+            return;
+        };
+        if self.confirm.is_some() {
+            return;
+        }
+        egui::Modal::new(egui::Id::unique("recovery prompt")).show(ctx, |ui| {
+            ui.heading("Restore unsaved work?");
+            let when = offer
+                .written
+                .and_then(|t| t.elapsed().ok())
+                .map_or(String::new(), |d| {
+                    format!(" {} min ago", (d.as_secs() + 30) / 60)
+                });
+            ui.label(format!(
+                "Clay closed without saving the sculpt of {} (last kept{when}).",
+                offer.grammar
+            ));
+            // the buttons first, at a fixed place, whatever the message's length
+            ui.horizontal(|ui| {
+                if ui.button("Restore").clicked() {
+                    self.actions.push(Action::RestoreRecovery);
+                }
+                if ui
+                    .button("Discard")
+                    .on_hover_text("forgets that work")
+                    .clicked()
+                {
+                    self.actions.push(Action::DiscardRecovery);
+                }
+            });
+        });
+    }
+
+    /// Restores the sculpt in the recovery file: unsaved, with no session file of its own.
+    fn restore_recovery(&mut self) -> Result<Option<String>, String> {
+        let Some(path) = self.recovery.as_ref().map(|r| r.path().to_path_buf()) else {
+            return Ok(None);
+        };
+        let restored = self.open_session(&path);
+        if let Some(r) = &mut self.recovery {
+            r.answered();
+        }
+        restored?;
+        self.session_path = None;
+        self.sculpt.dirty = true;
+        Ok(Some("restored the unsaved sculpt".to_string()))
     }
 
     /// The typed-path dialog (where the desktop has no file dialog), with the recent files.
@@ -1117,6 +1231,13 @@ impl EditorApp {
             }),
             Action::TryAuthored => self.try_authored().map(Some),
             Action::Report(m) => Ok(Some(m)),
+            Action::RestoreRecovery => self.restore_recovery(),
+            Action::DiscardRecovery => {
+                if let Some(r) = &mut self.recovery {
+                    r.clear();
+                }
+                Ok(Some("discarded the unsaved work".to_string()))
+            }
         };
         match result {
             Ok(Some(m)) => self.message = Some(m),

@@ -101,11 +101,26 @@ pub struct Compiled {
 ///
 /// Besides `.clay` text this accepts a compiled grammar in JSON (what `clayc compile` writes),
 /// recognised by its leading `{` (a `.clay` file starts with a keyword or comment).
+///
+/// A panic in the compiler is caught and reported as a problem at 1:1 (the caller keeps the
+/// last good model): the editor never exits on what a user wrote.
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
-    if source.trim_start().starts_with('{') {
-        return compile_json(source, path);
-    }
-    compile_clay(source, path)
+    let compiled = crate::guard::catching(|| {
+        if source.trim_start().starts_with('{') {
+            compile_json(source, path)
+        } else {
+            compile_clay(source, path)
+        }
+    });
+    compiled.unwrap_or_else(|why| {
+        Err(vec![Problem::whole_file(
+            path,
+            format!(
+                "internal error: the compiler stopped ({why}); the last good model stays. \
+                 Please report this file"
+            ),
+        )])
+    })
 }
 
 fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {

@@ -40,6 +40,9 @@ fn main() -> ExitCode {
                 None => EditorApp::bundled(),
             };
             app.set_waker(cc.egui_ctx.clone());
+            if let Some(path) = clay_editor::recovery::default_path() {
+                app.use_recovery(path);
+            }
             app.use_desktop(clay_editor::files::Desktop::detect());
             if args.follow {
                 let channel = clay_dsl::analysis::follow::channel();

@@ -117,6 +117,8 @@ pub struct Sculpt {
     frame: u64,
     /// Bumped whenever `data` may have changed, so views re-pose only then.
     revision: u64,
+    /// Bumped by every undo step taken, undone or redone.
+    history: u64,
     last_report: Option<FrameReport>,
     /// Solver frames run in the last UI frame.
     pub frames_last_step: usize,
@@ -150,19 +152,32 @@ struct FrameOutcome {
     notes: Vec<(String, Option<DVec2>)>,
     /// A rule rewrote the model.
     rewrote: bool,
+    /// The frame panicked: the model it worked on may be half rewritten.
+    panicked: bool,
 }
 
 /// One sculpting frame within `budget` (the session's: a solver frame, then the rules), on
 /// whichever thread, with its log lines in the grammar's names.
+///
+/// A panic in the solver or the rules is caught: the outcome says so, and the caller keeps
+/// the last good model (the editor never exits on a model it was given).
 fn solve_frame(assembly: &mut Assembly, session: &mut Session, budget: Duration) -> FrameOutcome {
-    let frame = match session.frame_within(assembly, budget) {
-        Ok(frame) => frame,
-        Err(e) => {
-            return FrameOutcome {
-                report: Err(e),
-                notes: Vec::new(),
-                rewrote: false,
-            };
+    let solved = crate::guard::catching(|| session.frame_within(assembly, budget));
+    let failed = |e: SolverError, panicked: bool| FrameOutcome {
+        report: Err(e),
+        notes: Vec::new(),
+        rewrote: false,
+        panicked,
+    };
+    let frame = match solved {
+        Ok(Ok(frame)) => frame,
+        Ok(Err(e)) => return failed(e, false),
+        Err(why) => {
+            let e = SolverError(format!(
+                "internal error: the solver stopped ({why}); the model before this gesture \
+                 is restored"
+            ));
+            return failed(e, true);
         }
     };
     // The editor keeps its own bounded log.
@@ -183,6 +198,7 @@ fn solve_frame(assembly: &mut Assembly, session: &mut Session, budget: Duration)
         report: Ok(frame.report),
         notes,
         rewrote,
+        panicked: false,
     }
 }
 
@@ -209,6 +225,7 @@ impl Sculpt {
             last_report: None,
             frames_last_step: 0,
             error: None,
+            history: 0,
             log: Vec::new(),
             next_seq: 0,
             job: None,
@@ -271,6 +288,11 @@ impl Sculpt {
     /// Solver frames run so far.
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// Changes with every undo step taken, undone or redone.
+    pub fn history(&self) -> u64 {
+        self.history
     }
 
     /// Changes whenever the assembly data may have changed.
@@ -449,6 +471,7 @@ impl Sculpt {
             Command::Undo => {
                 self.release();
                 if let Some(s) = self.undo.pop() {
+                    self.history += 1;
                     self.redo.push(self.snapshot());
                     self.restore(s);
                     self.dirty = true;
@@ -457,6 +480,7 @@ impl Sculpt {
             Command::Redo => {
                 self.release();
                 if let Some(s) = self.redo.pop() {
+                    self.history += 1;
                     self.undo.push(self.snapshot());
                     self.restore(s);
                     self.dirty = true;
@@ -633,6 +657,12 @@ impl Sculpt {
             return;
         }
         match handle.join() {
+            Ok(job) if job.outcome.panicked => {
+                // The frame's copy may be half rewritten: the model shown stays.
+                self.session = job.session;
+                self.session.reset_solver();
+                self.error = job.outcome.report.err().map(|e| e.to_string());
+            }
             Ok(job) => {
                 let mut solved = job.model;
                 // The grab moved on while the frame ran: its latest target wins.
@@ -685,10 +715,31 @@ impl Sculpt {
                 }
                 self.last_report = Some(report);
             }
+            Err(e) if outcome.panicked => {
+                self.recover(e.to_string());
+            }
             Err(e) => {
                 self.error = Some(e.to_string());
             }
         }
+    }
+
+    /// After a frame on this thread panicked: the model from before the gesture (or the
+    /// grammar's), a fresh solver, and the error shown; the solver stops until the next
+    /// command.
+    fn recover(&mut self, error: String) {
+        self.grab = None;
+        let snapshot = self.undo.pop().unwrap_or_else(|| {
+            let grammar = self.grammar().clone();
+            Snapshot {
+                data: grammar.assembly.clone(),
+                grammar,
+                pins: Vec::new(),
+                log: self.log.clone(),
+            }
+        });
+        self.restore(snapshot);
+        self.error = Some(error);
     }
 
     /// Why `part` is in the state it is in.
@@ -786,6 +837,7 @@ impl Sculpt {
 
     /// Records the model before a gesture.
     fn checkpoint(&mut self) {
+        self.history += 1;
         let s = self.snapshot();
         self.undo.push(s);
         if self.undo.len() > UNDO_LIMIT {

@@ -1,0 +1,160 @@
+//! Crash recovery (issue 37): an editor killed mid-sculpt leaves its work in the recovery file,
+//! and the next editor restores it; a save or a clean exit leaves nothing behind.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command as Process, Stdio};
+use std::time::Duration;
+
+use clay_editor::EditorApp;
+use clay_editor::action::Action;
+use clay_editor::recovery::WRITE_EVERY;
+use clay_editor::sculpt::Command;
+use clay_editor::session;
+use glam::DVec2;
+
+/// Set in the child process this test starts and kills.
+const CHILD: &str = "CLAY_RECOVERY_TEST_CHILD";
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-recovery-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// UI frames of the app's logic (solver, recovery) without a window.
+fn frames(app: &mut EditorApp, n: usize) {
+    let ctx = egui::Context::default();
+    for _ in 0..n {
+        app.logic(&ctx);
+    }
+}
+
+/// Drags the castle's last part down by a metre over 20 frames and lets go.
+fn sculpt(app: &mut EditorApp) {
+    frames(app, 40);
+    let part = app.sculpt.data().parts.len() - 1;
+    let at = app.sculpt.assembly().part_centroid(part);
+    app.sculpt.apply(Command::Grab { part, at });
+    for k in 1..=20 {
+        app.sculpt.apply(Command::MoveGrab {
+            translation: DVec2::new(0.0, -0.05 * f64::from(k)),
+            angle: 0.0,
+        });
+        frames(app, 1);
+    }
+    app.sculpt.apply(Command::Release);
+    frames(app, 40);
+}
+
+/// The child: sculpts with recovery on, goes on a few seconds (the file is kept up to date at
+/// most every `WRITE_EVERY` while nothing is undone), writes what it has to `expected`, says
+/// so, and waits to be killed.
+fn child(recovery: &Path, expected: &Path) -> ! {
+    let mut app = EditorApp::bundled();
+    app.use_recovery(recovery.to_path_buf());
+    sculpt(&mut app);
+    assert!(app.sculpt.dirty);
+    std::thread::sleep(WRITE_EVERY + Duration::from_millis(100));
+    frames(&mut app, 1);
+    session::write(expected, &app.session()).unwrap();
+    println!("sculpted");
+    loop {
+        std::thread::sleep(Duration::from_secs(1));
+    }
+}
+
+#[test]
+fn a_killed_editor_is_restored_by_the_next() {
+    if let Some(dir) = std::env::var_os(CHILD) {
+        let dir = PathBuf::from(dir);
+        child(
+            &dir.join("recovery.clay-session"),
+            &dir.join("expected.json"),
+        );
+    }
+    let dir = scratch("killed");
+    let recovery = dir.join("recovery.clay-session");
+    let mut editor = Process::new(std::env::current_exe().unwrap())
+        .args([
+            "a_killed_editor_is_restored_by_the_next",
+            "--exact",
+            "--nocapture",
+        ])
+        .env(CHILD, &dir)
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = BufReader::new(editor.stdout.take().unwrap());
+    let said = out
+        .lines()
+        .map_while(Result::ok)
+        .any(|l| l.contains("sculpted"));
+    editor.kill().unwrap();
+    editor.wait().unwrap();
+    assert!(said, "the child editor sculpted");
+
+    let expected = session::read(&dir.join("expected.json")).unwrap();
+    let left = std::fs::read(&recovery).expect("the killed editor left its work");
+    assert_eq!(
+        session::read(&recovery).unwrap(),
+        expected,
+        "the recovery file holds the sculpt as it was"
+    );
+    let mut next = EditorApp::bundled();
+    next.use_recovery(recovery.clone());
+    let offer = next.recovery().and_then(|r| r.offer()).cloned();
+    assert!(offer.is_some(), "the next editor finds the work");
+    frames(&mut next, 3);
+    assert_eq!(
+        std::fs::read(&recovery).unwrap(),
+        left,
+        "nothing is written over the work on offer"
+    );
+    next.perform(Action::RestoreRecovery);
+    assert!(
+        next.sculpt.data() == &expected.assembly,
+        "the sculpt is restored exactly"
+    );
+    assert_eq!(next.sculpt.pins(), expected.pins);
+    assert!(next.sculpt.dirty, "restored work is unsaved work");
+}
+
+#[test]
+fn the_recovery_file_follows_the_sculpt_and_leaves_on_save_and_quit() {
+    let dir = scratch("follows");
+    let recovery = dir.join("recovery.clay-session");
+    let mut app = EditorApp::bundled();
+    app.use_recovery(recovery.clone());
+    assert!(app.recovery().unwrap().offer().is_none());
+    frames(&mut app, 40);
+    assert!(!recovery.exists(), "nothing unsaved, nothing kept");
+    sculpt(&mut app);
+    let kept = session::read(&recovery).expect("the unsaved sculpt is kept");
+    // the drag was one undo step; the file has the model after it settled or a few
+    // seconds before (it is written after each undo step and then every few seconds)
+    assert_eq!(kept.pins, app.sculpt.pins());
+    app.save_session(&dir.join("saved.json")).unwrap();
+    frames(&mut app, 1);
+    assert!(!recovery.exists(), "a save leaves nothing to recover");
+
+    sculpt(&mut app);
+    assert!(recovery.exists());
+    app.sculpt.apply(Command::Undo);
+    frames(&mut app, 1);
+    let undone = session::read(&recovery).unwrap();
+    assert!(
+        &undone.assembly == app.sculpt.data(),
+        "an undo step is kept at once"
+    );
+    app.perform(Action::Quit);
+    // the unsaved prompt: discard, and the clean exit removes the file
+    assert!(app.confirming());
+    app.sculpt.dirty = false;
+    frames(&mut app, 1);
+    assert!(
+        !recovery.exists(),
+        "discarded work leaves nothing to recover"
+    );
+}
