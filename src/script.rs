@@ -259,12 +259,15 @@ impl Script {
     /// Parses and validates a script; every error names the step index, its line and column
     /// and what is wrong.
     pub fn parse(json: &str) -> Result<Self, ScriptError> {
-        let doc: Value = serde_json::from_str(json).map_err(|e| ScriptError {
-            step: None,
-            message: format!("the script is not valid JSON: {e}"),
-            position: (e.line() > 0).then(|| (e.line(), e.column())),
-            hint: None,
-        })?;
+        if json.trim().is_empty() {
+            return Err(ScriptError {
+                step: None,
+                message: "the script is empty: expected {\"steps\": [...]}".into(),
+                position: Some((1, 1)),
+                hint: None,
+            });
+        }
+        let doc: Value = serde_json::from_str(json).map_err(json_error)?;
         let whole = |message: String| ScriptError {
             step: None,
             message,
@@ -312,6 +315,21 @@ impl Script {
                 _ => 0,
             })
             .sum()
+    }
+}
+
+/// A JSON syntax error at its 1-based line and column. serde_json counts a position at the
+/// start of a line as column 0, and its message ends with that position, which the error
+/// carries apart.
+fn json_error(e: serde_json::Error) -> ScriptError {
+    let text = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let what = text.strip_suffix(&suffix).unwrap_or(&text);
+    ScriptError {
+        step: None,
+        message: format!("the script is not valid JSON: {what}"),
+        position: (e.line() > 0).then(|| (e.line(), e.column().max(1))),
+        hint: None,
     }
 }
 
@@ -366,4 +384,33 @@ fn step_offsets(json: &str) -> Vec<usize> {
         i += 1;
     }
     offsets
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_empty_or_blank_script_is_reported_at_line_1_column_1() {
+        for text in ["", "  \n\t\n"] {
+            let e = Script::parse(text).unwrap_err();
+            assert_eq!(e.position, Some((1, 1)), "{text:?}");
+            assert_eq!(e.step, None);
+            assert_eq!(
+                e.message, "the script is empty: expected {\"steps\": [...]}",
+                "{text:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_json_error_at_the_start_of_a_line_is_at_column_1() {
+        // serde_json says "line 2 column 0" for the end of this text.
+        let e = Script::parse("{\"steps\": [\n").unwrap_err();
+        assert_eq!(e.position, Some((2, 1)), "{e:?}");
+        assert_eq!(
+            e.message, "the script is not valid JSON: EOF while parsing a list",
+            "{e:?}"
+        );
+    }
 }

@@ -313,6 +313,18 @@ fn huge_script_coordinates_are_rejected_naming_the_step_and_its_line() {
 }
 
 #[test]
+fn an_empty_script_is_reported_at_line_1_column_1() {
+    for (name, text) in [("empty", ""), ("blank", " \n\n")] {
+        let (code, err) = run_script(name, text);
+        assert_eq!(code, Some(1), "{err}");
+        assert!(
+            err.contains("error: huge.json:1:1: the script is empty: expected {\"steps\": [...]}"),
+            "{name}: {err}"
+        );
+    }
+}
+
+#[test]
 fn script_errors_carry_the_steps_position() {
     let e = clay::script::Script::parse(
         "{\"steps\": [\n    {\"hold\": {\"frames\": 1}},\n    {\"pin\": {\"at\": [\"x\", 0]}}\n]}",
