@@ -1,7 +1,8 @@
 //! `clayc` at its edges (issue 16): a reader that closes the pipe early never makes a subcommand
 //! panic, an unreadable file never lets `check` pass, `-o -` writes to standard output for every
-//! subcommand that writes a file, and script coordinates beyond +/-1e9 are rejected with the step
-//! and its line and column named.
+//! subcommand that writes a file, `-o` through a symbolic link writes its target and keeps the
+//! link, `-o /dev/stdout` writes into the pipe, and script coordinates beyond +/-1e9 (or an empty
+//! script) are rejected with the step and its line and column named.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -239,6 +240,55 @@ fn dash_output_writes_to_stdout_and_creates_no_file() {
         std::fs::read_dir(&dir).unwrap().count(),
         0,
         "files appeared"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn output_through_a_symbolic_link_writes_its_target_and_keeps_the_link() {
+    use std::os::unix::fs::symlink;
+    let dir = scratch("link");
+    let g = wall();
+    std::fs::create_dir(dir.join("out")).unwrap();
+    std::fs::write(dir.join("out/wall.json"), "stale").unwrap();
+    symlink("out/wall.json", dir.join("wall.json")).unwrap();
+    symlink("out/wall.png", dir.join("wall.png")).unwrap(); // dangling until written
+    let (code, _, err) = run_in(&dir, &["build", &g, "-o", "wall.json"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, _, err) = run_in(&dir, &["render", &g, "-o", "wall.png", "--size", "64x48"]);
+    assert_eq!(code, Some(0), "{err}");
+    for link in ["wall.json", "wall.png"] {
+        let meta = std::fs::symlink_metadata(dir.join(link)).unwrap();
+        assert!(
+            meta.file_type().is_symlink(),
+            "{link} was replaced by a file"
+        );
+    }
+    let json = std::fs::read(dir.join("out/wall.json")).unwrap();
+    assert!(serde_json::from_slice::<serde_json::Value>(&json).is_ok());
+    let png = std::fs::read(dir.join("out/wall.png")).unwrap();
+    assert!(png.starts_with(PNG_SIGNATURE));
+    let mut written: Vec<_> = std::fs::read_dir(dir.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    written.sort();
+    assert_eq!(written, ["wall.json", "wall.png"], "no temporary left");
+}
+
+#[cfg(unix)]
+#[test]
+fn output_to_dev_stdout_writes_into_the_pipe() {
+    let dir = scratch("devstdout");
+    let (code, json, err) = run_in(&dir, &["build", &wall(), "-o", "/dev/stdout"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(serde_json::from_slice::<serde_json::Value>(&json).is_ok());
+    assert!(
+        std::fs::symlink_metadata("/dev/stdout")
+            .unwrap()
+            .file_type()
+            .is_symlink(),
+        "/dev/stdout was replaced"
     );
 }
 
