@@ -749,6 +749,38 @@ fn shutdown_then_exit_is_exit_code_0_and_exit_alone_is_1() {
 }
 
 #[test]
+fn after_a_frame_with_a_wrong_content_length_the_next_request_is_answered() {
+    let body = json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }).to_string();
+    let parse_errors = |c: &Client| {
+        c.stash
+            .iter()
+            .filter(|m| m["error"]["code"] == -32700 && m["id"] == Value::Null)
+            .count()
+    };
+    // One byte too many: the body swallows the first byte of the `initialize` frame.
+    let mut c = Client::spawn();
+    c.send_raw(format!("Content-Length: {}\r\n\r\n{body}", body.len() + 1).as_bytes());
+    let init = c.request("initialize", json!({ "capabilities": {} }));
+    assert!(init["result"]["capabilities"].is_object(), "{init}");
+    assert_eq!(parse_errors(&c), 1, "{:?}", c.stash);
+    c.notify("initialized", json!({}));
+    // One byte too few, the body's last byte left before the next frame.
+    let text = wall();
+    c.open(&text);
+    c.send_raw(format!("Content-Length: {}\r\n\r\n{body}", body.len() - 1).as_bytes());
+    let brick = at(&text, "chain brick", 0, 7);
+    let hover = c.result("textDocument/hover", at_pos(&text, brick));
+    assert!(
+        hover["contents"]["value"]
+            .as_str()
+            .unwrap()
+            .contains("piece brick")
+    );
+    assert_eq!(parse_errors(&c), 2, "{:?}", c.stash);
+    assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
 fn every_advertised_capability_has_its_row_in_docs_editors_md() {
     let doc =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();

@@ -2,6 +2,12 @@
 //! wrong: lsp-server's own stdio transport ends the connection at the first body that is not
 //! a message, where the protocol wants an error response (`ParseError`, `InvalidRequest`) and
 //! the server going on. Messages are lsp-server's; only the framing is ours.
+//!
+//! A frame that holds no JSON (a `Content-Length` off by a few bytes, a header without one)
+//! gets one `ParseError`, and then the reader resynchronises: it looks for the next
+//! `Content-Length:` from the first byte it has not accepted as a frame (inside the bad body
+//! too, which may have swallowed the start of the next frame), so the frames after it are read
+//! as they were sent.
 
 use std::io::{self, BufRead, Read, Write};
 use std::sync::mpsc;
@@ -12,6 +18,10 @@ use lsp_server::{ErrorCode, Message, RequestId, Response};
 const MAX_BODY: usize = 256 << 20;
 /// A header line longer than this is not a header.
 const MAX_HEADER_LINE: u64 = 64 << 10;
+/// A frame's header longer than this (all its lines) is no header.
+const MAX_HEADER: usize = 64 << 10;
+/// Where a frame starts, in lower case (header names are case-insensitive).
+const HEADER_START: &[u8] = b"content-length:";
 
 /// What the reader hands the server.
 #[derive(Debug)]
@@ -27,27 +37,83 @@ pub enum Input {
 
 enum Frame {
     Body(Vec<u8>),
-    Bad(String),
+    /// No frame: what is wrong, and the bytes read that may hold the start of the next one.
+    Bad {
+        message: String,
+        unframed: Vec<u8>,
+    },
     End,
+}
+
+/// The client's bytes, with room to read some of them again.
+struct Stream<R> {
+    inner: R,
+    again: Vec<u8>,
+    at: usize,
+    /// The last frame held no message: skip to the next header before reading on.
+    lost: bool,
+}
+
+impl<R: BufRead> Stream<R> {
+    fn new(inner: R) -> Self {
+        Self {
+            inner,
+            again: Vec::new(),
+            at: 0,
+            lost: false,
+        }
+    }
+
+    /// Puts `bytes` back in front of what is left to read.
+    fn unread(&mut self, bytes: &[u8]) {
+        let mut again = bytes.to_vec();
+        again.extend_from_slice(&self.again[self.at..]);
+        self.again = again;
+        self.at = 0;
+    }
+}
+
+impl<R: BufRead> Read for Stream<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let available = self.fill_buf()?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for Stream<R> {
+    fn fill_buf(&mut self) -> io::Result<&[u8]> {
+        if self.at < self.again.len() {
+            return Ok(&self.again[self.at..]);
+        }
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, n: usize) {
+        if self.at < self.again.len() {
+            self.at += n;
+            if self.at >= self.again.len() {
+                self.again.clear();
+                self.at = 0;
+            }
+        } else {
+            self.inner.consume(n);
+        }
+    }
 }
 
 /// Reads frames on a thread of its own until the stream ends (or the `exit` notification),
 /// so the server can wait for input with a timeout (the diagnostics' debounce).
-pub fn spawn_reader<R: BufRead + Send + 'static>(mut input: R) -> mpsc::Receiver<Input> {
+pub fn spawn_reader<R: BufRead + Send + 'static>(input: R) -> mpsc::Receiver<Input> {
     let (tx, rx) = mpsc::channel();
+    let mut input = Stream::new(input);
     std::thread::Builder::new()
         .name("lsp-reader".into())
         .spawn(move || {
-            loop {
-                let item = match read_frame(&mut input) {
-                    Ok(Frame::Body(body)) => parse(&body),
-                    Ok(Frame::Bad(message)) => Input::Malformed {
-                        id: None,
-                        code: ErrorCode::ParseError,
-                        message,
-                    },
-                    Ok(Frame::End) | Err(_) => break,
-                };
+            // The end of the stream, or an error reading it, ends reading.
+            while let Ok(Some(item)) = next(&mut input) {
                 let exit =
                     matches!(&item, Input::Message(Message::Notification(n)) if n.method == "exit");
                 if tx.send(item).is_err() || exit {
@@ -59,10 +125,70 @@ pub fn spawn_reader<R: BufRead + Send + 'static>(mut input: R) -> mpsc::Receiver
     rx
 }
 
+/// The next message or error to answer with, `None` at the end of the stream. After a frame
+/// that holds no JSON, skips to the next `Content-Length:` first; the skip waits for bytes, so
+/// it comes after the error is handed on, not before (a client may wait for that answer).
+fn next(input: &mut Stream<impl BufRead>) -> io::Result<Option<Input>> {
+    if std::mem::take(&mut input.lost) {
+        skip_to_header(input)?;
+    }
+    let (message, unframed) = match read_frame(input)? {
+        Frame::End => return Ok(None),
+        Frame::Body(body) => match parse(&body) {
+            Input::Malformed {
+                code: ErrorCode::ParseError,
+                message,
+                ..
+            } => (message, body),
+            item => return Ok(Some(item)),
+        },
+        Frame::Bad { message, unframed } => (message, unframed),
+    };
+    input.unread(&unframed);
+    input.lost = true;
+    Ok(Some(Input::Malformed {
+        id: None,
+        code: ErrorCode::ParseError,
+        message,
+    }))
+}
+
+/// Consumes bytes up to the next `Content-Length:` (any case), which is left to read, or to
+/// the end of the stream.
+fn skip_to_header(input: &mut Stream<impl BufRead>) -> io::Result<()> {
+    let mut matched = 0;
+    loop {
+        let buf = input.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(());
+        }
+        let mut used = 0;
+        for &b in buf {
+            used += 1;
+            let b = b.to_ascii_lowercase();
+            // The pattern's first letter occurs only there, so a mismatch restarts it.
+            matched = if b == HEADER_START[matched] {
+                matched + 1
+            } else {
+                usize::from(b == HEADER_START[0])
+            };
+            if matched == HEADER_START.len() {
+                break;
+            }
+        }
+        input.consume(used);
+        if matched == HEADER_START.len() {
+            input.unread(b"Content-Length:");
+            return Ok(());
+        }
+    }
+}
+
 fn read_frame(input: &mut impl BufRead) -> io::Result<Frame> {
     let mut length: Option<Result<usize, String>> = None;
     let mut bad_header: Option<String> = None;
     let mut seen_header = false;
+    let mut header = Vec::new();
     let mut line = Vec::new();
     loop {
         line.clear();
@@ -73,6 +199,13 @@ fn read_frame(input: &mut impl BufRead) -> io::Result<Frame> {
             == 0
         {
             return Ok(Frame::End);
+        }
+        header.extend_from_slice(&line);
+        if header.len() > MAX_HEADER {
+            return Ok(bad(
+                format!("a header of more than {MAX_HEADER} bytes"),
+                header,
+            ));
         }
         let text = String::from_utf8_lossy(&line);
         let text = text.trim_end_matches(['\r', '\n']);
@@ -98,15 +231,17 @@ fn read_frame(input: &mut impl BufRead) -> io::Result<Frame> {
         }
     }
     match length {
-        None => Ok(Frame::Bad(bad_header.unwrap_or_else(|| {
-            "a message without a Content-Length header".into()
-        }))),
-        Some(Err(message)) => Ok(Frame::Bad(message)),
+        None => Ok(bad(
+            bad_header.unwrap_or_else(|| "a message without a Content-Length header".into()),
+            header,
+        )),
+        Some(Err(message)) => Ok(bad(message, header)),
         Some(Ok(n)) if n > MAX_BODY => {
             io::copy(&mut input.by_ref().take(n as u64), &mut io::sink())?;
-            Ok(Frame::Bad(format!(
-                "a message of {n} bytes (at most {MAX_BODY})"
-            )))
+            Ok(bad(
+                format!("a message of {n} bytes (at most {MAX_BODY})"),
+                Vec::new(),
+            ))
         }
         Some(Ok(n)) => {
             let mut body = vec![0; n];
@@ -116,6 +251,18 @@ fn read_frame(input: &mut impl BufRead) -> io::Result<Frame> {
                 Err(e) => Err(e),
             }
         }
+    }
+}
+
+/// A header that frames nothing; the next frame is looked for from its second byte on (at least
+/// one byte is always skipped, so resynchronising ends).
+fn bad(message: String, mut header: Vec<u8>) -> Frame {
+    if !header.is_empty() {
+        header.remove(0);
+    }
+    Frame::Bad {
+        message,
+        unframed: header,
     }
 }
 
@@ -198,8 +345,8 @@ mod tests {
     #[test]
     fn bad_frames_become_errors_and_reading_goes_on() {
         let mut bytes = String::new();
-        bytes += &framed("{not json");
         bytes += "X-Nonsense\r\n\r\n";
+        bytes += &framed("{not json");
         bytes += &framed(r#"{"jsonrpc":"2.0","id":7}"#);
         bytes += "Content-Length: 99999999999\r\n\r\n";
         bytes += &framed(r#"{"jsonrpc":"2.0","id":1,"method":"shutdown"}"#);
@@ -227,6 +374,60 @@ mod tests {
         // The absurd length swallows the rest of the stream, which then ends: no message is
         // invented from it.
         assert!(matches!(&got[3], Input::Malformed { .. }));
+    }
+
+    /// The methods of the messages read, `parse error` for each malformed frame.
+    fn methods(bytes: &[u8]) -> Vec<String> {
+        frames(bytes)
+            .iter()
+            .map(|input| match input {
+                Input::Message(Message::Request(r)) => r.method.clone(),
+                Input::Message(Message::Notification(n)) => n.method.clone(),
+                Input::Message(Message::Response(_)) => "response".into(),
+                Input::Malformed {
+                    code: ErrorCode::ParseError,
+                    ..
+                } => "parse error".into(),
+                Input::Malformed { .. } => "invalid request".into(),
+            })
+            .collect()
+    }
+
+    fn request(id: i32, method: &str) -> String {
+        framed(&format!(
+            r#"{{"jsonrpc":"2.0","id":{id},"method":"{method}","params":{{}}}}"#
+        ))
+    }
+
+    #[test]
+    fn after_a_wrong_content_length_the_next_frames_are_read() {
+        let body = r#"{"jsonrpc":"2.0","method":"initialized","params":{}}"#;
+        let next = request(1, "initialize") + &request(2, "shutdown");
+        for delta in [-3i64, -1, 1, 2, 40] {
+            let length = body.len() as i64 + delta;
+            let bytes = format!("Content-Length: {length}\r\n\r\n{body}{next}");
+            assert_eq!(
+                methods(bytes.as_bytes()),
+                ["parse error", "initialize", "shutdown"],
+                "a length off by {delta}"
+            );
+        }
+        // Junk between frames, a header glued to the junk, and lower-case header names.
+        let bytes = format!(
+            "Content-Length: 5\r\n\r\n{{\"a\":junk here}}content-length: 0\r\n\r\n{}",
+            request(3, "initialize")
+        );
+        assert_eq!(
+            methods(bytes.as_bytes()),
+            ["parse error", "parse error", "initialize"]
+        );
+        // A header that never ends is skipped to the next frame too.
+        let bytes = format!(
+            "{}\r\n{}",
+            "x".repeat(MAX_HEADER + 10),
+            request(4, "initialize")
+        );
+        assert_eq!(methods(bytes.as_bytes()), ["parse error", "initialize"]);
     }
 
     #[test]
