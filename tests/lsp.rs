@@ -5,7 +5,7 @@
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde_json::{Value, json};
 
@@ -241,17 +241,18 @@ impl Client {
         );
     }
 
-    /// Closes stdin and waits for the process to end.
+    /// Closes stdin and waits for the process to end (looking at most `PATIENCE` / 50 ms
+    /// times: a guard against a hang, not a measure).
     fn wait(mut self) -> ExitStatus {
         drop(self.stdin.take());
-        let until = Instant::now() + PATIENCE;
-        loop {
+        let step = Duration::from_millis(50);
+        for _ in 0..PATIENCE.as_millis() / step.as_millis() {
             if let Some(status) = self.child.try_wait().unwrap() {
                 return status;
             }
-            assert!(Instant::now() < until, "the server did not exit");
-            std::thread::sleep(Duration::from_millis(20));
+            std::thread::sleep(step);
         }
+        panic!("the server did not exit");
     }
 
     fn shutdown_and_exit(mut self) -> ExitStatus {
@@ -778,6 +779,16 @@ fn after_a_frame_with_a_wrong_content_length_the_next_request_is_answered() {
     );
     assert_eq!(parse_errors(&c), 2, "{:?}", c.stash);
     assert!(c.shutdown_and_exit().success());
+}
+
+#[test]
+fn closing_the_input_stops_the_server_with_exit_code_0() {
+    // Nothing sent at all.
+    assert_eq!(Client::spawn().wait().code(), Some(0));
+    // Running with a document open, without `shutdown` or `exit`.
+    let mut c = Client::start();
+    c.open(&wall());
+    assert_eq!(c.wait().code(), Some(0));
 }
 
 #[test]

@@ -9,7 +9,8 @@
 //! the text, and the analysis (and its published diagnostics) waits until no change has come
 //! for [`DEBOUNCE`] (at most [`MAX_DELAY`] after the first unchecked change) or until a
 //! request needs it, so a burst of typing is checked once. A panic in a handler or in the
-//! analysis becomes an error response (or a log line) and the server goes on.
+//! analysis becomes an error response (or a log line) and the server goes on. The server
+//! stops at `exit` or when its input ends.
 
 mod convert;
 mod follow;
@@ -43,7 +44,8 @@ pub struct LspArgs {
     pub stdio: bool,
 }
 
-/// Runs the server until `exit`: 0 after `shutdown`, 1 without it (or when the client goes).
+/// Runs the server until `exit` (0 after `shutdown`, 1 without it) or until its input ends (0:
+/// the client is gone and nothing failed here).
 pub fn lsp(_args: LspArgs) -> u8 {
     let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
     let mut server = Server::new(Writer::new(std::io::stdout().lock()));
@@ -69,8 +71,8 @@ pub fn lsp(_args: LspArgs) -> u8 {
             Err(RecvTimeoutError::Disconnected) => None,
         };
         let Some(next) = next else {
-            errln!("clayc lsp: the client closed the connection without `exit`");
-            return 1;
+            errln!("clayc lsp: the input ended without `exit`; stopping");
+            return 0;
         };
         match server.handle(next) {
             Ok(Some(code)) => return code,
