@@ -100,8 +100,21 @@ impl Client {
 
     /// A server whose channel to a following Clay editor is the folder `follow`.
     fn spawn_following(follow: &std::path::Path) -> Self {
+        Self::spawn_in(follow, &[])
+    }
+
+    /// A server started with `clayc lsp ARGS...`.
+    fn spawn_with(args: &[&str]) -> Self {
+        Self::spawn_in(
+            &std::env::temp_dir().join("clay-lsp-tests-follow-nobody"),
+            args,
+        )
+    }
+
+    fn spawn_in(follow: &std::path::Path, args: &[&str]) -> Self {
         let mut child = Command::new(env!("CARGO_BIN_EXE_clayc"))
             .arg("lsp")
+            .args(args)
             .env("CLAY_FOLLOW_DIR", follow)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
@@ -789,6 +802,61 @@ fn closing_the_input_stops_the_server_with_exit_code_0() {
     let mut c = Client::start();
     c.open(&wall());
     assert_eq!(c.wait().code(), Some(0));
+}
+
+/// Writes `text` into the FIFO at `path` on a thread of its own (the write waits for a reader).
+#[cfg(unix)]
+fn feed_fifo(path: &std::path::Path, text: &'static str) {
+    let path = path.to_path_buf();
+    std::thread::spawn(move || std::fs::write(path, text));
+}
+
+#[cfg(unix)]
+#[test]
+fn an_analysis_past_its_timeout_is_reported_and_the_server_answers_on() {
+    // The imported library is a FIFO: reading it waits until the test writes it, so the
+    // analysis of the importer outlasts any timeout until then.
+    let dir = std::env::temp_dir().join(format!("clay-lsp-late-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("lib.clay");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let uri = format!("file://{}/main.clay", dir.display());
+    let mut c = Client::initialised(Client::spawn_with(&["--analysis-timeout-ms", "100"]));
+    let timed_out = |published: &Value, version: i32| {
+        assert_eq!(published["version"], version, "{published}");
+        let diags = published["diagnostics"].as_array().unwrap();
+        assert_eq!(diags.len(), 1, "{published}");
+        assert_eq!(diags[0]["severity"], 2, "a warning: {published}");
+        let message = diags[0]["message"].as_str().unwrap();
+        assert!(message.contains("analysis timed out"), "{message}");
+    };
+    timed_out(&c.open_as(&uri, MAIN), 1);
+
+    // The server answers on: another document is checked and queried meanwhile.
+    let text = wall();
+    assert_eq!(c.open(&text)["diagnostics"], json!([]));
+    let brick = at(&text, "chain brick", 0, 7);
+    let hover = c.result("textDocument/hover", at_pos(&text, brick));
+    assert!(hover["contents"]["value"].is_string(), "{hover}");
+
+    // Changed while its analysis is late: that analysis' result, once it ends, is of an old
+    // text and is dropped, and the new text is analysed (and waits for the library again).
+    let changed = MAIN.replace("x 3", "x 4");
+    c.change_uri(&uri, 2, &changed);
+    feed_fifo(&fifo, LIB);
+    timed_out(&c.published(&uri, None), 2);
+    feed_fifo(&fifo, LIB);
+    let published = c.published(&uri, Some(2));
+    assert_eq!(published["diagnostics"], json!([]), "{published}");
+    let stale = c
+        .stash
+        .iter()
+        .any(|m| m["params"]["uri"] == uri.as_str() && m["params"]["version"] == 1);
+    assert!(!stale, "the late result of version 1 was published");
+    assert!(c.shutdown_and_exit().success());
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

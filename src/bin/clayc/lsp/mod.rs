@@ -8,18 +8,21 @@
 //! One thread answers everything in order. Documents are synced whole; a change only stores
 //! the text, and the analysis (and its published diagnostics) waits until no change has come
 //! for [`DEBOUNCE`] (at most [`MAX_DELAY`] after the first unchecked change) or until a
-//! request needs it, so a burst of typing is checked once. A panic in a handler or in the
-//! analysis becomes an error response (or a log line) and the server goes on. The server
-//! stops at `exit` or when its input ends.
+//! request needs it, so a burst of typing is checked once. Each analysis runs on a thread of
+//! its own (`worker`), waited for at most the analysis timeout: a document that takes longer
+//! gets a diagnostic saying so and the server answers on, taking the late analysis when it
+//! ends. A panic in a handler or in the analysis becomes an error response (or a log line)
+//! and the server goes on. The server stops at `exit` or when its input ends.
 
 mod convert;
 mod follow;
 mod handlers;
 mod transport;
+mod worker;
 
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::rc::Rc;
+use std::sync::Arc;
 use std::sync::mpsc::RecvTimeoutError;
 use std::time::{Duration, Instant};
 
@@ -42,13 +45,18 @@ pub struct LspArgs {
     /// clients pass it).
     #[arg(long)]
     pub stdio: bool,
+    /// How long to wait for the analysis of a document, in milliseconds, before answering
+    /// without it (it goes on in the background).
+    #[arg(long, value_name = "MS", default_value_t = worker::DEFAULT_TIMEOUT_MS)]
+    pub analysis_timeout_ms: u64,
 }
 
 /// Runs the server until `exit` (0 after `shutdown`, 1 without it) or until its input ends (0:
 /// the client is gone and nothing failed here).
-pub fn lsp(_args: LspArgs) -> u8 {
+pub fn lsp(args: LspArgs) -> u8 {
     let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
-    let mut server = Server::new(Writer::new(std::io::stdout().lock()));
+    let timeout = Duration::from_millis(args.analysis_timeout_ms);
+    let mut server = Server::new(Writer::new(std::io::stdout().lock()), timeout);
     loop {
         // Wake for the debounce's deadline, and every so often for the Clay editor's reveals.
         let wait = server
@@ -60,8 +68,10 @@ pub fn lsp(_args: LspArgs) -> u8 {
         let next = match input.recv_timeout(wait) {
             Ok(m) => Some(m),
             Err(RecvTimeoutError::Timeout) => {
-                let due = server.deadline.is_some_and(|d| d <= Instant::now());
-                let done = if due { server.check_changed() } else { Ok(()) };
+                let done = server.poll_late().and_then(|()| {
+                    let due = server.deadline.is_some_and(|d| d <= Instant::now());
+                    if due { server.check_changed() } else { Ok(()) }
+                });
                 if let Err(e) = done.and_then(|()| server.reveal()) {
                     errln!("clayc lsp: cannot write to the client: {e}");
                     return 1;
@@ -90,11 +100,13 @@ pub struct Document {
     pub uri: lsp::Uri,
     pub text: String,
     pub version: i32,
-    /// The analysis of `text` (of an earlier text while `dirty`).
-    pub analysis: Option<Rc<Analysis>>,
+    /// The analysis of `text` (of an earlier text while `dirty` or `late`).
+    pub analysis: Option<Arc<Analysis>>,
     /// The last analysis whose text parsed: it answers for what lies after a syntax error.
-    pub last_parsed: Option<Rc<Analysis>>,
+    pub last_parsed: Option<Arc<Analysis>>,
     pub dirty: bool,
+    /// An analysis that outlasted the timeout and runs on (of `text` unless `dirty`).
+    late: Option<worker::Job>,
 }
 
 impl Document {
@@ -106,31 +118,51 @@ impl Document {
             analysis: None,
             last_parsed: None,
             dirty: true,
+            late: None,
         }
     }
 
-    /// Analyses the present text, reading imports through `loader`; `false` when the analysis
-    /// panicked (then the old one stays).
-    fn analyse(&mut self, path: &str, loader: &dyn Loader) -> bool {
-        let text = &self.text;
-        let previous = self.last_parsed.as_deref();
-        let fresh = catch_unwind(AssertUnwindSafe(|| {
-            Analysis::with_loader(text, path, previous, loader)
-        }));
+    /// Starts analysing the present text, imports read through `loader`.
+    fn start(&mut self, loader: Arc<dyn Loader + Send + Sync>) -> worker::Job {
         self.dirty = false;
-        match fresh {
-            Ok(a) => {
-                let a = Rc::new(a);
-                if a.parses() {
-                    self.last_parsed = Some(a.clone());
-                }
-                self.analysis = Some(a);
-                true
-            }
-            Err(_) => false,
+        worker::Job::start(worker::Work {
+            text: self.text.clone(),
+            path: convert::file_path(self.uri.as_str()),
+            previous: self.last_parsed.clone(),
+            loader,
+        })
+    }
+
+    /// Takes the finished analysis of the present text; gives what to publish.
+    fn finished(&mut self, a: Box<Analysis>) -> Published {
+        let a = Arc::new(*a);
+        if a.parses() {
+            self.last_parsed = Some(a.clone());
         }
+        let diagnostics = convert::diagnostics(&self.uri, a.line_index(), a.diagnostics());
+        self.analysis = Some(a);
+        (self.uri.clone(), diagnostics, self.version)
+    }
+
+    /// What to publish when the analysis outlasts `timeout`: one warning at the start.
+    fn timed_out(&self, timeout: Duration) -> Published {
+        let message = format!(
+            "analysis timed out after {} ms: it goes on in the background and its diagnostics \
+             replace this one when it ends; until then, answers are about the last text analysed",
+            timeout.as_millis()
+        );
+        let warning = lsp::Diagnostic {
+            severity: Some(lsp::DiagnosticSeverity::WARNING),
+            source: Some("clay".into()),
+            message,
+            ..Default::default()
+        };
+        (self.uri.clone(), vec![warning], self.version)
     }
 }
+
+/// Diagnostics to publish: the document, its diagnostics and the version they are of.
+type Published = (lsp::Uri, Vec<lsp::Diagnostic>, i32);
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum State {
@@ -153,12 +185,14 @@ struct Server<W: std::io::Write> {
     reveals: follow::Reveals,
     /// Requests sent to the client (`window/showDocument`), for their ids.
     sent: u64,
+    /// How long an analysis is waited for.
+    timeout: Duration,
 }
 
 type Flow = std::io::Result<Option<u8>>;
 
 impl<W: std::io::Write> Server<W> {
-    fn new(out: Writer<W>) -> Self {
+    fn new(out: Writer<W>, timeout: Duration) -> Self {
         let channel = clay_dsl::analysis::follow::channel();
         Self {
             out,
@@ -169,6 +203,7 @@ impl<W: std::io::Write> Server<W> {
             cursor: follow::Cursor::new(channel.clone()),
             reveals: follow::Reveals::new(&channel),
             sent: 0,
+            timeout,
         }
     }
 
@@ -365,30 +400,75 @@ impl<W: std::io::Write> Server<W> {
         self.deadline = Some((now + DEBOUNCE).min(first + MAX_DELAY));
     }
 
-    /// Analyses every changed document once and publishes its diagnostics.
+    /// Analyses every changed document once, waiting for each until the timeout, and publishes
+    /// its diagnostics (or that it timed out). A document whose late analysis still runs waits
+    /// for it to end.
     fn check_changed(&mut self) -> std::io::Result<()> {
+        self.poll_late()?;
         self.deadline = None;
         self.first_change = None;
-        if !self.docs.values().any(|d| d.dirty) {
-            return Ok(());
+        let started = self.start_analyses();
+        let until = Instant::now() + self.timeout;
+        let mut ready = Vec::new();
+        for (uri, job) in started {
+            let Some(doc) = self.docs.get_mut(&uri) else {
+                continue;
+            };
+            match job.wait(until) {
+                worker::State::Done(a) => ready.push(doc.finished(a)),
+                worker::State::Failed => errln!("clayc lsp: the analysis of `{uri}` failed"),
+                worker::State::Running => {
+                    errln!("clayc lsp: the analysis of `{uri}` timed out; it goes on");
+                    ready.push(doc.timed_out(self.timeout));
+                    doc.late = Some(job);
+                }
+            }
+        }
+        self.publish_all(ready)
+    }
+
+    /// Starts the analysis of every changed document that has none running.
+    fn start_analyses(&mut self) -> Vec<(String, worker::Job)> {
+        if !self.docs.values().any(|d| d.dirty && d.late.is_none()) {
+            return Vec::new();
         }
         // An import of an open document reads its text in the editor, saved or not.
-        let buffers = Buffers(
+        let buffers: Arc<dyn Loader + Send + Sync> = Arc::new(Buffers(
             self.docs
                 .iter()
                 .map(|(uri, d)| (normalised_path(uri), d.text.clone()))
                 .collect(),
-        );
+        ));
+        self.docs
+            .iter_mut()
+            .filter(|(_, d)| d.dirty && d.late.is_none())
+            .map(|(uri, d)| (uri.clone(), d.start(buffers.clone())))
+            .collect()
+    }
+
+    /// Takes the late analyses that have ended: the diagnostics of one whose document has not
+    /// changed since are published; a changed document is checked again.
+    fn poll_late(&mut self) -> std::io::Result<()> {
         let mut ready = Vec::new();
-        for (uri, doc) in self.docs.iter_mut().filter(|(_, d)| d.dirty) {
-            if !doc.analyse(&convert::file_path(uri), &buffers) {
-                errln!("clayc lsp: the analysis of `{uri}` panicked");
-                continue;
+        let mut again = false;
+        for (uri, doc) in &mut self.docs {
+            let Some(job) = &doc.late else { continue };
+            match job.poll() {
+                worker::State::Running => continue,
+                worker::State::Done(a) if !doc.dirty => ready.push(doc.finished(a)),
+                worker::State::Done(_) => {}
+                worker::State::Failed => errln!("clayc lsp: the analysis of `{uri}` failed"),
             }
-            let Some(a) = &doc.analysis else { continue };
-            let diagnostics = convert::diagnostics(&doc.uri, a.line_index(), a.diagnostics());
-            ready.push((doc.uri.clone(), diagnostics, doc.version));
+            doc.late = None;
+            again |= doc.dirty;
         }
+        if again {
+            self.changed();
+        }
+        self.publish_all(ready)
+    }
+
+    fn publish_all(&mut self, ready: Vec<Published>) -> std::io::Result<()> {
         for (uri, diagnostics, version) in ready {
             self.publish(uri, diagnostics, Some(version))?;
         }
