@@ -823,7 +823,9 @@ fn an_analysis_past_its_timeout_is_reported_and_the_server_answers_on() {
     let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
     assert!(made.success());
     let uri = format!("file://{}/main.clay", dir.display());
-    let mut c = Client::initialised(Client::spawn_with(&["--analysis-timeout-ms", "100"]));
+    // Long enough for wall.clay's analysis (milliseconds) on a busy machine; the FIFO's
+    // outlasts any.
+    let mut c = Client::initialised(Client::spawn_with(&["--analysis-timeout-ms", "1000"]));
     let timed_out = |published: &Value, version: i32| {
         assert_eq!(published["version"], version, "{published}");
         let diags = published["diagnostics"].as_array().unwrap();
