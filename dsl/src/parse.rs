@@ -311,7 +311,8 @@ fn found_token(source: &str, pos: usize) -> (Span, String) {
         pos -= 1;
     }
     let rest = &source[pos..];
-    let trimmed = rest.trim_start();
+    // Only what the grammar skips: other white space (U+3000) is what it stopped at.
+    let trimmed = rest.trim_start_matches([' ', '\t', '\n', '\r', '\u{FEFF}']);
     let start = pos + (rest.len() - trimmed.len());
     let Some(c) = trimmed.chars().next() else {
         return (
@@ -327,12 +328,18 @@ fn found_token(source: &str, pos: usize) -> (Span, String) {
         c.len_utf8()
     };
     let text = &trimmed[..len];
-    let words = if c.is_control() {
+    let words = if c.is_control() || (!c.is_ascii() && (c.is_whitespace() || invisible(c))) {
         format!("character {c:?}")
     } else {
         format!("`{text}`")
     };
     (Span::new(start, start + len), words)
+}
+
+/// A character that shows as nothing: zero-width spaces and joiners, direction marks, the
+/// word joiner and the byte-order mark.
+fn invisible(c: char) -> bool {
+    matches!(c, '\u{200B}'..='\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2060}'..='\u{2064}' | '\u{FEFF}')
 }
 
 /// Joins words as "a, b or c".
@@ -410,9 +417,11 @@ fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
 fn declaration_in_open_block(source: &str, span: Span) -> Option<(&str, Span)> {
     const STARTS: [&str; 6] = ["state", "piece", "stretch", "merge", "cut", "model"];
     let before = source.get(..span.start)?.trim_end();
+    // The word's start is found by trimming it off, which stays on a char boundary even after
+    // a multi-byte character (`m²`).
     let word_start = before
-        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-        .map_or(0, |i| i + 1);
+        .trim_end_matches(|c: char| c.is_ascii_alphanumeric() || c == '_')
+        .len();
     let keyword = &before[word_start..];
     let open = unclosed(&source[..word_start])?;
     if !(STARTS.contains(&keyword) && source.as_bytes().get(open.start) == Some(&b'{')) {
