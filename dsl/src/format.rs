@@ -55,13 +55,20 @@ pub fn format_number(x: f64) -> String {
 }
 
 /// The spans of every comment (`// ...` without its newline, and whole nested `/* ... */`) in
-/// the text, in order. An unterminated block comment runs to the end of the text.
+/// the text, in order. An unterminated block comment runs to the end of the text. A string
+/// (`"..."`, to its closing quote or the end of its line) holds no comment: `"a//b.obj"`.
 pub fn comment_spans(source: &str) -> Vec<Span> {
     let b = source.as_bytes();
     let mut spans = Vec::new();
     let mut i = 0;
     while i + 1 < b.len() {
-        if b[i] == b'/' && b[i + 1] == b'/' {
+        if b[i] == b'"' {
+            i += 1;
+            while i < b.len() && !matches!(b[i], b'"' | b'\n') {
+                i += 1;
+            }
+            i += 1;
+        } else if b[i] == b'/' && b[i + 1] == b'/' {
             let start = i;
             while i < b.len() && b[i] != b'\n' {
                 i += 1;

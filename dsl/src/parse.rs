@@ -190,12 +190,21 @@ pub fn describe(rule: Rule) -> &'static str {
 /// that follows the grammar and whose numbers are all finite.
 pub fn parse(source: &str) -> Result<File, Diagnostics> {
     let base = span_base();
-    if let Some(d) = check_nesting(source) {
+    let scan = scan(source);
+    if let Some(d) = scan.too_deep {
         return Err(d.shifted(base).into());
     }
     let mut pairs = match ClayParser::parse(Rule::file, source) {
         Ok(p) => p,
-        Err(e) => return Err(syntax_error(source, e).shifted(base).into()),
+        Err(e) => {
+            // A comment left open swallows the rest of the file: that is the mistake, unless
+            // the text has one before it.
+            let d = match scan.unclosed_comment {
+                Some(open) if open.start <= error_position(&e) => unclosed_comment(open),
+                _ => syntax_error(source, e),
+            };
+            return Err(d.shifted(base).into());
+        }
     };
     let Some(file) = pairs.next() else {
         return Err(
@@ -214,7 +223,8 @@ pub fn parse(source: &str) -> Result<File, Diagnostics> {
 }
 
 /// One event of a scan of the source that knows comments (line comments skipped, block
-/// comments nested): a bracket opened or closed outside comments, or a block comment opened.
+/// comments nested) and strings (skipped): a bracket opened or closed outside comments and
+/// strings, or a block comment opened or closed.
 enum Nesting {
     Open(usize),
     Close,
@@ -223,10 +233,15 @@ enum Nesting {
         at: usize,
         depth: usize,
     },
+    /// A block comment closed; `depth` is the comment nesting after it.
+    CommentEnd {
+        depth: usize,
+    },
 }
 
-/// The bracket and comment events of `bytes`, in order: the one lexer that both the nesting
-/// guard and the unclosed-bracket hint use, so they agree on what a comment is.
+/// The bracket and comment events of `bytes`, in order: the one lexer that the nesting guard,
+/// the unclosed-comment check and the unclosed-bracket hint use, so they agree on what a
+/// comment is. A string runs to its closing `"` or the end of its line, as in the grammar.
 fn nesting_events(bytes: &[u8]) -> impl Iterator<Item = Nesting> + '_ {
     let mut i = 0;
     let mut comments = 0usize;
@@ -246,11 +261,17 @@ fn nesting_events(bytes: &[u8]) -> impl Iterator<Item = Nesting> + '_ {
                 } else if b == b'*' && next == Some(b'/') {
                     comments -= 1;
                     i += 1;
+                    return Some(Nesting::CommentEnd { depth: comments });
                 }
             } else if b == b'/' && next == Some(b'/') {
                 while i < bytes.len() && bytes[i] != b'\n' {
                     i += 1;
                 }
+            } else if b == b'"' {
+                while i < bytes.len() && !matches!(bytes[i], b'"' | b'\n') {
+                    i += 1;
+                }
+                i += 1;
             } else if b == b'/' && next == Some(b'*') {
                 comments = 1;
                 i += 1;
@@ -268,40 +289,90 @@ fn nesting_events(bytes: &[u8]) -> impl Iterator<Item = Nesting> + '_ {
     })
 }
 
-/// Rejects input nested deeper than [`MAX_NESTING`] (brackets of any kind and block comments)
-/// with one scan, before the recursive parser runs.
-fn check_nesting(source: &str) -> Option<Diagnostic> {
+/// What the scan before pest finds in the source.
+struct Scan {
+    /// E002 at the first place nested deeper than [`MAX_NESTING`] (brackets of any kind, or
+    /// block comments): rejected before the recursive parser runs.
+    too_deep: Option<Diagnostic>,
+    /// The `/*` of the outermost block comment still open at the end of the text.
+    unclosed_comment: Option<Span>,
+}
+
+/// One linear scan of the source for the nesting guard and the unclosed-comment check.
+fn scan(source: &str) -> Scan {
     let mut brackets = 0usize;
+    let mut comments = 0usize;
+    // Where the outermost block comment (the one open at depth 1) starts.
+    let mut outermost = 0usize;
+    let mut too_deep = None;
     for event in nesting_events(source.as_bytes()) {
-        let (i, comments) = match event {
+        let deeper = match event {
             Nesting::Open(at) => {
                 brackets += 1;
-                (at, 0)
+                (brackets > MAX_NESTING).then_some((at, "brackets"))
             }
             Nesting::Close => {
                 brackets = brackets.saturating_sub(1);
-                continue;
+                None
             }
-            Nesting::Comment { at, depth } => (at, depth),
+            Nesting::Comment { at, depth } => {
+                comments = depth;
+                if depth == 1 {
+                    outermost = at - 1;
+                }
+                (depth > MAX_NESTING).then_some((at, "block comments"))
+            }
+            Nesting::CommentEnd { depth } => {
+                comments = depth;
+                None
+            }
         };
-        if brackets > MAX_NESTING || comments > MAX_NESTING {
-            let what = if comments > MAX_NESTING {
-                "block comments"
-            } else {
-                "brackets"
-            };
-            return Some(
-                Diagnostic::error(
-                    codes::TOO_DEEP,
-                    format!("{what} nested more than {MAX_NESTING} deep"),
-                    Span::new(i, i + 1),
-                    format!("nesting level {} starts here", MAX_NESTING + 1),
-                )
-                .with_hint("a clay file never needs more than three levels of brackets; look for an unclosed bracket or comment"),
-            );
+        if too_deep.is_none() {
+            too_deep = deeper;
         }
     }
-    None
+    let unclosed_comment = (comments > 0).then(|| Span::new(outermost, outermost + 2));
+    Scan {
+        too_deep: too_deep.map(|(at, what)| nested_too_deep(at, what, unclosed_comment)),
+        unclosed_comment,
+    }
+}
+
+/// E002 at `at`, where `what` (brackets or block comments) pass [`MAX_NESTING`]; the open
+/// comment, when it holds that place, is named too.
+fn nested_too_deep(at: usize, what: &str, unclosed_comment: Option<Span>) -> Diagnostic {
+    let d = Diagnostic::error(
+        codes::TOO_DEEP,
+        format!("{what} nested more than {MAX_NESTING} deep"),
+        Span::new(at, at + 1),
+        format!("nesting level {} starts here", MAX_NESTING + 1),
+    )
+    .with_hint("a clay file never needs more than three levels of brackets; look for an unclosed bracket or comment");
+    match unclosed_comment.filter(|c| c.start <= at) {
+        Some(open) => d.with_secondary(open, "this block comment is never closed"),
+        None => d,
+    }
+}
+
+/// E001 for a block comment that is never closed, at its `/*`.
+fn unclosed_comment(open: Span) -> Diagnostic {
+    Diagnostic::error(
+        codes::SYNTAX,
+        "unclosed block comment",
+        open,
+        "this comment is never closed",
+    )
+    .with_hint(
+        "close it with `*/`; block comments nest, so every `/*` inside it needs its own `*/`",
+    )
+}
+
+/// Where pest stopped.
+fn error_position(e: &pest::error::Error<Rule>) -> usize {
+    match e.location {
+        InputLocation::Pos(p) => p,
+        InputLocation::Span((s, _)) => s,
+    }
 }
 
 /// The span of the token starting at `pos` (after whitespace), and words for it.
@@ -352,11 +423,7 @@ fn one_of(words: &[&str]) -> String {
 }
 
 fn syntax_error(source: &str, e: pest::error::Error<Rule>) -> Diagnostic {
-    let pos = match e.location {
-        InputLocation::Pos(p) => p,
-        InputLocation::Span((s, _)) => s,
-    };
-    let (span, found) = found_token(source, pos);
+    let (span, found) = found_token(source, error_position(&e));
     match &e.variant {
         ErrorVariant::ParsingError { positives, .. } => {
             let mut words: Vec<&str> = Vec::new();
@@ -443,7 +510,7 @@ fn unclosed(source: &str) -> Option<Span> {
             Nesting::Close => {
                 open.pop();
             }
-            Nesting::Comment { .. } => {}
+            Nesting::Comment { .. } | Nesting::CommentEnd { .. } => {}
         }
     }
     open.last().map(|&i| Span::new(i, i + 1))

@@ -1,5 +1,6 @@
 //! Regression tests for what fuzzing found, each with its minimal input: a syntax error after a
-//! multi-byte character (a panic slicing inside it).
+//! multi-byte character (a panic slicing inside it) and unclosed block comments (exponential
+//! time).
 
 use clay_dsl::analysis::Analysis;
 use clay_dsl::{Diagnostic, compile, render};
@@ -87,4 +88,78 @@ fn a_character_the_grammar_does_not_skip_is_what_the_error_names() {
         "{}",
         e.message
     );
+}
+
+// ---- 2. unclosed block comments -----------------------------------------------------------------
+
+#[test]
+fn thirty_unclosed_block_comments_are_one_error_at_the_first() {
+    let text = "/* ".repeat(30);
+    let d = compile(&text, "a.clay").expect_err("unclosed");
+    assert_eq!(d.items.len(), 1, "{d:?}");
+    let e = &d.items[0];
+    assert_eq!(
+        (e.code, e.message.as_str()),
+        ("E001", "unclosed block comment")
+    );
+    assert_eq!((e.primary.span.start, e.primary.span.end), (0, 2));
+    assert!(clay_dsl::format(&text).is_err());
+    let a = Analysis::new(&text, "a.clay");
+    assert_eq!(a.diagnostics().items[0].message, "unclosed block comment");
+}
+
+#[test]
+fn ten_thousand_unclosed_block_comments_are_too_deep_and_name_the_first() {
+    let text = "/* ".repeat(10_000);
+    let d = compile(&text, "a.clay").expect_err("unclosed");
+    assert_eq!(d.items.len(), 1, "{d:?}");
+    let e = &d.items[0];
+    // The nesting guard stops it before pest: at the `*` of the 257th `/*`.
+    assert_eq!(e.code, "E002");
+    assert_eq!(e.primary.span.start, 256 * 3 + 1);
+    let open = &e.secondary[0];
+    assert_eq!((open.span.start, open.span.end), (0, 2));
+    assert!(open.message.contains("never closed"), "{}", open.message);
+}
+
+#[test]
+fn an_unclosed_comment_after_the_items_points_at_its_opening() {
+    let text = "site type a\n/* one /* two */\npiece p {}\n";
+    let d = compile(text, "a.clay").expect_err("unclosed");
+    let e = &d.items[0];
+    assert_eq!(
+        (e.code, e.message.as_str()),
+        ("E001", "unclosed block comment")
+    );
+    assert_eq!(e.primary.span.start, text.find("/*").unwrap());
+    // Inside an expression the `/` reads as a division first; still the comment is the error.
+    let text = "let a = 1 /* never closed";
+    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    assert_eq!(
+        (e.message.as_str(), e.primary.span.start),
+        ("unclosed block comment", 10)
+    );
+}
+
+#[test]
+fn an_earlier_syntax_error_is_still_the_one_reported() {
+    let text = "piece p { vertex }\n/* never closed";
+    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    assert_eq!(e.code, "E001");
+    assert!(e.message.starts_with("expected"), "{}", e.message);
+    assert!(e.primary.span.start < text.find("/*").unwrap());
+}
+
+#[test]
+fn comment_openers_inside_strings_are_not_comments() {
+    // The scan skips strings as the grammar reads them: no unclosed comment, no bracket.
+    let text = "import \"a/*b(.clay\" x";
+    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    assert!(e.message.starts_with("expected"), "{}", e.message);
+    assert!(e.secondary.is_empty(), "{e:?}");
+    // And the formatter keeps a `//` inside a string as it is, not as a comment.
+    let text = "piece p {\n    mesh \"a//b.obj\"\n}\n";
+    assert!(clay_dsl::parse(text).is_ok());
+    assert_eq!(clay_dsl::format(text).unwrap(), text);
+    assert!(clay_dsl::comment_spans(text).is_empty());
 }
