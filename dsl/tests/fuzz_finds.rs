@@ -1,6 +1,8 @@
 //! Regression tests for what fuzzing found, each with its minimal input: a syntax error after a
-//! multi-byte character (a panic slicing inside it) and unclosed block comments (exponential
-//! time).
+//! multi-byte character (a panic slicing inside it), unclosed block comments (exponential time)
+//! and a `.mtl` colour line with fewer than three numbers (a panic inside tobj).
+
+use std::path::{Path, PathBuf};
 
 use clay_dsl::analysis::Analysis;
 use clay_dsl::{Diagnostic, compile, render};
@@ -162,4 +164,69 @@ fn comment_openers_inside_strings_are_not_comments() {
     assert!(clay_dsl::parse(text).is_ok());
     assert_eq!(clay_dsl::format(text).unwrap(), text);
     assert!(clay_dsl::comment_spans(text).is_empty());
+}
+
+// ---- 3. and 4. files read on the grammar's behalf -----------------------------------------------
+
+/// A fresh folder for one test.
+fn folder(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-fuzz-finds-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A grammar of one triangle piece carrying `stmt` (a `mesh`), and a model of it.
+fn hut(stmt: &str) -> String {
+    format!(
+        "piece hut {{\n    vertex a (0, 0)\n    vertex b (1, 0)\n    vertex c (0, 1)\n    \
+         edges a-b-c-a\n    {stmt}\n}}\nmodel {{\n    h = hut\n}}\n"
+    )
+}
+
+/// Writes `grammar` as `hut.clay` in `dir` and compiles it from the file system: the one error.
+fn one_error(dir: &Path, grammar: &str) -> Diagnostic {
+    let path = dir.join("hut.clay").to_string_lossy().into_owned();
+    std::fs::write(&path, grammar).unwrap();
+    let d = compile(grammar, &path).expect_err("refused");
+    assert_eq!(d.items.len(), 1, "one error per mistake: {d:?}");
+    let e = d.items[0].clone();
+    let (line, _) = clay_dsl::line_col(grammar, e.primary.span.start);
+    assert!(line >= 1 && !e.hints.is_empty(), "{e:?}");
+    assert!(render(&d, grammar, &path, false).contains(&format!("hut.clay:{line}:")));
+    e
+}
+
+const TRIANGLE_OBJ: &str = "mtllib hut.mtl\nv 0 0 0\nv 1 0 0\nv 0 0 -1\nusemtl red\nf 1 2 3\n";
+
+#[test]
+fn an_mtl_colour_with_one_number_is_an_error_naming_its_line() {
+    let dir = folder("mtl");
+    std::fs::write(dir.join("hut.obj"), TRIANGLE_OBJ).unwrap();
+    std::fs::write(dir.join("hut.mtl"), "newmtl red\n  Kd 0.5\n").unwrap();
+    let grammar = hut("mesh \"hut.obj\"");
+    let e = one_error(&dir, &grammar);
+    assert_eq!(e.code, "E066");
+    assert_eq!(e.primary.span.start, grammar.find("\"hut.obj\"").unwrap());
+    assert!(
+        e.message.contains("hut.mtl`, line 2, column 3"),
+        "{}",
+        e.message
+    );
+    assert!(e.message.contains("`Kd`"), "{}", e.message);
+    for line in ["Ka", "Ks 1 0", "Ke 1 x 0"] {
+        std::fs::write(dir.join("hut.mtl"), format!("newmtl red\n{line}\n")).unwrap();
+        let e = one_error(&dir, &grammar);
+        assert!(
+            e.message.contains("line 2, column 1"),
+            "{line}: {}",
+            e.message
+        );
+    }
+    // Three numbers read; a missing `.mtl` only loses the colour.
+    std::fs::write(dir.join("hut.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
+    assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
+    std::fs::remove_file(dir.join("hut.mtl")).unwrap();
+    assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
+    std::fs::remove_dir_all(dir).unwrap();
 }

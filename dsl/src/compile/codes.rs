@@ -88,7 +88,8 @@ pub const MESH_MISSING: &str = "E064";
 /// A `mesh` asset that exists but cannot be read (a folder, no permission).
 pub const MESH_UNREADABLE: &str = "E065";
 /// A `mesh` asset that is not a mesh Clay reads: an unknown extension, or a file that is not
-/// valid glTF 2.0 or OBJ, or has no triangles, or refers to data it does not contain.
+/// valid glTF 2.0 or OBJ, or has no triangles, or refers to data it does not contain, or
+/// whose `.mtl` has a colour line without three numbers.
 pub const MESH_MALFORMED: &str = "E066";
 /// A `mesh` asset beyond a limit: its file size, its vertices or its triangles.
 pub const MESH_TOO_LARGE: &str = "E067";

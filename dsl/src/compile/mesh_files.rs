@@ -503,12 +503,19 @@ pub(super) fn obj(
         ..Default::default()
     };
     let mut mtl_bytes: HashMap<String, Vec<u8>> = HashMap::new();
-    // tobj asks for materials through a `Fn`; read them first so the budget sees them.
+    // tobj asks for materials through a `Fn`; read them first so the budget sees them, and
+    // check them, since tobj panics on some malformed lines.
     for line in String::from_utf8_lossy(bytes).lines() {
         if let Some(name) = line.trim().strip_prefix("mtllib ") {
             let path = resolve(target, name.trim());
-            if let Ok(b) = budget.load(&path) {
-                mtl_bytes.insert(name.trim().to_string(), b);
+            match budget.load(&path) {
+                Ok(b) => {
+                    check_mtl(&b, &path)?;
+                    mtl_bytes.insert(name.trim().to_string(), b);
+                }
+                // A missing `.mtl` only loses the colours.
+                Err(Problem::Io(_, e)) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(problem) => return Err(problem),
             }
         }
     }
@@ -542,4 +549,26 @@ pub(super) fn obj(
         c.add(fill, &positions, triangles)?;
     }
     c.finish()
+}
+
+/// A `.mtl` file's colour lines (`Ka`, `Kd`, `Ks`, `Ke`) must each have three numbers: tobj
+/// panics on fewer. The first line that does not is reported with its line and column.
+fn check_mtl(bytes: &[u8], path: &str) -> Result<(), Problem> {
+    let text = String::from_utf8_lossy(bytes);
+    for (n, line) in text.split('\n').enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            continue;
+        };
+        let numbers = words.take(3).filter(|w| w.parse::<f32>().is_ok()).count();
+        if numbers < 3 {
+            let column = line[..line.find(key).unwrap_or(0)].chars().count() + 1;
+            return Err(malformed(format!(
+                "its material file `{path}`, line {}, column {column}: `{key}` must be \
+                 followed by three numbers (red, green, blue)",
+                n + 1
+            )));
+        }
+    }
+    Ok(())
 }
