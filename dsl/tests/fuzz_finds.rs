@@ -1,6 +1,7 @@
 //! Regression tests for what fuzzing found, each with its minimal input: a syntax error after a
-//! multi-byte character (a panic slicing inside it), unclosed block comments (exponential time)
-//! and a `.mtl` colour line with fewer than three numbers (a panic inside tobj).
+//! multi-byte character (a panic slicing inside it), unclosed block comments (exponential time),
+//! a `.mtl` colour line with fewer than three numbers (a panic inside tobj) and named pipes
+//! where the compiler reads a file (a wait for ever).
 
 use std::path::{Path, PathBuf};
 
@@ -228,5 +229,87 @@ fn an_mtl_colour_with_one_number_is_an_error_naming_its_line() {
     assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
     std::fs::remove_file(dir.join("hut.mtl")).unwrap();
     assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Makes a named pipe at `path`; false (with a note) where `mkfifo` is missing.
+fn mkfifo(path: &Path) -> bool {
+    match std::process::Command::new("mkfifo").arg(path).status() {
+        Ok(s) if s.success() => true,
+        other => {
+            println!("note: no named pipe made ({other:?}); the pipe case is skipped");
+            false
+        }
+    }
+}
+
+/// A glTF triangle whose buffer is the file `uri`, and that buffer's bytes.
+fn gltf_with_buffer(uri: &str) -> (String, Vec<u8>) {
+    let mut bin: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 0., -1.]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    bin.extend([0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "buffers":[{{"byteLength":44,"uri":"{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":8}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,-1],"max":[1,0,0]}},
+                     {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#
+    );
+    (json, bin)
+}
+
+#[test]
+fn named_pipes_are_refused_before_they_are_opened() {
+    let dir = folder("fifo");
+    if !mkfifo(&dir.join("pipe")) {
+        return;
+    }
+    let not_regular = |e: &Diagnostic| {
+        assert!(e.message.contains("is not a regular file"), "{}", e.message);
+        assert!(e.message.contains("named pipe"), "{}", e.message);
+    };
+    // Imported, directly and through a symbolic link.
+    std::os::unix::fs::symlink(dir.join("pipe"), dir.join("link.clay")).unwrap();
+    for target in ["pipe", "link.clay"] {
+        let grammar = format!("import \"{target}\"\n");
+        let e = one_error(&dir, &grammar);
+        assert_eq!((e.code, e.primary.span.start), ("E060", 7), "{e:?}");
+        not_regular(&e);
+    }
+    // A mesh asset.
+    std::fs::rename(dir.join("pipe"), dir.join("pipe.glb")).unwrap();
+    let grammar = hut("mesh \"pipe.glb\"");
+    let e = one_error(&dir, &grammar);
+    assert_eq!(e.code, "E065");
+    assert_eq!(e.primary.span.start, grammar.find("\"pipe.glb\"").unwrap());
+    not_regular(&e);
+    // A glTF's buffer.
+    std::fs::rename(dir.join("pipe.glb"), dir.join("pipe.bin")).unwrap();
+    let (json, bin) = gltf_with_buffer("pipe.bin");
+    std::fs::write(dir.join("tri.gltf"), json).unwrap();
+    let e = one_error(&dir, &hut("mesh \"tri.gltf\""));
+    assert_eq!(e.code, "E065");
+    assert!(e.message.contains("pipe.bin"), "{}", e.message);
+    not_regular(&e);
+    // An OBJ's materials.
+    std::fs::rename(dir.join("pipe.bin"), dir.join("hut.mtl")).unwrap();
+    std::fs::write(dir.join("hut.obj"), TRIANGLE_OBJ).unwrap();
+    let e = one_error(&dir, &hut("mesh \"hut.obj\""));
+    assert_eq!(e.code, "E065");
+    assert!(e.message.contains("hut.mtl"), "{}", e.message);
+    not_regular(&e);
+    // The same files as regular files compile.
+    std::fs::remove_file(dir.join("hut.mtl")).unwrap();
+    std::fs::write(dir.join("tri.bin"), bin).unwrap();
+    let (json, _) = gltf_with_buffer("tri.bin");
+    std::fs::write(dir.join("tri.gltf"), json).unwrap();
+    for mesh in ["tri.gltf", "hut.obj"] {
+        let grammar = hut(&format!("mesh \"{mesh}\""));
+        let path = dir.join("hut.clay").to_string_lossy().into_owned();
+        assert!(compile(&grammar, &path).is_ok(), "{mesh}");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -54,8 +54,9 @@ pub fn write(dir: &Path, name: &str, focus: &Focus) -> std::io::Result<()> {
     std::fs::rename(&tmp, dir.join(name))
 }
 
-/// The focus in the file at `path`, if it holds one.
+/// The focus in the file at `path`, if it holds one (a named pipe there is not waited on).
 pub fn read(path: &Path) -> Option<Focus> {
+    crate::compile::regular_file(path).ok()?;
     serde_json::from_slice(&std::fs::read(path).ok()?).ok()
 }
 

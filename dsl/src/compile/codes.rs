@@ -74,7 +74,7 @@ pub const BAD_CALL: &str = "E051";
 /// A constant used above its `let`.
 pub const USED_BEFORE_LET: &str = "E052";
 
-/// An imported file that cannot be read (missing, a folder, not readable).
+/// An imported file that cannot be read (missing, a folder, not readable, not a regular file).
 pub const IMPORT_UNREADABLE: &str = "E060";
 /// A file that imports itself, directly or through other files.
 pub const IMPORT_CYCLE: &str = "E061";
@@ -85,7 +85,8 @@ pub const EXTENDS_CYCLE: &str = "E062";
 pub const TOO_MUCH_REUSE: &str = "E063";
 /// A `mesh` asset that does not exist.
 pub const MESH_MISSING: &str = "E064";
-/// A `mesh` asset that exists but cannot be read (a folder, no permission).
+/// A `mesh` asset (or a file it names) that exists but cannot be read (a folder, no
+/// permission, not a regular file).
 pub const MESH_UNREADABLE: &str = "E065";
 /// A `mesh` asset that is not a mesh Clay reads: an unknown extension, or a file that is not
 /// valid glTF 2.0 or OBJ, or has no triangles, or refers to data it does not contain, or

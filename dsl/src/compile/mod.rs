@@ -27,6 +27,7 @@ use crate::suggest::closest;
 use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
 pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
+pub(crate) use imports::regular_file;
 pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
 pub use meshes::{MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 
