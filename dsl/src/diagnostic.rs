@@ -4,7 +4,7 @@
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term;
-use codespan_reporting::term::termcolor::{Buffer, ColorChoice, StandardStream};
+use codespan_reporting::term::termcolor::{Buffer, BufferWriter, ColorChoice};
 use serde::Serialize;
 
 use crate::line_index::LineIndex;
@@ -220,22 +220,56 @@ fn term_config() -> term::Config {
     term::Config::default()
 }
 
+/// Most diagnostics a human rendering shows ([`render`], [`emit_to_stderr`]); one closing line
+/// counts the rest ([`omitted_line`]). A file with thousands of mistakes has one cause more
+/// often than thousands, and each diagnostic prints its source line. The JSON form keeps all.
+pub const MAX_HUMAN_DIAGNOSTICS: usize = 50;
+
 /// Renders diagnostics rustc-style (`error[E011]: ...`, `--> file:line:col`, source line,
-/// labels, help notes). `color` adds ANSI colours; the caller decides (terminal, NO_COLOR).
+/// labels, help notes): the first [`MAX_HUMAN_DIAGNOSTICS`], then [`omitted_line`] if there
+/// are more. `color` adds ANSI colours; the caller decides (terminal, NO_COLOR).
 pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) -> String {
-    let files = all_files(&diagnostics.sources, source, path);
     let mut buffer = if color {
         Buffer::ansi()
     } else {
         Buffer::no_color()
     };
+    render_into(&mut buffer, diagnostics, source, path);
+    String::from_utf8_lossy(buffer.as_slice()).into_owned()
+}
+
+/// The line that ends a human rendering of more than [`MAX_HUMAN_DIAGNOSTICS`] diagnostics
+/// (`... and 2950 more errors (use `clayc check --format json` for all)`), or `None` when all
+/// are shown.
+pub fn omitted_line(diagnostics: &Diagnostics) -> Option<String> {
+    let rest = diagnostics
+        .items
+        .get(MAX_HUMAN_DIAGNOSTICS..)
+        .filter(|rest| !rest.is_empty())?;
+    let errors = rest.iter().filter(|d| d.is_error()).count();
+    let warnings = rest.len() - errors;
+    let plural = |n: usize, w: &str| format!("{n} more {w}{}", if n == 1 { "" } else { "s" });
+    let counts = match (errors, warnings) {
+        (e, 0) => plural(e, "error"),
+        (0, w) => plural(w, "warning"),
+        (e, w) => format!("{} and {}", plural(e, "error"), plural(w, "warning")),
+    };
+    Some(format!(
+        "... and {counts} (use `clayc check --format json` for all)\n"
+    ))
+}
+
+/// The human rendering into a colour buffer: the files' line index is built once, and each
+/// shown diagnostic costs the length of its own lines.
+fn render_into(buffer: &mut Buffer, diagnostics: &Diagnostics, source: &str, path: &str) {
+    let files = all_files(&diagnostics.sources, source, path);
     let config = term_config();
-    for d in diagnostics {
+    for d in diagnostics.iter().take(MAX_HUMAN_DIAGNOSTICS) {
         let (primary, secondary) = d.located(&diagnostics.sources, source, path);
         // Emitting into a memory buffer with clamped spans cannot fail; if it ever does, fall
         // back to a plain line so the diagnostic is not lost.
         if term::emit(
-            &mut buffer,
+            buffer,
             &config,
             &files,
             &d.to_codespan(&primary, &secondary),
@@ -244,7 +278,7 @@ pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) 
         {
             let (line, col) = line_col(primary.text, primary.start);
             buffer_push(
-                &mut buffer,
+                buffer,
                 &format!(
                     "{}[{}]: {}\n --> {}:{line}:{col}\n",
                     sev_word(d.severity),
@@ -255,7 +289,9 @@ pub fn render(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) 
             );
         }
     }
-    String::from_utf8_lossy(buffer.as_slice()).into_owned()
+    if let Some(line) = omitted_line(diagnostics) {
+        buffer_push(buffer, &line);
+    }
 }
 
 /// The main file (id 0) and the imported files (ids 1..) for codespan.
@@ -284,26 +320,19 @@ fn sev_word(s: Severity) -> &'static str {
     }
 }
 
-/// Writes diagnostics straight to stderr, coloured when `color` (the caller checks for a
-/// terminal and NO_COLOR).
+/// Writes diagnostics to stderr as [`render`] does, coloured when `color` (the caller checks
+/// for a terminal and NO_COLOR). The rendering is written in one piece: codespan writes a
+/// source line a character at a time, which is a system call each on unbuffered stderr.
 pub fn emit_to_stderr(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) {
     let choice = if color {
         ColorChoice::Always
     } else {
         ColorChoice::Never
     };
-    let mut stream = StandardStream::stderr(choice);
-    let files = all_files(&diagnostics.sources, source, path);
-    let config = term_config();
-    for d in diagnostics {
-        let (primary, secondary) = d.located(&diagnostics.sources, source, path);
-        let _ = term::emit(
-            &mut stream,
-            &config,
-            &files,
-            &d.to_codespan(&primary, &secondary),
-        );
-    }
+    let writer = BufferWriter::stderr(choice);
+    let mut buffer = writer.buffer();
+    render_into(&mut buffer, diagnostics, source, path);
+    let _ = writer.print(&buffer);
 }
 
 /// A position in the JSON form: 1-based line and column.

@@ -1,12 +1,13 @@
 //! Regression tests for what fuzzing found, each with its minimal input: a syntax error after a
 //! multi-byte character (a panic slicing inside it), unclosed block comments (exponential time),
-//! a `.mtl` colour line with fewer than three numbers (a panic inside tobj) and named pipes
-//! where the compiler reads a file (a wait for ever).
+//! a `.mtl` colour line with fewer than three numbers (a panic inside tobj), named pipes where
+//! the compiler reads a file (a wait for ever), and thousands of diagnostics rendered for a
+//! terminal (minutes and megabytes).
 
 use std::path::{Path, PathBuf};
 
 use clay_dsl::analysis::Analysis;
-use clay_dsl::{Diagnostic, compile, render};
+use clay_dsl::{Diagnostic, Diagnostics, MAX_HUMAN_DIAGNOSTICS, compile, render};
 
 // ---- 1. syntax errors after multi-byte characters -----------------------------------------------
 
@@ -312,4 +313,61 @@ fn named_pipes_are_refused_before_they_are_opened() {
         assert!(compile(&grammar, &path).is_ok(), "{mesh}");
     }
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+// ---- 5. many diagnostics for a terminal ---------------------------------------------------------
+
+/// A model of `n` instances of an unknown piece, all on one line when `one_line`: `n` errors.
+fn unknown_pieces(n: usize, one_line: bool) -> String {
+    let sep = if one_line { " " } else { "\n" };
+    let body: Vec<String> = (0..n).map(|i| format!("i{i} = nope")).collect();
+    format!("model {{{sep}{}{sep}}}\n", body.join(sep))
+}
+
+#[test]
+fn a_human_rendering_stops_after_its_limit_and_counts_the_rest() {
+    let text = unknown_pieces(3_000, true);
+    let d: Diagnostics = compile(&text, "a.clay").unwrap_err();
+    assert_eq!(d.error_count(), 3_000);
+    let shown = render(&d, &text, "a.clay", false);
+    assert_eq!(shown.matches("error[E011]").count(), MAX_HUMAN_DIAGNOSTICS);
+    let more = 3_000 - MAX_HUMAN_DIAGNOSTICS;
+    assert!(
+        shown.ends_with(&format!(
+            "... and {more} more errors (use `clayc check --format json` for all)\n"
+        )),
+        "{}",
+        &shown[shown.len() - 200..]
+    );
+    // Each shown diagnostic prints its (long) source line once or twice, no more.
+    assert!(
+        shown.len() < MAX_HUMAN_DIAGNOSTICS * 3 * text.len(),
+        "{}",
+        shown.len()
+    );
+    // The JSON form keeps them all.
+    assert_eq!(clay_dsl::to_json(&d, &text, "a.clay").len(), 3_000);
+}
+
+#[test]
+fn the_closing_line_counts_errors_and_warnings_and_is_absent_within_the_limit() {
+    let text = unknown_pieces(MAX_HUMAN_DIAGNOSTICS, false);
+    let mut d = compile(&text, "a.clay").unwrap_err();
+    assert_eq!(d.len(), MAX_HUMAN_DIAGNOSTICS);
+    assert_eq!(clay_dsl::omitted_line(&d), None);
+    assert!(!render(&d, &text, "a.clay", false).contains("... and"));
+    let warning = Diagnostic::warning("W001", "unused", d.items[0].primary.span, "here");
+    d.push(warning.clone());
+    assert_eq!(
+        clay_dsl::omitted_line(&d).as_deref(),
+        Some("... and 1 more warning (use `clayc check --format json` for all)\n")
+    );
+    d.items.insert(0, d.items[1].clone());
+    d.push(warning);
+    assert_eq!(
+        clay_dsl::omitted_line(&d).as_deref(),
+        Some(
+            "... and 1 more error and 2 more warnings (use `clayc check --format json` for all)\n"
+        )
+    );
 }
