@@ -16,22 +16,8 @@ use generated::{ChainGrammar, Pull, Run, claims, family, more, norm, step, strat
 
 use glam::DVec2;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
 
-/// `cases` cases (or `CLAY_CLAIMS_CASES`), from a fixed seed per property.
-fn config(cases: u32, seed: u64) -> Config {
-    let cases = std::env::var("CLAY_CLAIMS_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(cases);
-    Config {
-        cases,
-        rng_seed: RngSeed::Fixed(seed),
-        failure_persistence: None,
-        max_shrink_iters: 256,
-        ..Config::default()
-    }
-}
+use generated::config;
 
 /// A pull or push of a generated chain, of at most `cap` elements at either end.
 fn pulls(cap: usize) -> impl Strategy<Value = Pull> {

@@ -489,13 +489,7 @@ impl Sculpt {
             Command::Reset => {
                 self.release();
                 self.checkpoint();
-                let grammar = self.grammar().clone();
-                self.restore(Snapshot {
-                    data: grammar.assembly.clone(),
-                    grammar,
-                    pins: Vec::new(),
-                    log: self.log.clone(),
-                });
+                self.restore(self.initial(self.grammar().clone()));
                 self.note("reset to the initial model".to_string(), None);
             }
             Command::Settings(s) => {
@@ -555,12 +549,7 @@ impl Sculpt {
                 log: self.log.clone(),
             }
         } else {
-            Snapshot {
-                data: grammar.assembly.clone(),
-                grammar,
-                pins: Vec::new(),
-                log: self.log.clone(),
-            }
+            self.initial(grammar)
         };
         self.restore(snapshot);
         self.note(
@@ -729,17 +718,19 @@ impl Sculpt {
     /// command.
     fn recover(&mut self, error: String) {
         self.grab = None;
-        let snapshot = self.undo.pop().unwrap_or_else(|| {
-            let grammar = self.grammar().clone();
-            Snapshot {
-                data: grammar.assembly.clone(),
-                grammar,
-                pins: Vec::new(),
-                log: self.log.clone(),
-            }
-        });
+        let snapshot = (self.undo.pop()).unwrap_or_else(|| self.initial(self.grammar().clone()));
         self.restore(snapshot);
         self.error = Some(error);
+    }
+
+    /// `grammar`'s initial model, nothing pinned, with the log as it is.
+    fn initial(&self, grammar: Arc<CompiledGrammar>) -> Snapshot {
+        Snapshot {
+            data: grammar.assembly.clone(),
+            grammar,
+            pins: Vec::new(),
+            log: self.log.clone(),
+        }
     }
 
     /// Why `part` is in the state it is in.

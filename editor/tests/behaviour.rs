@@ -17,7 +17,6 @@ use clay_editor::sculpt::{Command, Sculpt};
 use generated::{ChainGrammar, Pull, Run, family, more, strategy};
 use glam::DVec2;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
 
 /// One 60 Hz UI frame of the editor's solver work, as `EditorApp` schedules it: on the UI
 /// thread within `SOLVER_BUDGET`, or, for a model whose frames cost more than
@@ -163,17 +162,8 @@ fn near_a_tie(pull: &Pull, factor: f64) -> bool {
     ((k - k.floor()) - 0.5).abs() < 0.1
 }
 
-fn config(cases: u32) -> Config {
-    let cases = std::env::var("CLAY_CLAIMS_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(cases);
-    Config {
-        cases,
-        rng_seed: RngSeed::Fixed(36),
-        failure_persistence: None,
-        ..Config::default()
-    }
+fn config(cases: u32) -> proptest::test_runner::Config {
+    generated::config(cases, 36)
 }
 
 fn pulls() -> impl Strategy<Value = Pull> {

@@ -193,6 +193,22 @@ pub mod step {
     }
 }
 
+/// `cases` cases (or `CLAY_CLAIMS_CASES`), from a fixed seed per property, shrinking a
+/// failure to a minimal grammar and script.
+pub fn config(cases: u32, seed: u64) -> proptest::test_runner::Config {
+    let cases = std::env::var("CLAY_CLAIMS_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(cases);
+    proptest::test_runner::Config {
+        cases,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
+        failure_persistence: None,
+        max_shrink_iters: 256,
+        ..proptest::test_runner::Config::default()
+    }
+}
+
 /// A headless session over a generated grammar, with the rules; it records every step it ran
 /// so a failure can print the script that reproduces it.
 pub struct Run {
