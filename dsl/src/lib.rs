@@ -28,8 +28,8 @@ mod suggest;
 pub use compile::{
     Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH, MAX_IMPORT_BYTES, MAX_IMPORTS,
     MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES,
-    MAX_MESH_VERTICES, codes, compile, compile_bytes, compile_bytes_with, compile_with,
-    resolve_import,
+    MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes, compile, compile_bytes, compile_bytes_with,
+    compile_with, resolve_import,
 };
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{

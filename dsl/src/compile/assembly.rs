@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet, VecDeque};
 use glam::DVec2;
 
 use super::rules::{dock_motion, rotate, site_centre};
-use super::{Compiler, DOCK_TOLERANCE, MAX_INSTANCES, codes, fmt};
+use super::{Compiler, DOCK_TOLERANCE, MAX_MODEL_INSTANCES, codes, fmt};
 use crate::compiled::*;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, ElementIndexKind, ModelStmt, Span};
@@ -58,7 +58,15 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 }
                 let piece = c.resolve_piece(&d.piece);
                 let at = d.at.as_ref().map(|p| c.point(p));
-                let (Some(piece), false) = (piece, insts.len() >= MAX_INSTANCES) else {
+                let full = insts.len() >= MAX_MODEL_INSTANCES;
+                if full && piece.is_some() && !too_many {
+                    c.error(
+                        Diagnostic::error(codes::TOO_MANY, format!("the model would have more than {MAX_MODEL_INSTANCES} instances"), d.name.span, "one instance more")
+                            .with_hint(format!("a model holds at most {MAX_MODEL_INSTANCES} instances; start with a shorter chain, the stretch rule inserts more as you sculpt")),
+                    );
+                    too_many = true;
+                }
+                let (Some(piece), false) = (piece, full) else {
                     names.insert(d.name.name.clone(), (Named::Broken, d.name.span));
                     continue;
                 };
@@ -88,11 +96,11 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 let (Some(piece), Some(count)) = (piece, count) else {
                     continue;
                 };
-                if count > (MAX_INSTANCES - insts.len().min(MAX_INSTANCES)) as u64 {
+                if count > (MAX_MODEL_INSTANCES - insts.len().min(MAX_MODEL_INSTANCES)) as u64 {
                     if !too_many {
                         c.error(
-                            Diagnostic::error(codes::TOO_MANY, format!("the model would have more than {MAX_INSTANCES} instances"), d.count.span, format!("{count} more instances"))
-                                .with_hint(format!("a model holds at most {MAX_INSTANCES} instances; start with a shorter chain, the stretch rule inserts more as you sculpt")),
+                            Diagnostic::error(codes::TOO_MANY, format!("the model would have more than {MAX_MODEL_INSTANCES} instances"), d.count.span, format!("{count} more instances"))
+                                .with_hint(format!("a model holds at most {MAX_MODEL_INSTANCES} instances; start with a shorter chain, the stretch rule inserts more as you sculpt")),
                         );
                     }
                     too_many = true;
