@@ -41,6 +41,22 @@ enum Named {
     Broken,
 }
 
+/// E014 at `span`: the model would pass `MAX_MODEL_INSTANCES` (reported once per model).
+fn too_many_instances(c: &mut Compiler, span: Span, label: String) {
+    c.error(
+        Diagnostic::error(
+            codes::TOO_MANY,
+            format!("the model would have more than {MAX_MODEL_INSTANCES} instances"),
+            span,
+            label,
+        )
+        .with_hint(format!(
+            "a model holds at most {MAX_MODEL_INSTANCES} instances; start with a shorter chain, \
+             the stretch rule inserts more as you sculpt"
+        )),
+    );
+}
+
 // Long because: one ordered walk (instances, chains, docks, placement by docks) over tables each step fills for the next.
 pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> AssemblyData {
     let mut insts: Vec<Inst> = Vec::new();
@@ -60,10 +76,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 let at = d.at.as_ref().map(|p| c.point(p));
                 let full = insts.len() >= MAX_MODEL_INSTANCES;
                 if full && piece.is_some() && !too_many {
-                    c.error(
-                        Diagnostic::error(codes::TOO_MANY, format!("the model would have more than {MAX_MODEL_INSTANCES} instances"), d.name.span, "one instance more")
-                            .with_hint(format!("a model holds at most {MAX_MODEL_INSTANCES} instances; start with a shorter chain, the stretch rule inserts more as you sculpt")),
-                    );
+                    too_many_instances(c, d.name.span, "one instance more".into());
                     too_many = true;
                 }
                 let (Some(piece), false) = (piece, full) else {
@@ -98,10 +111,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 };
                 if count > (MAX_MODEL_INSTANCES - insts.len().min(MAX_MODEL_INSTANCES)) as u64 {
                     if !too_many {
-                        c.error(
-                            Diagnostic::error(codes::TOO_MANY, format!("the model would have more than {MAX_MODEL_INSTANCES} instances"), d.count.span, format!("{count} more instances"))
-                                .with_hint(format!("a model holds at most {MAX_MODEL_INSTANCES} instances; start with a shorter chain, the stretch rule inserts more as you sculpt")),
-                        );
+                        too_many_instances(c, d.count.span, format!("{count} more instances"));
                     }
                     too_many = true;
                     continue;
