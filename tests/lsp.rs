@@ -83,6 +83,19 @@ fn at_pos(text: &str, offset: usize) -> Value {
     json!({ "textDocument": doc(), "position": pos(text, offset) })
 }
 
+/// A hover on wall.clay's `chain brick` (`text`) is answered with the piece.
+fn hover_shows_the_brick(c: &mut Client, text: &str) {
+    let brick = at(text, "chain brick", 0, 7);
+    let hover = c.result("textDocument/hover", at_pos(text, brick));
+    assert!(
+        hover["contents"]["value"]
+            .as_str()
+            .unwrap()
+            .contains("piece brick"),
+        "{hover}"
+    );
+}
+
 struct Client {
     child: Child,
     stdin: Option<ChildStdin>,
@@ -732,14 +745,7 @@ fn malformed_messages_and_unknown_methods_get_errors_and_the_server_goes_on() {
     c.notify("clay/whatever", json!([1, 2]));
 
     // Still serving.
-    let brick = at(&text, "chain brick", 0, 7);
-    let hover = c.result("textDocument/hover", at_pos(&text, brick));
-    assert!(
-        hover["contents"]["value"]
-            .as_str()
-            .unwrap()
-            .contains("piece brick")
-    );
+    hover_shows_the_brick(&mut c, &text);
     assert!(c.shutdown_and_exit().success());
 }
 
@@ -782,14 +788,7 @@ fn after_a_frame_with_a_wrong_content_length_the_next_request_is_answered() {
     let text = wall();
     c.open(&text);
     c.send_raw(format!("Content-Length: {}\r\n\r\n{body}", body.len() - 1).as_bytes());
-    let brick = at(&text, "chain brick", 0, 7);
-    let hover = c.result("textDocument/hover", at_pos(&text, brick));
-    assert!(
-        hover["contents"]["value"]
-            .as_str()
-            .unwrap()
-            .contains("piece brick")
-    );
+    hover_shows_the_brick(&mut c, &text);
     assert_eq!(parse_errors(&c), 2, "{:?}", c.stash);
     assert!(c.shutdown_and_exit().success());
 }

@@ -174,16 +174,8 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
             claim: 0,
         };
     }
-    // judged on the shared vertices when the part has enough of them, else on all
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
-    let judge = |rest: &[DVec2]| match &boundary {
-        Some(ks) => {
-            let r: Vec<DVec2> = ks.iter().map(|&k| rest[k]).collect();
-            let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
-            align(&r, &vs, positions)
-        }
-        None => align(rest, &part.vertices, positions),
-    };
+    let judge = |rest: &[DVec2]| judged(part, positions, boundary.as_deref(), rest);
     let mut best = (active, judge(&current.positions));
     let judged_here = best.1;
     for (j, state) in part.states.iter().enumerate() {
@@ -205,6 +197,24 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
         state,
         rotation,
         claim: 0,
+    }
+}
+
+/// How well rest shape `rest` of `part` fits the pose: on the `boundary` vertices
+/// ([`boundary_of`]) when there are such, else on all of the part's vertices.
+fn judged(
+    part: &Part,
+    positions: &[DVec2],
+    boundary: Option<&[usize]>,
+    rest: &[DVec2],
+) -> Alignment {
+    match boundary {
+        Some(ks) => {
+            let r: Vec<DVec2> = ks.iter().map(|&k| rest[k]).collect();
+            let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
+            align(&r, &vs, positions)
+        }
+        None => align(rest, &part.vertices, positions),
     }
 }
 
@@ -517,14 +527,7 @@ pub fn judge(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Jud
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
     let distances = (part.states.iter())
-        .map(|st| match &boundary {
-            Some(ks) => {
-                let r: Vec<DVec2> = ks.iter().map(|&k| st.positions[k]).collect();
-                let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
-                align(&r, &vs, positions).distance
-            }
-            None => align(&st.positions, &part.vertices, positions).distance,
-        })
+        .map(|st| judged(part, positions, boundary.as_deref(), &st.positions).distance)
         .collect();
     Judgement {
         distances,

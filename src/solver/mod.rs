@@ -503,8 +503,7 @@ impl Solver {
         // still and strained, other states not yet tried: the next frame tries them
         // (`settling`), so this one is not the last (a host that stops at convergence, as the
         // editor does, would never run it)
-        let e = self.mean_rest_edge;
-        let trial_due = !self.work.tried && terms.elastic > 1e-6 * e * e;
+        let trial_due = !self.work.tried && self.strained(terms.elastic);
         report.converged = report.complete
             && report.switches.is_empty()
             && !trial_due
@@ -526,10 +525,15 @@ impl Solver {
         if !still {
             w.tried = false;
         }
-        let e = self.mean_rest_edge;
-        let stopped = w.last_moved <= 1e-3 * e;
-        let strained = w.start.elastic > 1e-6 * e * e;
-        still && stopped && strained && !w.tried
+        let stopped = w.last_moved <= 1e-3 * self.mean_rest_edge;
+        let untried = !w.tried;
+        still && stopped && untried && self.strained(self.work.start.elastic)
+    }
+
+    /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
+    /// squared (what [`Solver::try_states`] tries to lower).
+    fn strained(&self, elastic: f64) -> bool {
+        elastic > 1e-6 * self.mean_rest_edge * self.mean_rest_edge
     }
 
     /// A held model that does not come to rest tries other rest states (a move): the few

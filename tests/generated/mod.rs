@@ -15,7 +15,7 @@ use std::sync::Arc;
 use clay::assembly::Assembly;
 use clay::rules::RuleKind;
 use clay::script::Script;
-use clay::solver::{SolverConfig, bbox, edge_strains};
+use clay::solver::{SolverConfig, bbox, bbox_diagonal, edge_strains};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
@@ -273,13 +273,7 @@ impl Run {
     }
 
     pub fn count(&self, piece: &str) -> usize {
-        let g = &self.grammar;
-        self.asm
-            .data()
-            .instances
-            .iter()
-            .filter(|i| g.pieces[i.piece].name == piece)
-            .count()
+        self.states(piece).len()
     }
 
     pub fn instances(&self) -> usize {
@@ -307,8 +301,7 @@ impl Run {
 
     /// The model's bounding box diagonal.
     pub fn size(&self) -> f64 {
-        let (lo, hi) = bbox(&self.asm.data().positions).unwrap_or_default();
-        (hi - lo).length()
+        bbox_diagonal(&self.asm.data().positions)
     }
 
     pub fn bbox(&self) -> [f64; 4] {
