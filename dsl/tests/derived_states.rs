@@ -314,9 +314,11 @@ fn tiny_and_odd_angles_stay_finite() {
     }
 }
 
+/// How long this takes (near-linear, not quadratic) is timed by `benches/dsl.rs`
+/// (`dsl/mirror_listed_piece`).
 #[test]
-fn mirroring_a_big_listed_piece_is_fast() {
-    // 20,000 vertices on two rails, a listed state and its mirror: near-linear, not quadratic.
+fn mirroring_a_big_listed_piece_compiles_and_mirrors() {
+    // 20,000 vertices on two rails, a listed state and its mirror.
     let n = 10_000;
     let mut src = String::from("site type t\npiece big {\n");
     for i in 0..n {
@@ -331,9 +333,7 @@ fn mirroring_a_big_listed_piece_is_fast() {
         src += &format!("s{i} ({i}, -0.6) n{i} ({i}, 0.4)\n");
     }
     src += "}\nstate lean_back mirror lean\n}\nmodel { b = big }\n";
-    let t = std::time::Instant::now();
     let g = ok(&src);
-    assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
     assert!(pos(&g.pieces[0], "lean_back", "s7").distance(DVec2::new(7.0, -0.4)) < 1e-12);
 }
 

@@ -354,8 +354,9 @@ model { w = chain brick x 3  t = tower2 at (0, 5)  b = brick2 at (0, 9) }";
     }
 }
 
+/// How long the 10,000-deep chain takes is timed by `benches/dsl.rs` (`dsl/extends_chain`).
 #[test]
-fn deep_and_cyclic_extends_chains_return_quickly() {
+fn deep_and_cyclic_extends_chains_give_one_error() {
     let base = "piece p0 { vertex a (0, 0) vertex b (1, 0) edges a-b }\n";
     for n in [100, 10_000] {
         let mut src = base.to_string();
@@ -363,12 +364,10 @@ fn deep_and_cyclic_extends_chains_return_quickly() {
             src += &format!("piece p{i} extends p{} {{ vertex v{i} ({i}, 1) }}\n", i - 1);
         }
         src += &format!("model {{ x = p{} }}", n - 1);
-        let t = std::time::Instant::now();
         let d = compile(&src, "deep.clay").unwrap_err();
         assert_eq!(d.items.iter().filter(|d| d.is_error()).count(), 1, "{n}");
         assert_eq!(d.items[0].code, "E063");
         assert_spans_valid(&d, &src, "deep extends");
-        assert!(t.elapsed().as_secs() < 10, "took {:?}", t.elapsed());
     }
     // One long cycle: one error, every piece silent.
     let mut src = String::new();
