@@ -411,3 +411,36 @@ fn every_number_of_a_gltf_replaced_by_an_odd_one_is_an_error_or_a_mesh() {
         }
     }
 }
+
+/// Found by `tests/fuzz_assets.rs`: a relative normal or texture-coordinate index before the
+/// first one (`f 1//-3`) or a huge one made tobj's index arithmetic overflow, a panic where
+/// overflow is checked (debug builds, CI). Clay reads only positions, so those indices are not
+/// read at all: the shape loads; a bad position index is still an error.
+#[test]
+fn face_normal_and_texture_indices_out_of_range_are_not_read() {
+    let source = hut("mesh \"t.obj\"");
+    let head = "v 0 0 0\nv 1 0 0\nv 0 0 -1\nvt 0 0\nvn 0 1 0\n";
+    for faces in [
+        "f 1//-3 2//1 3//1\n",
+        "f 1/-3 2/1 3/1\n",
+        "f 1/1/-2147483648 2/1/1 3/1/1\n",
+        "f 1/6148914691236517206 2/1 3/1\n",
+        "f\u{a0}1//-3 2//1 3//1\n",
+        "l 1/-3 2/1\nf 1 2 3\n",
+    ] {
+        let files = Files::default().with("g/t.obj", format!("{head}{faces}"));
+        let g = compile(&source, &files).unwrap_or_else(|d| panic!("{faces:?}: {d:?}"));
+        let ProxyShape::Mesh { triangles, .. } = &g.pieces[0].states[0].geometry[0].shape else {
+            panic!("a mesh proxy")
+        };
+        assert_eq!(triangles.len(), 1, "{faces:?}");
+    }
+    for faces in [
+        "f 1//1 2//1 9//1\n",
+        "f /1/1 2/1/1 3/1/1\n",
+        "f 1/1 -9/1 3/1\n",
+    ] {
+        let files = Files::default().with("g/t.obj", format!("{head}{faces}"));
+        assert_eq!(one_error(&source, &files).0, "E066", "{faces:?}");
+    }
+}

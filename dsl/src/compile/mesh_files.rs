@@ -8,6 +8,7 @@
 //! height above the ground; so an asset seen from above (looking down -y) shows the floor plan
 //! as the piece draws it, and `clayc export` writes it back as it was read.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::Cursor;
 
@@ -519,7 +520,8 @@ pub(super) fn obj(
             }
         }
     }
-    let (models, materials) = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |p| {
+    let bytes = positions_only(bytes);
+    let (models, materials) = tobj::load_obj_buf(&mut Cursor::new(&bytes[..]), &options, |p| {
         let name = p.to_string_lossy();
         match mtl_bytes.get(name.as_ref()) {
             Some(b) => tobj::load_mtl_buf(&mut Cursor::new(b)),
@@ -549,6 +551,46 @@ pub(super) fn obj(
         c.add(fill, &positions, triangles)?;
     }
     c.finish()
+}
+
+/// The OBJ with every vertex of a face or line reduced to its position index (`f 1/2/3` is
+/// `f 1`): Clay reads no texture coordinates or normals, and tobj's arithmetic on their
+/// indices overflows, a panic where overflow is checked, on a relative one such as
+/// `f 1//-3` or a huge one. Lines are split into words as tobj splits them; other lines, and
+/// lines that are not UTF-8, stay as they are.
+fn positions_only(bytes: &[u8]) -> Cow<'_, [u8]> {
+    if !bytes
+        .split(|&b| b == b'\n')
+        .any(|line| face(line).is_some())
+    {
+        return Cow::Borrowed(bytes);
+    }
+    let mut out = Vec::with_capacity(bytes.len());
+    for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if k > 0 {
+            out.push(b'\n');
+        }
+        let Some((keyword, words)) = face(line) else {
+            out.extend_from_slice(line);
+            continue;
+        };
+        out.extend_from_slice(keyword.as_bytes());
+        for w in words {
+            // `/2/3` names no position: `0` is as out of range as that.
+            let position = w.split('/').next().filter(|p| !p.is_empty());
+            out.push(b' ');
+            out.extend_from_slice(position.unwrap_or("0").as_bytes());
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// The keyword (`f` or `l`) and the vertices of a face or line with a `/` in it.
+fn face(line: &[u8]) -> Option<(&str, std::str::SplitWhitespace<'_>)> {
+    let text = std::str::from_utf8(line).ok()?;
+    let mut words = text.split_whitespace();
+    let keyword = words.next().filter(|k| matches!(*k, "f" | "l"))?;
+    text.contains('/').then_some((keyword, words))
 }
 
 /// A `.mtl` file's colour lines (`Ka`, `Kd`, `Ks`, `Ke`) must each have three numbers: tobj
