@@ -280,3 +280,52 @@ fn keep_with_its_roofs_loads_as_obj_in_tobj() {
         .fold(f32::MIN, f32::max);
     assert!((top - 9.8).abs() < 1e-4, "the spires' apex: {top}");
 }
+
+/// Found by `tests/fuzz_assets.rs`: a glTF node scaled by 3e38 gave a vertex finite in f64 and
+/// infinite in the export's f32 (`inf` written to the `.glb` and the `.obj`). The loader now
+/// refuses a vertex beyond the grammar's coordinate limit; at the limit, in any model
+/// placement, the export is finite.
+#[test]
+fn an_asset_at_the_coordinate_limit_exports_only_finite_numbers() {
+    // One triangle, x up to 1 and z down to -1, at y up to 2 (a strip of three vertices).
+    let gltf = |scale: &str| {
+        let data = "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAEAAAIC/";
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0,"scale":[{scale},{scale},{scale}]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+            "min":[0,0,-1],"max":[1,2,0]}}]}}"#
+        )
+    };
+    let source = WALL.replace("box.obj", "far.gltf");
+    for (scale, loads) in [("3e38", false), ("5e8", true)] {
+        let dir = scratch(
+            &format!("far-{scale}"),
+            &[("wall.clay", &source), ("far.gltf", &gltf(scale))],
+        );
+        let path = dir.join("wall.clay");
+        let compiled = clay_dsl::compile(&source, &path.to_string_lossy());
+        assert_eq!(
+            compiled.is_ok(),
+            loads,
+            "scale {scale}: {:?}",
+            compiled.as_ref().err()
+        );
+        if let Ok(c) = compiled {
+            let s = scene(&c.grammar, &c.grammar.assembly, &ExportOptions::default());
+            assert!(s.triangle_count() > 0);
+            for p in s.nodes.iter().flat_map(|n| &n.primitives) {
+                for v in p.positions.iter().chain(&p.normals) {
+                    assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
+                }
+            }
+            let (obj, _) = clay::export::obj::to_obj(&s, "far.mtl");
+            assert!(!obj.contains("inf") && !obj.contains("NaN"));
+            assert!(gltf::to_glb(&s).is_ok());
+        }
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}

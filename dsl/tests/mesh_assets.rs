@@ -444,3 +444,30 @@ fn face_normal_and_texture_indices_out_of_range_are_not_read() {
         assert_eq!(one_error(&source, &files).0, "E066", "{faces:?}");
     }
 }
+
+/// Found by `tests/fuzz_assets.rs`: a node's scale of 3e38 put a vertex at 6.8e38 m, finite in
+/// the loader's f64 but not in the f32 of the renderer and the export, which wrote `inf`. An
+/// asset's vertices are held to the coordinates a grammar may have (E066 beyond).
+#[test]
+fn a_vertex_beyond_the_coordinate_limit_is_malformed() {
+    let source = hut("mesh \"big.gltf\"");
+    let scaled = |s: &str| {
+        declaring(3, 3).replace(
+            r#""nodes":[{"mesh":0}]"#,
+            &format!(r#""nodes":[{{"mesh":0,"scale":[{s},{s},{s}]}}]"#),
+        )
+    };
+    assert_ne!(scaled("1"), declaring(3, 3));
+    for s in ["3e38", "1e10", "-2e9"] {
+        let files = Files::default().with("g/big.gltf", scaled(s));
+        let (code, message, _) = one_error(&source, &files);
+        assert_eq!(code, "E066", "scale {s}: {message}");
+        assert!(message.contains("from the origin"), "{message}");
+    }
+    // At the limit itself the asset reads.
+    let files = Files::default().with("g/big.gltf", scaled("1e9"));
+    assert!(compile(&source, &files).is_ok());
+    let far = "v 0 0 0\nv 1e10 0 0\nv 0 0 -1\nf 1 2 3\n";
+    let files = Files::default().with("g/t.obj", far);
+    assert_eq!(one_error(&hut("mesh \"t.obj\""), &files).0, "E066");
+}

@@ -16,8 +16,8 @@ use base64::Engine;
 use glam::{DMat4, DVec2, DVec3};
 use gltf::mesh::Mode;
 
-use super::Loader;
 use super::imports::resolve;
+use super::{Loader, MAX_COORDINATE};
 use crate::compiled::{ProxyShape, Rgba};
 
 /// Largest mesh asset file, with its external buffers (16 MiB).
@@ -137,6 +137,18 @@ impl Collect {
     ) -> Result<(), Problem> {
         if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
             return Err(malformed(format!("a vertex position is not finite ({p})")));
+        }
+        // Within the coordinates a grammar may have, so that every later computation stays
+        // finite: a vertex beyond f32's range, which a node's scale can put it at, would be
+        // exported and drawn at infinity.
+        if let Some(p) = positions
+            .iter()
+            .find(|p| p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(malformed(format!(
+                "a vertex is at {p}, more than {MAX_COORDINATE:e} m from the origin along an axis \
+                 (the limit of every coordinate)"
+            )));
         }
         let at = match self.groups.iter().position(|(f, _)| *f == fill) {
             Some(i) => i,
