@@ -1,7 +1,7 @@
 //! The fuzzing engine the fuzz tests share (`tests/fuzz.rs`, `editor/tests/fuzz_sessions.rs`):
 //! seeded mutation of a corpus and a runner that reports a panic, a failed property or a hang
-//! with the input that did it. `CLAY_FUZZ_CASES=N` runs N cases (default 10,000),
-//! `CLAY_FUZZ_SEED` another seed.
+//! with the input that did it. `CLAY_FUZZ_CASES=N` runs N cases (default 10,000, or what a
+//! slower target gives [`fuzz_cases`]), `CLAY_FUZZ_SEED` another seed.
 
 use std::sync::mpsc;
 use std::time::Duration;
@@ -72,10 +72,15 @@ pub const TOKENS: &[&str] = &[
 ];
 
 pub fn cases() -> usize {
+    cases_or(10_000)
+}
+
+/// `CLAY_FUZZ_CASES`, else `default`.
+pub fn cases_or(default: usize) -> usize {
     std::env::var("CLAY_FUZZ_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(10_000)
+        .unwrap_or(default)
 }
 
 pub fn seed() -> u64 {
@@ -135,7 +140,23 @@ pub fn mutate(rng: &mut TestRng, input: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
 /// Runs `check` on every case's input in a worker thread; a panic, a property that fails or
 /// a case over `HANG` fails the test with the input that did it.
 pub fn fuzz(name: &str, corpus: Vec<Vec<u8>>, check: fn(&[u8]) -> Result<(), String>) {
-    let (n, seed) = (cases(), seed());
+    fuzz_cases(name, cases(), corpus, mutate, check);
+}
+
+/// How a case's input is made from a corpus entry (the whole corpus is there for splices).
+pub type Mutator = fn(&mut TestRng, &[u8], &[Vec<u8>]) -> Vec<u8>;
+
+/// [`fuzz`] over `n` cases (say `cases_or(500)` for a slow target) with a mutator that may
+/// know the inputs' structure. A failing input is also written to a file in the temporary
+/// folder, whose path the message gives: the message shows binary input only lossily.
+pub fn fuzz_cases(
+    name: &str,
+    n: usize,
+    corpus: Vec<Vec<u8>>,
+    mutate: Mutator,
+    check: fn(&[u8]) -> Result<(), String>,
+) {
+    let seed = seed();
     let (tx, rx) = mpsc::channel::<(usize, Vec<u8>, Option<Result<(), String>>)>();
     std::thread::spawn(move || {
         let mut rng = rng(seed);
@@ -160,18 +181,29 @@ pub fn fuzz(name: &str, corpus: Vec<Vec<u8>>, check: fn(&[u8]) -> Result<(), Str
             Ok((_, _, Some(Ok(())))) => done += 1,
             Ok((i, input, Some(Err(why)))) => {
                 panic!(
-                    "{name}, case {i} (seed {seed}): {why}\ninput: {:?}",
-                    lossy(&input)
+                    "{name}, case {i} (seed {seed}): {why}\ninput: {:?}\nsaved: {}",
+                    lossy(&input),
+                    keep(name, seed, i, &input)
                 )
             }
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
             Err(mpsc::RecvTimeoutError::Timeout) => panic!(
-                "{name} (seed {seed}): a case ran over {HANG:?}\ninput: {:?}",
-                current.as_deref().map(lossy)
+                "{name} (seed {seed}): a case ran over {HANG:?}\ninput: {:?}\nsaved: {}",
+                current.as_deref().map(lossy),
+                keep(name, seed, done, current.as_deref().unwrap_or_default())
             ),
         }
     }
     assert_eq!(done, n, "{name}: every case ran");
+}
+
+/// Writes a failing input to a file, byte for byte; where.
+fn keep(name: &str, seed: u64, case: usize, input: &[u8]) -> String {
+    let path = std::env::temp_dir().join(format!("clay-fuzz-{name}-{seed}-{case}.bin"));
+    match std::fs::write(&path, input) {
+        Ok(()) => path.display().to_string(),
+        Err(e) => format!("nowhere ({e})"),
+    }
 }
 
 pub fn lossy(b: &[u8]) -> String {
