@@ -12,6 +12,7 @@ mod config;
 pub mod follow;
 mod global;
 mod growth;
+mod layout;
 pub(crate) mod local;
 mod measure;
 mod report;
@@ -93,6 +94,8 @@ struct Work {
     last_targets: Vec<DVec2>,
     /// How far the last frame moved the displayed pose.
     last_moved: f64,
+    /// The elastic energy the last frame ended with, and the one before it.
+    last_energy: [f64; 2],
     /// Other rest states were tried since the handles, the states or the structure last
     /// changed, and none helped ([`Solver::try_states`]).
     tried: bool,
@@ -445,11 +448,14 @@ impl Solver {
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
-        let settling = self.settling(&report);
+        let settling = self.settling(&report, asm.handles().is_empty());
         self.work.last_targets.clone_from(&self.work.handle_sum);
         if settling && !out_of_time(deadline, Duration::ZERO) {
             let handles = asm.handles().to_vec();
-            self.try_states(&mut asm.data_mut().parts, &handles, &warm, &mut report)?;
+            let parts = &mut asm.data_mut().parts;
+            if let Some(laid) = self.try_states(parts, &handles, &warm, &mut report)? {
+                warm.copy_from_slice(&laid);
+            }
         }
         let t = Instant::now();
         let before = asm.generation();
@@ -489,6 +495,7 @@ impl Solver {
         }
         report.moved = max_move(&asm.data().positions, &f);
         self.work.last_moved = report.moved;
+        self.work.last_energy = [terms.elastic, self.work.last_energy[0]];
         asm.positions_mut().copy_from_slice(&f);
         let rot = asm.rotations_mut();
         if rot.len() == self.work.rotations.len() {
@@ -519,15 +526,19 @@ impl Solver {
     /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
     /// pose all but still and yet not at rest, and no try since the handles, the states or
     /// the structure last changed.
-    fn settling(&mut self, report: &FrameReport) -> bool {
+    fn settling(&mut self, report: &FrameReport, free: bool) -> bool {
         let w = &mut self.work;
         let still = w.last_targets == w.handle_sum && report.switches.is_empty();
         if !still {
             w.tried = false;
         }
         let stopped = w.last_moved <= 1e-3 * self.mean_rest_edge;
+        // nothing held and the energy all but flat: a long, thin chain unbending, which
+        // least squares would take hundreds of frames over (or a fold it never leaves)
+        let [last, before] = w.last_energy;
+        let creeping = free && last > CREEP * before;
         let untried = !w.tried;
-        still && stopped && untried && self.strained(self.work.start.elastic)
+        still && (stopped || creeping) && untried && self.strained(self.work.start.elastic)
     }
 
     /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
@@ -550,7 +561,7 @@ impl Solver {
         handles: &[Handle],
         warm: &[DVec2],
         report: &mut FrameReport,
-    ) -> Result<(), SolverError> {
+    ) -> Result<Option<Vec<DVec2>>, SolverError> {
         const CANDIDATES: usize = 4;
         const ITERATIONS: usize = 3;
         // more parts out of their first state than this: no reverting moves (each is a settle)
@@ -610,11 +621,6 @@ impl Solver {
         if (1..=REVERT_LIMIT).contains(&bent.len()) {
             moves.push(bent.iter().map(|&q| (q, 0)).collect());
         }
-        if moves.is_empty() {
-            // nothing to try is a try that found nothing
-            self.work.tried = true;
-            return Ok(());
-        }
         let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
         let baseline = self.settle(parts, handles, warm, ITERATIONS, &actives, &[])?;
         let mut best: Option<(f64, Vec<usize>)> = None;
@@ -631,6 +637,27 @@ impl Solver {
                 best = Some((e, parts.iter().map(|p| p.active).collect()));
             }
         }
+        // the same states from the rest layout: a fold the iteration cannot leave
+        for (p, &a) in parts.iter_mut().zip(&actives) {
+            p.active = a;
+        }
+        let w = &self.work;
+        let laid = layout::rest_layout(
+            parts,
+            &w.vertex_parts,
+            &self.components,
+            warm,
+            &w.handle_count,
+            &w.handle_sum,
+        );
+        let mut unfolded = None;
+        if laid.iter().all(|p| p.is_finite()) {
+            let e = self.settle(parts, handles, &laid, ITERATIONS, &actives, &[])?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+                unfolded = Some(laid);
+            }
+        }
         self.work.tried = best.is_none();
         let chosen = best.map_or(actives.clone(), |b| b.1);
         for (pi, (p, (&from, &to))) in parts
@@ -644,7 +671,7 @@ impl Solver {
             }
         }
         self.work.start.valid = None;
-        Ok(())
+        Ok(unfolded)
     }
 
     /// Settles a trial assignment from `warm`: `iterations` least-squares iterations in which
@@ -839,6 +866,7 @@ impl Solver {
             return;
         }
         let lengths = self.chain_lengths(asm, start);
+        let rest_chords = self.rest_chords(asm, start, &lengths);
         let reversal = self.config.reversal;
         let w = &mut self.work;
         let held_ids: Vec<u64> = asm
@@ -872,18 +900,70 @@ impl Solver {
             let length = (lengths.get(chain).copied().flatten()).map_or(count as f64, |l| l.path);
             // a change that reverses the chain's last one waits for `reversal` elements
             let shrink_below = count as f64 - if c.trend > 0 { reversal } else { 0.0 };
-            let grow_above = count as f64 + if c.trend < 0 { reversal } else { 0.0 };
+            // Against the chain's chord at rest (in elements): ends closer than that by half
+            // an element squeeze the chain as a whole, and a part of it that reads as
+            // stretched is a buckle, not room for an element; ends no further apart than at
+            // rest (a chain pulled straight after a buckle, a pinned chain pulled out in the
+            // middle) grow only once its elements span a whole element more than it has.
+            let rest = rest_chords.get(chain).copied().flatten();
+            let chord = lengths.get(chain).copied().flatten().map(|l| l.chord);
+            let (squeezed, slack) = match (chord, rest) {
+                (Some(chord), Some(rest)) => (chord < rest - 0.5, chord < rest + 0.5),
+                _ => (false, false),
+            };
+            let wait = match (c.trend < 0, slack) {
+                (true, _) => reversal,
+                (false, true) => 1.0,
+                (false, false) => 0.0,
+            };
+            let grow_above = count as f64 + wait;
             let mut allowed = 1 << STRETCH_TWO;
             if count > rule.min.max(1) && !both_held && length <= shrink_below {
                 allowed |= 1 << STRETCH_ONE;
             }
-            if rule.max.is_none_or(|max| count < max) && length >= grow_above {
+            if rule.max.is_none_or(|max| count < max) && length >= grow_above && !squeezed {
                 allowed |= 1 << STRETCH_THREE;
             }
             w.stretch
                 .push(Some(local::StretchContext { reference, allowed }));
         }
         w.chain_lengths = lengths;
+    }
+
+    /// Per chain, its chord in the rest layout ([`layout::rest_layout`], in elements) where a
+    /// stretch could be in question (its elements span at least its count) while its ends are
+    /// not half an element further apart than a straight chain's (no chord at rest is longer):
+    /// `None` for the others, which are taut.
+    fn rest_chords(
+        &self,
+        asm: &Assembly,
+        pose: &[DVec2],
+        lengths: &[Option<ChainLength>],
+    ) -> Vec<Option<f64>> {
+        let chains = &asm.data().chains;
+        let asked = |c: usize| {
+            let count = chains[c].instances.len() as f64;
+            lengths[c].is_some_and(|l| l.path >= count && l.chord < count + 0.5)
+        };
+        if !(0..chains.len().min(lengths.len())).any(asked) {
+            return vec![None; chains.len()];
+        }
+        let w = &self.work;
+        let laid = layout::rest_layout(
+            &asm.data().parts,
+            &w.vertex_parts,
+            &self.components,
+            pose,
+            &[],
+            &[],
+        );
+        let at_rest = self.chain_lengths(asm, &laid);
+        (0..chains.len())
+            .map(|c| {
+                let asked = c < lengths.len() && asked(c);
+                asked.then(|| at_rest.get(c).copied().flatten().map(|l| l.chord))?
+            })
+            .collect()
     }
 
     /// Per part, the factor of its term in the sparse norm: for a stretch part holding a
@@ -1784,6 +1864,10 @@ fn refresh_least_squares(pattern: &Pattern, w: &mut Work, factor: &mut NumericFa
 /// ([`Solver::try_states`]): a bend moved to the neighbouring segment moves every segment
 /// between it and the handle, which least squares settles slowly.
 const SETTLE_ITERATIONS: usize = 60;
+
+/// A model with nothing held whose energy fell by less than this factor's complement over a
+/// frame (5%) creeps: it tries other states and the rest layout without waiting to stop.
+const CREEP: f64 = 0.95;
 
 /// Pass-1 iterations a budgeted frame always runs (when configured to run that many): the
 /// first judges the pose the last frame left, the second the pose with the handles moved.
