@@ -54,9 +54,25 @@ pub struct LspArgs {
 /// Runs the server until `exit` (0 after `shutdown`, 1 without it) or until its input ends (0:
 /// the client is gone and nothing failed here).
 pub fn lsp(args: LspArgs) -> u8 {
-    let input = transport::spawn_reader(std::io::BufReader::new(std::io::stdin()));
-    let timeout = Duration::from_millis(args.analysis_timeout_ms);
-    let mut server = Server::new(Writer::new(std::io::stdout().lock()), timeout);
+    serve(
+        std::io::BufReader::new(std::io::stdin()),
+        std::io::stdout().lock(),
+        Duration::from_millis(args.analysis_timeout_ms),
+        clay_dsl::analysis::follow::channel(),
+    )
+}
+
+/// The server reading `input` and writing `output` (what [`lsp`] runs over stdio, and what
+/// `tests/fuzz_lsp.rs` drives in process), waiting `timeout` for an analysis, following a Clay
+/// editor through the folder `follow`. Gives the exit code.
+pub fn serve<R: std::io::BufRead + Send + 'static, W: std::io::Write>(
+    input: R,
+    output: W,
+    timeout: Duration,
+    follow: std::path::PathBuf,
+) -> u8 {
+    let input = transport::spawn_reader(input);
+    let mut server = Server::new(Writer::new(output), timeout, follow);
     loop {
         // Wake for the debounce's deadline, and every so often for the Clay editor's reveals.
         let wait = server
@@ -192,8 +208,7 @@ struct Server<W: std::io::Write> {
 type Flow = std::io::Result<Option<u8>>;
 
 impl<W: std::io::Write> Server<W> {
-    fn new(out: Writer<W>, timeout: Duration) -> Self {
-        let channel = clay_dsl::analysis::follow::channel();
+    fn new(out: Writer<W>, timeout: Duration, channel: std::path::PathBuf) -> Self {
         Self {
             out,
             state: State::Uninitialised,
