@@ -793,6 +793,27 @@ fn after_a_frame_with_a_wrong_content_length_the_next_request_is_answered() {
     assert!(c.shutdown_and_exit().success());
 }
 
+/// Found by tests/fuzz_lsp.rs: a header line without the blank line that ends the header ran on
+/// into the next frame's header, and the body was read from that frame's body; the reader
+/// looked for the next frame only inside the body it had read, so the request was never
+/// answered. It looks inside the bad frame's header too.
+#[test]
+fn after_a_header_without_its_blank_line_the_next_request_is_answered() {
+    let body = json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }).to_string();
+    let mut c = Client::spawn();
+    // Shorter than the next frame's body, which it runs into.
+    c.send_raw(format!("Content-Length: {}\r\n{body}", body.len()).as_bytes());
+    let init = c.request("initialize", json!({ "capabilities": {} }));
+    assert!(init["result"]["capabilities"].is_object(), "{init}");
+    let parse_errors = c
+        .stash
+        .iter()
+        .filter(|m| m["error"]["code"] == -32700 && m["id"] == Value::Null)
+        .count();
+    assert_eq!(parse_errors, 1, "{:?}", c.stash);
+    assert!(c.shutdown_and_exit().success());
+}
+
 #[test]
 fn closing_the_input_stops_the_server_with_exit_code_0() {
     // Nothing sent at all.

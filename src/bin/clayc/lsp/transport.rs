@@ -5,9 +5,9 @@
 //!
 //! A frame that holds no JSON (a `Content-Length` off by a few bytes, a header without one)
 //! gets one `ParseError`, and then the reader resynchronises: it looks for the next
-//! `Content-Length:` from the first byte it has not accepted as a frame (inside the bad body
-//! too, which may have swallowed the start of the next frame), so the frames after it are read
-//! as they were sent.
+//! `Content-Length:` from the first byte it has not accepted as a frame (inside the bad frame's
+//! header and body too, either of which may have swallowed the start of the next frame), so
+//! the frames after it are read as they were sent.
 
 use std::io::{self, BufRead, Read, Write};
 use std::sync::mpsc;
@@ -36,7 +36,11 @@ pub enum Input {
 }
 
 enum Frame {
-    Body(Vec<u8>),
+    /// A body, and the header that framed it.
+    Body {
+        header: Vec<u8>,
+        body: Vec<u8>,
+    },
     /// No frame: what is wrong, and the bytes read that may hold the start of the next one.
     Bad {
         message: String,
@@ -134,12 +138,19 @@ fn next(input: &mut Stream<impl BufRead>) -> io::Result<Option<Input>> {
     }
     let (message, unframed) = match read_frame(input)? {
         Frame::End => return Ok(None),
-        Frame::Body(body) => match parse(&body) {
+        Frame::Body { header, body } => match parse(&body) {
             Input::Malformed {
                 code: ErrorCode::ParseError,
                 message,
                 ..
-            } => (message, body),
+            } => {
+                // Nothing of it was a frame: its header too may have swallowed the start of
+                // the next one (a header line without the blank line that ends it runs on
+                // into the next frame's header).
+                let mut bytes = unframed(header);
+                bytes.extend_from_slice(&body);
+                (message, bytes)
+            }
             item => return Ok(Some(item)),
         },
         Frame::Bad { message, unframed } => (message, unframed),
@@ -244,26 +255,38 @@ fn read_frame(input: &mut impl BufRead) -> io::Result<Frame> {
             ))
         }
         Some(Ok(n)) => {
-            let mut body = vec![0; n];
-            match input.read_exact(&mut body) {
-                Ok(()) => Ok(Frame::Body(body)),
-                Err(e) if e.kind() == io::ErrorKind::UnexpectedEof => Ok(Frame::End),
-                Err(e) => Err(e),
+            let mut body = Vec::with_capacity(n.min(1 << 20));
+            input.by_ref().take(n as u64).read_to_end(&mut body)?;
+            if body.len() < n {
+                // The input ended inside the body: a length larger than what followed, which
+                // may hold whole frames.
+                let message = format!(
+                    "the input ended {} bytes into a message of {n} bytes",
+                    body.len()
+                );
+                header.extend_from_slice(&body);
+                return Ok(bad(message, header));
             }
+            Ok(Frame::Body { header, body })
         }
     }
 }
 
-/// A header that frames nothing; the next frame is looked for from its second byte on (at least
-/// one byte is always skipped, so resynchronising ends).
-fn bad(message: String, mut header: Vec<u8>) -> Frame {
-    if !header.is_empty() {
-        header.remove(0);
-    }
+/// A header that frames nothing.
+fn bad(message: String, header: Vec<u8>) -> Frame {
     Frame::Bad {
         message,
-        unframed: header,
+        unframed: unframed(header),
     }
+}
+
+/// Where the next frame is looked for after a frame that held nothing: from its second byte on
+/// (at least one byte is always skipped, so resynchronising ends).
+fn unframed(mut bytes: Vec<u8>) -> Vec<u8> {
+    if !bytes.is_empty() {
+        bytes.remove(0);
+    }
+    bytes
 }
 
 /// A body as a message, or the error to answer it with.
@@ -421,6 +444,23 @@ mod tests {
             methods(bytes.as_bytes()),
             ["parse error", "parse error", "initialize"]
         );
+        // A header line without the blank line that ends the header runs on into the next
+        // frame's header, and the body is read from the next frame's body: that frame is found
+        // again in the bad one's header (found by tests/fuzz_lsp.rs).
+        let body = r#"{"jsonrpc":"2.0","method":"x"}"#;
+        let bytes = format!(
+            "Content-Length: {}\r\n{body}{}",
+            body.len(),
+            request(5, "initialize")
+        );
+        assert_eq!(methods(bytes.as_bytes()), ["parse error", "initialize"]);
+        // The input ends inside a body whose length runs past the frames after it: they are
+        // read (found by tests/fuzz_lsp.rs).
+        let bytes = format!(
+            "Content-Length: 1000000\r\n\r\n{{{}",
+            request(6, "initialize")
+        );
+        assert_eq!(methods(bytes.as_bytes()), ["parse error", "initialize"]);
         // A header that never ends is skipped to the next frame too.
         let bytes = format!(
             "{}\r\n{}",
