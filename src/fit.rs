@@ -1,7 +1,9 @@
 //! Least-squares maps between corresponding point sets: the best rigid motion (2D Procrustes:
 //! posing rigid proxy geometry, placing a junction over the instance it replaces, handles'
-//! rest placement) and the best affine map (laying new chain elements into a deformed pose).
-//! The one home of these fits, so the renderer, the rules and the assembly agree exactly.
+//! rest placement) and a rest state's alignment with its shape distance (the solver's local
+//! step), both from one closed form, and the best affine map (laying new chain elements into a
+//! deformed pose). The one home of these fits, so the solver, the renderer, the rules and the
+//! assembly agree exactly.
 
 use glam::{DMat2, DVec2};
 
@@ -71,24 +73,109 @@ fn fitted(from: &[DVec2], to: &[DVec2]) -> Option<(RigidMotion, bool)> {
     if from.len() != to.len() || from.is_empty() || !from.iter().chain(to).all(|p| p.is_finite()) {
         return None;
     }
-    let n = from.len() as f64;
-    let from_centre = from.iter().sum::<DVec2>() / n;
-    let to_centre = to.iter().sum::<DVec2>() / n;
-    let (mut dot, mut cross) = (0.0, 0.0);
-    for (a, b) in from.iter().zip(to) {
-        let (a, b) = (*a - from_centre, *b - to_centre);
-        dot += a.dot(b);
-        cross += a.perp_dot(b);
-    }
-    let rotation = DVec2::new(dot, cross).try_normalize();
+    let s = CentredSums::of(from.len(), |k| from[k], |k| to[k]);
+    let rotation = DVec2::new(s.dot, s.cross).try_normalize();
     Some((
         RigidMotion {
             rotation: rotation.unwrap_or(DVec2::X),
-            from_centre,
-            to_centre,
+            from_centre: s.from_centre,
+            to_centre: s.to_centre,
         },
         rotation.is_some(),
     ))
+}
+
+/// The sums 2D Procrustes needs over `m` pairs `(p(k), q(k))` centred on their centroids:
+/// of dot and cross products (the best rotation angle is `atan2(cross, dot)`) and of squared
+/// norms (the residual after it is `pp + qq - 2 |(dot, cross)|`). The one place both fits
+/// ([`fitted`], [`align`]) compute them.
+struct CentredSums {
+    from_centre: DVec2,
+    to_centre: DVec2,
+    dot: f64,
+    cross: f64,
+    pp: f64,
+    qq: f64,
+}
+
+impl CentredSums {
+    #[inline]
+    fn of(m: usize, p: impl Fn(usize) -> DVec2, q: impl Fn(usize) -> DVec2) -> Self {
+        let inv = 1.0 / m as f64;
+        let from_centre = (0..m).map(&p).sum::<DVec2>() * inv;
+        let to_centre = (0..m).map(&q).sum::<DVec2>() * inv;
+        let (mut dot, mut cross, mut pp, mut qq) = (0.0, 0.0, 0.0, 0.0);
+        for k in 0..m {
+            let a = p(k) - from_centre;
+            let b = q(k) - to_centre;
+            dot += a.dot(b);
+            cross += a.perp_dot(b);
+            pp += a.length_squared();
+            qq += b.length_squared();
+        }
+        Self {
+            from_centre,
+            to_centre,
+            dot,
+            cross,
+            pp,
+            qq,
+        }
+    }
+}
+
+/// Optimal rigid alignment of a rest state onto a current pose (2D Procrustes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Alignment {
+    /// The rotation taking the centred rest state onto the centred pose, as `(cos, sin)`.
+    pub rotation: DVec2,
+    /// Sum of squared vertex distances after the alignment (never negative).
+    pub distance: f64,
+}
+
+/// Aligns `rest` (one position per vertex) to the current positions of `vertices`.
+/// Degenerate poses (all coincident) give the identity rotation, never NaN.
+pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignment {
+    let m = vertices.len().min(rest.len());
+    if m == 0 {
+        return Alignment {
+            rotation: DVec2::X,
+            distance: 0.0,
+        };
+    }
+    let s = CentredSums::of(m, |k| rest[k], |k| positions[vertices[k]]);
+    finish(s.dot, s.cross, s.pp, s.qq)
+}
+
+/// The alignment from the sums of dot and cross products of the centred rest (p) and pose (q)
+/// vectors and their squared norms; shared by [`align`] and the solver's rest cache so both give the
+/// same result bit for bit.
+pub(crate) fn finish(dot: f64, cross: f64, pp: f64, qq: f64) -> Alignment {
+    let len = (dot * dot + cross * cross).sqrt();
+    Alignment {
+        rotation: rotation_of(dot, cross, len),
+        distance: distance_of(pp, qq, len),
+    }
+}
+
+#[inline]
+pub(crate) fn rotation_of(dot: f64, cross: f64, len: f64) -> DVec2 {
+    // divided before the test, as in `normalised_or`
+    let unit = DVec2::new(dot, cross) / len;
+    if len > 1e-300 && len.is_finite() {
+        unit
+    } else {
+        DVec2::X
+    }
+}
+
+pub(crate) fn distance_of(pp: f64, qq: f64, len: f64) -> f64 {
+    let distance = (pp + qq - 2.0 * len).max(0.0);
+    if distance.is_finite() {
+        distance
+    } else {
+        f64::MAX
+    }
 }
 
 fn centroids(from: &[DVec2], to: &[DVec2]) -> (DVec2, DVec2) {

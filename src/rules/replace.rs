@@ -9,8 +9,8 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
 use super::{RuleEvent, RuleKind};
+use crate::fit::align;
 use crate::solver::StateSwitch;
-use crate::solver::local::align;
 
 /// Sets each piece part's instance to the part's active state and returns one event per
 /// instance that ends the frame in a different state than it started. `switches` are the

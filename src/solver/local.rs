@@ -7,14 +7,7 @@
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
-/// Optimal rigid alignment of a rest state onto a current pose (2D Procrustes).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Alignment {
-    /// The rotation taking the centred rest state onto the centred pose, as `(cos, sin)`.
-    pub rotation: DVec2,
-    /// Sum of squared vertex distances after the alignment (never negative).
-    pub distance: f64,
-}
+use crate::fit::{Alignment, align, distance_of, finish, rotation_of};
 
 /// What the local step knows of a stretch part besides its rest states (paper 5.1): the
 /// direction its chain ran in when the frame started, and which of its states the stretch
@@ -87,65 +80,6 @@ pub struct Chosen {
 
 /// The most elements a stretch part may claim or give up (far beyond any model).
 pub const MAX_CLAIM: i32 = 1 << 20;
-
-/// Aligns `rest` (one position per vertex) to the current positions of `vertices`.
-/// Degenerate poses (all coincident) give the identity rotation, never NaN.
-pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignment {
-    let m = vertices.len().min(rest.len());
-    if m == 0 {
-        return Alignment {
-            rotation: DVec2::X,
-            distance: 0.0,
-        };
-    }
-    let inv = 1.0 / m as f64;
-    let rest_centre = rest[..m].iter().copied().sum::<DVec2>() * inv;
-    let pose_centre = vertices[..m].iter().map(|&v| positions[v]).sum::<DVec2>() * inv;
-    // sum of dot products and of cross products of centred rest (p) and pose (q) vectors:
-    // the best rotation angle is atan2(cross, dot), and the residual after it is
-    // |p|^2 + |q|^2 - 2 * |(dot, cross)|.
-    let (mut dot, mut cross, mut pp, mut qq) = (0.0, 0.0, 0.0, 0.0);
-    for k in 0..m {
-        let p = rest[k] - rest_centre;
-        let q = positions[vertices[k]] - pose_centre;
-        dot += p.dot(q);
-        cross += p.perp_dot(q);
-        pp += p.length_squared();
-        qq += q.length_squared();
-    }
-    finish(dot, cross, pp, qq)
-}
-
-/// The alignment from the sums of dot and cross products of the centred rest (p) and pose (q)
-/// vectors and their squared norms; shared by [`align`] and [`RestCache`] so both give the
-/// same result bit for bit.
-fn finish(dot: f64, cross: f64, pp: f64, qq: f64) -> Alignment {
-    let len = (dot * dot + cross * cross).sqrt();
-    Alignment {
-        rotation: rotation_of(dot, cross, len),
-        distance: distance_of(pp, qq, len),
-    }
-}
-
-#[inline]
-fn rotation_of(dot: f64, cross: f64, len: f64) -> DVec2 {
-    // divided before the test, as in `normalised_or`
-    let unit = DVec2::new(dot, cross) / len;
-    if len > 1e-300 && len.is_finite() {
-        unit
-    } else {
-        DVec2::X
-    }
-}
-
-fn distance_of(pp: f64, qq: f64, len: f64) -> f64 {
-    let distance = (pp + qq - 2.0 * len).max(0.0);
-    if distance.is_finite() {
-        distance
-    } else {
-        f64::MAX
-    }
-}
 
 /// Picks the active state of part `pi` (`part`) for the current positions: the nearest rest
 /// state, but only when it is closer than `(1 - hysteresis)` times the active one (paper

@@ -571,7 +571,7 @@ impl Solver {
         let mut singles: Vec<(f64, usize, usize)> = Vec::new();
         for (pi, part) in parts.iter().enumerate().filter(|(_, p)| multi(p)) {
             let d: Vec<f64> = (part.states.iter())
-                .map(|st| local::align(&st.positions, &part.vertices, warm).distance)
+                .map(|st| crate::fit::align(&st.positions, &part.vertices, warm).distance)
                 .collect();
             let here = d[part.active.min(d.len() - 1)];
             if here > 0.0 {
