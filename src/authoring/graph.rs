@@ -5,10 +5,19 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::DVec2;
 
+use super::grid::{PointGrid, self_crossing};
 use super::{AuthorError, Drawing};
 
-/// Largest absolute coordinate accepted (metres), as in the compiler: keeps the grid finite.
-const MAX_COORDINATE: f64 = 1e9;
+/// Largest absolute coordinate accepted (metres). The compiler takes coordinates up to 1e9 m;
+/// a piece is written relative to its lower-left corner and an instance's `at` is where that
+/// corner goes after a rotation, so those can reach about four times the drawing's extent: a
+/// tenth of the compiler's limit keeps every written number inside it (issue 37).
+pub const MAX_COORDINATE: f64 = 1e8;
+
+/// Smallest snap (and congruence) tolerance accepted (metres). The grammar is written to the
+/// micrometre, so vertices kept apart by a finer tolerance could be written at one place (E023)
+/// or an edge with no length (E022); ten micrometres keeps them apart after rounding.
+pub const MIN_TOLERANCE: f64 = 1e-5;
 
 /// A closed path of the drawing as a cycle of graph vertices.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,6 +38,17 @@ pub struct Graph {
     pub loops: Vec<Loop>,
     /// Fill colour and name of each drawing polyline.
     pub sources: Vec<(Option<[u8; 3]>, Option<String>)>,
+    /// The snap tolerance it was built with (metres).
+    pub snap: f64,
+}
+
+/// A graph split into regions: the regions, the contacts between them, and notes on what was
+/// left out and why.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Split {
+    pub regions: Vec<Region>,
+    pub contacts: Vec<Contact>,
+    pub notes: Vec<String>,
 }
 
 /// A region: the vertices and edges that become one instance of a piece.
@@ -77,17 +97,24 @@ impl Graph {
     /// `snap` of another stroke's segment splits that segment (a T-junction), and repeated edges
     /// are kept once.
     pub fn build(drawing: &Drawing, snap: f64) -> Result<Graph, AuthorError> {
-        let mut g = Graph::default();
+        check_tolerance("snap tolerance", snap)?;
+        let mut g = Graph {
+            snap,
+            ..Graph::default()
+        };
         let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
         let mut strokes: Vec<(Vec<usize>, bool)> = Vec::new();
-        for (k, line) in drawing.polylines.iter().enumerate() {
+        for line in &drawing.polylines {
             g.sources.push((line.fill, line.name.clone()));
+        }
+        for (k, line) in drawing.polylines.iter().enumerate() {
             let mut ids: Vec<usize> = Vec::new();
             for &p in &line.points {
                 if !(p.is_finite() && p.abs().max_element() <= MAX_COORDINATE) {
                     return Err(AuthorError(format!(
-                        "point ({}, {}) of stroke {k} is not a finite coordinate within {MAX_COORDINATE} m",
-                        p.x, p.y
+                        "{} has a point at {}, beyond the {MAX_COORDINATE:e} m a drawing may reach; check its coordinates and the scale",
+                        g.stroke_name(k),
+                        metres(p)
                     )));
                 }
                 let id = g.snap_vertex(&mut grid, p, snap);
@@ -103,7 +130,11 @@ impl Graph {
             strokes.push((ids, closed && line.points.len() >= 3));
         }
         // T-junctions: a vertex lying on another stroke's segment splits it, so that both
-        // strokes share it (bricks in staggered courses, a wall meeting another's side).
+        // strokes share it (bricks in staggered courses, a wall meeting another's side). A
+        // grid of the vertices keeps this to the cells along each segment (issue 37: asking
+        // every vertex of every segment took seconds on a path of ten thousand points).
+        let grid = PointGrid::new(&g.positions, snap);
+        let mut near = Vec::new();
         for (ids, closed) in &mut strokes {
             if ids.len() < 2 {
                 continue;
@@ -115,14 +146,17 @@ impl Graph {
                 let (a, b) = (ids[i], ids[(i + 1) % n]);
                 out.push(a);
                 let (pa, pb) = (g.positions[a], g.positions[b]);
-                let mut inner: Vec<(f64, usize)> = (0..g.positions.len())
+                grid.near_segment(pa, pb, &mut near);
+                let mut inner: Vec<(f64, usize)> = near
+                    .iter()
+                    .copied()
                     .filter(|&c| c != a && c != b)
                     .filter_map(|c| {
                         let (d, t) = segment_distance(g.positions[c], pa, pb);
                         (d <= snap && t > 0.0 && t < 1.0).then_some((t, c))
                     })
                     .collect();
-                inner.sort_by(|x, y| x.0.total_cmp(&y.0));
+                inner.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
                 out.extend(inner.into_iter().map(|(_, c)| c));
             }
             if !*closed {
@@ -334,7 +368,8 @@ impl Graph {
     }
 
     /// The regions after cutting: the connected pieces of the graph, with one contact per cut.
-    pub fn regions(&self, cuts: &[CutSection]) -> Result<(Vec<Region>, Vec<Contact>), AuthorError> {
+    /// An outline that crosses itself is an error ([`Graph::simple_outline`]).
+    pub fn regions(&self, cuts: &[CutSection]) -> Result<Split, AuthorError> {
         let n = self.positions.len();
         let mut parent: Vec<usize> = (0..n).collect();
         fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -376,6 +411,9 @@ impl Graph {
         for (r, region) in regions.iter_mut().enumerate() {
             region.outline = self.cycle(&region.vertices, &region.edges);
             region.source = most_common(&sources[r]);
+            if let Some(o) = &region.outline {
+                self.simple_outline(o, region.source)?;
+            }
         }
         let mut contacts = Vec::new();
         for c in cuts {
@@ -400,41 +438,92 @@ impl Graph {
                     .collect(),
             });
         }
-        Ok((regions, contacts))
+        Ok(Split {
+            regions,
+            contacts,
+            notes: Vec::new(),
+        })
     }
 
     /// With no cuts: every closed path is a region, and regions dock where they share vertices
     /// (two or more; a single shared corner docks only when it is in no other contact of the
-    /// two regions).
-    pub fn loop_regions(&self) -> Result<(Vec<Region>, Vec<Contact>), AuthorError> {
-        let mut regions = Vec::new();
+    /// two regions). A closed path with no area (it runs out and back along a line) is left out
+    /// like an open stroke, and one drawn again on top of another (an exporter's fill and
+    /// stroke copies) is authored once, each with a note; one that touches or crosses itself is
+    /// an error ([`Graph::simple_outline`]).
+    // Long because: the regions, their duplicates and the contacts between them, over shared vertex tables.
+    pub fn loop_regions(&self) -> Result<Split, AuthorError> {
+        let mut edges_at: HashMap<usize, Vec<usize>> = HashMap::new();
+        for (i, e) in self.edges.iter().enumerate() {
+            for v in e {
+                edges_at.entry(*v).or_default().push(i);
+            }
+        }
+        let mut split = Split::default();
+        let mut by_vertices: HashMap<Vec<usize>, usize> = HashMap::new();
         for l in &self.loops {
             let set: HashSet<usize> = l.vertices.iter().copied().collect();
             if set.len() < 3 {
                 continue;
             }
             let mut outline = l.vertices.clone();
+            if self.flat(&outline) {
+                split.notes.push(format!(
+                    "{} encloses no area (it runs along a line and back); it is left out like an open stroke",
+                    self.stroke_name(l.source)
+                ));
+                continue;
+            }
+            self.simple_outline(&outline, Some(l.source))?;
             if signed_area(&self.positions, &outline) < 0.0 {
                 outline.reverse();
             }
-            let edges = self
-                .edges
+            let mut key = outline.clone();
+            key.sort_unstable();
+            if let Some(&r) = by_vertices.get(&key) {
+                let first: &mut Region = &mut split.regions[r];
+                if first
+                    .outline
+                    .as_deref()
+                    .is_some_and(|o| same_cycle(o, &outline))
+                {
+                    split.notes.push(format!(
+                        "{} is drawn again on top of {}; it is authored once",
+                        self.stroke_name(l.source),
+                        first
+                            .source
+                            .map_or_else(String::new, |s| self.stroke_name(s))
+                    ));
+                    // Keep the copy that has a fill, for the piece's colour.
+                    let fill =
+                        |s: Option<usize>| s.and_then(|s| self.sources.get(s)).and_then(|s| s.0);
+                    if fill(first.source).is_none() && fill(Some(l.source)).is_some() {
+                        first.source = Some(l.source);
+                    }
+                    continue;
+                }
+            }
+            let mut edges: Vec<usize> = outline
                 .iter()
-                .filter(|e| set.contains(&e[0]) && set.contains(&e[1]))
-                .copied()
+                .flat_map(|v| edges_at.get(v).into_iter().flatten().copied())
+                .filter(|&i| set.contains(&self.edges[i][0]) && set.contains(&self.edges[i][1]))
                 .collect();
-            regions.push(Region {
+            edges.sort_unstable();
+            edges.dedup();
+            by_vertices.insert(key, split.regions.len());
+            split.regions.push(Region {
                 vertices: outline.clone(),
-                edges,
+                edges: edges.into_iter().map(|i| self.edges[i]).collect(),
                 outline: Some(outline),
                 source: Some(l.source),
             });
         }
-        if regions.is_empty() {
+        if split.regions.is_empty() {
             return Err(AuthorError(
                 "the drawing has no closed path; close the outlines, or give cut points (--cut x,y) to split open strokes".into(),
             ));
         }
+        let regions = &split.regions;
         let mut shared: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
         let mut owners: HashMap<usize, Vec<usize>> = HashMap::new();
         for (r, region) in regions.iter().enumerate() {
@@ -445,7 +534,9 @@ impl Graph {
         for (v, rs) in &owners {
             for (i, &a) in rs.iter().enumerate() {
                 for &b in &rs[i + 1..] {
-                    shared.entry((a.min(b), a.max(b))).or_default().push(*v);
+                    if a != b {
+                        shared.entry((a.min(b), a.max(b))).or_default().push(*v);
+                    }
                 }
             }
         }
@@ -458,7 +549,6 @@ impl Graph {
                 }
             }
         }
-        let mut contacts = Vec::new();
         for ((a, b), vs) in shared {
             let lone_corner = vs.len() == 1
                 && !in_contact.contains(&(a, vs[0]))
@@ -466,14 +556,89 @@ impl Graph {
             if vs.len() >= 2 || lone_corner {
                 let mut vs = vs;
                 vs.sort_unstable();
-                contacts.push(Contact {
+                split.contacts.push(Contact {
                     a,
                     b,
                     pairs: vs.iter().map(|&v| (v, v)).collect(),
                 });
             }
         }
-        Ok((regions, contacts))
+        Ok(split)
+    }
+
+    /// How a message names drawing polyline `k`: by its SVG id, else by its place in the
+    /// drawing.
+    pub fn stroke_name(&self, k: usize) -> String {
+        match self.sources.get(k).and_then(|s| s.1.as_deref()) {
+            Some(id) => format!("path `{id}`"),
+            None => format!(
+                "stroke {} of {} (a path without an id)",
+                k + 1,
+                self.sources.len()
+            ),
+        }
+    }
+
+    /// Whether every vertex of `cycle` lies within the snap tolerance of one line: a closed
+    /// path that encloses nothing. (T-junctions split every edge a vertex lies on, so a flat
+    /// cycle passes through a vertex twice; one that does not is not flat.)
+    fn flat(&self, cycle: &[usize]) -> bool {
+        if cycle.iter().collect::<HashSet<_>>().len() == cycle.len() {
+            return false;
+        }
+        let p = |i: usize| self.positions[i];
+        let far = |from: DVec2| {
+            cycle
+                .iter()
+                .map(|&v| p(v))
+                .max_by(|x, y| x.distance(from).total_cmp(&y.distance(from)))
+                .unwrap_or(from)
+        };
+        let a = far(p(cycle[0]));
+        let b = far(a);
+        let span = a.distance(b);
+        span == 0.0
+            || cycle
+                .iter()
+                .all(|&v| (b - a).perp_dot(p(v) - a).abs() / span <= self.snap)
+    }
+
+    /// Refuses an outline that is not a simple polygon: one that passes through a point twice
+    /// (it touches itself, as a figure eight drawn in one stroke does) or whose edges cross (a
+    /// bowtie). The error names the path and the place, in metres with y up.
+    ///
+    /// Why refuse rather than repair: the outline becomes the piece's polygon and its edges the
+    /// piece's structure, and a crossing outline has no one inside (SVG's even-odd and
+    /// non-zero fill rules already disagree about it); splitting it at its crossings would
+    /// guess shapes the author never drew and leave them to be discovered in the grammar. CAD
+    /// sketchers refuse self-intersecting profiles the same way; naming the place makes the
+    /// fix in the drawing quick (redraw it there, or draw the parts as separate closed paths).
+    pub fn simple_outline(
+        &self,
+        cycle: &[usize],
+        source: Option<usize>,
+    ) -> Result<(), AuthorError> {
+        let what = || match source {
+            Some(k) => format!("the outline of {}", self.stroke_name(k)),
+            None => "an outline".to_string(),
+        };
+        let mut seen = HashSet::new();
+        if let Some(&v) = cycle.iter().find(|v| !seen.insert(**v)) {
+            return Err(AuthorError(format!(
+                "{} passes through {} twice: it touches or runs back along itself there; a piece outline must be a simple closed path, so redraw it there or draw its parts as separate closed paths",
+                what(),
+                metres(self.positions[v])
+            )));
+        }
+        let ring: Vec<DVec2> = cycle.iter().map(|&v| self.positions[v]).collect();
+        if let Some((_, _, at)) = self_crossing(&ring) {
+            return Err(AuthorError(format!(
+                "{} crosses itself at {}; a piece outline must be a simple closed path, so redraw it without the crossing or draw its parts as separate closed paths",
+                what(),
+                metres(at)
+            )));
+        }
+        Ok(())
     }
 
     /// The vertices as a counter-clockwise cycle, when the edges form exactly one simple cycle.
@@ -513,6 +678,45 @@ impl Graph {
         }
         Some(cycle)
     }
+}
+
+/// Refuses a tolerance that is not a number of metres from [`MIN_TOLERANCE`] up.
+pub fn check_tolerance(what: &str, v: f64) -> Result<(), AuthorError> {
+    if v.is_finite() && v >= MIN_TOLERANCE {
+        Ok(())
+    } else {
+        Err(AuthorError(format!(
+            "the {what} must be a number of metres from {MIN_TOLERANCE} up (the grammar is written to the micrometre), found {v}"
+        )))
+    }
+}
+
+/// Whether `a` and `b` are the same cycle of vertices, whatever vertex each starts from.
+fn same_cycle(a: &[usize], b: &[usize]) -> bool {
+    a.len() == b.len()
+        && b.iter()
+            .position(|&v| Some(&v) == a.first())
+            .is_some_and(|k| {
+                a.iter()
+                    .enumerate()
+                    .all(|(i, &v)| b[(i + k) % b.len()] == v)
+            })
+}
+
+/// A point for a message: `(x, y) m`, to the micrometre.
+pub(crate) fn metres(p: DVec2) -> String {
+    let r = |x: f64| {
+        let r = (x * 1e6).round() / 1e6;
+        if r == 0.0 { 0.0 } else { r }
+    };
+    let show = |x: f64| {
+        if x.abs() < 1e9 {
+            r(x).to_string()
+        } else {
+            format!("{x:e}")
+        }
+    };
+    format!("({}, {}) m", show(p.x), show(p.y))
 }
 
 /// The signed area of a polygon of graph vertices (positive when counter-clockwise).

@@ -87,12 +87,12 @@ pub struct Design {
     pub notes: Vec<String>,
 }
 
-fn round6(x: f64) -> f64 {
+pub(crate) fn round6(x: f64) -> f64 {
     let r = (x * 1e6).round() / 1e6;
     if r == 0.0 { 0.0 } else { r }
 }
 
-fn round_point(p: DVec2) -> DVec2 {
+pub(crate) fn round_point(p: DVec2) -> DVec2 {
     DVec2::new(round6(p.x), round6(p.y))
 }
 
@@ -102,7 +102,8 @@ fn rotate(p: DVec2, angle: f64) -> DVec2 {
 
 /// The rigid motion taking region `rep` onto region `other` within `tol`, as (angle,
 /// translation, `map[i]` = index in `other` of vertex `i` of `rep`); of all motions that fit
-/// (a symmetric shape has several) the one turning least.
+/// (a symmetric shape has several) the one turning least. Each vertex's partner is looked up
+/// in a grid, so a fit costs about the number of vertices (issue 37).
 fn congruence(
     rep: &[DVec2],
     rep_edges: &HashSet<[usize; 2]>,
@@ -130,38 +131,121 @@ fn congruence(
             })
             .collect()
     };
-    let mut best: Option<(f64, DVec2, Vec<usize>)> = None;
-    for angle in angles {
+    // The motion turning least is the one wanted: try the angles in that order and take the
+    // first that fits (a regular polygon of many corners fits at every one of them).
+    let mut angles: Vec<(usize, f64)> = angles.into_iter().enumerate().collect();
+    angles.sort_by(|x, y| x.1.abs().total_cmp(&y.1.abs()).then(x.0.cmp(&y.0)));
+    let near = NearGrid::new(other, 2.0 * tol);
+    for (_, angle) in angles {
         let shift = co - rotate(cr, angle);
         let mut map = Vec::with_capacity(rep.len());
         let mut used = vec![false; other.len()];
         for p in rep {
             let q = rotate(*p, angle) + shift;
-            let hit = (0..other.len())
-                .filter(|&j| !used[j])
-                .min_by(|&a, &b| other[a].distance(q).total_cmp(&other[b].distance(q)));
-            match hit {
-                Some(j) if other[j].distance(q) <= 2.0 * tol => {
+            match near.nearest_unused(other, q, &used) {
+                Some(j) => {
                     used[j] = true;
                     map.push(j);
                 }
-                _ => break,
+                None => break,
             }
         }
         if map.len() != rep.len() {
             continue;
         }
-        if !rep_edges
+        if rep_edges
             .iter()
             .all(|e| other_edges.contains(&[map[e[0]].min(map[e[1]]), map[e[0]].max(map[e[1]])]))
         {
-            continue;
-        }
-        if best.as_ref().is_none_or(|b| angle.abs() < b.0.abs() - 1e-9) {
-            best = Some((angle, shift, map));
+            return Some((angle, shift, map));
         }
     }
-    best
+    None
+}
+
+/// Points bucketed in cells as wide as the distance asked about, for "the nearest point within
+/// it": a look at nine cells instead of every point.
+struct NearGrid {
+    cell: f64,
+    cells: HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl NearGrid {
+    fn new(points: &[DVec2], within: f64) -> Self {
+        let mut grid = Self {
+            cell: within,
+            cells: HashMap::new(),
+        };
+        for (i, p) in points.iter().enumerate() {
+            let c = grid.key(*p);
+            grid.cells.entry(c).or_default().push(i);
+        }
+        grid
+    }
+
+    fn key(&self, p: DVec2) -> (i64, i64) {
+        // Saturating: a point far beyond the drawing's limit only shares a cell with others.
+        (
+            (p.x / self.cell).floor() as i64,
+            (p.y / self.cell).floor() as i64,
+        )
+    }
+
+    /// The nearest point not yet `used` within the distance, the lowest index on a tie.
+    fn nearest_unused(&self, points: &[DVec2], q: DVec2, used: &[bool]) -> Option<usize> {
+        let (cx, cy) = self.key(q);
+        let mut best: Option<(f64, usize)> = None;
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                let c = (cx.saturating_add(dx), cy.saturating_add(dy));
+                for &j in self.cells.get(&c).into_iter().flatten() {
+                    let d = points[j].distance(q);
+                    if !used[j] && d <= self.cell && best.is_none_or(|b| (d, j) < b) {
+                        best = Some((d, j));
+                    }
+                }
+            }
+        }
+        best.map(|(_, j)| j)
+    }
+}
+
+/// What regions congruent within a tolerance have in common: their vertex and edge counts and
+/// their radius of gyration (root mean square distance of the vertices from their centroid)
+/// in steps of eight times the tolerance. Moving each vertex by up to twice the tolerance (as
+/// [`congruence`] allows) moves the centroid and so each distance by up to four times it, so
+/// congruent regions are in the same step or the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct ShapeClass {
+    vertices: usize,
+    edges: usize,
+    step: i64,
+}
+
+impl ShapeClass {
+    fn of(points: &[DVec2], edges: usize, tol: f64) -> Self {
+        let n = points.len().max(1) as f64;
+        let centre = points.iter().copied().sum::<DVec2>() / n;
+        let gyration = (points
+            .iter()
+            .map(|p| p.distance_squared(centre))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        Self {
+            vertices: points.len(),
+            edges,
+            step: (gyration / (8.0 * tol)).floor() as i64,
+        }
+    }
+
+    /// This class and the steps either side.
+    fn neighbours(self) -> impl Iterator<Item = ShapeClass> {
+        (-1..=1).map(move |d| ShapeClass {
+            step: self.step.saturating_add(d),
+            ..self
+        })
+    }
 }
 
 /// Compass name of a direction.
@@ -240,15 +324,28 @@ pub fn find_pieces(
         notes: Vec::new(),
     };
     let mut instance_of_region = vec![usize::MAX; regions.len()];
+    // Representatives by shape class, so that a region is compared only with those that could
+    // be congruent to it (a drawing of two thousand different shapes asked every pair).
+    let mut classes: HashMap<ShapeClass, Vec<usize>> = HashMap::new();
     for (ri, region) in regions.iter().enumerate() {
         let (pts, edges) = local(region);
-        let found = reps.iter().enumerate().find_map(|(pi, rep)| {
+        let class = ShapeClass::of(&pts, edges.len(), tol);
+        let mut candidates: Vec<usize> = class
+            .neighbours()
+            .filter_map(|c| classes.get(&c))
+            .flatten()
+            .copied()
+            .collect();
+        candidates.sort_unstable();
+        let found = candidates.iter().find_map(|&pi| {
+            let rep = &reps[pi];
             congruence(&rep.points, &rep.edges, &pts, &edges, tol).map(|m| (pi, m))
         });
         let (piece, angle, shift, map) = match found {
             Some((pi, (angle, shift, map))) => (pi, angle, shift, map),
             None => {
                 design.pieces.push(new_piece(graph, region, &pts, &edges));
+                classes.entry(class).or_default().push(reps.len());
                 reps.push(Rep {
                     points: pts.clone(),
                     edges,
@@ -272,21 +369,29 @@ pub fn find_pieces(
     }
     name_pieces(graph, regions, &mut design);
     // Contacts -> sites (per piece, keyed by their vertex set) and docks.
-    let mut type_keys: Vec<(usize, Vec<i64>)> = Vec::new();
+    let index_of: Vec<HashMap<usize, usize>> = design
+        .instances
+        .iter()
+        .map(|i| {
+            i.vertices
+                .iter()
+                .enumerate()
+                .map(|(k, &v)| (v, k))
+                .collect()
+        })
+        .collect();
+    let mut sites = Sites::default();
+    // Which instance each docked instance site docks with: a site docks once (E034).
+    let mut docked: HashMap<(usize, usize), usize> = HashMap::new();
     for c in contacts {
         let (ia, ib) = (instance_of_region[c.a], instance_of_region[c.b]);
-        let sa = site_for(
-            &mut design,
-            &mut type_keys,
-            ia,
-            &c.pairs.iter().map(|p| p.0).collect::<Vec<_>>(),
-        );
-        let sb = site_for(
-            &mut design,
-            &mut type_keys,
-            ib,
-            &c.pairs.iter().map(|p| p.1).collect::<Vec<_>>(),
-        );
+        if ia == usize::MAX || ib == usize::MAX || ia == ib {
+            continue;
+        }
+        let firsts: Vec<usize> = c.pairs.iter().map(|p| p.0).collect();
+        let seconds: Vec<usize> = c.pairs.iter().map(|p| p.1).collect();
+        let sa = site_for(&mut design, &mut sites, &index_of[ia], ia, &firsts);
+        let sb = site_for(&mut design, &mut sites, &index_of[ib], ib, &seconds);
         let (Some(sa), Some(sb)) = (sa, sb) else {
             continue;
         };
@@ -294,30 +399,60 @@ pub fn find_pieces(
         let va = &design.pieces[design.instances[ia].piece].sites[sa].vertices;
         let vb = &design.pieces[design.instances[ib].piece].sites[sb].vertices;
         let n = va.len();
+        let pairs: HashSet<(usize, usize)> = c.pairs.iter().copied().collect();
         let meets = vb.len() == n
             && (0..n).all(|i| {
                 let ga = design.instances[ia].vertices[va[i]];
                 let gb = design.instances[ib].vertices[vb[n - 1 - i]];
-                c.pairs.contains(&(ga, gb))
+                pairs.contains(&(ga, gb))
             });
-        if meets {
-            design.docks.push(DockDesign {
-                a: (ia, sa),
-                b: (ib, sb),
-            });
-        } else {
+        let name = |i: usize| design.instances[i].name.clone();
+        if !meets {
             design.notes.push(format!(
                 "`{}` and `{}` touch, but their shared vertices do not pair up as docked sites need (vertex i with vertex n-1-i); they are left undocked",
-                design.instances[ia].name, design.instances[ib].name
+                name(ia),
+                name(ib)
             ));
+            continue;
         }
+        // Three shapes along one edge (overlapping shapes, a shape drawn twice slightly
+        // apart): the first contact docks, the others are left undocked.
+        if let Some(&(site_of, other)) = [((ia, sa), ib), ((ib, sb), ia)]
+            .iter()
+            .find_map(|(k, _)| docked.get(k).map(|o| (k, *o)))
+            .as_ref()
+        {
+            design.notes.push(format!(
+                "`{}` and `{}` touch where `{}` already docks with `{}` (a site docks once); they are left undocked",
+                name(ia),
+                name(ib),
+                name(site_of.0),
+                name(other)
+            ));
+            continue;
+        }
+        if design.turns_away((ia, sa), (ib, sb), tol) {
+            design.notes.push(format!(
+                "`{}` and `{}` touch, but docking them there would turn or move one away from where it is drawn; they are left undocked",
+                name(ia),
+                name(ib)
+            ));
+            continue;
+        }
+        docked.insert((ia, sa), ib);
+        docked.insert((ib, sb), ia);
+        design.docks.push(DockDesign {
+            a: (ia, sa),
+            b: (ib, sb),
+        });
     }
     for p in &mut design.pieces {
         name_sites(p);
     }
-    design.site_types = (0..type_keys.len())
+    let count = unify_docked_types(&mut design, sites.types.len());
+    design.site_types = (0..count)
         .map(|i| {
-            if type_keys.len() == 1 {
+            if count == 1 {
                 "joint".to_string()
             } else {
                 format!("joint{}", i + 1)
@@ -325,6 +460,55 @@ pub fn find_pieces(
         })
         .collect();
     Ok(design)
+}
+
+/// Docked sites must be of one type (E030), and sites are typed by their shape to the
+/// millimetre: two instances of pieces congruent within the tolerance can fall either side of
+/// a rounding. Types joined by a dock become one, numbered again in the order they were made.
+/// Returns the number of types.
+fn unify_docked_types(design: &mut Design, count: usize) -> usize {
+    let mut parent: Vec<usize> = (0..count).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let type_of =
+        |d: &Design, (i, s): (usize, usize)| design_site(d, i, s).map(|site| site.site_type);
+    for dock in &design.docks {
+        if let (Some(a), Some(b)) = (type_of(design, dock.a), type_of(design, dock.b)) {
+            let (a, b) = (find(&mut parent, a), find(&mut parent, b));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    // Roots are the lowest type of their class: numbering them in order keeps the types in
+    // the order they were first made.
+    let mut number = vec![0; count];
+    let mut next = 0;
+    for t in 0..count {
+        let root = find(&mut parent, t);
+        if root == t {
+            number[t] = next;
+            next += 1;
+        } else {
+            number[t] = number[root];
+        }
+    }
+    for p in &mut design.pieces {
+        for s in &mut p.sites {
+            s.site_type = number[s.site_type];
+        }
+    }
+    next
+}
+
+fn design_site(d: &Design, instance: usize, site: usize) -> Option<&SiteDesign> {
+    d.pieces
+        .get(d.instances.get(instance)?.piece)?
+        .sites
+        .get(site)
 }
 
 fn origin_of(points: &[DVec2]) -> DVec2 {
@@ -354,13 +538,14 @@ fn new_piece(
         .outline
         .as_ref()
         .map(|o| o.iter().map(|v| index[v]).collect());
-    let mut edges: Vec<[usize; 2]> = edges.iter().copied().collect();
+    let drawn = edges;
+    let mut edges: Vec<[usize; 2]> = drawn.iter().copied().collect();
     edges.sort_unstable();
     // A quadrilateral of edges can shear; a fan of diagonals makes the outline rigid.
     if let Some(o) = &outline {
         for k in 2..o.len().saturating_sub(1) {
             let e = [o[0].min(o[k]), o[0].max(o[k])];
-            if !edges.contains(&e) {
+            if !drawn.contains(&e) {
                 edges.push(e);
             }
         }
@@ -381,55 +566,95 @@ fn new_piece(
     }
 }
 
-/// Names pieces after the drawing's ids (`brick3` -> `brick`) when they are unambiguous,
-/// else `piece1`, `piece2`, ...; instances are the piece name and a number.
+/// Names pieces after the drawing's ids (`brick3` -> `brick`) when they are unambiguous and
+/// not a keyword, else `piece1`, `piece2`, ...; instances are named by [`instance_names`].
 fn name_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
     let mut taken: HashSet<String> = ["base".to_string()].into_iter().collect();
+    let mut first = vec![None; design.pieces.len()];
+    for i in &design.instances {
+        first[i.piece].get_or_insert(i.region);
+    }
     for (pi, piece) in design.pieces.iter_mut().enumerate() {
-        let first = design
-            .instances
-            .iter()
-            .find(|i| i.piece == pi)
-            .map(|i| i.region);
-        let drawn = first
+        let drawn = first[pi]
             .and_then(|r| regions[r].source)
             .and_then(|s| graph.sources.get(s))
             .and_then(|s| s.1.as_deref())
-            .and_then(clean_name);
+            .and_then(clean_name)
+            .filter(|n| !clay_dsl::analysis::KEYWORDS.contains(&n.as_str()));
         let name = match drawn {
             Some(n) if !taken.contains(&n) => n,
-            _ => format!("piece{}", pi + 1),
+            _ => (pi + 1..)
+                .map(|k| format!("piece{k}"))
+                .find(|g| !taken.contains(g))
+                .unwrap_or_default(),
         };
         taken.insert(name.clone());
         piece.name = name;
     }
-    let mut counts = vec![0usize; design.pieces.len()];
-    for inst in &mut design.instances {
-        inst.name = format!("{}{}", design.pieces[inst.piece].name, counts[inst.piece]);
-        counts[inst.piece] += 1;
+    let piece_names: Vec<String> = design.pieces.iter().map(|p| p.name.clone()).collect();
+    let of: Vec<usize> = design.instances.iter().map(|i| i.piece).collect();
+    for (inst, name) in design
+        .instances
+        .iter_mut()
+        .zip(instance_names(&piece_names, &of))
+    {
+        inst.name = name;
     }
+}
+
+/// Instance names, all different (E010): the piece's name and a count from 0 (`brick0`,
+/// `brick1`), with `_` between when the name ends in a digit (`piece1_0`: `piece10` could be
+/// `piece1`'s eleventh instance or `piece10`'s first). A name still taken (a piece renamed to
+/// end in `_`, say) gets `_2`, `_3`, ... `of[i]` is instance `i`'s piece.
+pub(crate) fn instance_names(pieces: &[String], of: &[usize]) -> Vec<String> {
+    let mut counts = vec![0usize; pieces.len()];
+    let mut taken: HashSet<String> = HashSet::new();
+    of.iter()
+        .map(|&p| {
+            let name = &pieces[p];
+            let sep = if name.ends_with(|c: char| c.is_ascii_digit()) {
+                "_"
+            } else {
+                ""
+            };
+            let base = format!("{name}{sep}{}", counts[p]);
+            counts[p] += 1;
+            let unique = std::iter::once(base.clone())
+                .chain((2..).map(|k| format!("{base}_{k}")))
+                .find(|n| !taken.contains(n))
+                .unwrap_or(base);
+            taken.insert(unique.clone());
+            unique
+        })
+        .collect()
+}
+
+/// The sites made so far and their types: per piece, its sites by their sorted vertices; the
+/// type of each site shape.
+#[derive(Default)]
+struct Sites {
+    by_vertices: HashMap<(usize, Vec<usize>), usize>,
+    types: HashMap<(usize, Vec<i64>), usize>,
 }
 
 /// The site of `instance`'s piece made of the given graph vertices (created on first use).
 fn site_for(
     design: &mut Design,
-    type_keys: &mut Vec<(usize, Vec<i64>)>,
+    sites: &mut Sites,
+    index_of: &HashMap<usize, usize>,
     instance: usize,
     graph_vertices: &[usize],
 ) -> Option<usize> {
     let inst = &design.instances[instance];
     let mut vs: Vec<usize> = graph_vertices
         .iter()
-        .map(|g| inst.vertices.iter().position(|v| v == g))
+        .map(|g| index_of.get(g).copied())
         .collect::<Option<_>>()?;
     let piece = &mut design.pieces[inst.piece];
     let mut sorted = vs.clone();
     sorted.sort_unstable();
-    if let Some(i) = piece.sites.iter().position(|s| {
-        let mut k = s.vertices.clone();
-        k.sort_unstable();
-        k == sorted
-    }) {
+    let key = (inst.piece, sorted);
+    if let Some(&i) = sites.by_vertices.get(&key) {
         return Some(i);
     }
     let pos = &piece.positions;
@@ -441,7 +666,7 @@ fn site_for(
         let a = (pos[v] - centre).to_angle() - towards;
         (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
     };
-    vs.sort_by(|&a, &b| rel(a).total_cmp(&rel(b)));
+    vs.sort_by(|&a, &b| rel(a).total_cmp(&rel(b)).then(a.cmp(&b)));
     let mut out = DVec2::ZERO;
     for w in vs.windows(2) {
         let d = pos[w[1]] - pos[w[0]];
@@ -452,28 +677,28 @@ fn site_for(
     }
     let out = out.try_normalize().unwrap_or(DVec2::X);
     let out = round_point(out);
-    // Sites of one shape (vertex count and distances) share a type.
-    let mut dists: Vec<i64> = Vec::new();
-    for (i, &a) in vs.iter().enumerate() {
-        for &b in &vs[i + 1..] {
-            dists.push((pos[a].distance(pos[b]) * 1e3).round() as i64);
-        }
-    }
-    dists.sort_unstable();
-    let tkey = (vs.len(), dists);
-    let site_type = match type_keys.iter().position(|k| *k == tkey) {
-        Some(t) => t,
-        None => {
-            type_keys.push(tkey);
-            type_keys.len() - 1
-        }
+    // Sites of one shape share a type: the shape is the vertex count, the distances between
+    // neighbours along the site and from its first vertex to each (to the millimetre), read
+    // from whichever end gives the smaller list, so that a site and the one it docks with
+    // (which runs the other way) agree. Linear in the vertices: a site along a shared curve
+    // of thousands of points is no burden.
+    let d = |a: usize, b: usize| (pos[a].distance(pos[b]) * 1e3).round() as i64;
+    let shape = |order: &[usize]| -> Vec<i64> {
+        let along = order.windows(2).map(|w| d(w[0], w[1]));
+        let from_first = order.iter().skip(1).map(|&v| d(order[0], v));
+        along.chain(from_first).collect()
     };
+    let backwards: Vec<usize> = vs.iter().rev().copied().collect();
+    let tkey = (vs.len(), shape(&vs).min(shape(&backwards)));
+    let next = sites.types.len();
+    let site_type = *sites.types.entry(tkey).or_insert(next);
     piece.sites.push(SiteDesign {
         name: String::new(),
         site_type,
         vertices: vs,
         out,
     });
+    sites.by_vertices.insert(key, piece.sites.len() - 1);
     Some(piece.sites.len() - 1)
 }
 
@@ -515,6 +740,15 @@ impl Design {
                 a.name, b.name, p.name
             )));
         }
+        if !self.self_docks(piece, from, to) {
+            return Err(AuthorError(format!(
+                "sites `{}` and `{}` of piece `{}` are not the same shape (docked end to end, copies of it miss by {} m), so it cannot repeat between them; draw its repeated shapes alike within the tolerance",
+                a.name,
+                b.name,
+                p.name,
+                round6(self.self_dock_gap(piece, from, to))
+            )));
+        }
         self.pieces[piece].stretch = Some([from, to]);
         Ok(())
     }
@@ -542,11 +776,12 @@ impl Design {
         let best = pairs
             .into_iter()
             .filter(|((a, b), _)| sites[*a].out.dot(sites[*b].out) < -0.5)
+            .filter(|((a, b), _)| self.self_docks(piece, *a, *b) && self.self_docks(piece, *b, *a))
             .max_by_key(|&((a, b), n)| (n, std::cmp::Reverse((a, b))))
             .map(|(k, _)| k);
         let Some((a, b)) = best else {
             return Err(AuthorError(format!(
-                "no two instances of `{}` are docked through opposite sites, so there is no row to stretch",
+                "no two instances of `{}` are docked through opposite sites of one shape, so there is no row to stretch",
                 self.pieces[piece].name
             )));
         };
@@ -736,57 +971,37 @@ impl Design {
 
     // Long because: the model block's items in order (instances, chains, placement, docks).
     fn model_block(&self) -> ModelBlock {
-        let chains = self.chains();
-        let mut chain_of: HashMap<usize, (usize, usize)> = HashMap::new();
+        let layout = self.layout();
+        let (chains, chain_of) = (&layout.chains, &layout.chain_of);
         let mut chain_names = Vec::new();
         let mut per_piece: HashMap<usize, usize> = HashMap::new();
-        for (c, run) in chains.iter().enumerate() {
-            for (k, &i) in run.iter().enumerate() {
-                chain_of.insert(i, (c, k));
-            }
+        let mut taken: HashSet<String> = self.instances.iter().map(|i| i.name.clone()).collect();
+        for run in chains {
             let piece = self.instances[run[0]].piece;
             let n = per_piece.entry(piece).or_insert(0);
-            *n += 1;
+            // A chain's name is an instance name too (E010): skip those taken.
             let base = format!("{}_chain", self.pieces[piece].name);
-            chain_names.push(if *n == 1 { base } else { format!("{base}{n}") });
+            let name = loop {
+                *n += 1;
+                let name = if *n == 1 {
+                    base.clone()
+                } else {
+                    format!("{base}{n}")
+                };
+                if !taken.contains(name.as_str()) {
+                    break name;
+                }
+            };
+            taken.insert(name.clone());
+            chain_names.push(name);
         }
         // One instance per connected group is placed with `at`; the rest through their docks.
-        let n = self.instances.len();
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for d in &self.docks {
-            let (a, b) = (find(&mut parent, d.a.0), find(&mut parent, d.b.0));
-            parent[a.max(b)] = a.min(b);
-        }
-        let mut placed_root: HashMap<usize, usize> = HashMap::new();
-        for run in &chains {
-            let r = find(&mut parent, run[0]);
-            placed_root.entry(r).or_insert(run[0]);
-        }
-        for i in 0..n {
-            let r = find(&mut parent, i);
-            placed_root.entry(r).or_insert(i);
-        }
-        let anchored: HashSet<usize> = placed_root.values().copied().collect();
         let place = |i: usize| -> (Option<Point>, Option<Expr>) {
-            if !anchored.contains(&i) {
+            if !layout.anchored.contains(&i) {
                 return (None, None);
             }
-            let inst = &self.instances[i];
-            let mut deg = round6(inst.angle.to_degrees());
-            if deg <= -180.0 {
-                deg += 360.0;
-            }
-            (
-                Some(point(round_point(inst.at))),
-                (deg != 0.0).then(|| number(deg)),
-            )
+            let (deg, at) = self.written_motion(i);
+            (Some(point(at)), (deg != 0.0).then(|| number(deg)))
         };
         let mut stmts = Vec::new();
         for (i, inst) in self.instances.iter().enumerate() {
@@ -831,16 +1046,9 @@ impl Design {
                 },
             }
         };
-        for d in &self.docks {
+        for (k, d) in self.docks.iter().enumerate() {
             // Docks inside a chain are implied by the chain.
-            let internal = |x: (usize, usize), y: (usize, usize)| match (
-                chain_of.get(&x.0),
-                chain_of.get(&y.0),
-            ) {
-                (Some(&(c1, k1)), Some(&(c2, k2))) => c1 == c2 && k2 == k1 + 1,
-                _ => false,
-            };
-            if internal(d.a, d.b) || internal(d.b, d.a) {
+            if self.implied_by_chain(&layout, k) {
                 continue;
             }
             stmts.push(ModelStmt::Dock(DockDecl {

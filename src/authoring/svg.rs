@@ -32,6 +32,22 @@ pub fn drawing_from_svg(text: &str, scale: f64) -> Result<Drawing, AuthorError> 
     Ok(drawing)
 }
 
+/// The line (from 1) of the first element of SVG `text` whose `id` attribute is `id`, for
+/// pointing at a path an error names.
+pub fn line_of_id(text: &str, id: &str) -> Option<usize> {
+    ["\"", "'"].iter().find_map(|q| {
+        let needle = format!("id={q}{id}{q}");
+        text.match_indices(&needle)
+            .find(|(at, _)| {
+                text[..*at]
+                    .chars()
+                    .next_back()
+                    .is_some_and(char::is_whitespace)
+            })
+            .map(|(at, _)| text[..at].matches('\n').count() + 1)
+    })
+}
+
 fn collect(group: &usvg::Group, scale: f64, drawing: &mut Drawing) {
     for node in group.children() {
         match node {

@@ -4,7 +4,7 @@
 //! graph, regions, pieces, then the declarations written into the syntax tree). The editor's
 //! author mode keeps only the undo history and its UI; `clayc author` computes the same way.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::DVec2;
 
@@ -171,14 +171,16 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
         .map(|&p| graph.cut(p, tol))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;
-    let (regions, contacts) = if sections.is_empty() {
+    let split = if sections.is_empty() {
         graph.loop_regions()
     } else {
         graph.regions(&sections)
     }
     .map_err(|e| e.to_string())?;
-    let mut design =
-        super::pieces::find_pieces(&graph, &regions, &contacts, tol).map_err(|e| e.to_string())?;
+    let regions = split.regions;
+    let mut design = super::pieces::find_pieces(&graph, &regions, &split.contacts, tol)
+        .map_err(|e| e.to_string())?;
+    design.notes.splice(0..0, split.notes);
     let generated_piece_names = name_pieces(&graph, &regions, work, &mut design);
     colour_pieces(&graph, &regions, &mut design);
     if let Some(choice) = &work.stretch
@@ -239,6 +241,7 @@ pub fn compute(work: &Work) -> Result<Computed, String> {
         let mut keep = used.iter();
         generated_site_types.retain(|_| *keep.next().unwrap_or(&true));
     }
+    design.fit_docks();
     for d in &design.docks {
         if let (Some(a), Some(b)) = (piece_site(&design, d.a), piece_site(&design, d.b)) {
             let ty = |(p, s): (usize, usize)| design.pieces[p].sites[s].site_type;
@@ -337,12 +340,14 @@ fn instance_sources<'g>(
 /// Every piece's fill: the drawing's fill of one of its instances, else a palette colour (the
 /// library would write one brown for all of them).
 fn colour_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
-    let sources = instance_sources(graph, regions, design);
+    let mut fills: Vec<Option<[u8; 3]>> = vec![None; design.pieces.len()];
+    for s in instance_sources(graph, regions, design) {
+        if fills[s.piece].is_none() {
+            fills[s.piece] = s.fill;
+        }
+    }
     for (pi, piece) in design.pieces.iter_mut().enumerate() {
-        piece.fill = sources
-            .iter()
-            .find_map(|s| if s.piece == pi { s.fill } else { None })
-            .unwrap_or(PALETTE[pi % PALETTE.len()]);
+        piece.fill = fills[pi].unwrap_or(PALETTE[pi % PALETTE.len()]);
     }
 }
 
@@ -363,30 +368,35 @@ fn name_pieces(graph: &Graph, regions: &[Region], work: &Work, design: &mut Desi
         counts[s.piece] += 1;
     }
     // Each piece's ids, most frequent first (ties: in instance order).
-    let ids: Vec<Vec<String>> = (0..n)
-        .map(|pi| {
-            let mut seen: Vec<(String, usize)> = Vec::new();
-            for name in sources
-                .iter()
-                .filter(|s| s.piece == pi)
-                .filter_map(|s| s.id.and_then(name_from_id))
-            {
-                match seen.iter_mut().find(|(s, _)| *s == name) {
-                    Some((_, k)) => *k += 1,
-                    None => seen.push((name, 1)),
-                }
+    let mut seen: Vec<Vec<(String, usize)>> = vec![Vec::new(); n];
+    let mut where_seen: HashMap<(usize, String), usize> = HashMap::new();
+    for s in &sources {
+        let Some(name) = s.id.and_then(name_from_id) else {
+            continue;
+        };
+        let list = &mut seen[s.piece];
+        match where_seen.get(&(s.piece, name.clone())) {
+            Some(&k) => list[k].1 += 1,
+            None => {
+                where_seen.insert((s.piece, name.clone()), list.len());
+                list.push((name, 1));
             }
-            seen.sort_by_key(|(_, k)| std::cmp::Reverse(*k));
-            seen.into_iter().map(|(s, _)| s).collect()
+        }
+    }
+    let ids: Vec<Vec<String>> = seen
+        .into_iter()
+        .map(|mut list| {
+            list.sort_by_key(|(_, k)| std::cmp::Reverse(*k));
+            list.into_iter().map(|(s, _)| s).collect()
         })
         .collect();
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&p| std::cmp::Reverse(counts[p]));
-    let mut taken: Vec<String> = vec!["base".into()];
+    let mut taken: HashSet<String> = ["base".to_string()].into_iter().collect();
     let mut names: Vec<Option<String>> = vec![None; n];
     for &p in &order {
-        if let Some(id) = ids[p].iter().find(|i| !taken.contains(i)) {
-            taken.push(id.clone());
+        if let Some(id) = ids[p].iter().find(|i| !taken.contains(*i)) {
+            taken.insert(id.clone());
             names[p] = Some(id.clone());
         }
     }
@@ -397,7 +407,7 @@ fn name_pieces(graph: &Graph, regions: &[Region], work: &Work, design: &mut Desi
                     .map(|k| format!("piece{k}"))
                     .find(|g| !taken.contains(g))
                     .unwrap_or_default();
-                taken.push(name.clone());
+                taken.insert(name.clone());
                 name
             })
         })
@@ -418,10 +428,13 @@ fn name_pieces(graph: &Graph, regions: &[Region], work: &Work, design: &mut Desi
     for (piece, name) in design.pieces.iter_mut().zip(&shown) {
         piece.name.clone_from(name);
     }
-    let mut counts = vec![0usize; n];
-    for inst in &mut design.instances {
-        inst.name = format!("{}{}", shown[inst.piece], counts[inst.piece]);
-        counts[inst.piece] += 1;
+    let of: Vec<usize> = design.instances.iter().map(|i| i.piece).collect();
+    for (inst, name) in design
+        .instances
+        .iter_mut()
+        .zip(super::pieces::instance_names(&shown, &of))
+    {
+        inst.name = name;
     }
     generated
 }

@@ -7,8 +7,10 @@
 use std::path::PathBuf;
 
 use crate::out;
+use clay::authoring::graph::MIN_TOLERANCE;
+use clay::authoring::svg::{drawing_from_svg, line_of_id as svg_line_of_id};
 use clay::authoring::work::{MergeChoice, SiteName, StateChoice, VariantChoice, Work, compute};
-use clay::authoring::{StretchChoice, svg::drawing_from_svg};
+use clay::authoring::{StretchChoice, check_authored};
 use glam::DVec2;
 
 #[derive(clap::Args)]
@@ -119,8 +121,10 @@ fn work_from(args: &AuthorArgs) -> Result<Work, String> {
         .iter()
         .map(|c| parse_point(c))
         .collect::<Result<Vec<_>, _>>()?;
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err("--tolerance must be a positive number of metres".into());
+    if !(args.tolerance.is_finite() && args.tolerance >= MIN_TOLERANCE) {
+        return Err(format!(
+            "--tolerance must be a number of metres from {MIN_TOLERANCE} up (the grammar is written to the micrometre)"
+        ));
     }
     if !args.variants.is_empty() && !args.stretch {
         return Err("--variant needs --stretch: variants belong to the stretch rule".into());
@@ -148,6 +152,19 @@ fn work_from(args: &AuthorArgs) -> Result<Work, String> {
     })
 }
 
+/// `error: FILE[:LINE]: message`, the line being that of the SVG element a message names
+/// (`path `ID``), when the drawing has one such id.
+fn report(path: &str, svg: &str, message: &str) {
+    let line = message
+        .split_once("path `")
+        .and_then(|(_, rest)| rest.split_once('`'))
+        .and_then(|(id, _)| svg_line_of_id(svg, id));
+    match line {
+        Some(line) => errln!("error: {path}:{line}: {message}"),
+        None => errln!("error: {path}: {message}"),
+    }
+}
+
 pub fn author_cmd(args: AuthorArgs) -> u8 {
     let mut work = match work_from(&args) {
         Ok(w) => w,
@@ -157,17 +174,17 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
         }
     };
     let path = args.drawing.display().to_string();
-    let text = match std::fs::read_to_string(&args.drawing) {
+    let svg = match std::fs::read_to_string(&args.drawing) {
         Ok(t) => t,
         Err(e) => {
             errln!("error: cannot read `{path}`: {e}");
             return 2;
         }
     };
-    let drawing = match drawing_from_svg(&text, args.scale) {
+    let drawing = match drawing_from_svg(&svg, args.scale) {
         Ok(d) => d,
         Err(e) => {
-            errln!("error: {path}: {e}");
+            report(&path, &svg, &e.to_string());
             return 1;
         }
     };
@@ -175,7 +192,7 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
     let computed = match compute(&work) {
         Ok(c) => c,
         Err(e) => {
-            errln!("error: {path}: {e}");
+            report(&path, &svg, &e);
             return 1;
         }
     };
@@ -204,12 +221,17 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
         path, args.scale
     );
     text += &computed.text;
-    let authored = computed;
+    // The last line of defence: never write a grammar that fails `clayc check`.
+    let out_name = args.output.display().to_string();
+    if let Err(e) = check_authored(&text, &out_name) {
+        errln!("error: {path}: {e}");
+        return 1;
+    }
     let code = out::write_output(&args.output, text.as_bytes());
     if code != 0 {
         return code;
     }
-    let d = &authored.design;
+    let d = &computed.design;
     errln!(
         "authored {} piece(s), {} instance(s), {} dock(s)",
         d.pieces.len(),
