@@ -62,6 +62,25 @@ pub fn triangle_contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
     !(neg && pos)
 }
 
+/// Whether `p` is inside `rings` by the even-odd rule (inside the outer ring and outside every
+/// hole; rings may wind either way): a horizontal ray from `p` crosses the rings' edges an odd
+/// number of times, each edge counted half-open in y so a ray through a vertex counts once.
+/// The containment rule of every ring test (tessellation keeps the triangles it puts inside);
+/// a triangle with its boundary is [`triangle_contains`].
+pub fn rings_contain(rings: &[Vec<DVec2>], p: DVec2) -> bool {
+    let mut inside = false;
+    for ring in rings {
+        let n = ring.len();
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
 /// The mean of the points (the centroid of a vertex set, not of an area); `None` for none.
 pub fn centroid(points: impl IntoIterator<Item = DVec2>) -> Option<DVec2> {
     let (sum, n) = points

@@ -2,7 +2,8 @@
 //! geometry-frame coordinates, computed once per piece and rest state.
 //!
 //! Polygons (concave, with holes) go through spade's constrained Delaunay triangulation: every
-//! ring is inserted as constraint edges and the triangles inside by the even-odd rule are kept.
+//! ring is inserted as constraint edges and the triangles inside by the even-odd rule
+//! (`plane::rings_contain`) are kept.
 //! Which triangles are inside is found in one walk over the triangulation from its outside, the
 //! parity flipping across every edge that an odd number of ring segments cover: O(n) after the
 //! O(n log n) triangulation, for 200,000-point rings too. Only when a self-crossing ring had a
@@ -139,7 +140,7 @@ pub fn tessellate_polygon(
             .inner_faces()
             .map(|face| {
                 let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
-                inside_even_odd((a + b + c) / 3.0, &rings)
+                crate::plane::rings_contain(&rings, (a + b + c) / 3.0)
             })
             .collect(),
     };
@@ -424,21 +425,6 @@ fn clean_ring(ring: &[DVec2]) -> Option<Vec<DVec2>> {
         .then_some(out)
 }
 
-/// Even-odd rule over all rings: inside the outer ring and outside every hole.
-fn inside_even_odd(p: DVec2, rings: &[Vec<DVec2>]) -> bool {
-    let mut inside = false;
-    for ring in rings {
-        let n = ring.len();
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-                inside = !inside;
-            }
-        }
-    }
-    inside
-}
-
 /// Edges that belong to exactly one triangle, oriented as in that triangle, in the order the
 /// triangles give them. Sorting the undirected edges counts them in O(n log n).
 fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
@@ -525,7 +511,11 @@ mod tests {
                 let pts = face.positions().map(|p| DVec2::new(p.x, p.y));
                 if signed_area(pts).abs() > 1e-9 {
                     let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
-                    assert_eq!(inside, inside_even_odd(centroid, &rings), "{rings:?}");
+                    assert_eq!(
+                        inside,
+                        crate::plane::rings_contain(&rings, centroid),
+                        "{rings:?}"
+                    );
                     compared += 1;
                 }
             }
