@@ -13,6 +13,9 @@ use glam::DVec2;
 
 use crate::session::{Pin, Settings};
 
+mod worker;
+use worker::Worker;
+
 /// What the user asks of the model. The UI emits these; [`Sculpt::apply`] applies them after
 /// the frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -126,14 +129,47 @@ pub struct Sculpt {
     log: Vec<LogEntry>,
     /// The sequence number of the next log entry (entries keep their order across undo).
     next_seq: u64,
-    /// A solver frame running on another thread ([`Sculpt::step_in_background`]).
-    job: Option<std::thread::JoinHandle<Job>>,
+    /// The thread of the background solver frames ([`Sculpt::step_in_background`]), started
+    /// at the first; busy while a frame runs there.
+    worker: Option<Worker<Request, Job>>,
     /// The model the last background frame started from, reused for the next one.
     spare: Option<Assembly>,
     /// The grab moved while a background frame ran (its result is then not a fixed point).
     moved_while_solving: bool,
     /// A model no longer needed, freed by the next background frame's thread.
     stale: Option<Assembly>,
+}
+
+/// A background solver frame to run: the model, solver and rules to work on, within `budget`.
+struct Request {
+    model: Assembly,
+    session: Session,
+    budget: Duration,
+    /// A model no longer needed, freed on the worker's thread.
+    stale: Option<Assembly>,
+}
+
+/// One background solver frame, as the worker's thread runs it.
+fn run_request(request: Request) -> Job {
+    let Request {
+        mut model,
+        mut session,
+        budget,
+        stale,
+    } = request;
+    // freeing a whole model costs milliseconds at 10k parts: not on the UI thread
+    drop(stale);
+    let generation = model.generation();
+    let outcome = solve_frame(&mut model, &mut session, budget);
+    // After a rewrite the model shown now can no longer be brought up to date in place for
+    // the next frame: copy the result here, off the UI thread.
+    let spare = (model.generation() != generation).then(|| model.clone());
+    Job {
+        model,
+        spare,
+        session,
+        outcome,
+    }
 }
 
 /// What a background solver frame hands back: the model, solver and rules it worked on.
@@ -228,7 +264,7 @@ impl Sculpt {
             history: 0,
             log: Vec::new(),
             next_seq: 0,
-            job: None,
+            worker: None,
             spare: None,
             moved_while_solving: false,
             stale: None,
@@ -331,7 +367,7 @@ impl Sculpt {
 
     /// Whether the solver has work left; the app keeps repainting while it has.
     pub fn needs_work(&self) -> bool {
-        (self.unsettled || self.job.is_some()) && self.error.is_none()
+        (self.unsettled || self.solving_in_background()) && self.error.is_none()
     }
 
     /// Whether the model rests: the solver has nothing left to do and the last frame's energy
@@ -425,7 +461,7 @@ impl Sculpt {
     pub fn apply(&mut self, command: Command) {
         if matches!(command, Command::MoveGrab { .. }) {
             // applied to the model shown; a running frame picks the new target up when done
-            self.moved_while_solving |= self.job.is_some();
+            self.moved_while_solving |= self.solving_in_background();
         } else {
             self.collect_job(true);
         }
@@ -588,64 +624,68 @@ impl Sculpt {
     /// the next one (budgeted by `budget`) on a copy of the model as it is now. The model shown
     /// is the last finished frame, one frame behind the solver. Commands other than moving the
     /// grab wait for a running frame first, so they always act on the latest model. Returns
-    /// whether work remains (call again next UI frame).
+    /// whether work remains (call again next UI frame). The thread is the sculpt's own, started
+    /// at the first call and ended with the sculpt; where it cannot be started the frame runs
+    /// on this thread ([`Sculpt::step`]).
     pub fn step_in_background(&mut self, budget: Duration) -> bool {
         self.frames_last_step = 0;
         self.collect_job(false);
-        if self.job.is_none() && self.needs_work() {
-            // A frame moves positions, states, rotations and handles only: the spare copy of
-            // the last frame is brought up to date in place; after a rule rewrote the model
-            // (new generation) it is cloned afresh.
-            let mut model = match self.spare.take() {
-                Some(mut spare) => {
-                    if spare.sync_from(&self.assembly) {
-                        spare
-                    } else {
-                        self.stale = Some(spare);
-                        self.assembly.clone()
-                    }
+        if self.solving_in_background() || !self.needs_work() {
+            return self.needs_work();
+        }
+        if self.worker.is_none() {
+            match Worker::start("clay-sculpt-solver", run_request) {
+                Ok(worker) => self.worker = Some(worker),
+                Err(_) => return self.step(budget),
+            }
+        }
+        // A frame moves positions, states, rotations and handles only: the spare copy of the
+        // last frame is brought up to date in place; after a rule rewrote the model (new
+        // generation) it is cloned afresh.
+        let model = match self.spare.take() {
+            Some(mut spare) => {
+                if spare.sync_from(&self.assembly) {
+                    spare
+                } else {
+                    self.stale = Some(spare);
+                    self.assembly.clone()
                 }
-                None => self.assembly.clone(),
-            };
-            let placeholder = Session::new(self.session.config());
-            let mut session = std::mem::replace(&mut self.session, placeholder);
-            let stale = self.stale.take();
-            self.moved_while_solving = false;
-            self.job = Some(std::thread::spawn(move || {
-                // freeing a whole model costs milliseconds at 10k parts: not on the UI thread
-                drop(stale);
-                let generation = model.generation();
-                let outcome = solve_frame(&mut model, &mut session, budget);
-                // After a rewrite the model shown now can no longer be brought up to date in
-                // place for the next frame: copy the result here, off the UI thread.
-                let spare = (model.generation() != generation).then(|| model.clone());
-                Job {
-                    model,
-                    spare,
-                    session,
-                    outcome,
-                }
-            }));
+            }
+            None => self.assembly.clone(),
+        };
+        let placeholder = Session::new(self.session.config());
+        let session = std::mem::replace(&mut self.session, placeholder);
+        let stale = self.stale.take();
+        self.moved_while_solving = false;
+        let request = Request {
+            model,
+            session,
+            budget,
+            stale,
+        };
+        let worker = self.worker.as_mut().expect("started above");
+        if let Err(request) = worker.submit(request) {
+            // the thread is gone: this frame runs here, and the next call starts another
+            self.worker = None;
+            self.session = request.session;
+            self.spare = Some(request.model);
+            return self.step(budget);
         }
         self.needs_work()
     }
 
     /// Whether a solver frame is running on another thread.
     pub fn solving_in_background(&self) -> bool {
-        self.job.is_some()
+        self.worker.as_ref().is_some_and(Worker::busy)
     }
 
     /// Takes in the background frame, waiting for it when `wait` (before any command that
     /// changes the model), else only if it has finished.
     fn collect_job(&mut self, wait: bool) {
-        let Some(handle) = self.job.take() else {
+        let Some(result) = self.worker.as_mut().and_then(|w| w.take(wait)) else {
             return;
         };
-        if !wait && !handle.is_finished() {
-            self.job = Some(handle);
-            return;
-        }
-        match handle.join() {
+        match result {
             Ok(job) if job.outcome.panicked => {
                 // The frame's copy may be half rewritten: the model shown stays.
                 self.session = job.session;
@@ -677,7 +717,8 @@ impl Sculpt {
                 }
             }
             Err(_) => {
-                // The frame's model is lost with the thread; the one shown stays.
+                // The frame's model is lost (a panic outside the guarded frame, or the thread
+                // gone); the one shown stays.
                 self.error = Some("the solver stopped unexpectedly".to_string());
             }
         }
