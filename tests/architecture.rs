@@ -1,7 +1,8 @@
 //! The architecture invariants of `docs/architecture.md` that a reading of the source can
 //! check: no import cycle between the modules of a crate, the editor uses only the library's
 //! surfaces (the session, rendering, authoring, and the solver's settings and report types),
-//! rules never import sessions or scripts, and protocol types stay in the language server.
+//! rules never import sessions or scripts, protocol types stay in the language server, a
+//! solver frame changes no part, instance or connection, and the libraries print nothing.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -254,5 +255,119 @@ fn protocol_types_live_only_in_the_language_server() {
             !text.contains("lsp-"),
             "{manifest} depends on a protocol crate"
         );
+    }
+}
+
+/// The structure of an assembly a solver frame must leave alone: its parts (all but the
+/// active state), its instances (all but the state shown), docks and chains.
+fn structure(data: &clay_dsl::compiled::AssemblyData) -> String {
+    let parts: Vec<_> = (data.parts.iter())
+        .map(|p| (p.kind, &p.vertices, &p.edges, &p.states))
+        .collect();
+    let instances: Vec<_> = (data.instances.iter())
+        .map(|i| (i.id, &i.name, i.piece, &i.vertices))
+        .collect();
+    format!(
+        "{parts:?}\n{instances:?}\n{:?}\n{:?}\n{}",
+        data.docks,
+        data.chains,
+        data.positions.len()
+    )
+}
+
+/// Architecture Invariant: the solver moves vertices and picks rest states; only the rules
+/// change what the assembly is made of. Frames that stretch, squeeze, bend and let go of the
+/// example models (where the rules would rewrite them) leave parts, instances and connections
+/// as they were.
+#[test]
+fn a_solver_frame_changes_no_part_instance_or_connection() {
+    use clay::assembly::{Assembly, Compass, HandleKind};
+    use clay::solver::{Solver, SolverConfig};
+    use glam::DVec2;
+    let mut models = Vec::new();
+    for name in [
+        "wall.clay",
+        "bend.clay",
+        "castle.clay",
+        "junction.clay",
+        "centipede.clay",
+    ] {
+        let path = root().join("grammars").join(name);
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let compiled = clay_dsl::compile(&text, &path.to_string_lossy()).unwrap();
+        models.push((name, compiled.grammar));
+    }
+    assert!(models.len() >= 3, "the example grammars are read");
+    for (name, grammar) in models {
+        let mut asm = Assembly::new(std::sync::Arc::new(grammar));
+        let before = structure(asm.data());
+        let mut solver = Solver::new(SolverConfig::from_params(&asm.grammar().solver));
+        let west = asm.part_extreme(Compass::West).unwrap();
+        let east = asm.part_extreme(Compass::East).unwrap();
+        asm.hold_part(west, HandleKind::Pin).unwrap();
+        let grab = asm.hold_part(east, HandleKind::Grab).unwrap();
+        let size = clay::solver::bbox_diagonal(&asm.data().positions);
+        let moves = [
+            (DVec2::new(size, 0.0), 0.0),
+            (DVec2::new(-0.8 * size, 0.0), 0.0),
+            (DVec2::new(0.0, 0.5 * size), 1.2),
+        ];
+        for (translation, angle) in moves {
+            let h = asm.handle_mut(grab).unwrap();
+            h.translation = translation;
+            h.angle = angle;
+            for _ in 0..20 {
+                solver.frame(&mut asm).unwrap();
+                assert_eq!(structure(asm.data()), before, "{name}");
+            }
+        }
+        asm.release(grab);
+        for _ in 0..40 {
+            solver.frame(&mut asm).unwrap();
+        }
+        assert_eq!(structure(asm.data()), before, "{name}");
+    }
+}
+
+/// Architecture Invariant: the libraries (`clay` outside its binaries, `clay-dsl`) never
+/// write to the terminal; they return text and diagnostics, and the binaries (and the editor)
+/// decide where they go. Whole files are read, tests included.
+#[test]
+fn the_libraries_print_nothing() {
+    let bin = root().join("src/bin");
+    let mut files = Vec::new();
+    for dir in ["src", "dsl/src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    files.retain(|f| !f.starts_with(&bin));
+    assert!(files.len() > 40, "only {} files read", files.len());
+    let writers = [
+        "println!",
+        "eprintln!",
+        "print!(",
+        "eprint!(",
+        "dbg!(",
+        "io::stdout",
+        "io::stderr",
+        "stdout()",
+        "stderr()",
+        "BufferWriter",
+        "StandardStream",
+    ];
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for w in writers {
+                assert!(
+                    !code.contains(w),
+                    "{}:{}: `{w}` in a library: return the text and let the binary print it",
+                    f.display(),
+                    n + 1
+                );
+            }
+        }
     }
 }

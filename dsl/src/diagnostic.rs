@@ -4,7 +4,7 @@
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term;
-use codespan_reporting::term::termcolor::{Buffer, BufferWriter, ColorChoice};
+use codespan_reporting::term::termcolor::Buffer;
 use serde::Serialize;
 
 use crate::line_index::LineIndex;
@@ -220,7 +220,7 @@ fn term_config() -> term::Config {
     term::Config::default()
 }
 
-/// Most diagnostics a human rendering shows ([`render`], [`emit_to_stderr`]); one closing line
+/// Most diagnostics a human rendering shows ([`render`]); one closing line
 /// counts the rest ([`omitted_line`]). A file with thousands of mistakes has one cause more
 /// often than thousands, and each diagnostic prints its source line. The JSON form keeps all.
 pub const MAX_HUMAN_DIAGNOSTICS: usize = 50;
@@ -318,21 +318,6 @@ fn sev_word(s: Severity) -> &'static str {
         Severity::Error => "error",
         Severity::Warning => "warning",
     }
-}
-
-/// Writes diagnostics to stderr as [`render`] does, coloured when `color` (the caller checks
-/// for a terminal and NO_COLOR). The rendering is written in one piece: codespan writes a
-/// source line a character at a time, which is a system call each on unbuffered stderr.
-pub fn emit_to_stderr(diagnostics: &Diagnostics, source: &str, path: &str, color: bool) {
-    let choice = if color {
-        ColorChoice::Always
-    } else {
-        ColorChoice::Never
-    };
-    let writer = BufferWriter::stderr(choice);
-    let mut buffer = writer.buffer();
-    render_into(&mut buffer, diagnostics, source, path);
-    let _ = writer.print(&buffer);
 }
 
 /// A position in the JSON form: 1-based line and column.

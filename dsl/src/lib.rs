@@ -34,7 +34,7 @@ pub use compile::{
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{
     Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, MAX_HUMAN_DIAGNOSTICS,
-    Severity, emit_to_stderr, omitted_line, render, to_json,
+    Severity, omitted_line, render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
 pub use line_index::{LineIndex, LinePos};

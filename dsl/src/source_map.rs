@@ -5,7 +5,7 @@
 //! renderers map a span back to its file and local offset through [`SourceMap::locate`].
 //!
 //! The map holds the imported files only: the main file's text and path are what the caller of
-//! `render`, `to_json` and `emit_to_stderr` passes, as before imports existed.
+//! `render` and `to_json` pass, as before imports existed.
 
 use std::sync::Arc;
 

@@ -114,8 +114,12 @@ pub fn read(path: &Path) -> Result<Vec<u8>, Unreadable> {
 }
 
 fn print_human(diags: &Diagnostics, bytes: &[u8], path: &str) {
+    use std::io::Write;
     let source = String::from_utf8_lossy(bytes);
-    clay_dsl::emit_to_stderr(diags, &source, path, stderr_color());
+    // in one piece: codespan writes a source line a character at a time, a system call each
+    // on unbuffered stderr
+    let text = clay_dsl::render(diags, &source, path, stderr_color());
+    let _ = std::io::stderr().lock().write_all(text.as_bytes());
 }
 
 pub fn check(args: CheckArgs) -> u8 {
