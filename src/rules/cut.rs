@@ -10,10 +10,10 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, InstanceSite};
 use glam::DVec2;
 
 use super::merge::take_over;
-use super::{
-    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, remove_instances,
-    site_centre, transaction,
+use super::rewrite::{
+    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, remove_instances, transaction,
 };
+use super::sites::site_centre;
 
 /// How far (metres) from the nearest docked site's centre a cut may point; at least this,
 /// or twice the grammar's merge distance if that is larger.

@@ -15,10 +15,12 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, Dock, Instance, Instance
 use glam::DVec2;
 
 use super::proximity::SiteGrid;
-use super::{
-    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, fit, generated_name,
-    remove_instances, site_centre, site_out, transaction,
+use super::rewrite::{
+    PartsBefore, Rewrite, RuleEvent, RuleKind, derive_chains, finish, generated_name,
+    remove_instances, transaction,
 };
+use super::sites::{site_centre, site_out};
+use crate::fit;
 
 /// The most the dot product of two sites' current `out` directions may be for a merge to weld
 /// them: -cos 45 degrees, so the two directions are within 45 degrees of exactly opposite

@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
-use super::{RuleEvent, RuleKind};
+use super::rewrite::{RuleEvent, RuleKind};
 use crate::fit::align;
 use crate::solver::StateSwitch;
 

@@ -17,7 +17,7 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
-use super::{
+use super::rewrite::{
     PartsBefore, Rewrite, RuleEvent, RuleKind, finish, generated_name, remove_instances,
     transaction,
 };
