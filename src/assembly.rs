@@ -68,6 +68,21 @@ impl Handle {
     pub fn target_centre(&self) -> DVec2 {
         self.centre + self.translation
     }
+
+    /// Holds the vertices at `at` (one per vertex) from now on, unmoved and unturned: a saved
+    /// pin put back where it held. Ignored unless `at` has one point per vertex.
+    pub fn place(&mut self, at: &[DVec2]) {
+        if at.len() != self.anchor.len() || at.is_empty() {
+            return;
+        }
+        self.centre = at.iter().copied().sum::<DVec2>() / at.len() as f64;
+        self.translation = DVec2::ZERO;
+        self.angle = 0.0;
+        self.anchor = at.to_vec();
+        if let Some(held) = &mut self.held {
+            held.anchor = at.to_vec();
+        }
+    }
 }
 
 /// A compass direction for picking the part reaching furthest that way.
@@ -451,6 +466,16 @@ impl Assembly {
             return None;
         }
         Some(vs.iter().map(|&v| self.data.positions[v]).sum::<DVec2>() / vs.len() as f64)
+    }
+
+    /// The instance of `part` whose centre is nearest `at` (a stretch part covers two): what
+    /// a handle made where the pointer is on that part holds.
+    pub fn instance_of_part_at(&self, part: usize, at: DVec2) -> Option<usize> {
+        let d = |i| {
+            self.instance_centroid(i)
+                .map_or(f64::INFINITY, |c| c.distance_squared(at))
+        };
+        (self.data.part_instances(part).into_iter()).min_by(|&a, &b| d(a).total_cmp(&d(b)))
     }
 
     /// The instance (piece element) whose centroid is nearest `point` (ties: lowest index).

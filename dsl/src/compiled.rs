@@ -420,6 +420,18 @@ impl CompiledGrammar {
 pub const COINCIDENCE_TOLERANCE: f64 = 1e-4;
 
 impl AssemblyData {
+    /// The instances a part covers, in chain order: one for a piece part, two for a stretch
+    /// part (none for a part that does not exist).
+    pub fn part_instances(&self, part: usize) -> Vec<usize> {
+        match self.parts.get(part).map(|p| p.kind) {
+            Some(PartKind::Piece { instance }) => vec![instance],
+            Some(PartKind::Stretch { chain, first }) => (self.chains.get(chain))
+                .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
+                .unwrap_or_default(),
+            None => Vec::new(),
+        }
+    }
+
     /// Checks the structural invariants every assembly keeps, whether the compiler or a rule made
     /// it: indices in range, vertex counts matching pieces and rest states, docked sites sharing
     /// their vertices in opposite order, chains docked `to` -> `from` element by element, every

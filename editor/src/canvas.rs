@@ -2,7 +2,7 @@
 //! hovered, grabbed and pinned parts marked, finds the part or connection under the cursor, and
 //! turns pointer and key input into [`Command`]s. It never changes the model itself.
 
-use clay::render::pick::{instances_of, part_at};
+use clay::render::pick::part_at;
 use clay::render::pose::pose_assembly_into;
 use clay::render::{TessellationCache, WorldMesh};
 use clay_dsl::compiled::AssemblyData;
@@ -311,7 +311,7 @@ impl Canvas {
             }
         }
         if let Some(part) = self.hovered {
-            let instances = instances_of(data, part);
+            let instances = data.part_instances(part);
             for m in self
                 .meshes
                 .iter()

@@ -8,7 +8,6 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
-use clay::render::pick::instances_of;
 use clay_dsl::analysis::follow::{self, Focus};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use egui::{Color32, Key, Stroke};
@@ -81,7 +80,7 @@ impl Follow {
         data: &AssemblyData,
         part: usize,
     ) {
-        let Some(instance) = instances_of(data, part).into_iter().min() else {
+        let Some(instance) = data.part_instances(part).into_iter().min() else {
             return;
         };
         let Some(i) = data.instances.get(instance) else {

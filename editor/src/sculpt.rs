@@ -5,8 +5,8 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clay::assembly::{Assembly, HandleId, HandleKind};
-use clay::session::Session;
+use clay::assembly::{Assembly, HandleKind};
+use clay::session::{Grab, Session};
 use clay::solver::{FrameReport, SolverConfig, SolverError};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
@@ -62,14 +62,6 @@ struct Snapshot {
     pins: Vec<Pin>,
     /// The rule log as it was: undoing a gesture takes back what its rules logged too.
     log: Vec<LogEntry>,
-}
-
-#[derive(Clone, Debug)]
-struct Grab {
-    handle: HandleId,
-    part: usize,
-    /// The pin the part had, released while it is held and put back where it is dropped.
-    was_pinned: bool,
 }
 
 /// Why a part is in the state it is in.
@@ -355,14 +347,12 @@ impl Sculpt {
 
     /// The part being dragged, if any.
     pub fn grabbed(&self) -> Option<usize> {
-        self.grab.as_ref().map(|g| g.part)
+        self.grab.and_then(|g| g.part())
     }
 
     /// The grabbed handle's current target centre and angle.
     pub fn grab_target(&self) -> Option<(DVec2, f64)> {
-        let g = self.grab.as_ref()?;
-        let h = self.assembly.handle(g.handle)?;
-        Some((h.target_centre(), h.angle))
+        self.grab?.target(&self.assembly)
     }
 
     /// Whether the solver has work left; the app keeps repainting while it has.
@@ -390,8 +380,8 @@ impl Sculpt {
             })
             .collect();
         if let Some(g) = &self.grab
-            && g.was_pinned
-            && let Some(h) = self.assembly.handle(g.handle)
+            && g.was_pinned()
+            && let Some(h) = self.assembly.handle(g.handle())
         {
             pins.push(Pin {
                 vertices: h.vertices.clone(),
@@ -416,45 +406,10 @@ impl Sculpt {
 
     /// Whether an instance of `part` is held by a pin.
     pub fn is_pinned(&self, part: usize) -> bool {
-        self.part_instances(part)
-            .into_iter()
-            .any(|i| self.pin_of(i).is_some())
-            || self
-                .grab
-                .as_ref()
-                .is_some_and(|g| g.part == part && g.was_pinned)
-    }
-
-    /// The instances a part covers (one for a piece part, two for a stretch part).
-    fn part_instances(&self, part: usize) -> Vec<usize> {
-        let data = &self.assembly.data();
-        match data.parts.get(part).map(|p| p.kind) {
-            Some(PartKind::Piece { instance }) => vec![instance],
-            Some(PartKind::Stretch { chain, first }) => data
-                .chains
-                .get(chain)
-                .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
-                .unwrap_or_default(),
-            None => Vec::new(),
-        }
-    }
-
-    /// The instance of `part` whose centre is nearest `at`: what a handle on that part holds.
-    fn instance_at(&self, part: usize, at: DVec2) -> Option<usize> {
         let asm = &self.assembly;
-        self.part_instances(part).into_iter().min_by(|&a, &b| {
-            let d = |i| {
-                asm.instance_centroid(i)
-                    .map_or(f64::INFINITY, |c| c.distance_squared(at))
-            };
-            d(a).total_cmp(&d(b))
-        })
-    }
-
-    /// The pin holding `instance`, found by the instance's stable id (its vertices change when
-    /// rules rewrite the chain around it).
-    fn pin_of(&self, instance: usize) -> Option<HandleId> {
-        Session::pin_of(&self.assembly, instance)
+        (asm.data().part_instances(part).into_iter())
+            .any(|i| clay::session::pin_of(asm, i).is_some())
+            || (self.grab).is_some_and(|g| g.part() == Some(part) && g.was_pinned())
     }
 
     /// Applies one command.
@@ -468,35 +423,24 @@ impl Sculpt {
         match command {
             Command::Grab { part, at } => self.grab(part, at),
             Command::MoveGrab { translation, angle } => {
-                if !(translation.is_finite() && angle.is_finite()) {
-                    return;
-                }
-                if let Some(g) = &self.grab
-                    && let Some(h) = self.assembly.handle_mut(g.handle)
-                    && (h.translation != translation || h.angle != angle)
+                if let Some(g) = self.grab
+                    && g.move_to(&mut self.assembly, translation, angle)
                 {
-                    h.translation = translation;
-                    h.angle = angle;
                     self.unsettled = true;
                 }
             }
             Command::Release => self.release(),
             Command::TogglePin { part, at } => {
-                let Some(instance) = self.instance_at(part, at) else {
+                let Some(instance) = self.assembly.instance_of_part_at(part, at) else {
                     return;
                 };
                 self.release();
                 self.checkpoint();
                 let name = self.assembly.data().instances[instance].name.clone();
-                match self.pin_of(instance) {
-                    Some(id) => {
-                        self.assembly.release(id);
-                        self.note(format!("unpinned {name}"), None);
-                    }
-                    None => {
-                        self.assembly.hold_instance(instance, HandleKind::Pin);
-                        self.note(format!("pinned {name}"), None);
-                    }
+                if clay::session::toggle_pin(&mut self.assembly, instance) {
+                    self.note(format!("pinned {name}"), None);
+                } else {
+                    self.note(format!("unpinned {name}"), None);
                 }
                 self.unsettled = true;
             }
@@ -696,11 +640,9 @@ impl Sculpt {
                 let mut solved = job.model;
                 // The grab moved on while the frame ran: its latest target wins.
                 if let Some(g) = &self.grab
-                    && let Some(now) = self.assembly.handle(g.handle)
-                    && let Some(h) = solved.handle_mut(g.handle)
+                    && let Some(now) = self.assembly.handle(g.handle())
                 {
-                    h.translation = now.translation;
-                    h.angle = now.angle;
+                    g.move_to(&mut solved, now.translation, now.angle);
                 }
                 let shown = std::mem::replace(&mut self.assembly, solved);
                 match job.spare {
@@ -825,21 +767,11 @@ impl Sculpt {
 
     fn grab(&mut self, part: usize, at: DVec2) {
         self.release();
-        let Some(instance) = self.instance_at(part, at) else {
+        if self.assembly.instance_of_part_at(part, at).is_none() {
             return;
-        };
-        self.checkpoint();
-        let was_pinned = match self.pin_of(instance) {
-            Some(id) => self.assembly.release(id),
-            None => false,
-        };
-        if let Some(handle) = self.assembly.hold_instance(instance, HandleKind::Grab) {
-            self.grab = Some(Grab {
-                handle,
-                part,
-                was_pinned,
-            });
         }
+        self.checkpoint();
+        self.grab = Grab::at(&mut self.assembly, part, at);
     }
 
     /// Ends the gesture: a pinned part stays pinned where it was dropped.
@@ -854,15 +786,8 @@ impl Sculpt {
             let outcome = solve_frame(&mut self.assembly, &mut self.session, Duration::MAX);
             self.integrate(outcome);
         }
-        let Some(g) = self.grab.take() else {
-            return;
-        };
-        if let Some(h) = self.assembly.handle_mut(g.handle) {
-            if g.was_pinned {
-                h.kind = HandleKind::Pin;
-            } else {
-                self.assembly.release(g.handle);
-            }
+        if let Some(g) = self.grab.take() {
+            g.release(&mut self.assembly);
         }
         self.unsettled = true;
     }
@@ -903,28 +828,7 @@ impl Sculpt {
         self.log.sort_by_key(|e| e.seq);
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
-            // A pin on exactly one instance's vertices holds that instance, so it keeps
-            // following it through rules; any other vertex set is held as it is.
-            let instance = self
-                .assembly
-                .data()
-                .instances
-                .iter()
-                .position(|i| i.vertices == pin.vertices);
-            let held = match instance {
-                Some(i) => self.assembly.hold_instance(i, HandleKind::Pin),
-                None => self.assembly.hold_vertices(pin.vertices, HandleKind::Pin),
-            };
-            if let Some(id) = held
-                && let Some(h) = self.assembly.handle_mut(id)
-                && pin.at.len() == h.anchor.len()
-            {
-                h.centre = pin.at.iter().copied().sum::<DVec2>() / pin.at.len().max(1) as f64;
-                if let Some(held) = &mut h.held {
-                    held.anchor.clone_from(&pin.at);
-                }
-                h.anchor = pin.at;
-            }
+            clay::session::pin_at(&mut self.assembly, pin.vertices, &pin.at);
         }
         // A fresh solver: the old one's pattern belongs to another topology. The spare copy
         // belongs to it too (and a restored model counts its generations from 0 again).
@@ -963,22 +867,10 @@ impl Sculpt {
 
     /// After a rule renumbered the parts, the grabbed part is the one the handle still holds.
     fn follow_grab(&mut self) {
-        let Some(g) = &mut self.grab else {
-            return;
-        };
-        let Some(h) = self.assembly.handle(g.handle) else {
-            self.grab = None;
-            return;
-        };
-        let held: std::collections::HashSet<usize> = h.vertices.iter().copied().collect();
-        if let Some(p) = self
-            .assembly
-            .data()
-            .parts
-            .iter()
-            .position(|p| p.vertices.iter().all(|v| held.contains(v)))
+        if let Some(g) = &mut self.grab
+            && !g.follow(&self.assembly)
         {
-            g.part = p;
+            self.grab = None;
         }
     }
 

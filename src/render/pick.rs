@@ -2,9 +2,7 @@
 //! else whose edge is within a tolerance. The editor picks with it; it lives here because it
 //! reads the posed meshes ([`WorldMesh`]) the renderer makes.
 
-use std::collections::HashSet;
-
-use clay_dsl::compiled::{AssemblyData, PartKind};
+use clay_dsl::compiled::AssemblyData;
 use glam::DVec2;
 
 use super::pose::WorldMesh;
@@ -12,19 +10,6 @@ use crate::plane::{segment_distance, triangle_contains};
 
 fn world_of([x, y]: [f32; 2]) -> DVec2 {
     DVec2::new(x as f64, y as f64)
-}
-
-/// The instances a part covers.
-pub fn instances_of(data: &AssemblyData, part: usize) -> HashSet<usize> {
-    match data.parts.get(part).map(|p| p.kind) {
-        Some(PartKind::Piece { instance }) => HashSet::from([instance]),
-        Some(PartKind::Stretch { chain, first }) => data
-            .chains
-            .get(chain)
-            .map(|c| c.instances.iter().skip(first).take(2).copied().collect())
-            .unwrap_or_default(),
-        None => HashSet::new(),
-    }
 }
 
 /// The part under world point `w`: the part covering the top-most instance whose geometry
@@ -50,7 +35,7 @@ pub fn part_at(
             .parts
             .iter()
             .enumerate()
-            .filter(|(i, _)| instances_of(data, *i).contains(&m.instance))
+            .filter(|(i, _)| data.part_instances(*i).contains(&m.instance))
             .min_by(|a, b| {
                 centre(a.1)
                     .distance_squared(w)

@@ -14,7 +14,11 @@ use std::time::{Duration, Instant};
 
 use glam::DVec2;
 
-use crate::assembly::{Assembly, HandleId, HandleKind};
+mod gesture;
+
+pub use gesture::{Grab, pin, pin_at, pin_of, toggle_pin, unpin};
+
+use crate::assembly::{Assembly, HandleId};
 use crate::rules::cut::CUT_REACH;
 use crate::rules::{RuleEvent, RuleKind, Rules, replace};
 use crate::script::{Motion, Script, Selector, Step};
@@ -63,8 +67,8 @@ pub struct Session {
     /// `None`: a solver-only session (tests, benchmarks of the solver alone). Replacement
     /// still happens (it is the solver's state choice shown on the instances).
     rules: Option<Rules>,
-    /// The handle `drag`, `rotate` and `release` act on.
-    grab: Option<HandleId>,
+    /// The grab `drag`, `rotate` and `release` act on.
+    grab: Option<Grab>,
     rules_fired: BTreeMap<RuleKind, usize>,
     /// Wall time of every frame so far (solver and rules), in milliseconds.
     frame_ms: Vec<f64>,
@@ -151,7 +155,7 @@ impl Session {
 
     /// The grabbed handle.
     pub fn grabbed(&self) -> Option<HandleId> {
-        self.grab
+        self.grab.map(|g| g.handle())
     }
 
     /// One sculpting frame: a solver frame, then the rules.
@@ -202,58 +206,23 @@ impl Session {
         Ok(Frame { report, events })
     }
 
-    /// Grabs `instance` (releasing the previous grab; pins stay). `None` if it has no vertices.
+    /// Grabs `instance` ([`Grab::instance`]: its pin, if any, gives way and comes back where
+    /// it is dropped), letting go of the previous grab. `None` if it has no vertices.
     pub fn grab(&mut self, asm: &mut Assembly, instance: usize) -> Option<HandleId> {
         self.release(asm);
-        self.grab = asm.hold_instance(instance, HandleKind::Grab);
-        self.grab
+        self.grab = Grab::instance(asm, instance);
+        self.grabbed()
     }
 
-    /// Moves the grab's target: its start pose moved by `translation` and turned by `angle`
-    /// radians about its centre. Returns whether anything changed.
+    /// Moves the grab's target ([`Grab::move_to`]). Returns whether anything changed.
     pub fn move_grab(&mut self, asm: &mut Assembly, translation: DVec2, angle: f64) -> bool {
-        if !(translation.is_finite() && angle.is_finite()) {
-            return false;
-        }
-        match self.grab.and_then(|id| asm.handle_mut(id)) {
-            Some(h) if h.translation != translation || h.angle != angle => {
-                h.translation = translation;
-                h.angle = angle;
-                true
-            }
-            _ => false,
-        }
+        self.grab
+            .is_some_and(|g| g.move_to(asm, translation, angle))
     }
 
-    /// Lets go of the grab. Returns whether there was one.
+    /// Lets go of the grab ([`Grab::release`]). Returns whether there was one.
     pub fn release(&mut self, asm: &mut Assembly) -> bool {
-        match self.grab.take() {
-            Some(id) => asm.release(id),
-            None => false,
-        }
-    }
-
-    /// Pins `instance` where it is.
-    pub fn pin(&mut self, asm: &mut Assembly, instance: usize) -> Option<HandleId> {
-        asm.hold_instance(instance, HandleKind::Pin)
-    }
-
-    /// The pin holding `instance`, found by its stable id (its vertices change when rules
-    /// rewrite the chain around it).
-    pub fn pin_of(asm: &Assembly, instance: usize) -> Option<HandleId> {
-        let id = asm.data().instances.get(instance)?.id;
-        asm.handles()
-            .iter()
-            .find(|h| h.kind == HandleKind::Pin && h.held.as_ref().is_some_and(|x| x.id == id))
-            .map(|h| h.id)
-    }
-
-    /// Unpins `instance`. Returns whether it was pinned.
-    pub fn unpin(&mut self, asm: &mut Assembly, instance: usize) -> bool {
-        match Self::pin_of(asm, instance) {
-            Some(id) => asm.release(id),
-            None => false,
-        }
+        self.grab.take().is_some_and(|g| g.release(asm))
     }
 
     /// Cuts the connection nearest `point` (paper 5.1's cut rule).
@@ -402,11 +371,11 @@ impl Session {
                 if let Step::Grab(_) = step {
                     self.grab(asm, instance);
                 } else {
-                    self.pin(asm, instance);
+                    pin(asm, instance);
                 }
             }
             Step::Unpin(sel) => {
-                let unpinned = select(asm, sel).is_some_and(|i| self.unpin(asm, i));
+                let unpinned = select(asm, sel).is_some_and(|i| unpin(asm, i));
                 if !unpinned {
                     self.notes.push(format!(
                         "step {index}: unpin found no pinned instance there"
@@ -419,7 +388,7 @@ impl Session {
                         "step {index}: drag without a grabbed part only holds"
                     ));
                 }
-                let offset = match (motion, self.grab.and_then(|id| asm.handle(id))) {
+                let offset = match (motion, self.grabbed().and_then(|id| asm.handle(id))) {
                     (Motion::By(d), _) => d,
                     (Motion::To(p), Some(h)) => p - h.target_centre(),
                     (Motion::To(_), None) => DVec2::ZERO,
@@ -466,7 +435,7 @@ impl Session {
         angle: f64,
         frames: u64,
     ) -> Result<(), SolverError> {
-        let Some(h) = self.grab.and_then(|id| asm.handle(id)) else {
+        let Some(h) = self.grabbed().and_then(|id| asm.handle(id)) else {
             self.grab = None;
             return (0..frames).try_for_each(|_| self.frame(asm).map(drop));
         };
