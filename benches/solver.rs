@@ -52,7 +52,7 @@ fn frames(c: &mut Criterion) {
                 k += 1;
                 // a slow back-and-forth drag keeps every frame doing real work
                 let t = (k as f64 * 0.05).sin();
-                asm.handle_mut(h).unwrap().translation = DVec2::new(4.0 * t, 2.0 * t);
+                asm.move_handle(h, DVec2::new(4.0 * t, 2.0 * t), 0.0);
                 solver.frame(&mut asm).unwrap()
             })
         });
@@ -87,7 +87,7 @@ fn phases(parts: usize) {
     let frames = 60;
     let mut reports = Vec::new();
     for k in 1..=frames {
-        asm.handle_mut(h).unwrap().translation = offset * (k as f64 / frames as f64);
+        asm.move_handle(h, offset * (k as f64 / frames as f64), 0.0);
         reports.push(solver.frame(&mut asm).unwrap());
     }
     let later = &reports[1..];

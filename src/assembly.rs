@@ -30,34 +30,69 @@ pub enum HandleKind {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeldInstance {
     /// `Instance::id` (stable across rewrites), not an index.
-    pub id: u64,
+    pub(crate) id: u64,
     /// Anchor of the instance's `k`-th vertex (piece-vertex order).
-    pub anchor: Vec<DVec2>,
+    pub(crate) anchor: Vec<DVec2>,
 }
 
 /// A handle (paper Eq. 3): a set of vertices with a target rigid placement. The target of
-/// vertex `k` is `centre + translation + rot(angle) * (anchor[k] - centre)`.
+/// vertex `k` is `centre + translation + rot(angle) * (anchor[k] - centre)`. Made by the
+/// assembly's `hold_*`, moved by [`Assembly::move_handle`] (a gesture's
+/// `session::Grab`); its fields are the library's.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Handle {
-    pub id: HandleId,
-    pub kind: HandleKind,
+    pub(crate) id: HandleId,
+    pub(crate) kind: HandleKind,
     /// The part the handle was made from, if any (informative; parts are renumbered by rules).
-    pub part: Option<usize>,
+    pub(crate) part: Option<usize>,
     /// The instance the handle holds, when it was made by [`Assembly::hold_instance`]; its
     /// vertices follow that instance across rewrites.
-    pub held: Option<HeldInstance>,
+    pub(crate) held: Option<HeldInstance>,
     /// Global vertex indices the handle holds.
-    pub vertices: Vec<usize>,
+    pub(crate) vertices: Vec<usize>,
     /// Positions of `vertices` when the handle was made.
-    pub anchor: Vec<DVec2>,
+    pub(crate) anchor: Vec<DVec2>,
     /// Centroid of `anchor`; rotations turn about it.
-    pub centre: DVec2,
-    pub translation: DVec2,
+    pub(crate) centre: DVec2,
+    pub(crate) translation: DVec2,
     /// Rotation in radians, counter-clockwise.
-    pub angle: f64,
+    pub(crate) angle: f64,
 }
 
 impl Handle {
+    pub fn id(&self) -> HandleId {
+        self.id
+    }
+
+    pub fn kind(&self) -> HandleKind {
+        self.kind
+    }
+
+    /// The part the handle was made from, if any (informative; rules renumber parts).
+    pub fn part(&self) -> Option<usize> {
+        self.part
+    }
+
+    /// The stable id of the instance the handle holds, when it holds one.
+    pub fn held_instance(&self) -> Option<u64> {
+        self.held.as_ref().map(|h| h.id)
+    }
+
+    /// Global vertex indices the handle holds.
+    pub fn vertices(&self) -> &[usize] {
+        &self.vertices
+    }
+
+    /// How far the target is moved from where the handle was made.
+    pub fn translation(&self) -> DVec2 {
+        self.translation
+    }
+
+    /// How far the target is turned (radians, counter-clockwise) about its centre.
+    pub fn angle(&self) -> f64 {
+        self.angle
+    }
+
     /// Target position of the handle's `k`-th vertex.
     pub fn target(&self, k: usize) -> DVec2 {
         let rot = DVec2::from_angle(self.angle);
@@ -71,7 +106,7 @@ impl Handle {
 
     /// Holds the vertices at `at` (one per vertex) from now on, unmoved and unturned: a saved
     /// pin put back where it held. Ignored unless `at` has one point per vertex.
-    pub fn place(&mut self, at: &[DVec2]) {
+    pub(crate) fn place(&mut self, at: &[DVec2]) {
         if at.len() != self.anchor.len() || at.is_empty() {
             return;
         }
@@ -347,7 +382,24 @@ impl Assembly {
         self.handles.iter().find(|h| h.id == id)
     }
 
-    pub fn handle_mut(&mut self, id: HandleId) -> Option<&mut Handle> {
+    /// Moves handle `id`'s target: where it was made, moved by `translation` and turned by
+    /// `angle` radians about its centre. Returns whether anything changed; a non-finite move
+    /// or a handle that is gone changes nothing.
+    pub fn move_handle(&mut self, id: HandleId, translation: DVec2, angle: f64) -> bool {
+        if !(translation.is_finite() && angle.is_finite()) {
+            return false;
+        }
+        match self.handle_mut(id) {
+            Some(h) if h.translation != translation || h.angle != angle => {
+                h.translation = translation;
+                h.angle = angle;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    pub(crate) fn handle_mut(&mut self, id: HandleId) -> Option<&mut Handle> {
         self.handles.iter_mut().find(|h| h.id == id)
     }
 

@@ -251,7 +251,7 @@ fn drag_b(translation: DVec2, angle: f64) -> usize {
     let data = asm.data();
     let a = data.instances.iter().position(|i| i.name == "a").unwrap();
     let b = data.instances.iter().position(|i| i.name == "b").unwrap();
-    session.pin(&mut asm, a).unwrap();
+    clay::session::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     let mut merges = 0;
     for k in 1..=30 {
@@ -295,7 +295,7 @@ fn a_cut_pair_turned_away_and_back_within_reach_stays_apart_until_it_parts() {
         .iter()
         .position(|i| i.name == "b")
         .unwrap();
-    session.pin(&mut asm, a).unwrap();
+    clay::session::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     // `b` turned by `angle` about its west site, held at (1.2, 0.25), 0.2 m from `a`'s east
     // site: its centre starts at (3.5, 0.25), half a metre east of that site.

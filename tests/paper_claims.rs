@@ -345,7 +345,7 @@ const GRAMMARS: [&str; 6] = ["wall", "bend", "castle", "streets", "centipede", "
 fn grab_north(s: &mut Session, motion: impl Fn(DVec2, DVec2) -> DVec2) -> [f64; 4] {
     s.run(r#"{"grab": {"extreme": "north"}}"#);
     let handle = s.asm.handle(s.replay.grabbed().unwrap()).unwrap();
-    let (centre, held) = (handle.target_centre(), handle.vertices[0]);
+    let (centre, held) = (handle.target_centre(), handle.vertices()[0]);
     let n = s.asm.data().positions.len();
     let components = Components::build(&s.asm.data().parts, n);
     let expected: Vec<DVec2> = s

@@ -45,9 +45,7 @@ proptest! {
         let h = asm.hold_part(east, HandleKind::Grab).unwrap();
         for k in 1..=frames + 2 {
             let s = k.min(frames) as f64 / frames as f64;
-            let handle = asm.handle_mut(h).unwrap();
-            handle.translation = DVec2::new(by.0, by.1) * s;
-            handle.angle = angle * s;
+            asm.move_handle(h, DVec2::new(by.0, by.1) * s, angle * s);
             let r = solver.frame(&mut asm).unwrap();
             prop_assert!(asm.data().positions.iter().all(|p| p.is_finite()));
             let residual = r.linear_residual.unwrap();

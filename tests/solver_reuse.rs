@@ -22,7 +22,7 @@ fn dragged() -> (Assembly, Solver) {
     asm.hold_part(0, HandleKind::Pin);
     let last = asm.data().parts.len() - 1;
     let h = asm.hold_part(last, HandleKind::Grab).unwrap();
-    asm.handle_mut(h).unwrap().translation = DVec2::new(3.0, 1.0);
+    asm.move_handle(h, DVec2::new(3.0, 1.0), 0.0);
     let mut solver = Solver::new(config());
     solver.frame(&mut asm).unwrap();
     (asm, solver)

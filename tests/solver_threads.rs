@@ -25,7 +25,7 @@ fn drag(parts: usize, frames: usize, config: SolverConfig) -> (Vec<FrameReport>,
     let mut solver = Solver::new(config);
     let mut reports = Vec::new();
     for k in 1..=frames {
-        asm.handle_mut(h).unwrap().translation = offset * (k as f64 / 10.0);
+        asm.move_handle(h, offset * (k as f64 / 10.0), 0.0);
         reports.push(solver.frame(&mut asm).unwrap());
     }
     (reports, asm)

@@ -373,10 +373,10 @@ impl Sculpt {
             .assembly
             .handles()
             .iter()
-            .filter(|h| h.kind == HandleKind::Pin)
+            .filter(|h| h.kind() == HandleKind::Pin)
             .map(|h| Pin {
-                vertices: h.vertices.clone(),
-                at: (0..h.vertices.len()).map(|k| h.target(k)).collect(),
+                vertices: h.vertices().to_vec(),
+                at: (0..h.vertices().len()).map(|k| h.target(k)).collect(),
             })
             .collect();
         if let Some(g) = &self.grab
@@ -384,8 +384,8 @@ impl Sculpt {
             && let Some(h) = self.assembly.handle(g.handle())
         {
             pins.push(Pin {
-                vertices: h.vertices.clone(),
-                at: (0..h.vertices.len()).map(|k| h.target(k)).collect(),
+                vertices: h.vertices().to_vec(),
+                at: (0..h.vertices().len()).map(|k| h.target(k)).collect(),
             });
         }
         pins
@@ -396,9 +396,9 @@ impl Sculpt {
         let mut grabbed = Vec::new();
         let mut pinned = Vec::new();
         for h in self.assembly.handles() {
-            match h.kind {
-                HandleKind::Grab => grabbed.extend(h.vertices.iter().copied()),
-                HandleKind::Pin => pinned.extend(h.vertices.iter().copied()),
+            match h.kind() {
+                HandleKind::Grab => grabbed.extend(h.vertices().iter().copied()),
+                HandleKind::Pin => pinned.extend(h.vertices().iter().copied()),
             }
         }
         (grabbed, pinned)
@@ -642,7 +642,7 @@ impl Sculpt {
                 if let Some(g) = &self.grab
                     && let Some(now) = self.assembly.handle(g.handle())
                 {
-                    g.move_to(&mut solved, now.translation, now.angle);
+                    g.move_to(&mut solved, now.translation(), now.angle());
                 }
                 let shown = std::mem::replace(&mut self.assembly, solved);
                 match job.spare {

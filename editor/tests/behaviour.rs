@@ -96,9 +96,9 @@ impl Player {
                     Motion::By(by) => by,
                     Motion::To(p) => {
                         let grab = (s.assembly().handles().iter())
-                            .find(|h| h.kind == HandleKind::Grab)
+                            .find(|h| h.kind() == HandleKind::Grab)
                             .expect("a drag needs a grab");
-                        p - (grab.centre + self.translation)
+                        p - (grab.target_centre() - grab.translation() + self.translation)
                     }
                 };
                 self.spread(by, 0.0, frames);

@@ -70,17 +70,7 @@ impl Grab {
     /// radians about its centre. Returns whether anything changed; a non-finite move changes
     /// nothing.
     pub fn move_to(&self, asm: &mut Assembly, translation: DVec2, angle: f64) -> bool {
-        if !(translation.is_finite() && angle.is_finite()) {
-            return false;
-        }
-        match asm.handle_mut(self.handle) {
-            Some(h) if h.translation != translation || h.angle != angle => {
-                h.translation = translation;
-                h.angle = angle;
-                true
-            }
-            _ => false,
-        }
+        asm.move_handle(self.handle, translation, angle)
     }
 
     /// Where the grab is taking its instance: the target's centre and angle.

@@ -326,7 +326,7 @@ impl Run {
     pub fn element_strains(&self, rest: f64) -> Vec<f64> {
         let data = self.asm.data();
         let held: Vec<u64> = (self.asm.handles().iter())
-            .filter_map(|h| h.held.as_ref().map(|x| x.id))
+            .filter_map(|h| h.held_instance())
             .collect();
         let Some(chain) = data.chains.first() else {
             return Vec::new();
@@ -647,7 +647,7 @@ pub mod claims {
         let (pinned, _, _) = pull.ends();
         // the pin holds the instance nearest its element's rest centre
         let pinned_now = run.asm.handles().iter().find_map(|h| {
-            let id = h.held.as_ref()?.id;
+            let id = h.held_instance()?;
             let i = run.asm.data().instances.iter().position(|x| x.id == id)?;
             run.asm.instance_centroid(i)
         });
@@ -958,7 +958,7 @@ pub mod more {
     /// The centroid of the first instance some handle holds.
     pub fn held_centre(run: &Run) -> Option<DVec2> {
         run.asm.handles().iter().find_map(|h| {
-            let id = h.held.as_ref()?.id;
+            let id = h.held_instance()?;
             let i = run.asm.data().instances.iter().position(|x| x.id == id)?;
             run.asm.instance_centroid(i)
         })
@@ -1211,7 +1211,7 @@ pub mod norm {
         };
         let mut run = pull.start();
         let held: Vec<u64> = (run.asm.handles().iter())
-            .filter_map(|h| h.held.as_ref().map(|x| x.id))
+            .filter_map(|h| h.held_instance())
             .collect();
         // the chain's element ids in order, before anything is inserted
         let data = run.asm.data();

@@ -208,10 +208,8 @@ pub fn bench(args: BenchArgs) -> u8 {
     let mut rules_fired = 0;
     let mut reports: Vec<FrameReport> = Vec::with_capacity(args.frames);
     for k in 1..=args.frames {
-        if let Some((h, offset)) = drag
-            && let Some(handle) = asm.handle_mut(h)
-        {
-            handle.translation = offset * (k as f64 / args.frames as f64);
+        if let Some((h, offset)) = drag {
+            asm.move_handle(h, offset * (k as f64 / args.frames as f64), 0.0);
         }
         // A live session's frame: the solver, then the rules. Their cost is part of the
         // per-frame budget, so it is reported too, apart from the solver's.

@@ -162,8 +162,8 @@ pub(crate) fn replay(
         assembly
             .handles()
             .iter()
-            .filter(|h| h.kind == kind)
-            .flat_map(|h| h.vertices.iter().copied())
+            .filter(|h| h.kind() == kind)
+            .flat_map(|h| h.vertices().iter().copied())
             .collect()
     };
     let (handles, pins) = (vertices(HandleKind::Grab), vertices(HandleKind::Pin));
