@@ -1,8 +1,11 @@
 //! The architecture invariants of `docs/architecture.md` that a reading of the source can
-//! check: no import cycle between the modules of a crate, the editor uses only the library's
-//! surfaces (the session, rendering, authoring, and the solver's settings and report types),
-//! rules never import sessions or scripts, protocol types stay in the language server, a
-//! solver frame changes no part, instance or connection, and the libraries print nothing.
+//! check: no import cycle between the modules of a crate (children naming their parents
+//! counted, over an import graph parsed whole with `syn`, the binary included), the library's
+//! top-level modules import one another only along the documented table of allowed edges,
+//! the editor uses only the library's surfaces (the session, rendering, authoring, and the
+//! solver's settings and report types), rules never import sessions or scripts, protocol types
+//! stay in the language server, a solver frame changes no part, instance or connection, and
+//! the libraries print nothing.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -16,104 +19,6 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
             out.push(p);
         }
     }
-}
-
-/// The module path of a file under `src` (`solver/mod.rs` -> `solver`, `rules/cut.rs` ->
-/// `rules::cut`, `lib.rs` -> ``).
-fn module_of(src: &Path, file: &Path) -> String {
-    let rel = file.strip_prefix(src).unwrap().with_extension("");
-    let mut parts: Vec<String> = rel
-        .components()
-        .map(|c| c.as_os_str().to_string_lossy().into_owned())
-        .collect();
-    if parts
-        .last()
-        .is_some_and(|l| l == "mod" || l == "lib" || l == "main")
-    {
-        parts.pop();
-    }
-    parts.join("::")
-}
-
-/// Every `crate::a::b` a file names (in `use` lines and paths), as the longest known module.
-fn uses(text: &str, modules: &BTreeSet<String>) -> BTreeSet<String> {
-    let mut out = BTreeSet::new();
-    for (i, _) in text.match_indices("crate::") {
-        let rest = &text[i + "crate::".len()..];
-        let path: String = rest
-            .chars()
-            .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
-            .collect();
-        let segs: Vec<&str> = path.split("::").filter(|s| !s.is_empty()).collect();
-        for n in (1..=segs.len()).rev() {
-            let m = segs[..n].join("::");
-            if modules.contains(&m) {
-                out.insert(m);
-                break;
-            }
-        }
-    }
-    out
-}
-
-/// The file-level import graph of a crate's `src` (test modules left out).
-fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
-    let mut files = Vec::new();
-    rust_files(src, &mut files);
-    files.retain(|f| !f.starts_with(src.join("bin")));
-    let modules: BTreeSet<String> = files.iter().map(|f| module_of(src, f)).collect();
-    let mut g = BTreeMap::new();
-    for f in &files {
-        let text = std::fs::read_to_string(f).unwrap();
-        let text = text.split("#[cfg(test)]").next().unwrap_or("");
-        // Code only: a doc link to another module is no import.
-        let text: String = text
-            .lines()
-            .filter(|l| !l.trim_start().starts_with("//"))
-            .collect::<Vec<_>>()
-            .join("\n");
-        let text = text.as_str();
-        let m = module_of(src, f);
-        let mut to = uses(text, &modules);
-        // `super::x` names a sibling module.
-        let parent = m
-            .rsplit_once("::")
-            .map_or(String::new(), |(p, _)| p.to_string());
-        let base = if f.ends_with("mod.rs") {
-            m.clone()
-        } else {
-            parent
-        };
-        for (i, _) in text.match_indices("super::") {
-            let name: String = text[i + 7..]
-                .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect();
-            let up = base
-                .rsplit_once("::")
-                .map_or(String::new(), |(p, _)| p.to_string());
-            let sibling = if up.is_empty() {
-                name.clone()
-            } else {
-                format!("{up}::{name}")
-            };
-            if modules.contains(&sibling) {
-                to.insert(sibling);
-            } else if !up.is_empty() || modules.contains(&up) {
-                to.insert(up);
-            }
-        }
-        // A module may name its parent (re-exports) and its children; only edges between
-        // modules that are not one inside the other can make a cycle worth a name.
-        to.retain(|t| {
-            !(t.is_empty()
-                || t == &m
-                || m.starts_with(&format!("{t}::"))
-                || t.starts_with(&format!("{m}::")))
-        });
-        g.insert(m, to);
-    }
-    g
 }
 
 fn cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
@@ -159,28 +64,682 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+// The import graph. Every file of a crate is parsed whole with `syn` (test modules included),
+// starting at the crate's root file and following its `mod` declarations; every `use` tree and
+// every path (in code, types, patterns and macro bodies) that begins with `crate::`, `super::`,
+// `self::`, a child module's name, or (in the binary) `clay::` is resolved to the module it
+// names. A node is a file's module (`rules::cut`); an inline module (`mod tests { .. }`) counts
+// for its file. Paths through the crate root's re-exports (`crate::parse(..)` in clay-dsl)
+// count for the module the root re-exports them from.
+
+/// One crate's modules, read whole.
+struct Crate {
+    /// Every module path (file or inline) -> the file module it counts for (the root is "").
+    node_of: BTreeMap<String, String>,
+    /// Each file module, its file and its syntax tree.
+    files: Vec<(String, PathBuf, syn::File)>,
+    /// The root's re-exports: name -> the path it re-exports (`parse` -> `parse::parse`).
+    root_uses: BTreeMap<String, Vec<String>>,
+}
+
+/// One import: a file module names another module at `file:line`.
+#[derive(Clone, Debug)]
+struct Import {
+    from: String,
+    to: String,
+    file: PathBuf,
+    line: usize,
+}
+
+/// A file as the failure messages show it: from the repository's root.
+fn shown(file: &Path) -> String {
+    file.strip_prefix(root())
+        .unwrap_or(file)
+        .display()
+        .to_string()
+}
+
+fn join(module: &str, name: &str) -> String {
+    if module.is_empty() {
+        name.to_string()
+    } else {
+        format!("{module}::{name}")
+    }
+}
+
+fn parent(module: &str) -> Option<String> {
+    if module.is_empty() {
+        return None;
+    }
+    Some(module.rsplit_once("::").map_or("", |(p, _)| p).to_string())
+}
+
+/// The leaves of a `use` tree as paths (`use a::{b, c::*}` -> `a::b`, `a::c`), each with the
+/// name it binds (none for a glob) and its line.
+fn use_leaves(tree: &syn::UseTree, prefix: &mut Vec<String>, out: &mut Vec<UseLeaf>) {
+    let line = |i: &syn::Ident| i.span().start().line;
+    match tree {
+        syn::UseTree::Path(p) => {
+            prefix.push(p.ident.to_string());
+            use_leaves(&p.tree, prefix, out);
+            prefix.pop();
+        }
+        syn::UseTree::Name(n) => {
+            let mut path = prefix.clone();
+            path.push(n.ident.to_string());
+            // `use a::b::{self}` binds `b`.
+            let bound = match (n.ident == "self", prefix.last()) {
+                (true, Some(last)) => last.clone(),
+                _ => n.ident.to_string(),
+            };
+            out.push((path, Some(bound), line(&n.ident)));
+        }
+        syn::UseTree::Rename(r) => {
+            let mut path = prefix.clone();
+            path.push(r.ident.to_string());
+            out.push((path, Some(r.rename.to_string()), line(&r.ident)));
+        }
+        syn::UseTree::Glob(g) => out.push((prefix.clone(), None, g.star_token.span.start().line)),
+        syn::UseTree::Group(g) => {
+            for t in &g.items {
+                use_leaves(t, prefix, out);
+            }
+        }
+    }
+}
+
+/// A `use` leaf: its path, the name it binds (none for a glob) and its line.
+type UseLeaf = (Vec<String>, Option<String>, usize);
+
+impl Crate {
+    /// The crate whose root file is `root_file`, every module it declares read and parsed.
+    fn read(root_file: &Path) -> Crate {
+        let mut krate = Crate {
+            node_of: BTreeMap::new(),
+            files: Vec::new(),
+            root_uses: BTreeMap::new(),
+        };
+        krate.load(root_file, "");
+        let root = &krate.files.iter().find(|f| f.0.is_empty()).unwrap().2;
+        for item in &root.items {
+            if let syn::Item::Use(u) = item {
+                let mut leaves = Vec::new();
+                use_leaves(&u.tree, &mut Vec::new(), &mut leaves);
+                for (path, bound, _) in leaves {
+                    if let Some(bound) = bound {
+                        krate.root_uses.insert(bound, path);
+                    }
+                }
+            }
+        }
+        krate
+    }
+
+    fn load(&mut self, file: &Path, module: &str) {
+        let text =
+            std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let tree = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        self.node_of.insert(module.to_string(), module.to_string());
+        let name = file.file_name().unwrap().to_string_lossy();
+        let dir = if ["mod.rs", "lib.rs", "main.rs"].contains(&name.as_ref()) {
+            file.parent().unwrap().to_path_buf()
+        } else {
+            file.with_extension("")
+        };
+        self.declare(&tree.items, module, &dir, module);
+        self.files
+            .push((module.to_string(), file.to_path_buf(), tree));
+    }
+
+    /// Follows the `mod` declarations among `items` (of `module`, whose child files are in
+    /// `dir`); inline modules count for the file module `node`.
+    fn declare(&mut self, items: &[syn::Item], module: &str, dir: &Path, node: &str) {
+        for item in items {
+            let syn::Item::Mod(m) = item else { continue };
+            assert!(
+                !m.attrs.iter().any(|a| a.path().is_ident("path")),
+                "{module}: `#[path]` on `mod {}` is not followed by this test",
+                m.ident
+            );
+            let name = m.ident.to_string();
+            let path = join(module, &name);
+            match &m.content {
+                Some((_, inner)) => {
+                    self.node_of.insert(path.clone(), node.to_string());
+                    self.declare(inner, &path, &dir.join(&name), node);
+                }
+                None => {
+                    let flat = dir.join(format!("{name}.rs"));
+                    let file = if flat.exists() {
+                        flat
+                    } else {
+                        dir.join(&name).join("mod.rs")
+                    };
+                    self.load(&file, &path);
+                }
+            }
+        }
+    }
+
+    /// The file module a path names, or `None` for a path outside the crate. `current` is the
+    /// module the path is written in; `whole`: the last name may be a module (a `use`), else it
+    /// is a type's, value's or macro's own name (which may still be one the root re-exports).
+    fn resolve(&self, current: &str, segments: &[String], whole: bool) -> Option<String> {
+        self.resolve_hops(current, segments, whole, 0)
+    }
+
+    fn resolve_hops(
+        &self,
+        current: &str,
+        segments: &[String],
+        whole: bool,
+        hops: usize,
+    ) -> Option<String> {
+        let first = segments.first()?;
+        let (mut at, rest) = match first.as_str() {
+            "crate" => (String::new(), &segments[1..]),
+            "self" => (current.to_string(), &segments[1..]),
+            "super" => {
+                let mut at = current.to_string();
+                let mut k = 0;
+                while segments.get(k).is_some_and(|s| s == "super") {
+                    at = parent(&at)?;
+                    k += 1;
+                }
+                (at, &segments[k..])
+            }
+            name if self.node_of.contains_key(&join(current, name)) => {
+                (current.to_string(), segments)
+            }
+            _ => return None,
+        };
+        for (k, s) in rest.iter().enumerate() {
+            let item = !whole && k + 1 == rest.len();
+            let next = join(&at, s);
+            if s == "self" {
+                continue;
+            } else if !item && self.node_of.contains_key(&next) {
+                at = next;
+            } else if at.is_empty()
+                && hops < 8
+                && let Some(target) = self.root_uses.get(s)
+            {
+                // Through the root's re-export to where the name lives.
+                let mut path = target.clone();
+                path.extend(rest[k + 1..].iter().cloned());
+                return self.resolve_hops("", &path, whole, hops + 1);
+            } else {
+                break;
+            }
+        }
+        self.node(&at)
+    }
+
+    /// The file module that `module` counts for (a module inside a function body, which
+    /// `declare` does not list, counts for the nearest listed one around it).
+    fn node(&self, module: &str) -> Option<String> {
+        let mut at = module.to_string();
+        loop {
+            if let Some(node) = self.node_of.get(&at) {
+                return Some(node.clone());
+            }
+            at = parent(&at)?;
+        }
+    }
+}
+
+/// Reads one file's imports.
+struct Reader<'a> {
+    krate: &'a Crate,
+    /// The library, for the binary's `clay::` paths.
+    library: Option<&'a Crate>,
+    /// The module the code being read is in (an inline module's path inside its file).
+    current: String,
+    node: String,
+    file: PathBuf,
+    out: Vec<Import>,
+}
+
+impl Reader<'_> {
+    fn import(&mut self, segments: &[String], whole: bool, line: usize) {
+        let to = match (segments.first().map(String::as_str), self.library) {
+            (Some("clay"), Some(library)) => {
+                let mut path = vec!["crate".to_string()];
+                path.extend(segments[1..].iter().cloned());
+                library.resolve("", &path, whole).map(|m| join("clay", &m))
+            }
+            _ => self.krate.resolve(&self.current, segments, whole),
+        };
+        if let Some(to) = to
+            && to != self.node
+        {
+            self.out.push(Import {
+                from: self.node.clone(),
+                to,
+                file: self.file.clone(),
+                line,
+            });
+        }
+    }
+}
+
+impl<'ast> syn::visit::Visit<'ast> for Reader<'_> {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if let Some((_, items)) = &m.content {
+            let inner = join(&self.current, &m.ident.to_string());
+            let outer = std::mem::replace(&mut self.current, inner);
+            for item in items {
+                self.visit_item(item);
+            }
+            self.current = outer;
+        }
+    }
+
+    fn visit_item_use(&mut self, u: &'ast syn::ItemUse) {
+        if u.leading_colon.is_some() {
+            return;
+        }
+        let mut leaves = Vec::new();
+        use_leaves(&u.tree, &mut Vec::new(), &mut leaves);
+        for (path, _, line) in leaves {
+            self.import(&path, true, line);
+        }
+    }
+
+    fn visit_path(&mut self, p: &'ast syn::Path) {
+        if p.leading_colon.is_none() && p.segments.len() >= 2 {
+            let segments: Vec<String> = p.segments.iter().map(|s| s.ident.to_string()).collect();
+            let line = p.segments[0].ident.span().start().line;
+            self.import(&segments, false, line);
+        }
+        syn::visit::visit_path(self, p);
+    }
+
+    fn visit_macro(&mut self, m: &'ast syn::Macro) {
+        syn::visit::visit_macro(self, m);
+        // Macro bodies are tokens: every `a::b::c` run in them is read as a path.
+        let mut paths = Vec::new();
+        token_paths(m.tokens.clone(), &mut paths);
+        for (segments, line) in paths {
+            if segments.len() >= 2 {
+                self.import(&segments, false, line);
+            }
+        }
+    }
+}
+
+/// The `a::b::c` runs among `tokens` (groups searched too), each with its line.
+fn token_paths(tokens: proc_macro2::TokenStream, out: &mut Vec<(Vec<String>, usize)>) {
+    use proc_macro2::TokenTree;
+    let tokens: Vec<TokenTree> = tokens.into_iter().collect();
+    let mut i = 0;
+    while i < tokens.len() {
+        match &tokens[i] {
+            TokenTree::Group(g) => {
+                token_paths(g.stream(), out);
+                i += 1;
+            }
+            TokenTree::Ident(first) => {
+                let preceded_by_colons = i >= 2
+                    && matches!((&tokens[i - 2], &tokens[i - 1]),
+                        (TokenTree::Punct(a), TokenTree::Punct(b)) if a.as_char() == ':' && b.as_char() == ':');
+                let mut segments = vec![first.to_string()];
+                let mut j = i + 1;
+                while let (
+                    Some(TokenTree::Punct(a)),
+                    Some(TokenTree::Punct(b)),
+                    Some(TokenTree::Ident(next)),
+                ) = (tokens.get(j), tokens.get(j + 1), tokens.get(j + 2))
+                {
+                    if a.as_char() != ':' || b.as_char() != ':' {
+                        break;
+                    }
+                    segments.push(next.to_string());
+                    j += 3;
+                }
+                if !preceded_by_colons {
+                    out.push((segments, first.span().start().line));
+                }
+                i = j;
+            }
+            TokenTree::Punct(_) | TokenTree::Literal(_) => i += 1,
+        }
+    }
+}
+
+/// Every import of a crate, file by file (`library`: the crate the binary's `clay::` names).
+fn imports(krate: &Crate, library: Option<&Crate>) -> Vec<Import> {
+    let mut out = Vec::new();
+    for (module, file, tree) in &krate.files {
+        let mut reader = Reader {
+            krate,
+            library,
+            current: module.clone(),
+            node: module.clone(),
+            file: file.clone(),
+            out: Vec::new(),
+        };
+        syn::visit::Visit::visit_file(&mut reader, tree);
+        out.extend(reader.out);
+    }
+    out
+}
+
+/// The library, the binary (rooted at its `main.rs`; its `clay::` imports name `clay::X`
+/// nodes) and clay-dsl, each with its imports.
+fn crates() -> Vec<(&'static str, Crate, Vec<Import>)> {
+    let library = Crate::read(&root().join("src/lib.rs"));
+    let binary = Crate::read(&root().join("src/bin/clayc/main.rs"));
+    let dsl = Crate::read(&root().join("dsl/src/lib.rs"));
+    let lib_imports = imports(&library, None);
+    let bin_imports = imports(&binary, Some(&library));
+    let dsl_imports = imports(&dsl, None);
+    vec![
+        ("src", library, lib_imports),
+        ("src/bin/clayc", binary, bin_imports),
+        ("dsl/src", dsl, dsl_imports),
+    ]
+}
+
+/// Module -> the modules it imports, every file module a node (edges to the crate root, a
+/// list of `mod` and `pub use`, left out).
+fn graph_of(krate: &Crate, imports: &[Import]) -> BTreeMap<String, BTreeSet<String>> {
+    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for (m, _, _) in &krate.files {
+        g.entry(m.clone()).or_default();
+    }
+    for i in imports {
+        if !i.to.is_empty() {
+            g.entry(i.from.clone()).or_default().insert(i.to.clone());
+        }
+    }
+    g
+}
+
+/// The file-level import graph of the library (children naming their parents included).
+fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let krate = Crate::read(&src.join("lib.rs"));
+    let imports = imports(&krate, None);
+    graph_of(&krate, &imports)
+}
+
+/// `rules::cut` -> `rules`; `clay::solver::local` -> `clay::solver`.
+fn top(m: &str) -> String {
+    let mut parts = m.split("::");
+    let first = parts.next().unwrap_or("");
+    if first == "clay" {
+        join("clay", parts.next().unwrap_or(""))
+    } else {
+        first.to_string()
+    }
+}
+
+/// Edges between the library's top-level modules that the code has and means to have. An
+/// edge outside this table fails `the_library_imports_only_along_the_allowed_edges`; the same
+/// table is in docs/architecture.md ("Architecture Invariant: the library's modules import
+/// only along these edges"), and the two are kept equal by a test.
+const ALLOWED: &[(&str, &[&str])] = &[
+    ("assembly", &["fit"]),
+    ("authoring", &["plane"]),
+    ("export", &["render"]),
+    ("files", &[]),
+    ("fit", &[]),
+    (
+        "gallery",
+        &[
+            "assembly", "export", "render", "script", "session", "solver",
+        ],
+    ),
+    ("plane", &[]),
+    ("render", &["fit", "plane", "solver"]),
+    ("rules", &["assembly", "fit", "plane", "solver"]),
+    ("script", &["assembly"]),
+    (
+        "session",
+        &["assembly", "rules", "script", "solver", "summary"],
+    ),
+    // `synthetic`: only the tests of `solver/chunks.rs`, which build a city.
+    ("solver", &["assembly", "fit", "synthetic"]),
+    ("summary", &["assembly", "rules", "solver"]),
+    ("synthetic", &[]),
+];
+
+/// Children that still import their parent's items while the parent imports them, so that
+/// the two import each other. The cycle check over the full module graph leaves these edges
+/// out (and only these); `the_pending_exceptions_still_close_a_cycle` fails for an entry
+/// that no longer does, so the list only shrinks.
+const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[
+    // issue 38: solver/mod.rs split pending.
+    ("src", "solver::growth", "solver"),
+    ("src", "solver::cholesky::numeric", "solver::cholesky"),
+    ("src", "solver::cholesky::split", "solver::cholesky"),
+    // issue 38: authoring/mod.rs holds what its children share.
+    ("src", "authoring::graph", "authoring"),
+    ("src", "authoring::pieces", "authoring"),
+    // issue 38: the language server's shared state lives in lsp/mod.rs.
+    ("src/bin/clayc", "lsp::handlers", "lsp"),
+    // issue 38: clay-dsl's compile/mod.rs and analysis/mod.rs hold what their children share.
+    ("dsl/src", "compile::assembly", "compile"),
+    ("dsl/src", "compile::constants", "compile"),
+    ("dsl/src", "compile::extends", "compile"),
+    ("dsl/src", "compile::mesh_files", "compile"),
+    ("dsl/src", "compile::meshes", "compile"),
+    ("dsl/src", "compile::rules", "compile"),
+    ("dsl/src", "compile::usage", "compile"),
+    ("dsl/src", "analysis::complete", "analysis"),
+    ("dsl/src", "analysis::imports", "analysis"),
+    ("dsl/src", "analysis::tokens", "analysis"),
+];
+
+/// The strict graph: a crate's graph without the pending exceptions.
+fn strict(
+    name: &str,
+    g: &BTreeMap<String, BTreeSet<String>>,
+) -> BTreeMap<String, BTreeSet<String>> {
+    let mut g = g.clone();
+    for (krate, from, to) in CHILD_TO_PARENT_PENDING {
+        if *krate == name
+            && let Some(edges) = g.get_mut(*from)
+        {
+            edges.remove(*to);
+        }
+    }
+    g
+}
+
 #[test]
 fn no_module_imports_one_that_imports_it_back() {
-    for src in ["src", "dsl/src"] {
-        let g = graph(&root().join(src));
-        assert!(g.len() > 5, "{src}: only {} modules read", g.len());
-        if let Some(c) = cycle(&g) {
-            panic!("{src}: an import cycle: {}", c.join(" -> "));
+    for (name, krate, imports) in crates() {
+        let g = graph_of(&krate, &imports);
+        assert!(g.len() > 5, "{name}: only {} modules read", g.len());
+        // Every module, children naming their parents counted.
+        if let Some(c) = cycle(&strict(name, &g)) {
+            let at: Vec<String> = c
+                .iter()
+                .zip(c.iter().cycle().skip(1))
+                .filter_map(|(a, b)| imports.iter().find(|i| &i.from == a && &i.to == b))
+                .map(|i| format!("{}:{}", shown(&i.file), i.line))
+                .collect();
+            panic!(
+                "{name}: an import cycle: {} (imports at {})",
+                c.join(" -> "),
+                at.join(", ")
+            );
         }
         // The same between the crate's top-level modules (`rules::cut` counts as `rules`).
-        let mut top: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-        let first = |m: &str| m.split("::").next().unwrap_or("").to_string();
+        let mut tops: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         for (m, to) in &g {
-            let entry = top.entry(first(m)).or_default();
-            entry.extend(to.iter().map(|t| first(t)).filter(|t| *t != first(m)));
+            let entry = tops.entry(top(m)).or_default();
+            entry.extend(to.iter().map(|t| top(t)).filter(|t| *t != top(m)));
         }
-        if let Some(c) = cycle(&top) {
+        if let Some(c) = cycle(&tops) {
             panic!(
-                "{src}: an import cycle between top-level modules: {}",
+                "{name}: an import cycle between top-level modules: {}",
                 c.join(" -> ")
             );
         }
     }
+}
+
+/// Whether `to` is reachable from `from`.
+fn reaches(g: &BTreeMap<String, BTreeSet<String>>, from: &str, to: &str) -> bool {
+    let mut seen = BTreeSet::new();
+    let mut stack = vec![from.to_string()];
+    while let Some(m) = stack.pop() {
+        if m == to {
+            return true;
+        }
+        if seen.insert(m.clone()) {
+            stack.extend(g.get(&m).into_iter().flatten().cloned());
+        }
+    }
+    false
+}
+
+#[test]
+fn the_pending_exceptions_still_close_a_cycle() {
+    let crates = crates();
+    for (krate, from, to) in CHILD_TO_PARENT_PENDING {
+        let (_, c, imports) = crates.iter().find(|c| c.0 == *krate).unwrap();
+        let g = graph_of(c, imports);
+        assert!(
+            g.get(*from).is_some_and(|t| t.contains(*to)) && reaches(&g, to, from),
+            "{krate}: `{from}` -> `{to}` no longer closes an import cycle: remove it from \
+             CHILD_TO_PARENT_PENDING"
+        );
+    }
+}
+
+#[test]
+fn the_library_imports_only_along_the_allowed_edges() {
+    let krate = Crate::read(&root().join("src/lib.rs"));
+    let imports = imports(&krate, None);
+    let allowed: BTreeMap<&str, &[&str]> = ALLOWED.iter().copied().collect();
+    let tops: BTreeSet<String> = krate.files.iter().map(|f| top(&f.0)).collect();
+    for t in tops.iter().filter(|t| !t.is_empty()) {
+        assert!(
+            allowed.contains_key(t.as_str()),
+            "`{t}` has no row in the table of allowed imports: add it to the table in \
+             docs/architecture.md and here"
+        );
+    }
+    let mut used = BTreeSet::new();
+    for i in &imports {
+        let (from, to) = (top(&i.from), top(&i.to));
+        if from.is_empty() || to.is_empty() || from == to {
+            continue;
+        }
+        assert!(
+            allowed
+                .get(from.as_str())
+                .is_some_and(|a| a.contains(&to.as_str())),
+            "{}:{}: `{}` imports `{}`, an edge between top-level modules (`{from}` -> `{to}`) \
+             outside the table of allowed imports; add it to the table in docs/architecture.md \
+             and here if it is meant",
+            shown(&i.file),
+            i.line,
+            i.from,
+            i.to
+        );
+        used.insert((from, to));
+    }
+    for (from, to) in ALLOWED
+        .iter()
+        .flat_map(|(f, ts)| ts.iter().map(move |t| (*f, *t)))
+    {
+        assert!(
+            used.contains(&(from.to_string(), to.to_string())),
+            "`{from}` no longer imports `{to}`: remove the edge from the table in \
+             docs/architecture.md and here"
+        );
+    }
+}
+
+/// The table of allowed imports in docs/architecture.md, row by row.
+fn documented_edges() -> Vec<(String, Vec<String>)> {
+    let text = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let start = text
+        .find("the library's top-level modules import one another only along")
+        .expect("docs/architecture.md states the allowed imports");
+    let ticked = |cell: &str| -> Vec<String> {
+        cell.split('`')
+            .skip(1)
+            .step_by(2)
+            .map(str::to_string)
+            .collect()
+    };
+    text[start..]
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').collect();
+            let from = ticked(cells.get(1)?).pop()?;
+            Some((from, ticked(cells.get(2)?)))
+        })
+        .collect()
+}
+
+#[test]
+fn the_allowed_imports_are_the_documented_ones() {
+    let here: Vec<(String, Vec<String>)> = ALLOWED
+        .iter()
+        .map(|(f, t)| (f.to_string(), t.iter().map(|s| s.to_string()).collect()))
+        .collect();
+    assert_eq!(
+        documented_edges(),
+        here,
+        "the table in docs/architecture.md and ALLOWED in tests/architecture.rs differ"
+    );
+}
+
+/// The graph builder on a crate made for it: a `use` in a test module, a path in a macro, a
+/// path through the root's re-export and a child naming its parent's item each make an edge,
+/// and the cycle is found with its lines.
+#[test]
+fn the_import_graph_sees_test_modules_macros_re_exports_and_parents() {
+    let dir = std::env::temp_dir().join(format!("clay-architecture-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("a")).unwrap();
+    let files = [
+        ("lib.rs", "mod a;\nmod b;\nmod c;\npub use c::helper;\n"),
+        (
+            "a/mod.rs",
+            "mod child;\npub struct Shared;\nfn f() { child::g(); }\n",
+        ),
+        ("a/child.rs", "use super::Shared;\npub fn g() {}\n"),
+        (
+            "b.rs",
+            "pub fn f() {}\n#[cfg(test)]\nmod tests {\n    use crate::c::h;\n}\n",
+        ),
+        (
+            "c.rs",
+            "pub fn helper() {}\npub fn h() { assert!(crate::b::f() == ()); }\n",
+        ),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let krate = Crate::read(&dir.join("lib.rs"));
+    let imports = imports(&krate, None);
+    let g = graph_of(&krate, &imports);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let edges: Vec<(&str, &str)> = g
+        .iter()
+        .flat_map(|(f, ts)| ts.iter().map(move |t| (f.as_str(), t.as_str())))
+        .collect();
+    assert_eq!(
+        edges,
+        [
+            ("", "c"),
+            ("a", "a::child"),
+            ("a::child", "a"),
+            ("b", "c"),
+            ("c", "b"),
+        ]
+    );
+    let child = imports.iter().find(|i| i.from == "a::child").unwrap();
+    assert_eq!(child.line, 1);
+    assert!(cycle(&g).is_some());
 }
 
 #[test]
