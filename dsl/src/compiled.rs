@@ -16,7 +16,13 @@ use serde::{Deserialize, Serialize};
 pub const FORMAT_VERSION: u32 = 1;
 
 /// Everything the runtime needs to know about a grammar, and its initial assembly.
+///
+/// In its JSON form the initial assembly has no parts: they follow from the instances and
+/// chains ([`CompiledGrammar::parts`]) and are most of its size (a stretch part repeats its
+/// rule's rest states), so they are written out and rebuilt on reading. A file that lists
+/// parts (an older `clayc build`) keeps them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "Unparted")]
 pub struct CompiledGrammar {
     pub format_version: u32,
     /// The path the grammar was compiled from, as given (for messages and session files).
@@ -29,7 +35,65 @@ pub struct CompiledGrammar {
     /// Written and derived cut rules (derived ones have `derived: true`).
     pub cut_rules: Vec<CutRule>,
     /// The initial assembly described by the `model` block.
+    #[serde(serialize_with = "without_parts")]
     pub assembly: AssemblyData,
+}
+
+/// [`CompiledGrammar`] as read, its initial assembly's parts perhaps left out.
+#[derive(Deserialize)]
+struct Unparted {
+    format_version: u32,
+    source: String,
+    solver: SolverParams,
+    site_types: Vec<SiteType>,
+    pieces: Vec<Piece>,
+    stretch_rules: Vec<StretchRule>,
+    merge_rules: Vec<MergeRule>,
+    cut_rules: Vec<CutRule>,
+    assembly: AssemblyData,
+}
+
+impl From<Unparted> for CompiledGrammar {
+    fn from(u: Unparted) -> Self {
+        let mut grammar = CompiledGrammar {
+            format_version: u.format_version,
+            source: u.source,
+            solver: u.solver,
+            site_types: u.site_types,
+            pieces: u.pieces,
+            stretch_rules: u.stretch_rules,
+            merge_rules: u.merge_rules,
+            cut_rules: u.cut_rules,
+            assembly: u.assembly,
+        };
+        if grammar.assembly.parts.is_empty() {
+            // an assembly whose indices do not hold keeps no parts: its check says why
+            if let Some(parts) = grammar.try_parts(&grammar.assembly) {
+                grammar.assembly.parts = parts;
+            }
+        }
+        grammar
+    }
+}
+
+/// Writes an assembly without its parts (see [`CompiledGrammar`]).
+fn without_parts<S: serde::Serializer>(a: &AssemblyData, s: S) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct Unparted<'a> {
+        positions: &'a [DVec2],
+        instances: &'a [Instance],
+        docks: &'a [Dock],
+        chains: &'a [Chain],
+        next_id: u64,
+    }
+    Unparted {
+        positions: &a.positions,
+        instances: &a.instances,
+        docks: &a.docks,
+        chains: &a.chains,
+        next_id: a.next_id,
+    }
+    .serialize(s)
 }
 
 /// The solver parameters of paper 4.3 and 5.2.
@@ -256,6 +320,7 @@ pub struct AssemblyData {
     pub instances: Vec<Instance>,
     pub docks: Vec<Dock>,
     pub chains: Vec<Chain>,
+    #[serde(default)]
     pub parts: Vec<Part>,
     /// The id the next new instance gets; ids are never reused.
     pub next_id: u64,
@@ -388,6 +453,34 @@ impl CompiledGrammar {
             states: rule.part.states.clone(),
             active: 1,
         }
+    }
+
+    /// [`CompiledGrammar::parts`], or `None` when an index of the assembly (a chain's
+    /// instance or rule, an instance's piece or vertex) does not hold, where that would panic.
+    pub fn try_parts(&self, assembly: &AssemblyData) -> Option<Vec<Part>> {
+        let instances = &assembly.instances;
+        for inst in instances {
+            let piece = self.pieces.get(inst.piece)?;
+            let n = piece.states.first().map_or(0, |s| s.positions.len());
+            if inst.vertices.len() < n
+                || inst.vertices.iter().any(|&v| v >= assembly.positions.len())
+            {
+                return None;
+            }
+        }
+        for c in &assembly.chains {
+            let rule = self.stretch_rules.get(c.rule)?;
+            if c.instances.iter().any(|&i| i >= instances.len()) {
+                return None;
+            }
+            for first in 0..c.instances.len().saturating_sub(1) {
+                for ev in &rule.part.vertices {
+                    let i = *c.instances.get(first + ev.element as usize)?;
+                    instances[i].vertices.get(ev.vertex)?;
+                }
+            }
+        }
+        Some(self.parts(assembly))
     }
 
     /// All parts of an assembly: a stretch part for every consecutive pair of every chain of
