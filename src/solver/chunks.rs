@@ -12,7 +12,6 @@
 
 use std::ops::Range;
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -233,9 +232,10 @@ where
     on_pool(|| rayon::join(a, b))
 }
 
-/// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start.
-/// Called from a thread of the pool, `run` runs at once on that thread: a frame run as one
-/// task of the pool ([`on_pool_awake`]) hands no step over from a thread outside it.
+/// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start; the
+/// calling thread blocks until it is done. Called from a thread of the pool, `run` runs at
+/// once on that thread: a frame run as one task of the pool ([`on_pool_awake`]) hands no
+/// step over from a thread outside it.
 pub fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     match pool() {
         Some(pool) => pool.install(run),
@@ -243,37 +243,17 @@ pub fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     }
 }
 
-/// [`on_pool`], with a second thread of the pool kept awake until `run` returns, taking the
-/// frame's parallel halves as soon as they are pushed. A thread of the pool that finds no work
-/// goes to sleep within microseconds, and waking it took 0.15-0.3 ms on this machine (measured
-/// at the factorisation's halves, which take about 1.5 ms at 10,000 parts). Which thread runs
-/// a task changes no bit: the tasks are fixed by the data.
+/// Runs a whole frame on the pool, as one task ([`on_pool`]): each parallel step of the frame
+/// is then pushed to the pool from inside it, where handing every step over from a thread
+/// outside the pool put the caller to sleep and woke a pool thread about 90 times a frame at
+/// 10k parts. A pool thread with nothing to do blocks in rayon's sleep, and is woken when a
+/// step is pushed: no core is spun while the frame runs serial work, nor between frames.
+/// (This once kept the pool's second thread spinning through the whole frame, to save a
+/// wake-up per step: that held a core whenever a two-core frame ran, the editor's UI thread's
+/// too, and under load it gained nothing; the name stays for its callers.) Which
+/// thread runs a task changes no bit: the tasks are fixed by the data.
 pub fn on_pool_awake<R: Send>(run: impl FnOnce() -> R + Send) -> R {
-    /// Ends the waiting when `run` returns or unwinds (a join waits for both of its sides).
-    struct Done<'a>(&'a AtomicBool);
-    impl Drop for Done<'_> {
-        fn drop(&mut self) {
-            self.0.store(true, Ordering::Release);
-        }
-    }
-    on_pool(|| {
-        let done = AtomicBool::new(false);
-        let (result, ()) = rayon::join(
-            || {
-                let _done = Done(&done);
-                run()
-            },
-            || {
-                while !done.load(Ordering::Acquire) {
-                    if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                        // let other processes have the core; returns at once on an idle one
-                        std::thread::yield_now();
-                    }
-                }
-            },
-        );
-        result
-    })
+    on_pool(run)
 }
 
 /// The local step's thread pool (every core), started at the first parallel step; `None`
@@ -475,10 +455,10 @@ mod tests {
         a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
     }
 
-    /// A frame kept awake returns what it computed, runs its halves on the pool, and ends
-    /// (rather than waiting for ever on its helper) when it unwinds.
+    /// A frame run on the pool returns what it computed, runs its halves on the pool, and
+    /// ends, with its panic, when it unwinds.
     #[test]
-    fn a_frame_kept_awake_returns_and_unwinds() {
+    fn a_pooled_frame_returns_and_unwinds() {
         let (a, b) = on_pool_awake(|| join(2, || 20 + 1, || 2 * 10 + 1));
         assert_eq!((a, b), (21, 21));
         let sum: u64 = on_pool_awake(|| (0..10_000u64).into_par_iter().sum());
