@@ -874,9 +874,7 @@ fn a_solver_frame_changes_no_part_instance_or_connection() {
             (DVec2::new(0.0, 0.5 * size), 1.2),
         ];
         for (translation, angle) in moves {
-            let h = asm.handle_mut(grab).unwrap();
-            h.translation = translation;
-            h.angle = angle;
+            assert!(asm.move_handle(grab, translation, angle));
             for _ in 0..20 {
                 solver.frame(&mut asm).unwrap();
                 assert_eq!(structure(asm.data()), before, "{name}");
