@@ -9,7 +9,7 @@
 #![deny(clippy::print_stdout, clippy::print_stderr)]
 
 // pest is used without its `std` feature, which would probe the native stack on every rule
-// call (a sixth of `clayc check`'s time on a large grammar); the nesting scan in `parse.rs`
+// call (a sixth of `clayc check`'s time on a large grammar); the nesting scan in `parse/scan.rs`
 // bounds the recursion before pest runs instead. Without `std`, `pest_derive` names `alloc`.
 extern crate alloc;
 
