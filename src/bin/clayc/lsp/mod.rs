@@ -62,7 +62,7 @@ pub fn lsp(args: LspArgs) -> u8 {
     )
 }
 
-/// The server reading `input` and writing `output` (what [`lsp`] runs over stdio, and what
+/// The server reading `input` and writing `output` (what [`lsp()`] runs over stdio, and what
 /// `tests/fuzz_lsp.rs` drives in process), waiting `timeout` for an analysis, following a Clay
 /// editor through the folder `follow`. Gives the exit code.
 pub fn serve<R: std::io::BufRead + Send + 'static, W: std::io::Write>(
