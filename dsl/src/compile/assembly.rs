@@ -111,7 +111,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 };
                 if count > (MAX_MODEL_INSTANCES - insts.len().min(MAX_MODEL_INSTANCES)) as u64 {
                     if !too_many {
-                        too_many_instances(c, d.count.span, format!("{count} more instances"));
+                        too_many_instances(c, d.count.span, format!("a chain of {count}"));
                     }
                     too_many = true;
                     continue;

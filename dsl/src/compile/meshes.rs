@@ -115,12 +115,15 @@ fn read(target: &str, loader: &dyn Loader, total: &mut usize) -> Result<Vec<Asse
     Ok(parts)
 }
 
-/// How a file is named in a message: the asset itself, or a file it refers to (a `.bin`).
-fn shown(file: &str, target: &str) -> String {
+/// How a file is named in a message: the asset itself, or a file it refers to (a `.bin`),
+/// set off by commas when the sentence goes on after it (`continues`).
+fn shown(file: &str, target: &str, continues: bool) -> String {
     if file == target {
         format!("mesh asset `{file}`")
-    } else {
+    } else if continues {
         format!("`{file}`, a file that mesh asset `{target}` refers to,")
+    } else {
+        format!("`{file}`, a file that mesh asset `{target}` refers to")
     }
 }
 
@@ -134,7 +137,7 @@ fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Di
     match problem {
         Problem::Io(file, e) if e.kind() == std::io::ErrorKind::NotFound => Diagnostic::error(
             codes::MESH_MISSING,
-            format!("{} does not exist", shown(&file, target)),
+            format!("{} does not exist", shown(&file, target, true)),
             at,
             "no such file",
         )
@@ -150,7 +153,7 @@ fn diagnostic(problem: Problem, target: &str, declared_in: &str, at: Span) -> Di
             };
             Diagnostic::error(
                 codes::MESH_UNREADABLE,
-                format!("cannot read {}: {why}", shown(&file, target)),
+                format!("cannot read {}: {why}", shown(&file, target, false)),
                 at,
                 "cannot be read",
             )
