@@ -234,26 +234,16 @@ where
 
 /// Runs `run` on the pool ([`pool`]), or on rayon's global pool when it could not start; the
 /// calling thread blocks until it is done. Called from a thread of the pool, `run` runs at
-/// once on that thread: a frame run as one task of the pool ([`on_pool_awake`]) hands no
-/// step over from a thread outside it.
+/// once on that thread: a frame run as one task of the pool hands each parallel step to the
+/// pool from inside it (a step handed over from outside put the caller to sleep and woke a
+/// pool thread about 90 times a frame at 10k parts). A pool thread with nothing to do
+/// blocks in rayon's sleep: no core is spun while a frame runs serial work, nor between
+/// frames.
 pub fn on_pool<R: Send>(run: impl FnOnce() -> R + Send) -> R {
     match pool() {
         Some(pool) => pool.install(run),
         None => run(),
     }
-}
-
-/// Runs a whole frame on the pool, as one task ([`on_pool`]): each parallel step of the frame
-/// is then pushed to the pool from inside it, where handing every step over from a thread
-/// outside the pool put the caller to sleep and woke a pool thread about 90 times a frame at
-/// 10k parts. A pool thread with nothing to do blocks in rayon's sleep, and is woken when a
-/// step is pushed: no core is spun while the frame runs serial work, nor between frames.
-/// (This once kept the pool's second thread spinning through the whole frame, to save a
-/// wake-up per step: that held a core whenever a two-core frame ran, the editor's UI thread's
-/// too, and under load it gained nothing; the name stays for its callers.) Which
-/// thread runs a task changes no bit: the tasks are fixed by the data.
-pub fn on_pool_awake<R: Send>(run: impl FnOnce() -> R + Send) -> R {
-    on_pool(run)
 }
 
 /// The local step's thread pool (every core), started at the first parallel step; `None`
@@ -459,13 +449,13 @@ mod tests {
     /// ends, with its panic, when it unwinds.
     #[test]
     fn a_pooled_frame_returns_and_unwinds() {
-        let (a, b) = on_pool_awake(|| join(2, || 20 + 1, || 2 * 10 + 1));
+        let (a, b) = on_pool(|| join(2, || 20 + 1, || 2 * 10 + 1));
         assert_eq!((a, b), (21, 21));
-        let sum: u64 = on_pool_awake(|| (0..10_000u64).into_par_iter().sum());
+        let sum: u64 = on_pool(|| (0..10_000u64).into_par_iter().sum());
         assert_eq!(sum, 49_995_000);
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let unwound = std::panic::catch_unwind(|| on_pool_awake(|| -> u32 { panic!("frame") }));
+            let unwound = std::panic::catch_unwind(|| on_pool(|| -> u32 { panic!("frame") }));
             sender.send(unwound.is_err()).unwrap();
         });
         let unwound = receiver.recv_timeout(std::time::Duration::from_secs(60));
@@ -475,7 +465,7 @@ mod tests {
             "a frame that unwinds must end, with its panic"
         );
         // the pool still serves frames afterwards
-        assert_eq!(on_pool_awake(|| 7), 7);
+        assert_eq!(on_pool(|| 7), 7);
     }
 
     /// The chunked step gives the reference step's states, rotations, targets and (for one

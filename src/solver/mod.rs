@@ -359,19 +359,14 @@ impl Solver {
             self.prepare(asm)?;
             self.frame_prepared(asm, deadline, start, between)
         };
-        // A frame whose steps go to both cores runs as one task of the pool, with the pool's
-        // second thread kept awake for it: each step's parallel half then starts at once,
-        // where handing every step from this thread to the pool woke and put to sleep a
-        // thread about 90 times a frame at 10k parts, and a sleeping pool thread took
-        // 0.15-0.3 ms to wake (docs/performance.md). The steps, and so the bits, are the same
+        // A frame whose steps go to both cores runs as one task of the pool
+        // (`chunks::on_pool`): each step is pushed to the pool from inside it rather than
+        // handed over from this thread, which woke and put to sleep a thread about 90 times a
+        // frame at 10k parts (docs/performance.md). The steps, and so the bits, are the same
         // wherever the frame runs. The preparation runs in the same task, so the frame's
         // buffers reuse the memory its analysis frees (a thread allocates from its own arena:
         // prepared on this thread, the 100k city peaked 5 MB higher).
-        if on_pool {
-            chunks::on_pool_awake(run)
-        } else {
-            run()
-        }
+        if on_pool { chunks::on_pool(run) } else { run() }
     }
 
     /// Whether some step of a frame on `asm` runs on both cores (judged by the last

@@ -5,9 +5,9 @@
 //! columns wide, and faer's per-supernode dense kernels (gemm plans, scratch matrices) cost
 //! more there than the arithmetic, as for the solves; on the few wide separators our kernels
 //! run independent chains side by side and keep up with faer's (city, interleaved, factor
-//! time ours / faer's: under 0.5 at 10k parts, 0.96 at 100k, where 87% of the arithmetic is in
-//! supernodes wider than 16 columns), and the factor is made once, in solve order, with no
-//! second copy (peak memory at 100k 12% lower). Pass 1 factorises its matrix once per IRLS
+//! time ours / faer's, one core each: 0.49 at 10k parts and 0.94 at 100k, where 87% of the
+//! arithmetic is in supernodes wider than 16 columns), and the factor is made once, in
+//! solve order, with no second copy (peak memory at 100k 12% lower). Pass 1 factorises its matrix once per IRLS
 //! iteration, so this is most of a frame's factorisation time (docs/performance.md).
 //!
 //! The method is right-looking: supernodes in order (every update goes to a later one), each
