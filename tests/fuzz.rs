@@ -7,10 +7,13 @@
 //! `CLAY_FUZZ_SEED` another seed; a failure prints the input (escaped) to reproduce it.
 
 mod fuzzing;
+#[path = "fuzzing/located.rs"]
+mod located;
 
 use std::path::{Path, PathBuf};
 
 use fuzzing::fuzz;
+use located::located;
 
 fn files_under(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -41,35 +44,6 @@ fn corpus(ext: &str, extra: &[&str]) -> Vec<Vec<u8>> {
         "the corpus has the repository's {ext} files"
     );
     corpus
-}
-
-/// Every diagnostic lies on char boundaries of its file, has a 1-based line and column, and
-/// the whole list renders.
-fn located(diagnostics: &clay_dsl::Diagnostics, text: &str, path: &str) -> Result<(), String> {
-    for d in diagnostics.iter() {
-        for span in std::iter::once(&d.primary)
-            .chain(&d.secondary)
-            .map(|l| l.span)
-        {
-            let at = diagnostics.sources.locate(text, path, span);
-            let ok = at.start <= at.end
-                && at.end <= at.text.len()
-                && at.text.is_char_boundary(at.start)
-                && at.text.is_char_boundary(at.end);
-            if !ok {
-                return Err(format!(
-                    "{} {:?}: span {:?} off its file",
-                    d.code, d.message, span
-                ));
-            }
-            let (line, col) = clay_dsl::line_col(at.text, at.start);
-            if line == 0 || col == 0 {
-                return Err(format!("{} at {line}:{col}", d.code));
-            }
-        }
-    }
-    let _ = clay_dsl::render(diagnostics, text, path, false);
-    Ok(())
 }
 
 /// The grammar properties of one input (an input that is not UTF-8 is an E003 diagnostic).

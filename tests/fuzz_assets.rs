@@ -15,6 +15,8 @@
 
 #[allow(dead_code)] // the engine's plain `fuzz` is the other targets'
 mod fuzzing;
+#[path = "fuzzing/located.rs"]
+mod located;
 
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -25,6 +27,7 @@ use clay::export::{ExportOptions, gltf, obj, scene};
 use clay_dsl::compiled::{CompiledGrammar, ProxyShape};
 use clay_dsl::{Diagnostics, Severity};
 use fuzzing::{fuzz_cases, mutate};
+use located::located;
 use proptest::prelude::RngExt;
 use proptest::test_runner::TestRng;
 
@@ -763,34 +766,6 @@ fn write_files(dir: &Path, files: &[(String, Vec<u8>)]) -> String {
     files
         .first()
         .map_or_else(|| "gone.glb".to_string(), |f| safe_name(&f.0, 0))
-}
-
-/// Every diagnostic lies on char boundaries of its file with a 1-based line and column.
-fn located(d: &Diagnostics, text: &str, path: &str) -> Result<(), String> {
-    for e in d.iter() {
-        for span in std::iter::once(&e.primary)
-            .chain(&e.secondary)
-            .map(|l| l.span)
-        {
-            let at = d.sources.locate(text, path, span);
-            let ok = at.start <= at.end
-                && at.end <= at.text.len()
-                && at.text.is_char_boundary(at.start)
-                && at.text.is_char_boundary(at.end);
-            if !ok {
-                return Err(format!(
-                    "{} {:?}: span {span:?} off its file",
-                    e.code, e.message
-                ));
-            }
-            let (line, col) = clay_dsl::line_col(at.text, at.start);
-            if line == 0 || col == 0 {
-                return Err(format!("{} at {line}:{col}", e.code));
-            }
-        }
-    }
-    let _ = clay_dsl::render(d, text, path, false);
-    Ok(())
 }
 
 /// A refused asset is one error, E064-E067, at the path string.
