@@ -128,36 +128,40 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         report.piece,
         if report.pinned { ", pinned" } else { "" }
     ))
-    .on_hover_text(format!("part {} of the solver", report.part));
+    .on_hover_text(format!("part {} of the solver", report.why.part));
     let active_name = report
+        .why
         .states
-        .get(report.active)
+        .get(report.why.active)
         .map_or("?", |s| s.0.as_str());
-    if report.at_rest {
+    if report.why.at_rest {
         ui.label(format!("rests as `{active_name}`"));
     } else {
         ui.label(format!("in `{active_name}`, strained (not at rest)"));
     }
-    if let Some((_, length)) = report.candidate {
+    if let Some((_, length)) = report.why.candidate {
         ui.label(format!("its two elements span {length:.2} elements"));
     }
-    if report.states.len() > 1 {
+    if report.why.states.len() > 1 {
         let best_other = report
+            .why
             .states
             .iter()
             .enumerate()
-            .filter(|(i, _)| *i != report.active && report.available.get(*i) != Some(&false))
+            .filter(|(i, _)| {
+                *i != report.why.active && report.why.available.get(*i) != Some(&false)
+            })
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
         if let Some((_, (name, d))) = best_other {
             ui.label(format!(
                 "`{name}` takes over once its misfit drops below {:.4} ({:.0}% under \
                  `{active_name}`'s); it is {d:.4} now",
-                report.switch_below,
-                100.0 * report.hysteresis
+                report.why.switch_below,
+                100.0 * report.why.hysteresis
             ));
         }
-        for (i, (name, _)) in report.states.iter().enumerate() {
-            if report.available.get(i) == Some(&false) {
+        for (i, (name, _)) in report.why.states.iter().enumerate() {
+            if report.why.available.get(i) == Some(&false) {
                 ui.label(format!(
                     "`{name}` is ruled out now: the chain's length or its `min`/`max` does \
                      not call for it"
@@ -171,8 +175,8 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
             "shape-space distance from the current pose, squared, after the best rotation",
         );
         ui.end_row();
-        for (i, (name, d)) in report.states.iter().enumerate() {
-            let text = if i == report.active {
+        for (i, (name, d)) in report.why.states.iter().enumerate() {
+            let text = if i == report.why.active {
                 RichText::new(format!("{name} (active)")).strong()
             } else {
                 RichText::new(name)

@@ -64,28 +64,17 @@ struct Snapshot {
     log: Vec<LogEntry>,
 }
 
-/// Why a part is in the state it is in.
+/// Why a part is in the state it is in: the session's report
+/// ([`clay::session::PartReport`]) with the names the inspector shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartReport {
-    pub part: usize,
     /// `tower`, or `wall` for a stretch part.
     pub piece: String,
     /// "`t1`", or "`wall[3]` and `wall[4]`" for a stretch part.
     pub covers: String,
-    pub active: usize,
-    /// Every rest state with the shape-space distance (squared) the solver's state choice
-    /// compares to the current pose (`clay::session::PartReport`).
-    pub states: Vec<(String, f64)>,
-    /// Per rest state: whether it may become active now.
-    pub available: Vec<bool>,
-    /// For a stretch part: the state its length calls for, and its length in elements.
-    pub candidate: Option<(usize, f64)>,
-    pub hysteresis: f64,
-    /// Another state becomes active once its distance drops below this.
-    pub switch_below: f64,
-    /// The part rests in its active state (else it holds still under strain, or moves).
-    pub at_rest: bool,
     pub pinned: bool,
+    /// What the solver's state choice compares, from the session.
+    pub why: clay::session::PartReport,
 }
 
 /// Most log entries kept; older ones are dropped.
@@ -746,17 +735,10 @@ impl Sculpt {
         // The distances and the switch threshold are the session's (the solver's own rule).
         let why = self.session.inspect(&self.assembly, part)?;
         Some(PartReport {
-            part,
             piece,
             covers,
-            active: why.active,
-            hysteresis: why.hysteresis,
-            switch_below: why.switch_below,
-            states: why.states,
-            available: why.available,
-            candidate: why.candidate,
-            at_rest: why.at_rest,
             pinned: self.is_pinned(part),
+            why,
         })
     }
 

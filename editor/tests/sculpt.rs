@@ -171,7 +171,7 @@ fn settings_apply_live_and_bad_values_are_refused() {
     }));
     assert_eq!(s.settings(), good);
     let part = tower(&s);
-    assert_eq!(s.inspect(part).unwrap().hysteresis, 0.3);
+    assert_eq!(s.inspect(part).unwrap().why.hysteresis, 0.3);
 }
 
 #[test]
@@ -183,7 +183,7 @@ fn the_inspector_explains_the_active_state() {
         .iter()
         .position(|p| matches!(p.kind, PartKind::Stretch { .. }))
         .unwrap();
-    let r = s.inspect(stretch).unwrap();
+    let r = s.inspect(stretch).unwrap().why;
     assert_eq!(r.states.len(), 3, "one, two and three elements");
     let d_active = r.states[r.active].1;
     assert!((r.switch_below - (1.0 - r.hysteresis) * d_active).abs() < 1e-12);
