@@ -4,7 +4,8 @@
 
 mod generated;
 
-use generated::Run;
+use generated::{Run, step};
+use glam::DVec2;
 
 use clay::rules::RuleKind;
 
@@ -72,6 +73,16 @@ fn a_chain_pushed_past_its_min_and_brought_back_has_its_elements_back() {
     assert_at_rest(&run);
 }
 
+/// Paper 5.1, a round trip: 64 bricks (`min 49`) pushed to 0.35x shrink to 49; brought back
+/// in a single frame they are the 64 again, at rest (a second stretch made 65: the chain,
+/// laid out anew and not yet straight, read as longer along its path than its ends are apart).
+#[test]
+fn a_chain_let_out_of_a_squeeze_in_one_frame_has_its_elements_back() {
+    let run = replay("release_from_squeeze");
+    assert_eq!(run.count("brick"), 64, "{}", run.repro());
+    assert_at_rest(&run);
+}
+
 /// Paper 5.1, fill: 105 bricks (`min 85`) pushed to 0.28x shrink and never grow (one stretch
 /// fired among the shrinks).
 #[test]
@@ -96,4 +107,28 @@ fn a_far_chain_changes_nothing_of_a_buckled_one() {
     let without = replay_text(&alone, "far_chain").count("brick");
     assert_eq!(with_far, without);
     assert_eq!(without, 70);
+}
+
+/// The limit of the squeeze rule the cases above brought: a wall (`min 8`) pinned with its ends
+/// pushed 2 m together, then pulled out 4 m in the middle, grows to the ten bricks the V
+/// through its ends and the grab spans (it kept its 8 at strain 1.3: the chain's ends were
+/// still closer than at rest, and that alone made growing unavailable).
+#[test]
+fn a_squeezed_wall_pulled_out_in_the_middle_grows() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/grammars/wall.clay");
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("min 2", "min 8");
+    let mut run = Run::new(&text);
+    run.step(&step::pin_at(DVec2::new(0.5, 0.25)))
+        .step(&step::grab_at(DVec2::new(7.5, 0.25)))
+        .step(&step::drag(DVec2::new(-2.0, 0.0), 30))
+        .step(&step::hold(30));
+    assert_eq!(run.count("brick"), 8, "{}", run.repro());
+    run.step(&step::pin_at(DVec2::new(5.5, 0.25)))
+        .step(&step::release())
+        .step(&step::grab_at(DVec2::new(3.0, 0.25)))
+        .step(&step::drag(DVec2::new(0.0, 4.0), 30))
+        .step(&step::hold(60));
+    assert_eq!(run.count("brick"), 10, "{}", run.repro());
 }

@@ -810,6 +810,8 @@ impl Solver {
             if first + 2 == count {
                 length.path += m.lengths[1];
                 length.chord = (m.far - length.near).length() / m.element;
+                length.far = m.far;
+                length.element = m.element;
             }
         }
         lengths
@@ -874,6 +876,22 @@ impl Solver {
                 .get(instance)
                 .is_some_and(|i| held_ids.contains(&i.id))
         };
+        // per chain: `None` when its ends are further apart than at rest by half an element
+        // (taut), else whether what holds it stretches it half an element beyond its count
+        let slack: Vec<Option<bool>> = (0..data.chains.len())
+            .map(|chain| {
+                let l = lengths.get(chain).copied().flatten()?;
+                let rest = rest_chords.get(chain).copied().flatten()?;
+                (l.chord < rest + 0.5).then(|| {
+                    let c = &data.chains[chain];
+                    let centres = c.instances.iter().filter(|&&i| held(i)).map(|&i| {
+                        let vs = &data.instances[i].vertices;
+                        vs.iter().map(|&v| start[v]).sum::<DVec2>() / vs.len().max(1) as f64
+                    });
+                    l.taut(centres) >= c.instances.len() as f64 + 0.5
+                })
+            })
+            .collect();
         for (pi, part) in data.parts.iter().enumerate() {
             let PartKind::Stretch { chain, first } = part.kind else {
                 w.stretch.push(None);
@@ -895,17 +913,13 @@ impl Solver {
             let length = (lengths.get(chain).copied().flatten()).map_or(count as f64, |l| l.path);
             // a change that reverses the chain's last one waits for `reversal` elements
             let shrink_below = count as f64 - if c.trend > 0 { reversal } else { 0.0 };
-            // Against the chain's chord at rest (in elements): ends closer than that by half
-            // an element squeeze the chain as a whole, and a part of it that reads as
-            // stretched is a buckle, not room for an element; ends no further apart than at
-            // rest (a chain pulled straight after a buckle, a pinned chain pulled out in the
-            // middle) grow only once its elements span a whole element more than it has.
-            let rest = rest_chords.get(chain).copied().flatten();
-            let chord = lengths.get(chain).copied().flatten().map(|l| l.chord);
-            let (squeezed, slack) = match (chord, rest) {
-                (Some(chord), Some(rest)) => (chord < rest - 0.5, chord < rest + 0.5),
-                _ => (false, false),
-            };
+            // Against the chain's chord at rest (in elements): ends no further apart than at
+            // rest (a chain pulled straight after a buckle, a squeeze let go of, a wave a
+            // rewrite left) leave no room for an element, however far its path wanders, unless
+            // something holds it out of line ([`ChainLength::taut`]); and then it grows only
+            // once its elements span a whole element more than it has.
+            let slack = slack.get(chain).copied().flatten();
+            let (slack, held_out) = (slack.is_some(), slack == Some(true));
             let wait = match (c.trend < 0, slack) {
                 (true, _) => reversal,
                 (false, true) => 1.0,
@@ -916,7 +930,10 @@ impl Solver {
             if count > rule.min.max(1) && !both_held && length <= shrink_below {
                 allowed |= 1 << STRETCH_ONE;
             }
-            if rule.max.is_none_or(|max| count < max) && length >= grow_above && !squeezed {
+            if rule.max.is_none_or(|max| count < max)
+                && length >= grow_above
+                && (!slack || held_out)
+            {
                 allowed |= 1 << STRETCH_THREE;
             }
             w.stretch
@@ -1921,6 +1938,27 @@ struct ChainLength {
     chord: f64,
     /// Where the chain starts (its first element's `from` site's centre).
     near: DVec2,
+    /// Where the chain ends (its last element's `to` site's centre).
+    far: DVec2,
+    /// An element's length at rest (the unit of `path` and `chord`).
+    element: f64,
+}
+
+impl ChainLength {
+    /// The shortest the chain could be through what holds it, in elements: the polyline
+    /// from its near end through the centres of its held elements (`held`, in chain order,
+    /// positions in the measured pose) to its far end; its chord when none is held. A chain
+    /// no longer than this at rest needs no element more, however its path wanders.
+    fn taut(&self, held: impl IntoIterator<Item = DVec2>) -> f64 {
+        let mut at = self.near;
+        let mut length = 0.0;
+        for p in held {
+            length += (p - at).length();
+            at = p;
+        }
+        length += (self.far - at).length();
+        length / self.element.max(1e-12)
+    }
 }
 
 /// The handle term of the pass-2 objective at `f`.
