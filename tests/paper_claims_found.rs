@@ -132,3 +132,20 @@ fn a_squeezed_wall_pulled_out_in_the_middle_grows() {
         .step(&step::hold(60));
     assert_eq!(run.count("brick"), 10, "{}", run.repro());
 }
+
+/// Far pieces change nothing (issue 36): 13 bricks of 0.3 m pushed to 0.42x have 5 alone and
+/// had 6 with a chain of 3 m elements 700 m away (pass 1's tolerance was the whole model's
+/// mean edge, which the long elements raised; it is now each component's own).
+#[test]
+fn a_far_chain_of_long_elements_changes_nothing() {
+    let text = fixture("far_chain_borderline.clay");
+    let alone: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("far = "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_ne!(alone, text);
+    let with_far = replay_text(&text, "far_chain_borderline").count("brick");
+    let without = replay_text(&alone, "far_chain_borderline").count("brick");
+    assert_eq!((with_far, without), (5, 5));
+}

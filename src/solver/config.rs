@@ -55,9 +55,10 @@ pub struct SolverConfig {
     /// Pass 2: how many past iterates Anderson acceleration mixes (0: the plain local/global
     /// iteration); an accelerated iterate that does not lower the objective is dropped.
     pub l2_anderson: usize,
-    /// Handle weight relative to the mean edge weight (Eq. 3): large, so handles are hard.
+    /// Handle weight relative to the mean edge weight of the handle's connected component
+    /// (Eq. 3): large, so handles are hard.
     pub handle_weight: f64,
-    /// Proximal weight `mu` (relative to the mean edge weight) pulling every vertex towards the
+    /// Proximal weight `mu` (relative to the component's mean edge weight) pulling every vertex towards the
     /// current iterate; keeps components without handles well-posed.
     pub proximal_weight: f64,
     /// Parts whose rotations differ by more than this many degrees do not average into each
@@ -65,14 +66,16 @@ pub struct SolverConfig {
     /// paper's plain average, 0 (the default) each part's own rotation: see `docs/solver.md`
     /// for why (a cone makes the energy jump when a part crosses it).
     pub rotation_cone_degrees: f64,
-    /// Pass 2 stops early once no vertex moved more than this fraction of the model's size.
+    /// Pass 2 stops early once no vertex moved more than this fraction of its connected
+    /// component's size (the diagonal of its bounding box).
     pub tolerance: f64,
-    /// Pass 1 stops early once no vertex moved more than this fraction of the mean rest edge
-    /// and no state switched (from its second iteration on). Pass 1 only decides the rest
-    /// states, so its pose need not be as exact as the displayed one. Relative to the parts,
-    /// not to the model's size: a claim must not depend on how large the rest of the model
-    /// is (with 1e-3 of the size, a 50-brick wall stopped at its evenly stretched pose, 5 cm
-    /// steps being converged).
+    /// Pass 1 stops early once no vertex moved more than this fraction of its connected
+    /// component's mean rest edge and no state switched (from its second iteration on). Pass 1
+    /// only decides the rest states, so its pose need not be as exact as the displayed one.
+    /// Relative to the parts, not to the model's size, and each component to its own: a claim
+    /// must not depend on how large the rest of the model is (with 1e-3 of the size, a
+    /// 50-brick wall stopped at its evenly stretched pose, 5 cm steps being converged; with
+    /// the model's mean edge, a chain of long elements 700 m away kept a wall a brick longer).
     pub pass1_tolerance: f64,
     /// Relative residual each CG solve reaches (`SolverKind::Cg`), measured against the norm of
     /// the right-hand side's edge terms (the handle rows would otherwise dominate it).
@@ -87,7 +90,7 @@ pub struct SolverConfig {
     /// preconditioned pass-1 solves reach. Pass 2 is always solved directly.
     pub pcg_tolerance: f64,
     /// A frame counts as converged ([`FrameReport::converged`](super::FrameReport::converged)) when no state switched and the
-    /// displayed positions moved less than this fraction of the model's size.
+    /// displayed positions moved less than this fraction of their components' sizes.
     pub settle_tolerance: f64,
     /// Compute the relative residual of every linear solve into the report (one extra matrix
     /// product per solve).

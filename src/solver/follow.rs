@@ -107,16 +107,16 @@ impl Components {
 }
 
 /// Per component, the rigid motion taking its held vertices from `positions` onto their
-/// targets (`target[v]` for every `v` with `held[v]`), when there is one within `tolerance`
-/// (metres, the largest distance of a held vertex from the moved position) and it moves
-/// something by more than `tolerance`; `None` for components with nothing held, held at
+/// targets (`target[v]` for every `v` with `held[v]`), when there is one within its
+/// `tolerance(c)` (metres, the largest distance of a held vertex from the moved position) and
+/// it moves something by more than that; `None` for components with nothing held, held at
 /// places that moved differently, or not moved.
 pub fn motions(
     components: &Components,
     positions: &[DVec2],
     held: &[bool],
     target: &[DVec2],
-    tolerance: f64,
+    tolerance: impl Fn(usize) -> f64,
 ) -> Vec<Option<RigidMotion>> {
     let mut from: Vec<Vec<DVec2>> = vec![Vec::new(); components.count()];
     let mut to: Vec<Vec<DVec2>> = vec![Vec::new(); components.count()];
@@ -129,7 +129,9 @@ pub fn motions(
     }
     from.iter()
         .zip(&to)
-        .map(|(from, to)| {
+        .enumerate()
+        .map(|(c, (from, to))| {
+            let tolerance = tolerance(c);
             let motion = rigid_motion(from, to)?;
             let fits = from
                 .iter()

@@ -16,6 +16,7 @@ mod layout;
 pub(crate) mod local;
 mod measure;
 mod report;
+mod units;
 
 use config::cone_cosine;
 pub use config::{SolverConfig, SolverKind};
@@ -92,7 +93,8 @@ struct Work {
     snapped_moved: f64,
     /// The handle targets (`handle_sum`) of the last frame: still when equal.
     last_targets: Vec<DVec2>,
-    /// How far the last frame moved the displayed pose.
+    /// How far the last frame moved the displayed pose, in its components' rest edges
+    /// ([`units::Units::max_move_in_edges`]).
     last_moved: f64,
     /// The elastic energy the last frame ended with, and the one before it.
     last_energy: [f64; 2],
@@ -166,9 +168,10 @@ pub struct Solver {
     pass1_pose: Vec<DVec2>,
     /// The connected components of the vertex graph (rigid following, free centroids).
     components: follow::Components,
-    /// The mean rest edge length of the active states when the generation was prepared (the
-    /// unit of pass 1's tolerance and of the rest test of [`Solver::try_states`]).
-    mean_rest_edge: f64,
+    /// Each component's units of length: its mean rest edge in the active states when the
+    /// generation was prepared (pass 1's tolerance, the rest test of
+    /// [`Solver::try_states`]) and its size this frame (pass 2's).
+    units: units::Units,
     /// The components with no held vertex this frame, ascending (solves shift their
     /// centroids back).
     free_components: Vec<usize>,
@@ -195,7 +198,7 @@ impl Solver {
             pass1_pose: Vec::new(),
             components: follow::Components::default(),
             free_components: Vec::new(),
-            mean_rest_edge: 1.0,
+            units: units::Units::default(),
             anderson: anderson::Anderson::default(),
             factor_slot: Vec::new(),
             ordered: Vec::new(),
@@ -285,7 +288,7 @@ impl Solver {
         self.work.vertex_parts = local::VertexParts::build(&asm.data().parts, n);
         self.work.rest = local::RestCache::build(&asm.data().parts, &self.work.vertex_parts);
         self.components = follow::Components::build(&asm.data().parts, n);
-        self.mean_rest_edge = mean_rest_edge(&asm.data().parts);
+        self.units = units::Units::build(&asm.data().parts, &self.components);
         self.symbolic = match self.config.kind {
             SolverKind::Cholesky if n > 0 => Some(
                 SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
@@ -411,9 +414,8 @@ impl Solver {
                 "the warm start has non-finite positions".into(),
             ));
         }
-        let scale = bbox_diagonal(&warm).max(1e-9);
-        let step_tolerance = cfg.tolerance * scale;
-        self.follow_handles(&mut warm, step_tolerance);
+        self.units.measure(&self.components, &warm);
+        self.follow_handles(&mut warm, cfg.tolerance);
         let generation = self.generation.unwrap_or(u64::MAX);
         let start_key = Some((generation, cfg, 0));
         if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
@@ -467,6 +469,7 @@ impl Solver {
             if warm.iter().any(|p| !p.is_finite()) {
                 return Err(SolverError("a rule laid out non-finite positions".into()));
             }
+            self.units.measure(&self.components, &warm);
             self.work.start.valid = None;
         }
         report.phases.bookkeeping += ms_since(t);
@@ -475,7 +478,7 @@ impl Solver {
             &asm.data().parts,
             asm.handles(),
             warm,
-            step_tolerance,
+            cfg.tolerance,
             deadline,
             &mut report,
         );
@@ -489,7 +492,10 @@ impl Solver {
             ));
         }
         report.moved = max_move(&asm.data().positions, &f);
-        self.work.last_moved = report.moved;
+        let shown = &asm.data().positions;
+        self.work.last_moved = self.units.max_move_in_edges(&self.components, shown, &f);
+        let settled =
+            self.units.max_move_in_sizes(&self.components, shown, &f) <= cfg.settle_tolerance;
         self.work.last_energy = [terms.elastic, self.work.last_energy[0]];
         asm.positions_mut().copy_from_slice(&f);
         let rot = asm.rotations_mut();
@@ -501,7 +507,6 @@ impl Solver {
             .keep_start(cfg, generation, &asm.data().parts, terms.elastic);
         report.energy = terms.elastic;
         report.objective = terms.total();
-        let settled = report.moved <= cfg.settle_tolerance * scale;
         // still and strained, other states not yet tried: the next frame tries them
         // (`settling`), so this one is not the last (a host that stops at convergence, as the
         // editor does, would never run it)
@@ -527,7 +532,7 @@ impl Solver {
         if !still {
             w.tried = false;
         }
-        let stopped = w.last_moved <= 1e-3 * self.mean_rest_edge;
+        let stopped = w.last_moved <= 1e-3;
         // nothing held and the energy all but flat: a long, thin chain unbending, which
         // least squares would take hundreds of frames over (or a fold it never leaves)
         let [last, before] = w.last_energy;
@@ -539,7 +544,8 @@ impl Solver {
     /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
     /// squared (what [`Solver::try_states`] tries to lower).
     fn strained(&self, elastic: f64) -> bool {
-        elastic > 1e-6 * self.mean_rest_edge * self.mean_rest_edge
+        let edge = self.units.smallest_edge();
+        elastic > 1e-6 * edge * edge
     }
 
     /// A held model that does not come to rest tries other rest states (a move): the few
@@ -706,15 +712,15 @@ impl Solver {
                 }
             }
             self.evaluate_fixed(parts, &f);
-            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, &mut report)?;
+            self.solve_global(&f, &mut next, Pass::LeastSquares, &mut report)?;
             std::mem::swap(&mut f, &mut next);
         }
         self.work.vertex_parts = shared;
         let cfg = self.config;
         self.config.l2_iterations = SETTLE_ITERATIONS;
         self.work.start.valid = None;
-        let scale = bbox_diagonal(&f).max(1e-9);
-        let settled = self.pass2(parts, handles, f, cfg.tolerance * scale, None, &mut report);
+        // the sizes measured when the frame began (the same model, a pose near it)
+        let settled = self.pass2(parts, handles, f, cfg.tolerance, None, &mut report);
         self.config = cfg;
         let (_, terms, _) = settled?;
         Ok(terms.total())
@@ -1044,7 +1050,10 @@ impl Solver {
             .zip(&w.handle_sum)
             .map(|(&c, &s)| if c > 0.0 { s / c } else { DVec2::ZERO })
             .collect();
-        let motions = follow::motions(&self.components, warm, &held, &target, tolerance);
+        let units = &self.units;
+        let motions = follow::motions(&self.components, warm, &held, &target, |c| {
+            tolerance * units.size(c)
+        });
         if motions.iter().all(Option::is_none) {
             return;
         }
@@ -1066,7 +1075,7 @@ impl Solver {
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
         let iterations = cfg.irls_iterations;
-        let tolerance = cfg.pass1_tolerance * self.mean_rest_edge;
+        let tolerance = cfg.pass1_tolerance;
         let mut f = std::mem::take(pose);
         let mut next = std::mem::take(&mut self.work.next);
         next.clear();
@@ -1098,7 +1107,7 @@ impl Solver {
                 result = Err(e);
                 break;
             }
-            let delta = max_move(&f, &next);
+            let delta = self.units.max_move_in_edges(&self.components, &f, &next);
             std::mem::swap(&mut f, &mut next);
             last_iteration = iteration_start.elapsed();
             if (it > 0 || iterations == 1)
@@ -1142,9 +1151,9 @@ impl Solver {
             let v = irls_weight(d2.sqrt() + eps, p);
             *weight = c * if v.is_finite() { v } else { eps.powf(p - 2.0) };
         }
-        let mean = mean_over_edges(part_edges, &w.weights);
+        self.units.weigh(part_edges, &w.weights);
         report.phases.assembly += ms_since(t);
-        self.solve_global(f, next, mean, Pass::Irls, report)
+        self.solve_global(f, next, Pass::Irls, report)
     }
 
     /// Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose
@@ -1209,7 +1218,7 @@ impl Solver {
             }
             let iteration_start = Instant::now();
             report.l2_iterations += 1;
-            self.solve_global(&f, &mut next, 1.0, Pass::LeastSquares, report)?;
+            self.solve_global(&f, &mut next, Pass::LeastSquares, report)?;
             let t = Instant::now();
             // f's rotations and targets aside while the next iterate is judged
             let w = &mut self.work;
@@ -1236,7 +1245,7 @@ impl Solver {
                 converged = true;
                 break;
             }
-            let delta = max_move(&f, &next);
+            let delta = self.units.max_move_in_sizes(&self.components, &f, &next);
             std::mem::swap(&mut f, &mut next);
             terms = next_terms;
             last_iteration = iteration_start.elapsed();
@@ -1498,11 +1507,10 @@ impl Solver {
         &mut self,
         f: &[DVec2],
         next: &mut [DVec2],
-        mean_weight: f64,
         pass: Pass,
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
-        self.solve_global_raw(f, next, mean_weight, pass, report)?;
+        self.solve_global_raw(f, next, pass, report)?;
         let t = Instant::now();
         self.keep_free_centroids(f, next);
         report.phases.bookkeeping += ms_since(t);
@@ -1534,7 +1542,6 @@ impl Solver {
         &mut self,
         f: &[DVec2],
         next: &mut [DVec2],
-        mean_weight: f64,
         pass: Pass,
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
@@ -1548,11 +1555,18 @@ impl Solver {
         }
         let t = Instant::now();
         let w = &mut self.work;
-        let lambda = cfg.handle_weight * mean_weight;
-        let mu = cfg.proximal_weight * mean_weight;
+        // the handle and proximal weights are multiples of the component's mean edge weight
+        // (pass 1's reweighted edges; 1 in least squares): a far component's weights change
+        // nothing here
         w.diagonal.clear();
         w.extra.clear();
-        for ((&count, &sum), &p) in w.handle_count.iter().zip(&w.handle_sum).zip(f) {
+        for (v, ((&count, &sum), &p)) in w.handle_count.iter().zip(&w.handle_sum).zip(f).enumerate()
+        {
+            let mean = match pass {
+                Pass::Irls => self.units.weight(self.components.of(v)),
+                Pass::LeastSquares => 1.0,
+            };
+            let (lambda, mu) = (cfg.handle_weight * mean, cfg.proximal_weight * mean);
             w.diagonal.push(lambda * count + mu);
             w.extra.push(lambda * sum + mu * p);
         }
@@ -1890,27 +1904,6 @@ fn out_of_time(deadline: Option<Instant>, last: Duration) -> bool {
     deadline.is_some_and(|d| Instant::now() + last > d)
 }
 
-/// The mean length of the parts' rest edges in their active states (1 when there are none).
-fn mean_rest_edge(parts: &[Part]) -> f64 {
-    let (mut sum, mut count) = (0.0, 0usize);
-    for part in parts {
-        if let Some(rest) = part.states.get(part.active) {
-            for e in &part.edges {
-                if let (Some(a), Some(b)) = (rest.positions.get(e[0]), rest.positions.get(e[1])) {
-                    sum += (*a - *b).length();
-                    count += 1;
-                }
-            }
-        }
-    }
-    let mean = sum / count.max(1) as f64;
-    if mean.is_finite() && mean > 0.0 {
-        mean
-    } else {
-        1.0
-    }
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Pass {
     Irls,
@@ -2005,25 +1998,6 @@ fn irls_weight(a: f64, p: f64) -> f64 {
 
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
-}
-
-/// The mean over the edges of their parts' weights (1 when there are none or it is not a
-/// positive number; `part_edges`: each part's edge count): summed edge by edge, as one weight
-/// per edge would be.
-fn mean_over_edges(part_edges: &[usize], part_weights: &[f64]) -> f64 {
-    let count: usize = part_edges.iter().sum();
-    if count == 0 {
-        return 1.0;
-    }
-    let mut sum = 0.0;
-    for (&n, &w) in part_edges.iter().zip(part_weights) {
-        // added once per edge, in edge order (not `n * w`): the same bits as a sum over edges
-        for _ in 0..n {
-            sum += w;
-        }
-    }
-    let m = sum / count as f64;
-    if m.is_finite() && m > 0.0 { m } else { 1.0 }
 }
 
 fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {

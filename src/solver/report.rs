@@ -33,8 +33,8 @@ pub struct FrameReport {
     /// Wall time of the frame in milliseconds.
     pub ms: f64,
     /// The frame left the model at rest: the frame was complete, no rest state switched, and
-    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`](super::SolverConfig::settle_tolerance) times the
-    /// model's size (or both passes stopped on their step tolerance). Running another frame
+    /// the displayed positions moved less than [`SolverConfig::settle_tolerance`](super::SolverConfig::settle_tolerance) times
+    /// their components' sizes (or both passes stopped on their step tolerance). Running another frame
     /// with the same handles would change nothing visible, so a caller can stop solving.
     pub converged: bool,
     /// The frame ran the iterations its passes asked for; `false` when
