@@ -2,9 +2,10 @@
 //! into `file:line:col` problems the diagnostics panel lists.
 
 use std::fmt;
+use std::path::Path;
 use std::sync::Arc;
 
-use clay_dsl::compiled::CompiledGrammar;
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, SolverParams};
 
 /// The castle example, bundled so the editor opens something useful with no argument.
 pub const CASTLE_SOURCE: &str = include_str!("../../grammars/castle.clay");
@@ -120,6 +121,29 @@ pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
                  Please report this file"
             ),
         )])
+    })
+}
+
+/// Reads and compiles a grammar file without touching the editor's state.
+pub fn check_grammar(path: &Path) -> Result<Compiled, Vec<Problem>> {
+    let shown = path.display().to_string();
+    let source = std::fs::read_to_string(path)
+        .map_err(|e| vec![Problem::whole_file(&shown, format!("cannot read it: {e}"))])?;
+    compile(&source, &shown)
+}
+
+/// A grammar with nothing in it: the model shown when the first compile fails.
+pub fn empty_grammar(path: &str) -> Arc<CompiledGrammar> {
+    Arc::new(CompiledGrammar {
+        format_version: FORMAT_VERSION,
+        source: path.to_string(),
+        solver: SolverParams::default(),
+        site_types: Vec::new(),
+        pieces: Vec::new(),
+        stretch_rules: Vec::new(),
+        merge_rules: Vec::new(),
+        cut_rules: Vec::new(),
+        assembly: AssemblyData::default(),
     })
 }
 

@@ -1,0 +1,81 @@
+//! Exports of the sculpt: the view as PNG, the deformed assembly as JSON, the model as glTF or
+//! OBJ, each through the library code `clayc` uses.
+
+use std::path::Path;
+
+use glam::DVec2;
+
+use super::EditorApp;
+
+impl EditorApp {
+    /// Renders the current view to PNG through the same renderer as `clayc render`.
+    pub fn export_png(&self, path: &Path) -> Result<(), String> {
+        let rect = self.canvas.rect;
+        let width = (rect.width().round() as u32).max(16);
+        let height = (rect.height().round() as u32).max(16);
+        let cam = self.canvas.camera;
+        let mut pins = Vec::new();
+        for pin in self.sculpt.pins() {
+            pins.extend(pin.vertices);
+        }
+        let options = clay::render::RenderOptions {
+            width,
+            height,
+            view: Some(clay::render::View {
+                scale: cam.scale,
+                world_origin: cam.centre,
+                pixel_origin: DVec2::new(width as f64 / 2.0, height as f64 / 2.0),
+            }),
+            overlays: clay::render::Overlays {
+                pins,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let png = clay::render::render_png(self.sculpt.grammar(), self.sculpt.data(), &options)
+            .map_err(|e| e.to_string())?;
+        clay::files::write_atomic(path, &png).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Writes the deformed assembly as JSON (the contract's `AssemblyData`).
+    pub fn export_json(&self, path: &Path) -> Result<(), String> {
+        let text = serde_json::to_string_pretty(self.sculpt.data()).map_err(|e| e.to_string())?;
+        clay::files::write_atomic(path, text.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from
+    /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it).
+    pub fn export_3d(&self, path: &Path) -> Result<(), String> {
+        use clay::export::{gltf, obj, scene};
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let scene = scene(
+            self.sculpt.grammar(),
+            self.sculpt.data(),
+            &Default::default(),
+        );
+        let write = |p: &Path, bytes: &[u8]| {
+            clay::files::write_atomic(p, bytes).map_err(|e| format!("{}: {e}", p.display()))
+        };
+        match ext.as_deref() {
+            Some("glb") => write(path, &gltf::to_glb(&scene)?),
+            Some("gltf") => write(path, &gltf::to_gltf(&scene)?),
+            Some("obj") => {
+                let mtl = path.with_extension("mtl");
+                let name = mtl
+                    .file_name()
+                    .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
+                let (obj_text, mtl_text) = obj::to_obj(&scene, &name);
+                write(&mtl, mtl_text.as_bytes())?;
+                write(path, obj_text.as_bytes())
+            }
+            _ => Err(format!(
+                "{}: name the file .glb, .gltf or .obj to say the format",
+                path.display()
+            )),
+        }
+    }
+}
