@@ -80,6 +80,21 @@ impl std::fmt::Display for ScriptError {
 
 impl std::error::Error for ScriptError {}
 
+impl ScriptError {
+    /// The message for the script at `path`: `error: FILE:LINE:COLUMN: step N: ...` and, when
+    /// there is one, its hint on a second line (`  = help: ...`).
+    pub fn located(&self, path: &std::path::Path) -> String {
+        let at = match self.position {
+            Some((line, column)) => format!("{}:{line}:{column}", path.display()),
+            None => path.display().to_string(),
+        };
+        match &self.hint {
+            Some(hint) => format!("error: {at}: {self}\n  = help: {hint}"),
+            None => format!("error: {at}: {self}"),
+        }
+    }
+}
+
 /// What is wrong with one step, before it is tied to its index and position.
 struct Fault {
     message: String,
@@ -252,6 +267,20 @@ fn step(v: &Value) -> Result<Step, Fault> {
             "unknown step \"{other}\" (expected grab, pin, unpin, drag, rotate, release, hold or cut)"
         )
         .into()),
+    }
+}
+
+impl Step {
+    /// Parses and validates one step, as a script's `"steps"` holds it (`{"drag": {"by":
+    /// [1, 0], "frames": 10}}`): what a binding builds for a step given as a call. The error
+    /// has no step index or position.
+    pub fn from_json(value: &Value) -> Result<Self, ScriptError> {
+        step(value).map_err(|fault| ScriptError {
+            step: None,
+            message: fault.message,
+            position: None,
+            hint: fault.hint,
+        })
     }
 }
 

@@ -15,8 +15,10 @@ use std::time::{Duration, Instant};
 use glam::DVec2;
 
 mod gesture;
+mod settings;
 
 pub use gesture::{Grab, pin, pin_at, pin_of, toggle_pin, unpin};
+pub use settings::{SETTING_NAMES, apply_setting, configure};
 
 use crate::assembly::{Assembly, HandleId};
 use crate::rules::cut::CUT_REACH;

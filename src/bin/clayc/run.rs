@@ -7,8 +7,7 @@ use std::sync::Arc;
 use crate::out;
 use clay::assembly::Assembly;
 use clay::script::{Script, ScriptError};
-use clay::session::{Session, replay};
-use clay::solver::{SolverConfig, SolverKind};
+use clay::session::{Session, configure, replay};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
@@ -28,90 +27,7 @@ pub struct RunArgs {
 
 /// The message for a malformed script: `error: FILE:LINE:COLUMN: step N: ...` and its hint.
 pub fn script_error(path: &Path, e: &ScriptError) -> String {
-    let at = match e.position {
-        Some((line, column)) => format!("{}:{line}:{column}", path.display()),
-        None => path.display().to_string(),
-    };
-    match &e.hint {
-        Some(hint) => format!("error: {at}: {e}\n  = help: {hint}"),
-        None => format!("error: {at}: {e}"),
-    }
-}
-
-/// Applies one `NAME=VALUE` override, checking the name and the range.
-pub fn apply_setting(
-    config: &mut SolverConfig,
-    merge_distance: &mut f64,
-    setting: &str,
-) -> Result<(), String> {
-    let (name, value) = setting
-        .split_once('=')
-        .ok_or_else(|| format!("--set {setting}: expected NAME=VALUE"))?;
-    let (name, value) = (name.trim(), value.trim());
-    if name == "solver" {
-        config.kind = match value {
-            "cholesky" => SolverKind::Cholesky,
-            "cg" => SolverKind::Cg,
-            _ => return Err(format!("--set solver={value}: expected cholesky or cg")),
-        };
-        return Ok(());
-    }
-    let number: f64 = value
-        .parse()
-        .ok()
-        .filter(|x: &f64| x.is_finite())
-        .ok_or_else(|| format!("--set {name}={value}: the value must be a finite number"))?;
-    let check = |ok: bool, range: &str| {
-        if ok {
-            Ok(())
-        } else {
-            Err(format!("--set {name}={value}: must be {range}"))
-        }
-    };
-    let count = |x: f64| x.fract() == 0.0 && (0.0..=1000.0).contains(&x);
-    match name {
-        "hysteresis" => {
-            check((0.0..1.0).contains(&number), "in [0, 1)")?;
-            config.hysteresis = number;
-        }
-        "norm" => {
-            check(number > 0.0 && number <= 2.0, "in (0, 2]")?;
-            config.norm = number;
-        }
-        "irls_epsilon" => {
-            check(number > 0.0 && number <= 1.0, "in (0, 1]")?;
-            config.irls_epsilon = number;
-        }
-        "merge_distance" => {
-            check(number >= 0.0, "at least 0")?;
-            *merge_distance = number;
-        }
-        "irls_iterations" => {
-            check(count(number), "an integer from 0 to 1000")?;
-            config.irls_iterations = number as usize;
-        }
-        "l2_iterations" => {
-            check(count(number), "an integer from 0 to 1000")?;
-            config.l2_iterations = number as usize;
-        }
-        "l2_anderson" => {
-            check(
-                number.fract() == 0.0 && (0.0..=16.0).contains(&number),
-                "an integer from 0 to 16",
-            )?;
-            config.l2_anderson = number as usize;
-        }
-        "handle_weight" => {
-            check((1.0..=1e12).contains(&number), "in [1, 1e12]")?;
-            config.handle_weight = number;
-        }
-        _ => {
-            return Err(format!(
-                "--set {name}: unknown parameter (expected hysteresis, norm, irls_epsilon, merge_distance, irls_iterations, l2_iterations, l2_anderson, handle_weight or solver)"
-            ));
-        }
-    }
-    Ok(())
+    e.located(path)
 }
 
 pub fn run(args: RunArgs) -> u8 {
@@ -154,18 +70,23 @@ pub fn run(args: RunArgs) -> u8 {
         );
     }
     let mut grammar = compiled.grammar;
-    let mut config = SolverConfig::from_params(&grammar.solver);
-    let mut merge_distance = grammar.solver.merge_distance;
+    let mut settings = Vec::with_capacity(args.set.len());
     for s in &args.set {
-        if let Err(e) = apply_setting(&mut config, &mut merge_distance, s) {
-            errln!("error: {e}");
-            return 2;
+        match s.split_once('=') {
+            Some(pair) => settings.push(pair),
+            None => {
+                errln!("error: --set {s}: expected NAME=VALUE");
+                return 2;
+            }
         }
     }
-    grammar.solver.hysteresis = config.hysteresis;
-    grammar.solver.norm = config.norm;
-    grammar.solver.irls_epsilon = config.irls_epsilon;
-    grammar.solver.merge_distance = merge_distance;
+    let config = match configure(&mut grammar, settings) {
+        Ok(config) => config,
+        Err(e) => {
+            errln!("error: --set {e}");
+            return 2;
+        }
+    };
     let mut assembly = Assembly::new(Arc::new(grammar));
     if let Err(problems) = assembly.validate() {
         errln!(
