@@ -31,3 +31,17 @@ pub enum Action {
     /// Forget the sculpt a crashed editor left (the recovery file is removed).
     DiscardRecovery,
 }
+
+impl Action {
+    /// The action a picked path is for.
+    pub fn for_path(kind: FileKind, path: PathBuf) -> Self {
+        match kind {
+            FileKind::Grammar => Action::OpenGrammar(path),
+            FileKind::OpenSession => Action::OpenSession(path),
+            FileKind::SaveSession => Action::SaveSession(path),
+            FileKind::Png => Action::ExportPng(path),
+            FileKind::Json => Action::ExportJson(path),
+            FileKind::Model3d => Action::Export3d(path),
+        }
+    }
+}

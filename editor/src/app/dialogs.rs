@@ -11,7 +11,6 @@ use crate::help;
 use crate::recovery::Recovery;
 
 use super::EditorApp;
-use super::perform::file_action;
 
 /// The unsaved-changes prompt's answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -124,7 +123,7 @@ impl EditorApp {
         }
         match done {
             Some(true) if !d.text.trim().is_empty() => {
-                let action = file_action(d.kind, PathBuf::from(d.text.trim()));
+                let action = Action::for_path(d.kind, PathBuf::from(d.text.trim()));
                 self.dialog = None;
                 self.actions.push(action);
             }

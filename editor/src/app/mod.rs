@@ -1,6 +1,12 @@
-//! The editor application: the open grammar file, the sculpt, the canvas and panels, file
-//! actions (open, sessions, exports) with unsaved-change confirmation, and hot reload. The UI of
-//! a frame collects [`Command`]s and [`Action`]s; they are applied after it.
+//! The editor application: its state and one frame of it. [`EditorApp::logic`] does the work
+//! outside the UI (hot reload, the close request, the solver's budget), [`EditorApp::ui`] lays
+//! out the window, whose parts only collect [`Command`]s, authoring commands and [`Action`]s,
+//! and [`EditorApp::apply`] applies them after the frame (as egui's demos and rerun do).
+//!
+//! The jobs are in the children: `document` (the open grammar, hot reload, sessions),
+//! `perform` (file actions), `export`, `menus` (menu bar, shortcuts, status bar), `dialogs`
+//! (modal prompts) and `sculpt_view` (sculpt mode's canvas and side panels). They import this
+//! module; it imports none of them.
 
 mod dialogs;
 mod document;
@@ -52,6 +58,7 @@ pub enum Mode {
     Author,
 }
 
+/// The typed-path dialog's state (where the desktop has no file dialog).
 struct PathDialog {
     kind: FileKind,
     text: String,

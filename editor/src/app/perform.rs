@@ -12,18 +12,6 @@ use crate::files::{FileKind, NativeDialog};
 use super::document::load_session;
 use super::{EditorApp, Mode, PathDialog};
 
-/// The action a picked path is for.
-pub(super) fn file_action(kind: FileKind, path: PathBuf) -> Action {
-    match kind {
-        FileKind::Grammar => Action::OpenGrammar(path),
-        FileKind::OpenSession => Action::OpenSession(path),
-        FileKind::SaveSession => Action::SaveSession(path),
-        FileKind::Png => Action::ExportPng(path),
-        FileKind::Json => Action::ExportJson(path),
-        FileKind::Model3d => Action::Export3d(path),
-    }
-}
-
 impl EditorApp {
     /// Puts a file first in the recent files, kept in the user's config folder.
     pub(super) fn remember(&mut self, path: &Path, session: bool) {
@@ -201,7 +189,7 @@ impl EditorApp {
                 let kind = d.kind;
                 self.native = None;
                 match picked {
-                    Some(p) => self.actions.push(file_action(kind, p)),
+                    Some(p) => self.actions.push(Action::for_path(kind, p)),
                     // Cancelled: a Save the prompt asked for is not made, so nothing goes on.
                     None => self.after_save = None,
                 }
