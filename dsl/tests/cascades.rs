@@ -56,6 +56,17 @@ fn an_out_of_range_coordinate_is_one_error_wherever_it_is() {
 }
 
 #[test]
+fn a_failed_constant_in_a_stretch_piece_is_one_error() {
+    // The constant is poisoned: the site it places has no centre, which is not a second
+    // mistake ("no length along its stretch axis").
+    let src = wall().replacen("vertex ne (1, 0.5)", "vertex ne (bad, 0.5)", 1);
+    let src = format!("let bad = sqrt(-1)\n{src}");
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E012", "{e:?}");
+}
+
+#[test]
 fn a_shadowed_merge_rule_is_warned_but_not_one_with_another_reach() {
     let fixture = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -446,6 +446,11 @@ impl Compiler {
             .collect();
         let origin = site_centre(sf, base);
         let end = site_centre(st, &elem1);
+        if !(end - origin).is_finite() {
+            // A coordinate that failed (reported, or a poisoned constant's use): no length
+            // to measure, and nothing more to say.
+            return None;
+        }
         let axis = (end - origin).normalize_or_zero();
         if axis == DVec2::ZERO {
             self.error(
