@@ -71,6 +71,7 @@ fn empty_grammar(source: &str) -> CompiledGrammar {
         format_version: FORMAT_VERSION,
         source: source.into(),
         solver: SolverParams::default(),
+        params: Vec::new(),
         site_types: vec![],
         pieces: vec![],
         stretch_rules: vec![],

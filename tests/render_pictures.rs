@@ -21,6 +21,7 @@ fn grammar(pieces: Vec<Piece>) -> CompiledGrammar {
         format_version: FORMAT_VERSION,
         source: "test.clay".into(),
         solver: SolverParams::default(),
+        params: Vec::new(),
         site_types: vec![SiteType {
             name: "joint".into(),
             docks_with: vec![0],

@@ -28,6 +28,9 @@ pub struct CompiledGrammar {
     /// The path the grammar was compiled from, as given (for messages and session files).
     pub source: String,
     pub solver: SolverParams,
+    /// The grammar's parameters (`param`), in declaration order, with the values it was
+    /// compiled with: what a tool offers to change.
+    pub params: Vec<Param>,
     pub site_types: Vec<SiteType>,
     pub pieces: Vec<Piece>,
     pub stretch_rules: Vec<StretchRule>,
@@ -45,6 +48,9 @@ struct Unparted {
     format_version: u32,
     source: String,
     solver: SolverParams,
+    /// Absent in files written before parameters existed.
+    #[serde(default)]
+    params: Vec<Param>,
     site_types: Vec<SiteType>,
     pieces: Vec<Piece>,
     stretch_rules: Vec<StretchRule>,
@@ -59,6 +65,7 @@ impl From<Unparted> for CompiledGrammar {
             format_version: u.format_version,
             source: u.source,
             solver: u.solver,
+            params: u.params,
             site_types: u.site_types,
             pieces: u.pieces,
             stretch_rules: u.stretch_rules,
@@ -118,6 +125,20 @@ impl Default for SolverParams {
             merge_distance: 0.5,
         }
     }
+}
+
+/// A grammar parameter (`param NAME = DEFAULT [in LO..HI]`): a number the grammar uses as a
+/// constant and a user may set when compiling it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Param {
+    pub name: String,
+    /// The value this grammar was compiled with: the override given, else the default.
+    pub value: f64,
+    /// The value written in the grammar.
+    pub default: f64,
+    /// The inclusive range `[low, high]` of allowed values, when the grammar declares one;
+    /// without one, any finite number is allowed.
+    pub range: Option<[f64; 2]>,
 }
 
 /// A site type and the types it may dock with (symmetric, already closed over).

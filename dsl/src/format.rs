@@ -381,7 +381,7 @@ impl<'s> Printer<'s> {
         match item {
             Item::Import(_) => Some(3),
             Item::SiteType(_) => Some(1),
-            Item::Let(_) => Some(3),
+            Item::Let(_) | Item::Param(_) => Some(3),
             Item::Merge(_) | Item::Cut(_) => Some(2),
             Item::Stretch(s) if self.stretch_inline(s) => Some(2),
             _ => None,
@@ -393,6 +393,13 @@ impl<'s> Printer<'s> {
             Item::Let(l) => {
                 let t = format!("let {} = {}", l.name.name, self.num(&l.value));
                 self.stmt(0, &t, l.span);
+            }
+            Item::Param(p) => {
+                let mut t = format!("param {} = {}", p.name.name, self.num(&p.value));
+                if let Some(r) = &p.range {
+                    t += &format!(" in {}..{}", self.num(&r.low), self.num(&r.high));
+                }
+                self.stmt(0, &t, p.span);
             }
             Item::Import(i) => self.stmt(0, &format!("import \"{}\"", i.path.value), i.span),
             Item::Solver(s) => {

@@ -26,10 +26,11 @@ mod source_map;
 mod suggest;
 
 pub use compile::{
-    Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH, MAX_IMPORT_BYTES, MAX_IMPORTS,
-    MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES,
-    MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes, compile, compile_bytes, compile_bytes_with,
-    compile_with, resolve_import,
+    CompileOptions, Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH,
+    MAX_IMPORT_BYTES, MAX_IMPORTS, MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES,
+    MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes,
+    compile, compile_bytes, compile_bytes_with, compile_bytes_with_options, compile_with,
+    compile_with_options, resolve_import,
 };
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{

@@ -122,6 +122,26 @@ pub struct LetDecl {
     pub span: Span,
 }
 
+/// `param NAME = EXPR [in LO..HI]`: a grammar parameter, a constant whose value a user may
+/// override when compiling (within the range, when one is written). Visible like a `let`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamDecl {
+    pub name: Ident,
+    /// The default value.
+    pub value: Expr,
+    pub range: Option<ParamRange>,
+    pub span: Span,
+}
+
+/// `in LO..HI`: the inclusive range of a parameter's values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamRange {
+    pub low: Expr,
+    pub high: Expr,
+    /// From `in` to the end of HI.
+    pub span: Span,
+}
+
 /// A whole file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct File {
@@ -134,6 +154,7 @@ pub struct File {
 pub enum Item {
     Import(ImportDecl),
     Let(LetDecl),
+    Param(ParamDecl),
     Solver(SolverBlock),
     SiteType(SiteTypeDecl),
     Piece(PieceDecl),
@@ -148,6 +169,7 @@ impl Item {
         match self {
             Item::Import(x) => x.span,
             Item::Let(x) => x.span,
+            Item::Param(x) => x.span,
             Item::Solver(x) => x.span,
             Item::SiteType(x) => x.span,
             Item::Piece(x) => x.span,

@@ -1,9 +1,11 @@
 //! Every invalid fixture in tests/fixtures/invalid/ renders its diagnostics as snapshotted
-//! (no colour), and reports the code its header promises at the promised line.
+//! (no colour), and reports the code its header promises at the promised line. The fixtures in
+//! tests/fixtures/overrides/ do the same when compiled with the parameter values of their
+//! second line (`// params: NAME=VALUE, ...`): their mistakes are in the values, not the text.
 
 use std::path::{Path, PathBuf};
 
-use clay_dsl::{Loader, compile_bytes_with, line_col, render};
+use clay_dsl::{CompileOptions, Loader, compile_bytes_with_options, line_col, render};
 
 /// Reads imports of the fixtures (shown as `tests/fixtures/invalid/...`) from the workspace
 /// root, whatever the test's working directory.
@@ -16,7 +18,13 @@ impl Loader for FromRoot {
 }
 
 fn fixtures() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/invalid");
+    fixtures_in("invalid")
+}
+
+fn fixtures_in(folder: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures")
+        .join(folder);
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .expect("fixture directory")
         .map(|e| e.expect("entry").path())
@@ -44,6 +52,7 @@ fn expectation(bytes: &[u8]) -> (String, usize) {
 fn there_is_a_fixture_for_every_code() {
     let names: Vec<String> = fixtures()
         .iter()
+        .chain(&fixtures_in("overrides"))
         .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
         .collect();
     assert!(names.len() >= 30, "only {} fixtures", names.len());
@@ -66,16 +75,44 @@ fn there_is_a_fixture_for_every_code() {
     }
 }
 
+/// `// params: bays=20, width=1.5` on the second line.
+fn overrides(bytes: &[u8]) -> Vec<(String, f64)> {
+    let text = String::from_utf8_lossy(bytes);
+    let second = text.lines().nth(1).unwrap_or_default();
+    let list = second
+        .strip_prefix("// params: ")
+        .expect("an override fixture's second line is `// params: NAME=VALUE, ...`");
+    list.split(", ")
+        .map(|pair| {
+            let (name, value) = pair.split_once('=').expect("NAME=VALUE");
+            (name.to_string(), value.parse().expect("a number"))
+        })
+        .collect()
+}
+
 #[test]
 fn fixtures_report_their_code_at_their_line_and_match_snapshots() {
-    let files = fixtures();
+    check_fixtures("invalid", |_| Vec::new());
+}
+
+#[test]
+fn override_fixtures_report_their_code_at_their_line_and_match_snapshots() {
+    check_fixtures("overrides", overrides);
+}
+
+fn check_fixtures(folder: &str, params: fn(&[u8]) -> Vec<(String, f64)>) {
+    let files = fixtures_in(folder);
     assert!(!files.is_empty());
     for path in files {
         let bytes = std::fs::read(&path).unwrap();
         let (code, line) = expectation(&bytes);
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let shown = format!("tests/fixtures/invalid/{name}.clay");
-        let diags = match compile_bytes_with(&bytes, &shown, &FromRoot) {
+        let shown = format!("tests/fixtures/{folder}/{name}.clay");
+        let options = CompileOptions {
+            loader: &FromRoot,
+            params: params(&bytes),
+        };
+        let diags = match compile_bytes_with_options(&bytes, &shown, &options) {
             Ok(c) => c.warnings,
             Err(d) => d,
         };

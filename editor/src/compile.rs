@@ -138,6 +138,7 @@ pub fn empty_grammar(path: &str) -> Arc<CompiledGrammar> {
         format_version: FORMAT_VERSION,
         source: path.to_string(),
         solver: SolverParams::default(),
+        params: Vec::new(),
         site_types: Vec::new(),
         pieces: Vec::new(),
         stretch_rules: Vec::new(),

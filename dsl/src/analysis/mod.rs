@@ -42,12 +42,12 @@ pub const KEYWORDS: &[&str] = &[
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
     "min", "max", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x",
     "along", "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude",
-    "above", "mesh",
+    "above", "mesh", "param", "in",
 ];
 
 /// Words that start a top-level item, where a parsed prefix may end.
 const ITEM_STARTS: &[&str] = &[
-    "let", "solver", "site", "piece", "stretch", "merge", "cut", "model",
+    "let", "param", "solver", "site", "piece", "stretch", "merge", "cut", "model",
 ];
 
 /// A node of the outline (document symbols).
@@ -110,7 +110,8 @@ impl Analysis {
         // One parse for the tree and the compiler (`compile` would parse again).
         let (tree, parsed_to, diagnostics, sources) = match crate::parse(text) {
             Ok(tree) => {
-                let compiled = crate::compile::compile_tree(tree.clone(), text.len(), path, loader);
+                let compiled =
+                    crate::compile::compile_tree(tree.clone(), text.len(), path, loader, &[]);
                 let diagnostics = match compiled {
                     Ok(c) => c.warnings,
                     Err(d) => d,

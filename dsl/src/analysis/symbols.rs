@@ -131,6 +131,11 @@ impl Symbols {
                 let i = self.push(SymbolKind::Constant, &l.name, l.span, None);
                 scope.constants.entry(l.name.name.clone()).or_insert(i);
             }
+            // A parameter is a constant a user may set: the same namespace and uses.
+            Item::Param(p) => {
+                let i = self.push(SymbolKind::Constant, &p.name, p.span, None);
+                scope.constants.entry(p.name.name.clone()).or_insert(i);
+            }
             Item::SiteType(t) => {
                 let i = self.push(SymbolKind::SiteType, &t.name, t.span, None);
                 scope.site_types.entry(t.name.name.clone()).or_insert(i);
@@ -275,6 +280,13 @@ impl Symbols {
     fn resolve_item(&mut self, item: &Item, scope: &Scope) {
         match item {
             Item::Let(l) => self.expr(&l.value, scope),
+            Item::Param(p) => {
+                self.expr(&p.value, scope);
+                if let Some(r) = &p.range {
+                    self.expr(&r.low, scope);
+                    self.expr(&r.high, scope);
+                }
+            }
             Item::Import(_) => {}
             Item::Solver(s) => {
                 for e in &s.entries {

@@ -95,6 +95,13 @@ pub const MESH_MALFORMED: &str = "E066";
 /// A `mesh` asset beyond a limit: its file size, its vertices or its triangles.
 pub const MESH_TOO_LARGE: &str = "E067";
 
+/// A parameter override (`CompileOptions::params`) naming no parameter of the grammar.
+pub const UNKNOWN_PARAM: &str = "E070";
+/// A parameter override outside the parameter's range, or not a finite number.
+pub const PARAM_OUT_OF_RANGE: &str = "E071";
+/// A parameter whose default or range uses another parameter.
+pub const PARAM_NOT_FIXED: &str = "E072";
+
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";
 /// A rule that can never fire.
@@ -107,5 +114,5 @@ pub const IGNORED_ROTATE: &str = "W004";
 pub const NO_MODEL: &str = "W005";
 /// A merge rule with the mover and target of an earlier one: the earlier one always wins.
 pub const SHADOWED_MERGE: &str = "W006";
-/// A `let` constant that nothing uses.
+/// A `let` constant or `param` parameter that nothing uses.
 pub const UNUSED_CONSTANT: &str = "W007";

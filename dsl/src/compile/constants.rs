@@ -1,17 +1,21 @@
-//! Constants and expressions: the table of `let` constants, and the folding of every numeric
-//! expression to one number, with diagnostics that point inside the expression.
+//! Constants and expressions: the table of `let` constants and `param` parameters, the
+//! parameters' overrides, and the folding of every numeric expression to one number, with
+//! diagnostics that point inside the expression.
 //!
 //! Architecture Invariant: the compiled grammar holds numbers only; expressions live in the
 //! syntax tree and end here. A failed expression yields `None` once, with one diagnostic; a
 //! constant whose `let` failed is *poisoned*: its uses stay silent, as rustc stays silent
-//! about uses of a `{type error}`.
+//! about uses of a `{type error}`. A parameter is a constant whose value an override may
+//! replace; one whose declaration or override failed is poisoned the same way.
 
 use std::collections::{HashMap, HashSet};
 
 use super::{Compiler, codes};
+use crate::compiled::Param;
 use crate::diagnostic::Diagnostic;
+use crate::format::format_number;
 use crate::suggest::closest;
-use crate::syntax::{BinaryOp, Expr, ExprKind, Ident, Item, LetDecl, Span, UnaryOp};
+use crate::syntax::{BinaryOp, Expr, ExprKind, Ident, Item, LetDecl, ParamDecl, Span, UnaryOp};
 
 /// The built-in constants.
 const BUILTIN_CONSTANTS: [(&str, f64); 1] = [("pi", std::f64::consts::PI)];
@@ -32,108 +36,451 @@ const FUNCTIONS: [(&str, Option<usize>, &str); 11] = [
     ("max", None, "max(a, b, ...)"),
 ];
 
-/// One `let`.
+/// What declared a constant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Let,
+    Param,
+}
+
+impl Kind {
+    fn word(self) -> &'static str {
+        match self {
+            Kind::Let => "constant",
+            Kind::Param => "parameter",
+        }
+    }
+
+    fn keyword(self) -> &'static str {
+        match self {
+            Kind::Let => "let",
+            Kind::Param => "param",
+        }
+    }
+}
+
+/// A parameter a value depends on: its name and the name in its `param`.
+#[derive(Clone, Debug)]
+struct Dependency {
+    param: String,
+    decl: Span,
+}
+
+/// One `let` or `param`.
 #[derive(Clone, Debug)]
 struct Constant {
     /// `None` when its expression failed (reported there): the constant is poisoned.
     value: Option<f64>,
-    /// The name in its `let`.
+    /// The name in its declaration.
     span: Span,
-    /// Uses at or after this byte see it (the end of its `let`).
+    /// Uses at or after this byte see it (the end of its declaration).
     visible_from: usize,
     used: bool,
+    kind: Kind,
+    /// The parameter its value depends on (a parameter depends on itself), if any.
+    depends: Option<Dependency>,
 }
 
-/// The `let` constants of a file, and which expressions were already reported.
+/// A use of a parameter, directly or through a `let`, seen while folding.
+#[derive(Clone, Debug)]
+struct Touch {
+    dep: Dependency,
+    /// The name used, where it was used.
+    used: Ident,
+}
+
+/// The `let` constants and `param` parameters of a file, the parameters' overrides, and which
+/// expressions were already reported.
 #[derive(Debug, Default)]
 pub(crate) struct Constants {
     table: HashMap<String, Constant>,
-    /// Every `let` name with its span, known before any is evaluated, so that a use before
-    /// the declaration is told apart from an unknown name.
-    declared: HashMap<String, Span>,
+    /// Every `let` and `param` name with its span and kind, known before any is evaluated,
+    /// so that a use before the declaration is told apart from an unknown name.
+    declared: HashMap<String, (Span, Kind)>,
     /// Spans of expressions already evaluated with an error: a pass that reads an expression
     /// again stays silent.
     failed: HashSet<(usize, usize)>,
     /// Constants already reported as used before their `let`.
     early: HashSet<String>,
+    /// The values given for parameters, by name, in the order given (the last one counts).
+    pub overrides: Vec<(String, f64)>,
+    /// The parameters that compiled, in declaration order, for the compiled grammar.
+    pub params: Vec<Param>,
+    /// The first parameter the expression being folded depends on.
+    touched: Option<Touch>,
 }
 
 /// Why evaluation stopped; the diagnostic (if any) is already pushed.
 struct Stop;
 
 impl Compiler {
-    /// Evaluates every `let` in file order (a constant may use the constants above it).
+    /// Evaluates every `let` and `param` in file order (a constant may use the constants above
+    /// it), applying the overrides to the parameters; then reports overrides that name no
+    /// parameter.
     pub(crate) fn constants(&mut self, items: &[Item]) {
-        let lets: Vec<&LetDecl> = items
-            .iter()
-            .filter_map(|i| match i {
-                Item::Let(l) => Some(l),
-                _ => None,
-            })
-            .collect();
-        for l in &lets {
+        for item in items {
+            let (name, kind) = match item {
+                Item::Let(l) => (&l.name, Kind::Let),
+                Item::Param(p) => (&p.name, Kind::Param),
+                _ => continue,
+            };
             self.consts
                 .declared
-                .entry(l.name.name.clone())
-                .or_insert(l.name.span);
+                .entry(name.name.clone())
+                .or_insert((name.span, kind));
         }
-        for l in lets {
-            self.let_decl(l);
+        for item in items {
+            match item {
+                Item::Let(l) => self.let_decl(l),
+                Item::Param(p) => self.param_decl(p),
+                _ => {}
+            }
         }
+        self.unknown_overrides();
     }
 
-    fn let_decl(&mut self, l: &LetDecl) {
-        let name = &l.name.name;
-        if let Some(first) = self.consts.table.get(name) {
-            let first = first.span;
-            self.duplicate("constant", &l.name, first);
-            return;
+    /// Whether `name` may be declared as a new constant of `kind`; reports why not.
+    fn declare(&mut self, name: &Ident, kind: Kind) -> bool {
+        if let Some(first) = self.consts.table.get(&name.name) {
+            let (first_span, first_kind) = (first.span, first.kind);
+            if first_kind == kind {
+                self.duplicate(kind.word(), name, first_span);
+            } else {
+                let keep = match kind {
+                    Kind::Param => "remove the `let` if the number is meant to be set",
+                    Kind::Let => "remove the `let` and keep the `param`",
+                };
+                self.error(
+                    Diagnostic::error(
+                        codes::DUPLICATE,
+                        format!(
+                            "`{}` is defined twice, as a {} and as a {}",
+                            name.name,
+                            first_kind.word(),
+                            kind.word()
+                        ),
+                        name.span,
+                        format!("defined again here, as a {}", kind.word()),
+                    )
+                    .with_secondary(
+                        first_span,
+                        format!("first defined here, with `{}`", first_kind.keyword()),
+                    )
+                    .with_hint(format!(
+                        "a parameter is a constant a user may set: rename one of them, or {keep}"
+                    )),
+                );
+            }
+            return false;
         }
-        let builtin = BUILTIN_CONSTANTS.iter().any(|(n, _)| n == name)
-            || FUNCTIONS.iter().any(|(n, _, _)| n == name);
+        let builtin = BUILTIN_CONSTANTS.iter().any(|(n, _)| *n == name.name)
+            || FUNCTIONS.iter().any(|(n, _, _)| *n == name.name);
         if builtin {
             self.error(
                 Diagnostic::error(
                     codes::DUPLICATE,
-                    format!("`{name}` is built in"),
-                    l.name.span,
+                    format!("`{}` is built in", name.name),
+                    name.span,
                     "a built-in name",
                 )
-                .with_hint("choose another name for the constant"),
+                .with_hint(format!("choose another name for the {}", kind.word())),
             );
+            return false;
+        }
+        true
+    }
+
+    fn let_decl(&mut self, l: &LetDecl) {
+        if !self.declare(&l.name, Kind::Let) {
             return;
         }
+        self.consts.touched = None;
         let value = self.eval(&l.value);
+        let depends = self.consts.touched.take().map(|t| t.dep);
         self.consts.table.insert(
-            name.clone(),
+            l.name.name.clone(),
             Constant {
                 value,
                 span: l.name.span,
                 visible_from: l.span.end,
                 used: false,
+                kind: Kind::Let,
+                depends,
             },
         );
     }
 
+    fn param_decl(&mut self, p: &ParamDecl) {
+        if !self.declare(&p.name, Kind::Param) {
+            return;
+        }
+        let value = self.param_value(p);
+        self.consts.table.insert(
+            p.name.name.clone(),
+            Constant {
+                value,
+                span: p.name.span,
+                visible_from: p.span.end,
+                used: false,
+                kind: Kind::Param,
+                depends: Some(Dependency {
+                    param: p.name.name.clone(),
+                    decl: p.name.span,
+                }),
+            },
+        );
+    }
+
+    /// A parameter's value: its override, or else its default. `None` (poisoned) after an
+    /// error in its declaration, reported once.
+    fn param_value(&mut self, p: &ParamDecl) -> Option<f64> {
+        // One E072 per parameter, however many of its parts use another one.
+        let mut reported = false;
+        let default = self.fixed(p, &p.value, "default", &mut reported);
+        let range = match &p.range {
+            None => Some(None),
+            Some(r) => {
+                let low = self.fixed(p, &r.low, "range", &mut reported);
+                let high = self.fixed(p, &r.high, "range", &mut reported);
+                low.zip(high).map(Some)
+            }
+        };
+        let (default, range) = (default?, range?);
+        if let (Some((low, high)), Some(r)) = (range, &p.range) {
+            if low > high {
+                self.error(
+                    Diagnostic::error(
+                        codes::OUT_OF_RANGE,
+                        format!(
+                            "the range of parameter `{}` is empty: its low end is above its high end",
+                            p.name.name
+                        ),
+                        r.span,
+                        format!("{} is above {}", format_number(low), format_number(high)),
+                    )
+                    .with_hint(format!(
+                        "write the low end first: `in {}..{}`",
+                        format_number(high),
+                        format_number(low)
+                    )),
+                );
+                return None;
+            }
+            if !(low..=high).contains(&default) {
+                self.error(
+                    Diagnostic::error(
+                        codes::OUT_OF_RANGE,
+                        format!(
+                            "the default of parameter `{}` is outside its range",
+                            p.name.name
+                        ),
+                        p.value.span,
+                        format!(
+                            "{} is not in {}",
+                            format_number(default),
+                            range_text(low, high)
+                        ),
+                    )
+                    .with_secondary(r.span, "the range")
+                    .with_hint(format!(
+                        "make the default a number from {} to {}, or widen the range",
+                        format_number(low),
+                        format_number(high)
+                    )),
+                );
+                return None;
+            }
+        }
+        let range = range.map(|(low, high)| [low, high]);
+        let given = self
+            .consts
+            .overrides
+            .iter()
+            .rev()
+            .find(|(n, _)| *n == p.name.name)
+            .map(|(_, v)| *v);
+        // A rejected override is reported once; the rest of the grammar compiles with the
+        // default, so that nothing else is said about it.
+        let value = match given {
+            None => default,
+            Some(v) => self.checked_override(p, v, range).unwrap_or(default),
+        };
+        self.consts.params.push(Param {
+            name: p.name.name.clone(),
+            value,
+            default,
+            range,
+        });
+        Some(value)
+    }
+
+    /// A part of a parameter's declaration (its default or a bound of its range), which must
+    /// not depend on another parameter (E072).
+    fn fixed(&mut self, p: &ParamDecl, e: &Expr, part: &str, reported: &mut bool) -> Option<f64> {
+        self.consts.touched = None;
+        let value = self.eval(e);
+        let Some(t) = self.consts.touched.take() else {
+            return value;
+        };
+        if std::mem::replace(reported, true) {
+            return None;
+        }
+        let through = if t.used.name == t.dep.param {
+            format!("parameter `{}`", t.dep.param)
+        } else {
+            format!(
+                "`{}`, which depends on parameter `{}`",
+                t.used.name, t.dep.param
+            )
+        };
+        self.error(
+            Diagnostic::error(
+                codes::PARAM_NOT_FIXED,
+                format!("the {part} of parameter `{}` uses {through}", p.name.name),
+                t.used.span,
+                "depends on a parameter",
+            )
+            .with_secondary(
+                t.dep.decl,
+                format!("`{}` is a parameter: a user may set it", t.dep.param),
+            )
+            .with_hint(
+                "a parameter's default and range are fixed: write them with numbers and \
+                 `let` constants that use no parameter",
+            ),
+        );
+        None
+    }
+
+    /// An override of parameter `p` checked against its range (E071).
+    fn checked_override(&mut self, p: &ParamDecl, v: f64, range: Option<[f64; 2]>) -> Option<f64> {
+        let name = &p.name.name;
+        let (message, mut hint) = if !v.is_finite() {
+            (
+                format!(
+                    "parameter `{name}` is set to {}, which is not a finite number",
+                    shown(v)
+                ),
+                "a parameter's value must be a finite number".to_string(),
+            )
+        } else {
+            match range {
+                Some([low, high]) if v < low || v > high => (
+                    format!(
+                        "parameter `{name}` is set to {}, outside its range {}",
+                        shown(v),
+                        range_text(low, high)
+                    ),
+                    String::new(),
+                ),
+                _ => return Some(v),
+            }
+        };
+        if let Some([low, high]) = range {
+            if !hint.is_empty() {
+                hint.push_str("; ");
+            }
+            hint.push_str(&format!(
+                "choose a value of `{name}` from {} to {}",
+                format_number(low),
+                format_number(high)
+            ));
+        }
+        let mut d = Diagnostic::error(
+            codes::PARAM_OUT_OF_RANGE,
+            message,
+            p.name.span,
+            format!("set to {} from outside the file", shown(v)),
+        );
+        if let Some(r) = &p.range {
+            d = d.with_secondary(r.span, "its range");
+        }
+        self.error(d.with_hint(hint));
+        None
+    }
+
+    /// E070 for each override whose name is no parameter of the grammar (once per name).
+    fn unknown_overrides(&mut self) {
+        let mut params: Vec<(&str, Span)> = self
+            .consts
+            .declared
+            .iter()
+            .filter(|(_, (_, k))| *k == Kind::Param)
+            .map(|(n, (s, _))| (n.as_str(), *s))
+            .collect();
+        params.sort_by_key(|(_, s)| s.start);
+        let mut seen = HashSet::new();
+        let mut diags = Vec::new();
+        for (name, _) in &self.consts.overrides {
+            if !seen.insert(name.as_str()) {
+                continue;
+            }
+            match self.consts.declared.get(name) {
+                Some((_, Kind::Param)) => {}
+                Some((span, Kind::Let)) => diags.push(
+                    Diagnostic::error(
+                        codes::UNKNOWN_PARAM,
+                        format!("`{name}` is a constant, not a parameter: it cannot be set"),
+                        *span,
+                        "declared with `let`",
+                    )
+                    .with_hint(format!(
+                        "declare it with `param {name} = ...` to let it be set"
+                    )),
+                ),
+                None => {
+                    let mut d = Diagnostic::error(
+                        codes::UNKNOWN_PARAM,
+                        format!("unknown parameter `{name}`"),
+                        Span::new(0, 0),
+                        format!("the grammar has no parameter `{name}`"),
+                    );
+                    if let Some(c) = closest(name, params.iter().map(|(n, _)| *n)) {
+                        let at = params.iter().find(|(n, _)| *n == c).map(|(_, s)| *s);
+                        if let Some(at) = at {
+                            d = d.with_secondary(at, format!("`{c}` is declared here"));
+                        }
+                        d = d.with_hint(format!("did you mean `{c}`?"));
+                    }
+                    d = d.with_hint(if params.is_empty() {
+                        "the grammar declares no parameters (`param NAME = VALUE`)".to_string()
+                    } else {
+                        let list: Vec<String> =
+                            params.iter().map(|(n, _)| format!("`{n}`")).collect();
+                        format!("the parameters are {}", list.join(", "))
+                    });
+                    diags.push(d);
+                }
+            }
+        }
+        for d in diags {
+            self.error(d);
+        }
+    }
+
     /// Warns about constants nothing uses.
     pub(crate) fn unused_constants(&mut self) {
-        let mut unused: Vec<(String, Span)> = self
+        let mut unused: Vec<(String, Span, Kind)> = self
             .consts
             .table
             .iter()
             .filter(|(_, c)| !c.used)
-            .map(|(n, c)| (n.clone(), c.span))
+            .map(|(n, c)| (n.clone(), c.span, c.kind))
             .collect();
-        unused.sort_by_key(|(_, s)| s.start);
-        for (name, span) in unused {
+        unused.sort_by_key(|(_, s, _)| s.start);
+        for (name, span, kind) in unused {
+            let word = kind.word();
             self.error(
                 Diagnostic::warning(
                     codes::UNUSED_CONSTANT,
-                    format!("constant `{name}` is never used"),
+                    format!("{word} `{name}` is never used"),
                     span,
                     "declared here",
                 )
-                .with_hint("remove the `let`, or use the constant where its number belongs"),
+                .with_hint(format!(
+                    "remove the `{}`, or use the {word} where its number belongs",
+                    kind.keyword()
+                )),
             );
         }
     }
@@ -192,25 +539,32 @@ impl Compiler {
         match self.consts.table.get_mut(name) {
             Some(c) if c.visible_from <= id.span.start => {
                 c.used = true;
+                if let (Some(dep), None) = (&c.depends, &self.consts.touched) {
+                    self.consts.touched = Some(Touch {
+                        dep: dep.clone(),
+                        used: id.clone(),
+                    });
+                }
                 return c.value.ok_or(Stop);
             }
             _ => {}
         }
-        if let Some(&declared) = self.consts.declared.get(name) {
+        if let Some(&(declared, kind)) = self.consts.declared.get(name) {
             // One mistake (the `let` is too low), one error: later uses stay silent.
             if !self.consts.early.insert(name.to_string()) {
                 return Err(Stop);
             }
+            let (word, keyword) = (kind.word(), kind.keyword());
             self.error(
                 Diagnostic::error(
                     codes::USED_BEFORE_LET,
-                    format!("constant `{name}` is used before its `let`"),
+                    format!("{word} `{name}` is used before its `{keyword}`"),
                     id.span,
                     "used here",
                 )
                 .with_secondary(declared, "declared later here")
                 .with_hint(format!(
-                    "a constant is visible after its `let`: move `let {name}` above this use"
+                    "a {word} is visible after its `{keyword}`: move `{keyword} {name}` above this use"
                 )),
             );
             return Err(Stop);
@@ -384,6 +738,20 @@ pub(crate) fn constant_values(file: &crate::syntax::File) -> HashMap<String, f64
         .iter()
         .filter_map(|(n, k)| k.value.map(|v| (n.clone(), v)))
         .collect()
+}
+
+/// A value as messages show it: the shortest text that reads back, or `inf`, `-inf`, `NaN`.
+fn shown(v: f64) -> String {
+    if v.is_finite() {
+        format_number(v)
+    } else {
+        format!("{v}")
+    }
+}
+
+/// `LO..HI` as messages show a range.
+fn range_text(low: f64, high: f64) -> String {
+    format!("{}..{}", format_number(low), format_number(high))
 }
 
 /// Whether `name` is a built-in function.

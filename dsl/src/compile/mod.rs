@@ -1,5 +1,6 @@
 //! The compiler: syntax tree -> [`CompiledGrammar`]. This file drives the passes and compiles
-//! the declarations (solver, site types, pieces); `rules.rs` compiles stretch, merge and cut
+//! the declarations (solver, site types, pieces); `constants.rs` folds `let` constants,
+//! `param` parameters (with their overrides) and every expression; `rules.rs` compiles stretch, merge and cut
 //! rules, `assembly.rs` places the model, and `usage.rs` finds unused pieces and dead rules.
 
 pub mod codes;
@@ -62,10 +63,56 @@ pub const COINCIDENT_EPS: f64 = 1e-9;
 /// Tolerance for docked vertices meeting after placement, in metres.
 pub const DOCK_TOLERANCE: f64 = 1e-4;
 
+/// How to compile a grammar: where its imported files and mesh assets are read from, and the
+/// values of its parameters. `CompileOptions::default()` reads the file system and sets no
+/// parameter, as [`compile`] does.
+#[derive(Clone)]
+pub struct CompileOptions<'a> {
+    /// Reads imported files and mesh assets ([`FsLoader`] by default).
+    pub loader: &'a dyn Loader,
+    /// Values for the grammar's parameters (`param NAME = ...`), by name, replacing their
+    /// defaults; of two values for one name the last counts. A name that is not a parameter
+    /// of the grammar is E070; a value outside the parameter's range, or not finite, E071.
+    pub params: Vec<(String, f64)>,
+}
+
+impl Default for CompileOptions<'_> {
+    fn default() -> Self {
+        Self {
+            loader: &FsLoader,
+            params: Vec::new(),
+        }
+    }
+}
+
+impl<'a> CompileOptions<'a> {
+    /// Options that read through `loader` and set no parameter.
+    pub fn with_loader(loader: &'a dyn Loader) -> Self {
+        Self {
+            loader,
+            params: Vec::new(),
+        }
+    }
+
+    /// The same options, with parameter `name` set to `value`.
+    pub fn param(mut self, name: impl Into<String>, value: f64) -> Self {
+        self.params.push((name.into(), value));
+        self
+    }
+}
+
+impl std::fmt::Debug for CompileOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompileOptions")
+            .field("params", &self.params)
+            .finish_non_exhaustive()
+    }
+}
+
 /// Compiles the text of a `.clay` file. `path` is recorded in the result, and its folder is where
 /// `import`ed files are read from (through the file system, [`FsLoader`]).
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
-    compile_with(source, path, &FsLoader)
+    compile_with_options(source, path, &CompileOptions::default())
 }
 
 /// Like [`compile`], reading imported files through `loader` (a language server can serve
@@ -76,16 +123,33 @@ pub fn compile_with(
     path: &str,
     loader: &dyn Loader,
 ) -> Result<Compiled, Diagnostics> {
-    compile_tree(crate::parse::parse(source)?, source.len(), path, loader)
+    compile_with_options(source, path, &CompileOptions::with_loader(loader))
+}
+
+/// Like [`compile`], with a loader and parameter values ([`CompileOptions`]). The compiled
+/// grammar lists every parameter with the value used ([`CompiledGrammar::params`]).
+pub fn compile_with_options(
+    source: &str,
+    path: &str,
+    options: &CompileOptions,
+) -> Result<Compiled, Diagnostics> {
+    compile_tree(
+        crate::parse::parse(source)?,
+        source.len(),
+        path,
+        options.loader,
+        &options.params,
+    )
 }
 
 /// Compiles a parsed file whose text is `source_len` bytes long (the analysis layer parses
-/// once, for its tree and the compiler).
+/// once, for its tree and the compiler), with the parameter values `params`.
 pub(crate) fn compile_tree(
     file: syntax::File,
     source_len: usize,
     path: &str,
     loader: &dyn Loader,
+    params: &[(String, f64)],
 ) -> Result<Compiled, Diagnostics> {
     let span = file.span;
     let spliced = imports::splice(file, path, source_len, loader);
@@ -101,6 +165,7 @@ pub(crate) fn compile_tree(
         span,
     };
     let mut c = Compiler::new(path);
+    c.consts.overrides = params.to_vec();
     c.expand_extends(&mut file);
     c.meshes = meshes::load(
         &file,
@@ -132,7 +197,7 @@ pub(crate) fn compile_tree(
 /// Compiles raw bytes; text that is not UTF-8 is reported (E003) at the first bad byte. Render
 /// the diagnostics against `String::from_utf8_lossy(bytes)`: offsets before that byte agree.
 pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> {
-    compile_bytes_with(bytes, path, &FsLoader)
+    compile_bytes_with_options(bytes, path, &CompileOptions::default())
 }
 
 /// [`compile_bytes`] reading imported files through `loader`.
@@ -141,8 +206,17 @@ pub fn compile_bytes_with(
     path: &str,
     loader: &dyn Loader,
 ) -> Result<Compiled, Diagnostics> {
+    compile_bytes_with_options(bytes, path, &CompileOptions::with_loader(loader))
+}
+
+/// [`compile_bytes`] with a loader and parameter values ([`CompileOptions`]).
+pub fn compile_bytes_with_options(
+    bytes: &[u8],
+    path: &str,
+    options: &CompileOptions,
+) -> Result<Compiled, Diagnostics> {
     match std::str::from_utf8(bytes) {
-        Ok(source) => compile_with(source, path, loader),
+        Ok(source) => compile_with_options(source, path, options),
         Err(e) => {
             let at = e.valid_up_to();
             Err(Diagnostic::error(
@@ -464,6 +538,7 @@ impl Compiler {
             format_version: FORMAT_VERSION,
             source: self.path.clone(),
             solver: self.solver,
+            params: std::mem::take(&mut self.consts.params),
             site_types: std::mem::take(&mut self.site_types),
             pieces: std::mem::take(&mut self.pieces),
             stretch_rules: std::mem::take(&mut self.stretch_rules),

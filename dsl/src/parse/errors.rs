@@ -183,7 +183,7 @@ fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
         return Some("points are written `(x, y)`".into());
     }
     if positives.contains(&Rule::kw_piece) && positives.contains(&Rule::kw_model) {
-        return Some("a file is a list of `import`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` and `model` items".into());
+        return Some("a file is a list of `import`, `let`, `param`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` and `model` items".into());
     }
     None
 }

@@ -12,7 +12,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::WHITESPACE | Rule::COMMENT | Rule::line_comment | Rule::block_comment => "whitespace",
         Rule::ident_char => "a letter, digit or `_`",
         Rule::item => {
-            "`import`, `let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`"
+            "`import`, `let`, `param`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut` or `model`"
         }
         Rule::piece_stmt => "a piece statement",
         Rule::state_stmt => "a state statement",
@@ -28,6 +28,11 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::paren_expr => "`(`",
         Rule::let_decl => "a `let` constant",
         Rule::kw_let => "`let`",
+        Rule::param_decl => "a `param` parameter",
+        Rule::param_range => "a range `in LO..HI`",
+        Rule::kw_param => "`param`",
+        Rule::kw_in => "`in`",
+        Rule::dotdot => "`..`",
         Rule::kw_extrude => "`extrude`",
         Rule::kw_above => "`above`",
         Rule::extrude => "`extrude HEIGHT [above BASE]`",
@@ -91,7 +96,7 @@ pub fn describe(rule: Rule) -> &'static str {
         Rule::dash => "`-`",
         Rule::dot => "`.`",
         Rule::file => {
-            "`import`, `let`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
+            "`import`, `let`, `param`, `solver`, `site type`, `piece`, `stretch`, `merge`, `cut`, `model` or end of file"
         }
         Rule::solver_block => "a `solver` block",
         Rule::solver_entry => "a solver parameter `NAME = NUMBER`",

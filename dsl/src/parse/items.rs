@@ -1,4 +1,4 @@
-//! The small file-level items: `let` constants, `import`s and the `solver` block.
+//! The small file-level items: `let` constants, `param`eters, `import`s and the `solver` block.
 
 use pest::iterators::Pair;
 
@@ -13,6 +13,31 @@ impl Lower {
         let name = self.name_or(&ch, span);
         let value = self.expr_or(first(&ch, Rule::expr), span);
         LetDecl { name, value, span }
+    }
+
+    pub(super) fn param_decl(&mut self, p: Pair<Rule>) -> ParamDecl {
+        let span = span_of(&p);
+        let ch = kids(p);
+        let name = self.name_or(&ch, span);
+        let value = self.expr_or(first(&ch, Rule::expr), span);
+        let range = first(&ch, Rule::param_range).map(|r| {
+            let rspan = span_of(&r);
+            let bounds = of(&kids(r), Rule::expr);
+            let mut bounds = bounds.into_iter();
+            let low = self.expr_or(bounds.next(), rspan);
+            let high = self.expr_or(bounds.next(), rspan);
+            ParamRange {
+                low,
+                high,
+                span: rspan,
+            }
+        });
+        ParamDecl {
+            name,
+            value,
+            range,
+            span,
+        }
     }
 
     pub(super) fn import(&mut self, p: Pair<Rule>) -> ImportDecl {

@@ -78,6 +78,7 @@ pub(super) fn kids(p: Pair<Rule>) -> Vec<Pair<Rule>> {
                     | Rule::arrow
                     | Rule::dash
                     | Rule::dot
+                    | Rule::dotdot
                     | Rule::EOI
             )
         })

@@ -5,7 +5,7 @@
 //! The files, in the order text meets them: `scan.rs` (nesting and unclosed comments, before
 //! pest), `grammar.rs` (the pest parser and the words for its rules), `errors.rs` (syntax
 //! errors as diagnostics), `codes.rs`; then the lowering: `lower.rs` (its state and shared
-//! tools), `expr.rs` (expressions and points), `items.rs` (`let`, `import`, `solver`),
+//! tools), `expr.rs` (expressions and points), `items.rs` (`let`, `param`, `import`, `solver`),
 //! `pieces.rs`, `rules.rs` (stretch, merge, cut) and `model.rs`. This file is the entry and
 //! the list of a file's items; the others import their siblings, never this file.
 
@@ -80,6 +80,7 @@ impl Lower {
         for c in kids(p) {
             let item = match c.as_rule() {
                 Rule::let_decl => Item::Let(self.let_decl(c)),
+                Rule::param_decl => Item::Param(self.param_decl(c)),
                 Rule::import_decl => Item::Import(self.import(c)),
                 Rule::solver_block => Item::Solver(self.solver(c)),
                 Rule::site_type_decl => Item::SiteType(self.site_type(c)),
