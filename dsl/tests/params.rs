@@ -258,6 +258,45 @@ fn a_param_of_an_imported_file_is_a_param_of_the_grammar() {
     assert!(shown.contains("lib.clay:1:7"), "{shown}");
 }
 
+#[test]
+fn the_language_doc_example_of_params_compiles_as_it_says() {
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/language.md"))
+        .unwrap();
+    let section = &doc[doc.find("## Parameters").expect("the section")..];
+    let start = section.find("```clay\n").expect("an example") + "```clay\n".len();
+    let example = &section[start..start + section[start..].find("```").unwrap()];
+    // "Compiled as it is, this is a fence of 6 bays 2 m wide".
+    let g = ok(example, &[]);
+    assert_eq!(g.assembly.instances.len(), 6);
+    assert_eq!(brick_width(&g), 2.0);
+    // "with `bays` set to 12 and `bay_width` to 1.5, a fence of 12 bays 1.5 m wide".
+    let g = ok(example, &[("bays", 12.0), ("bay_width", 1.5)]);
+    assert_eq!(g.assembly.instances.len(), 12);
+    assert_eq!(brick_width(&g), 1.5);
+    assert_eq!(format(example).unwrap(), example);
+}
+
+#[test]
+fn keep_clay_sets_its_wall_height() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../grammars/keep.clay");
+    let source = std::fs::read_to_string(path).unwrap();
+    let wall_top = |g: &CompiledGrammar| {
+        let wall = g.pieces.iter().find(|p| p.name == "wall").unwrap();
+        wall.states[0].geometry[0].extrude.unwrap().height
+    };
+    let options = CompileOptions::default();
+    let g = compile_with_options(&source, path, &options)
+        .unwrap()
+        .grammar;
+    assert_eq!(wall_top(&g), 4.0);
+    assert_eq!(g.params[0].range, Some([3.0, 6.0]));
+    let options = CompileOptions::default().param("wall_height", 5.5);
+    let g = compile_with_options(&source, path, &options)
+        .unwrap()
+        .grammar;
+    assert_eq!(wall_top(&g), 5.5);
+}
+
 // ---- mistakes ------------------------------------------------------------------------------
 
 #[test]
