@@ -40,12 +40,13 @@ const grammar = await registry.loadGrammar("source.clay");
 
 // Keywords that begin a statement (or a block).
 const STATEMENT_KEYWORDS = new Set([
-  "import", "let", "solver", "site", "piece", "vertex", "edges", "axis", "polygon", "polyline",
+  "import", "let", "param", "solver", "site", "piece", "vertex", "edges", "axis", "polygon", "polyline",
   "mesh", "hole", "state", "stretch", "min", "max", "variants", "merge", "cut", "model", "dock",
 ]);
 // Keywords inside a statement, by the statement's first keyword ("=" for `NAME = ...`).
 const INNER_KEYWORDS = {
   "site type": ["type", "docks"],
+  param: ["in"],
   site: ["out"],
   piece: ["extends"],
   polygon: ["rigid", "skinned", "fill", "extrude", "above"],
@@ -127,7 +128,9 @@ function lex(text) {
       else if ((m = /^"[^"]*("|$)/.exec(rest))) push("string", m[0].length);
       else if ((m = /^#([0-9A-Fa-f]{8}|[0-9A-Fa-f]{6})(?![A-Za-z0-9_])/.exec(rest))) push("colour", m[0].length);
       else if ((m = /^#\w*/.exec(rest))) push("bad-colour", m[0].length);
-      else if ((m = /^(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?(?![\w.])/.exec(rest))) push("number", m[0].length);
+      else if (rest.startsWith("..")) push("punct", 2);
+      // a `.` before another `.` is a range's `..`, not a decimal point: `1..8`
+      else if ((m = /^(\d+(\.(?!\.)\d*)?|\.\d+)([eE][+-]?\d+)?(?!\w|\.(?!\.))/.exec(rest))) push("number", m[0].length);
       else if ((m = /^(\d|\.\d)[\w.]*/.exec(rest))) push("bad-number", m[0].length);
       else if ((m = /^[A-Za-z_]\w*/.exec(rest))) push("name", m[0].length);
       else if (rest.startsWith("->")) push("punct", 2);
@@ -298,7 +301,7 @@ for (const input of INPUTS) {
       for (const tok of tokens.filter((t) => t.kind === "punct")) {
         const want = {
           "+": "keyword.operator", "-": "keyword.operator", "*": "keyword.operator", "/": "keyword.operator",
-          "->": "keyword.operator.arrow", "=": "keyword.operator.assignment",
+          "->": "keyword.operator.arrow", "=": "keyword.operator.assignment", "..": "keyword.operator.range",
           ":": "punctuation.separator.colon", ",": "punctuation.separator.comma", ".": "punctuation.accessor",
           "{": "punctuation.section.block", "}": "punctuation.section.block",
           "[": "punctuation.section.brackets", "]": "punctuation.section.brackets",
@@ -374,6 +377,26 @@ test("the new syntax: import, extends, bend, mirror", () => {
   expectScope(fixture, 'out */ import "lib/walls.clay"', "import", "keyword.other.import.clay");
   expectScope(fixture, 'out */ import "lib/walls.clay"', '"lib/walls.clay"', "string.quoted.double.clay");
   expectScope(fixture, 'out */ import "lib/walls.clay"', "out", "comment.block.clay");
+});
+
+test("parameters: param, its name, in and the range", () => {
+  expectScope(fixture, "param bays = 6 in 2..40", "param", "keyword.other.param.clay");
+  expectScope(fixture, "param bays = 6 in 2..40", "bays", "entity.name.constant.clay");
+  expectScope(fixture, "param bays = 6 in 2..40", "in", "keyword.other.in.clay");
+  expectScope(fixture, "param bays = 6 in 2..40", "..", "keyword.operator.range.clay");
+  expectScope(fixture, "param bays = 6 in 2..40", "2", "constant.numeric.decimal.clay", { nth: 0 });
+  expectScope(fixture, "param bays = 6 in 2..40", "40", "constant.numeric.decimal.clay");
+  expectScope(fixture, "param depth = .5e1 in 0.5..1E+2", "0.5", "constant.numeric.decimal.clay");
+  expectScope(fixture, "param depth = .5e1 in 0.5..1E+2", "1E+2", "constant.numeric.decimal.clay");
+  expectScope(fixture, "param depth = .5e1 in 0.5..1E+2", "..", "keyword.operator.range.clay");
+  expectScope(fixture, "param free = -w in -w..(w + 1)", "(w + 1)", "meta.group.clay");
+  expectScope(fixture, "param free = -w in -w..(w + 1)", "w", "variable.other.clay", { nth: 1 });
+  expectScope(fixture, "param free = -w in -w..(w + 1)", "in", "keyword.other.in.clay");
+  // `in` and `param` are names elsewhere.
+  expectScope(fixture, "vertex in (1, 1)", "in", "entity.name.variable.vertex.clay");
+  expectScope(fixture, "vertex in (1, 1)", "in", "keyword", { not: true });
+  expectScope("piece param {\n}\n", "piece", "param", "entity.name.type.piece.clay");
+  expectScope("model {\n    param = p\n}\n", "param =", "param", "entity.name.variable.clay");
 });
 
 test("contextual keywords are names outside their positions", () => {
