@@ -1,0 +1,98 @@
+//! Conversions at the edge: files' errors to `OSError`, panics to `InternalError`, Python
+//! numbers and points to the library's, checked.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+use crate::InternalError;
+
+/// An `OSError` for `path` (Python picks the subclass from the errno: `FileNotFoundError`,
+/// `PermissionError`, `IsADirectoryError`, ...), with the path in its message.
+pub fn os_error(e: &std::io::Error, path: &Path) -> PyErr {
+    let why = match e.kind() {
+        std::io::ErrorKind::NotFound => "No such file or directory".to_string(),
+        std::io::ErrorKind::PermissionDenied => "Permission denied".to_string(),
+        _ => e.to_string(),
+    };
+    let name = path.display().to_string();
+    match e.raw_os_error() {
+        Some(errno) => PyOSError::new_err((errno, why, name)),
+        None => PyOSError::new_err(format!("{name}: {why}")),
+    }
+}
+
+/// Reads a file whole, or says why not as an `OSError`.
+pub fn read(path: &Path) -> PyResult<Vec<u8>> {
+    std::fs::read(path).map_err(|e| os_error(&e, path))
+}
+
+/// Runs library code, turning a panic (a bug) into `InternalError` instead of letting it
+/// unwind into the interpreter.
+pub fn guard<T>(what: &str, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(result) => result,
+        Err(payload) => {
+            let why = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "no message".into());
+            Err(InternalError::new_err(format!(
+                "{what} failed inside Clay (a bug, please report it): {why}"
+            )))
+        }
+    }
+}
+
+/// A path argument: `str` or `os.PathLike`.
+pub fn path_of(value: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    value.extract::<PathBuf>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "expected a path (str or os.PathLike), found {}",
+            type_name(value)
+        ))
+    })
+}
+
+pub fn type_name(value: &Bound<'_, PyAny>) -> String {
+    value
+        .get_type()
+        .name()
+        .map_or_else(|_| "an object".into(), |n| n.to_string())
+}
+
+/// A finite number for a JSON step (`what` names it in the message as a script would).
+pub fn finite(value: f64, what: &str) -> PyResult<serde_json::Value> {
+    serde_json::Number::from_f64(value)
+        .map(serde_json::Value::Number)
+        .ok_or_else(|| {
+            // As Python spells them.
+            let shown = if value.is_nan() {
+                "nan"
+            } else if value > 0.0 {
+                "inf"
+            } else {
+                "-inf"
+            };
+            PyValueError::new_err(format!("{what} must be a finite number, found {shown}"))
+        })
+}
+
+/// A point `(x, y)` of finite numbers, as a JSON array for a step.
+pub fn point(value: &Bound<'_, PyAny>, what: &str) -> PyResult<serde_json::Value> {
+    let (x, y): (f64, f64) = value.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what} must be a pair of numbers (x, y), found {}",
+            value
+                .repr()
+                .map_or_else(|_| type_name(value), |r| r.to_string())
+        ))
+    })?;
+    Ok(serde_json::Value::Array(vec![
+        finite(x, what)?,
+        finite(y, what)?,
+    ]))
+}

@@ -1,0 +1,248 @@
+//! `clay.Grammar`: a compiled grammar (what `clayc check` and `run` compile), its pieces and
+//! its parameters.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use clay_dsl::CompileOptions;
+use clay_dsl::compiled::CompiledGrammar;
+
+use crate::convert::{guard, path_of, read, type_name};
+use crate::diagnostics::{Diagnostic, grammar_error, to_python};
+
+/// A grammar parameter (`param NAME = EXPR in LO..HI`): its value in this compilation, the
+/// value the grammar gives it, and its range (`None`: unbounded).
+#[pyclass(module = "clay", frozen, get_all)]
+#[derive(Clone)]
+pub struct Param {
+    pub name: String,
+    pub value: f64,
+    pub default: f64,
+    pub range: Option<(f64, f64)>,
+}
+
+#[pymethods]
+impl Param {
+    fn __repr__(&self) -> String {
+        let range = self
+            .range
+            .map_or(String::new(), |(lo, hi)| format!(" in {lo}..{hi}"));
+        format!(
+            "Param({} = {}{range}, default {})",
+            self.name, self.value, self.default
+        )
+    }
+}
+
+/// A piece of the grammar: its name, rest states, vertices and docking sites, by name.
+#[pyclass(module = "clay", frozen, get_all)]
+#[derive(Clone)]
+pub struct Piece {
+    pub name: String,
+    pub states: Vec<String>,
+    pub vertices: Vec<String>,
+    pub sites: Vec<String>,
+}
+
+#[pymethods]
+impl Piece {
+    fn __repr__(&self) -> String {
+        format!("Piece({}, states={:?})", self.name, self.states)
+    }
+}
+
+/// A compiled grammar. Make one with `Grammar.open(path)` or `Grammar.parse(text)`; a grammar
+/// with errors raises `clay.GrammarError`. Warnings are kept in `.warnings`.
+#[pyclass(module = "clay", frozen)]
+pub struct Grammar {
+    pub compiled: Arc<CompiledGrammar>,
+    path: Option<String>,
+    warnings: Vec<Diagnostic>,
+    params: Vec<Param>,
+}
+
+/// Parameter overrides from Python: a mapping of names to numbers.
+fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, f64>> {
+    let Some(params) = params.filter(|p| !p.is_none()) else {
+        return Ok(BTreeMap::new());
+    };
+    let dict = params.cast::<PyDict>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "params must be a dict of names to numbers, found {}",
+            type_name(params)
+        ))
+    })?;
+    let mut out = BTreeMap::new();
+    for (k, v) in dict.iter() {
+        let name: String = k.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "params: a parameter's name must be a str, found {}",
+                type_name(&k)
+            ))
+        })?;
+        if v.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "params: {name} must be a number, found bool"
+            )));
+        }
+        let value: f64 = v.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "params: {name} must be a number, found {}",
+                type_name(&v)
+            ))
+        })?;
+        out.insert(name, value);
+    }
+    Ok(out)
+}
+
+impl Grammar {
+    /// Compiles `bytes` (the text of `path`) with parameter overrides.
+    fn compile(
+        py: Python<'_>,
+        bytes: &[u8],
+        path: &str,
+        shown_path: Option<String>,
+        params: BTreeMap<String, f64>,
+    ) -> PyResult<Self> {
+        let params: Vec<(String, f64)> = params.into_iter().collect();
+        let compiled = py.detach(|| {
+            guard("compiling the grammar", || {
+                // Made here: the file system loader it holds stays on this thread.
+                let options = CompileOptions {
+                    params,
+                    ..CompileOptions::default()
+                };
+                Ok(clay_dsl::compile_bytes_with_options(bytes, path, &options))
+            })
+        })?;
+        let text = String::from_utf8_lossy(bytes);
+        // An unknown parameter (E070) or a value outside its range (E071) is a diagnostic
+        // like any other: a GrammarError naming the parameter, its range and the known names.
+        let compiled = compiled.map_err(|d| grammar_error(py, &d, &text, path))?;
+        let params = (compiled.grammar.params.iter())
+            .map(|p| Param {
+                name: p.name.clone(),
+                value: p.value,
+                default: p.default,
+                range: p.range.map(|[lo, hi]| (lo, hi)),
+            })
+            .collect();
+        Ok(Self {
+            warnings: to_python(&compiled.warnings, &text, path),
+            compiled: Arc::new(compiled.grammar),
+            path: shown_path,
+            params,
+        })
+    }
+}
+
+#[pymethods]
+impl Grammar {
+    /// Reads and compiles the grammar at `path` (imports are found beside it). `params` sets
+    /// grammar parameters by name. Raises `OSError` when the file cannot be read,
+    /// `clay.GrammarError` when it has errors, also for an unknown parameter (E070) or a value
+    /// outside its range (E071).
+    #[staticmethod]
+    #[pyo3(signature = (path, params = None))]
+    fn open(
+        py: Python<'_>,
+        path: &Bound<'_, PyAny>,
+        params: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let path: PathBuf = path_of(path)?;
+        let params = overrides(params)?;
+        let bytes = read(&path)?;
+        let name = path.display().to_string();
+        Self::compile(py, &bytes, &name, Some(name.clone()), params)
+    }
+
+    /// Compiles grammar text. `path` names it in diagnostics and is where its imports are
+    /// found from (without it, `<string>` in the current directory). `params` as in `open`.
+    #[staticmethod]
+    #[pyo3(signature = (text, path = None, params = None))]
+    fn parse(
+        py: Python<'_>,
+        text: &str,
+        path: Option<&Bound<'_, PyAny>>,
+        params: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let params = overrides(params)?;
+        let path = path.filter(|p| !p.is_none()).map(path_of).transpose()?;
+        let name = path
+            .as_ref()
+            .map_or("<string>".to_string(), |p| p.display().to_string());
+        Self::compile(
+            py,
+            text.as_bytes(),
+            &name,
+            path.map(|p| p.display().to_string()),
+            params,
+        )
+    }
+
+    /// The file the grammar was read from (`None` for text without a path).
+    #[getter]
+    fn path(&self) -> Option<String> {
+        self.path.clone()
+    }
+
+    /// The compiler's warnings (clay.Diagnostic, severity "warning").
+    #[getter]
+    fn warnings(&self) -> Vec<Diagnostic> {
+        self.warnings.clone()
+    }
+
+    /// The grammar's parameters with the values of this compilation (clay.Param).
+    #[getter]
+    fn params(&self) -> Vec<Param> {
+        self.params.clone()
+    }
+
+    /// The pieces (clay.Piece), in declaration order.
+    #[getter]
+    fn pieces(&self) -> Vec<Piece> {
+        self.compiled
+            .pieces
+            .iter()
+            .map(|p| Piece {
+                name: p.name.clone(),
+                states: p.states.iter().map(|s| s.name.clone()).collect(),
+                vertices: p.vertices.clone(),
+                sites: p.sites.iter().map(|s| s.name.clone()).collect(),
+            })
+            .collect()
+    }
+
+    /// How many instances the grammar's model starts with.
+    #[getter]
+    fn instance_count(&self) -> usize {
+        self.compiled.assembly.instances.len()
+    }
+
+    /// The grammar's `solver` block: hysteresis, norm, irls_epsilon, merge_distance.
+    #[getter]
+    fn solver<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.compiled.solver;
+        let d = PyDict::new(py);
+        d.set_item("hysteresis", s.hysteresis)?;
+        d.set_item("norm", s.norm)?;
+        d.set_item("irls_epsilon", s.irls_epsilon)?;
+        d.set_item("merge_distance", s.merge_distance)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Grammar({}, {} pieces, {} instances)",
+            self.path.as_deref().unwrap_or("<string>"),
+            self.compiled.pieces.len(),
+            self.compiled.assembly.instances.len()
+        )
+    }
+}

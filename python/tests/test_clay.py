@@ -1,0 +1,482 @@
+"""The Python package against clayc: the same session through both gives the same summary;
+diagnostics, errors, parameters, arrays, exports and pictures."""
+
+import json
+import math
+import struct
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import clay
+
+
+def clayc_summary(clayc: str, grammar: Path, script: Path | None, *settings: str) -> dict:
+    args = [clayc, "run", str(grammar), "--json"]
+    if script is not None:
+        args += ["--script", str(script)]
+    for s in settings:
+        args += ["--set", s]
+    out = subprocess.run(args, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout)
+
+
+def without_times(summary: dict) -> dict:
+    """Frame times vary from run to run; everything else is deterministic."""
+    return {k: v for k, v in summary.items() if k != "frame_ms"}
+
+
+# --- the same session through Python and through clayc run ------------------------------
+
+
+def test_the_wall_script_as_calls_gives_clayc_runs_summary(clayc, grammars):
+    expected = clayc_summary(clayc, grammars / "wall.clay", grammars / "wall.script.json")
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    s.pin(extreme="west")
+    s.grab(extreme="east")
+    s.drag(by=(8, 0), frames=120)
+    s.hold(frames=30)
+    s.drag(by=(-8, 0), frames=120)
+    s.hold(frames=30)
+    got = s.summary()
+    assert without_times(got) == without_times(expected)
+    assert set(got["frame_ms"]) == {"median", "max"}
+    assert s.frames == expected["frames"] == 300
+
+
+@pytest.mark.parametrize("name", ["castle", "junction", "centipede"])
+def test_every_scripted_example_run_from_python_gives_clayc_runs_summary(clayc, grammars, name):
+    grammar, script = grammars / f"{name}.clay", grammars / f"{name}.script.json"
+    expected = clayc_summary(clayc, grammar, script)
+    s = clay.Session(clay.Grammar.open(grammar))
+    s.run_script(script)
+    assert without_times(s.summary()) == without_times(expected)
+    # The same script as a dict.
+    d = clay.Session(clay.Grammar.open(grammar))
+    d.run_script(json.loads(script.read_text()))
+    assert without_times(d.summary()) == without_times(expected)
+
+
+def test_solver_settings_are_clayc_runs_set(clayc, grammars):
+    expected = clayc_summary(
+        clayc, grammars / "wall.clay", grammars / "wall.script.json", "norm=2", "solver=cg"
+    )
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"), norm=2, solver="cg")
+    assert s.solver["norm"] == 2.0
+    s.run_script(grammars / "wall.script.json")
+    assert without_times(s.summary()) == without_times(expected)
+
+
+def test_the_initial_summary_is_clayc_runs_without_a_script(clayc, grammars):
+    expected = clayc_summary(clayc, grammars / "castle.clay", None)
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    assert without_times(s.summary()) == without_times(expected)
+
+
+def test_a_pulled_wall_grows_and_the_rule_log_says_how(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    s.pin(extreme="west")
+    s.grab(extreme="east")
+    s.drag(by=(8, 0), frames=120)
+    s.hold(frames=30)
+    assert s.summary()["pieces"] == {"brick": 16}
+    kinds = {e.kind for e in s.rule_log}
+    assert "stretch" in kinds
+    stretch = next(e for e in s.rule_log if e.kind == "stretch")
+    assert "brick" in stretch.detail or "wall" in stretch.detail
+    assert all(math.isfinite(c) for c in stretch.at)
+    assert len(s.instances) == 16
+    events = s.frame()
+    assert all(isinstance(e, clay.RuleEvent) for e in events)
+    assert s.frames == 151
+
+
+# --- diagnostics ---------------------------------------------------------------------------
+
+
+def test_check_gives_diagnostics_with_positions(root):
+    fixture = root / "tests/fixtures/invalid/E011-unknown-piece.clay"
+    diags = clay.check(fixture)
+    assert len(diags) == 1
+    d = diags[0]
+    assert (d.code, d.severity, d.line, d.column) == ("E011", "error", 18, 18)
+    assert (d.end_line, d.end_column) == (18, 22)
+    assert d.path == str(fixture)
+    assert "unknown piece `brik`" in d.message
+    assert any("brick" in h for h in d.hints)
+    assert str(d).startswith(f"{fixture}:18:18: error[E011]")
+
+
+def test_clean_grammars_check_clean(grammars):
+    for g in sorted(grammars.glob("*.clay")):
+        assert [d for d in clay.check(g) if d.severity == "error"] == [], g
+
+
+def test_a_malformed_grammar_raises_grammar_error_with_diagnostics():
+    text = "piece brick {\n    vertex a (0, 0)\n    vertex a (1, 0)\n"
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.parse(text, path="broken.clay")
+    err = caught.value
+    assert isinstance(err, ValueError)
+    assert err.diagnostics, "no diagnostics"
+    first = err.diagnostics[0]
+    assert first.path == "broken.clay"
+    assert first.severity == "error" and first.code.startswith("E")
+    assert first.line >= 1 and first.column >= 1
+    # The message is the rendering clayc check prints.
+    assert f"error[{first.code}]" in str(err)
+    assert "broken.clay:" in str(err)
+
+
+def test_the_rendered_message_points_into_the_file(root):
+    fixture = root / "tests/fixtures/invalid/E011-unknown-piece.clay"
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.open(fixture)
+    assert "18 │     wall = chain brik x 4" in str(caught.value)
+    assert [d.code for d in caught.value.diagnostics] == ["E011"]
+
+
+# --- errors are exceptions -----------------------------------------------------------------
+
+
+def test_a_missing_grammar_is_file_not_found(tmp_path):
+    missing = tmp_path / "nope.clay"
+    with pytest.raises(FileNotFoundError) as caught:
+        clay.Grammar.open(missing)
+    assert caught.value.filename == str(missing)
+    with pytest.raises(FileNotFoundError):
+        clay.check(missing)
+    with pytest.raises(IsADirectoryError):
+        clay.Grammar.open(tmp_path)
+
+
+def test_a_path_must_be_a_path():
+    with pytest.raises(TypeError, match="expected a path"):
+        clay.Grammar.open(42)
+
+
+def test_bad_scripts_are_value_errors_naming_the_step(grammars, tmp_path):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"steps": [\n  {"hold": {"frames": 1}},\n  {"jump": {}}\n]}')
+    with pytest.raises(ValueError, match=r'bad\.json:3:3: step 1: unknown step "jump"'):
+        s.run_script(bad)
+    with pytest.raises(ValueError, match="step 0: drag needs"):
+        s.run_script({"steps": [{"drag": {"frames": 3}}]})
+    with pytest.raises(ValueError, match="not valid JSON"):
+        bad.write_text("{")
+        s.run_script(bad)
+    with pytest.raises(FileNotFoundError):
+        s.run_script(tmp_path / "missing.json")
+    with pytest.raises(TypeError, match="run_script takes a path or a dict"):
+        s.run_script(3.5)
+    # Nothing ran.
+    assert s.frames == 0
+
+
+def test_non_finite_and_out_of_range_gestures_are_value_errors(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    s.grab(extreme="east")
+    with pytest.raises(ValueError, match="drag: by must be a finite number, found nan"):
+        s.drag(by=(float("nan"), 0), frames=3)
+    with pytest.raises(ValueError, match="finite"):
+        s.drag(to=(0, float("inf")))
+    with pytest.raises(ValueError, match=r"outside \+/-1e9 m"):
+        s.drag(by=(1e12, 0))
+    with pytest.raises(ValueError, match='"frames" must be an integer from 0 to 100000, found -1'):
+        s.hold(frames=-1)
+    with pytest.raises(ValueError, match="found 2.5"):
+        s.hold(frames=2.5)
+    with pytest.raises(ValueError, match="too large"):
+        s.hold(frames=2**80)
+    with pytest.raises(ValueError, match=r'"extreme" must be "east"'):
+        s.grab(extreme="up")
+    with pytest.raises(TypeError, match="one of them"):
+        s.grab(at=(0, 0), extreme="east")
+    with pytest.raises(TypeError, match="one of them"):
+        s.drag(frames=3)
+    with pytest.raises(TypeError, match="pair of numbers"):
+        s.cut(at=(1, 2, 3))
+    with pytest.raises(ValueError, match="rotate: degrees must be a finite number"):
+        s.rotate(float("nan"))
+    with pytest.raises(TypeError, match="bool"):
+        s.hold(frames=True)
+    # None of them ran a frame, and the session still works.
+    assert s.frames == 0
+    s.drag(by=(0.5, 0), frames=2)
+    assert s.frames == 2
+
+
+def test_bad_solver_settings_are_value_errors(grammars):
+    g = clay.Grammar.open(grammars / "wall.clay")
+    with pytest.raises(ValueError, match=r"solver setting hysteresis=1.5: must be in \[0, 1\)"):
+        clay.Session(g, hysteresis=1.5)
+    with pytest.raises(ValueError, match="solver setting nrom: unknown parameter"):
+        clay.Session(g, nrom=1)
+    with pytest.raises(ValueError, match="expected cholesky or cg"):
+        clay.Session(g, solver="lu")
+    with pytest.raises(ValueError, match="finite"):
+        clay.Session(g, norm=float("nan"))
+    with pytest.raises(TypeError, match="bool"):
+        clay.Session(g, norm=True)
+    assert sorted(clay.SOLVER_SETTINGS) == sorted(
+        [
+            "hysteresis",
+            "norm",
+            "irls_epsilon",
+            "merge_distance",
+            "irls_iterations",
+            "l2_iterations",
+            "l2_anderson",
+            "handle_weight",
+            "solver",
+        ]
+    )
+
+
+def test_notes_say_what_did_nothing(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    s.release()
+    s.drag(by=(1, 0), frames=1)
+    assert s.notes == [
+        "step 0: release without a grabbed part",
+        "step 1: drag without a grabbed part only holds",
+    ]
+
+
+# --- parameters ----------------------------------------------------------------------------
+
+FENCE = """\
+param bays = 4 in 2..12
+param width = 1 in 0.5..2
+let height = 0.5
+
+site type joint
+
+piece brick {
+    vertex sw (0, 0)
+    vertex se (width, 0)
+    vertex ne (width, height)
+    vertex nw (0, height)
+    edges sw-se-ne-nw-sw
+    site west: joint [nw, sw] out (-1, 0)
+    site east: joint [se, ne] out (1, 0)
+}
+
+stretch brick from west to east
+
+model {
+    wall = chain brick x bays
+}
+"""
+
+
+@pytest.fixture()
+def fence(tmp_path):
+    path = tmp_path / "fence.clay"
+    path.write_text(FENCE)
+    return path
+
+
+def test_parameters_are_listed_with_their_values_defaults_and_ranges(fence):
+    g = clay.Grammar.open(fence)
+    assert [(p.name, p.value, p.default, p.range) for p in g.params] == [
+        ("bays", 4.0, 4.0, (2.0, 12.0)),
+        ("width", 1.0, 1.0, (0.5, 2.0)),
+    ]
+    assert g.instance_count == 4
+    g = clay.Grammar.open(fence, params={"bays": 7, "width": 1.5})
+    assert [(p.name, p.value, p.default) for p in g.params] == [
+        ("bays", 7.0, 4.0),
+        ("width", 1.5, 1.0),
+    ]
+    assert g.instance_count == 7
+    s = clay.Session(g)
+    assert s.summary()["pieces"] == {"brick": 7}
+    assert s.summary()["bbox"][2] == pytest.approx(7 * 1.5)
+    parsed = clay.Grammar.parse(FENCE, params={"bays": 3})
+    assert parsed.instance_count == 3
+
+
+def test_a_value_outside_the_range_names_the_parameter_and_its_range(fence):
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.open(fence, params={"bays": 20})
+    [d] = caught.value.diagnostics
+    assert d.code == "E071"
+    assert (d.line, d.column) == (1, 7)
+    assert "parameter `bays` is set to 20, outside its range 2..12" in d.message
+    assert isinstance(caught.value, ValueError)
+    with pytest.raises(clay.GrammarError, match="E071"):
+        clay.Grammar.open(fence, params={"width": float("nan")})
+
+
+def test_an_unknown_parameter_names_the_known_ones(fence):
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.open(fence, params={"bys": 3})
+    [d] = caught.value.diagnostics
+    assert d.code == "E070"
+    assert "unknown parameter `bys`" in d.message
+    assert "did you mean `bays`?" in d.hints
+    assert "the parameters are `bays`, `width`" in d.hints
+    with pytest.raises(clay.GrammarError, match="E070"):
+        clay.Grammar.open(fence, params={"height": 1})
+
+
+def test_parameter_arguments_are_checked(grammars, fence):
+    assert clay.Grammar.open(grammars / "wall.clay").params == []
+    with pytest.raises(clay.GrammarError, match="unknown parameter `bay`"):
+        clay.Grammar.open(grammars / "wall.clay", params={"bay": 3})
+    with pytest.raises(TypeError, match="params must be a dict"):
+        clay.Grammar.open(fence, params=[("bays", 3)])
+    with pytest.raises(TypeError, match="bays must be a number"):
+        clay.Grammar.open(fence, params={"bays": "3"})
+    with pytest.raises(TypeError, match="bool"):
+        clay.Grammar.open(fence, params={"bays": True})
+
+
+# --- the grammar ---------------------------------------------------------------------------
+
+
+def test_pieces_and_counts(grammars):
+    g = clay.Grammar.open(grammars / "castle.clay")
+    names = [p.name for p in g.pieces]
+    assert names[:2] == ["wall", "tower"]
+    wall = g.pieces[0]
+    assert wall.vertices == ["sw", "se", "ne", "nw"]
+    assert wall.sites == ["west", "east"]
+    assert g.instance_count == 35
+    assert g.solver["hysteresis"] == 0.15
+    assert g.path == str(grammars / "castle.clay")
+    assert clay.Grammar.parse((grammars / "wall.clay").read_text()).path is None
+
+
+# --- arrays and instances ------------------------------------------------------------------
+
+
+def test_positions_are_a_float64_array_of_vertices_by_two(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    p = s.positions
+    assert isinstance(p, np.ndarray)
+    assert p.dtype == np.float64
+    assert p.shape == (s.summary()["vertices"], 2)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    assert list(np.concatenate([lo, hi])) == pytest.approx(s.summary()["bbox"])
+    # A copy: writing it changes nothing.
+    p[:] = 0
+    assert s.positions.max() > 0
+
+
+def test_instances_know_their_piece_state_chain_and_vertices(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    inst = s.instances
+    assert len(inst) == 35
+    walls = [i for i in inst if i.piece == "wall"]
+    towers = [i for i in inst if i.piece == "tower"]
+    assert len(towers) == 4
+    assert all(t.chain is None and t.index is None for t in towers)
+    assert all(w.chain is not None for w in walls)
+    chains = {w.chain for w in walls}
+    assert len(chains) == 5
+    for c in chains:
+        assert sorted(w.index for w in walls if w.chain == c) == list(
+            range(sum(1 for w in walls if w.chain == c))
+        )
+    p = s.positions
+    for i in inst:
+        assert len(i.vertices) == 4 or i.piece != "wall"
+        assert i.centroid == pytest.approx(tuple(p[i.vertices].mean(axis=0)))
+    assert len({i.id for i in inst}) == 35
+
+
+# --- export and pictures -------------------------------------------------------------------
+
+
+def test_exports_load(grammars, tmp_path):
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    s.run_script(grammars / "castle.script.json")
+    s.export(tmp_path / "castle.glb")
+    s.export(tmp_path / "castle.gltf", thickness=0.2)
+    s.export(tmp_path / "castle.obj")
+    glb = (tmp_path / "castle.glb").read_bytes()
+    magic, version, length = struct.unpack("<4sII", glb[:12])
+    assert (magic, version, length) == (b"glTF", 2, len(glb))
+    chunk_len, chunk_type = struct.unpack("<I4s", glb[12:20])
+    doc = json.loads(glb[20 : 20 + chunk_len])
+    assert chunk_type == b"JSON"
+    names = [n["name"] for n in doc["nodes"]]
+    assert names == [i.name for i in s.instances]
+    gltf = json.loads((tmp_path / "castle.gltf").read_text())
+    assert gltf["asset"]["version"] == "2.0"
+    assert len(gltf["nodes"]) == len(s.instances)
+    assert (tmp_path / "castle.mtl").is_file()
+    obj = (tmp_path / "castle.obj").read_text()
+    assert "mtllib castle.mtl" in obj
+    assert obj.count("\nv ") > 100
+    try:
+        import trimesh
+    except ImportError:
+        return
+    loaded = trimesh.load(tmp_path / "castle.glb")
+    assert len(loaded.geometry) > 0
+
+
+def test_export_errors(grammars, tmp_path):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    with pytest.raises(ValueError, match="name it .glb, .gltf or .obj"):
+        s.export(tmp_path / "wall.stl")
+    with pytest.raises(FileNotFoundError):
+        s.export(tmp_path / "no" / "such" / "dir" / "wall.glb")
+    with pytest.raises(ValueError, match="thickness"):
+        s.export(tmp_path / "wall.glb", thickness=-1)
+
+
+def test_the_scene_is_the_exports_meshes_with_z_up(grammars, tmp_path):
+    s = clay.Session(clay.Grammar.open(grammars / "keep.clay"))
+    nodes = s.scene()
+    assert [n.name for n in nodes] == [i.name for i in s.instances]
+    s.export(tmp_path / "keep.gltf")
+    doc = json.loads((tmp_path / "keep.gltf").read_text())
+    # The glTF's accessor bounds are y-up (x, height, -north); the scene's z-up.
+    tops = [doc["accessors"][p["attributes"]["POSITION"]]["max"][1] for m in doc["meshes"] for p in m["primitives"]]
+    zs = [float(p.positions[:, 2].max()) for n in nodes for p in n.primitives]
+    assert sorted(zs) == pytest.approx(sorted(tops), abs=1e-6)
+    prim = next(p for n in nodes for p in n.primitives)
+    assert prim.positions.dtype == np.float32 and prim.positions.shape[1] == 3
+    assert prim.triangles.dtype == np.uint32 and prim.triangles.shape[1] == 3
+    assert prim.triangles.max() < len(prim.positions)
+    assert len(prim.colour) == 4 and all(0 <= c <= 255 for c in prim.colour)
+
+
+def test_render_png_returns_png_bytes(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    s.run_script(grammars / "castle.script.json")
+    png = s.render_png(size=(320, 200), overlays=["strain", "handles"])
+    assert isinstance(png, bytes)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = struct.unpack(">II", png[16:24])
+    assert (width, height) == (320, 200)
+    iso = s.render_png(size=(200, 150), view="iso")
+    assert struct.unpack(">II", iso[16:24]) == (200, 150)
+    with pytest.raises(ValueError, match="unknown overlay"):
+        s.render_png(overlays=["nope"])
+    with pytest.raises(ValueError, match="between 1 and"):
+        s.render_png(size=(0, 10))
+    with pytest.raises(ValueError, match="unknown view"):
+        s.render_png(view="side")
+
+
+def test_the_package_has_stubs_and_docstrings():
+    import clay as package
+
+    folder = Path(package.__file__).parent
+    assert (folder / "py.typed").is_file()
+    assert (folder / "_clay.pyi").is_file()
+    for name in package.__all__:
+        obj = getattr(package, name)
+        if callable(obj):
+            assert obj.__doc__, name
+    for method in ["grab", "pin", "unpin", "drag", "rotate", "hold", "release", "cut", "frame",
+                   "run_script", "summary", "export", "render_png", "scene"]:
+        assert getattr(clay.Session, method).__doc__, method
