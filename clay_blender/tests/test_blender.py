@@ -1,0 +1,183 @@
+"""The add-on in a headless Blender (the `bpy` module from the package index, Blender 4.2 on
+CPython 3.11): register, import the castle through the operator, compare with the Python
+package's instances, reload, and render a small picture."""
+
+import struct
+from pathlib import Path
+
+import bpy
+import pytest
+
+import clay
+from scene_tools import CASTLE, CASTLE_SCRIPT, PICTURE, PICTURE_SIZE, bounds, fresh_file, render
+
+import clay_blender
+
+
+def png_size(path):
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    return struct.unpack(">II", data[16:24])
+
+
+def clay_collections():
+    return [c for c in bpy.data.collections if clay_blender.PATH in c]
+
+
+def test_the_operator_imports_the_castle_as_one_collection():
+    fresh_file()
+    result = bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
+    assert result == {"FINISHED"}
+    [coll] = clay_collections()
+    assert coll.name == "castle"
+    assert coll.name in bpy.context.scene.collection.children
+
+    session = clay.Session(clay.Grammar.open(CASTLE))
+    session.run_script(CASTLE_SCRIPT)
+    instances = session.instances
+    objects = list(coll.objects)
+    # 35 at the start; dragging the tower out inserts five wall elements.
+    assert len(objects) == len(instances) == 40
+
+    # Named as the glTF export names its nodes; each at its instance's centroid.
+    by_name = {o.name: o for o in objects}
+    assert sorted(by_name) == sorted(i.name for i in instances)
+    for inst in instances:
+        obj = by_name[inst.name]
+        assert obj.location.x == pytest.approx(inst.centroid[0], abs=1e-6)
+        assert obj.location.y == pytest.approx(inst.centroid[1], abs=1e-6)
+        assert obj.location.z == 0
+        assert obj["clay_piece"] == inst.piece
+        assert obj["clay_id"] == inst.id
+    assert any(o.location.length > 1 for o in objects), "every origin at 0"
+    assert len({tuple(round(c, 6) for c in o.location) for o in objects}) == len(objects)
+
+    # The meshes are the export's: same floor plan, heights from 0 to the thickness.
+    lo, hi = bounds(objects)
+    bbox = session.summary()["bbox"]
+    assert lo[0] <= bbox[0] + 1e-3 and hi[0] >= bbox[2] - 1e-3
+    assert lo[2] == pytest.approx(0, abs=1e-6)
+    assert 0.05 <= hi[2] < 0.1
+
+    # One material per fill colour, shared by the objects.
+    materials = {m.name for o in objects for m in o.data.materials}
+    colours = {p.colour for n in session.scene() for p in n.primitives}
+    assert len(materials) == len(colours)
+    assert all(name.startswith("clay #") for name in materials)
+
+
+def test_reload_rebuilds_from_the_file_and_keeps_the_collection():
+    fresh_file()
+    bpy.ops.clay.import_grammar(filepath=str(CASTLE))
+    [coll] = clay_collections()
+    assert len(coll.objects) == 35
+    assert coll[clay_blender.SCRIPT] == ""
+    # The script is a property of the collection: set it and reload.
+    coll[clay_blender.SCRIPT] = str(CASTLE_SCRIPT)
+    before = {o.name: tuple(o.location) for o in coll.objects}
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    [again] = clay_collections()
+    assert again == coll
+    after = {o.name: tuple(o.location) for o in coll.objects}
+    assert len(before) == 35 and len(after) == 40
+    assert after != before, "the script's drag moved nothing"
+    assert not [o for o in bpy.data.objects if o.users == 0]
+
+
+FENCE = """\
+param bays = 4 in 2..12
+param width = 1 in 0.5..2
+
+site type joint
+
+piece post {
+    vertex sw (0, 0)
+    vertex se (width, 0)
+    vertex ne (width, 0.3)
+    vertex nw (0, 0.3)
+    edges sw-se-ne-nw-sw
+    site west: joint [nw, sw] out (-1, 0)
+    site east: joint [se, ne] out (1, 0)
+    polygon skinned fill #8a6a4a extrude 1.2 { (0, 0) (width, 0) (width, 0.3) (0, 0.3) }
+}
+
+stretch post from west to east
+
+model {
+    fence = chain post x bays
+}
+"""
+
+
+def test_parameters_are_collection_properties_and_reload_reads_them(tmp_path):
+    fresh_file()
+    grammar = tmp_path / "fence.clay"
+    grammar.write_text(FENCE)
+    assert bpy.ops.clay.import_grammar(filepath=str(grammar)) == {"FINISHED"}
+    [coll] = clay_collections()
+    assert coll["bays"] == 4.0 and coll["width"] == 1.0
+    ui = coll.id_properties_ui("bays").as_dict()
+    assert (ui["min"], ui["max"], ui["default"]) == (2.0, 12.0, 4.0)
+    assert len(coll.objects) == 4
+    # Heights from the grammar's extrude, as clayc export gives them.
+    lo, hi = bounds(coll.objects)
+    assert (lo[2], hi[2]) == pytest.approx((0.0, 1.2), abs=1e-5)
+
+    coll["bays"] = 7.0
+    coll["width"] = 1.5
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    assert len(coll.objects) == 7
+    lo, hi = bounds(coll.objects)
+    assert hi[0] - lo[0] == pytest.approx(7 * 1.5, abs=1e-4)
+
+    # A value outside the range is reported; the collection keeps what it had.
+    coll["bays"] = 30.0
+    with pytest.raises(RuntimeError, match="E071"):
+        bpy.ops.clay.reload(collection=coll.name)
+    assert len(coll.objects) == 7
+
+    # The text file changed: Reload reads it again.
+    wider = FENCE.replace("param bays = 4 in 2..12", "param bays = 4 in 2..40")
+    grammar.write_text(wider)
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    assert len(coll.objects) == 30
+
+    # A parameter the text no longer declares is dropped from the collection.
+    grammar.write_text(wider.replace("param width = 1 in 0.5..2", "let width = 1"))
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    assert "width" not in coll and coll["bays"] == 30.0
+    lo, hi = bounds(coll.objects)
+    assert hi[0] - lo[0] == pytest.approx(30 * 1.0, abs=1e-4)
+
+
+def test_errors_are_reported_not_raised_into_blender(tmp_path):
+    fresh_file()
+    broken = tmp_path / "broken.clay"
+    broken.write_text("piece {\n")
+    with pytest.raises(RuntimeError, match="E001"):
+        bpy.ops.clay.import_grammar(filepath=str(broken))
+    assert clay_collections() == []
+    with pytest.raises(RuntimeError, match="No such file"):
+        bpy.ops.clay.import_grammar(filepath=str(tmp_path / "missing.clay"))
+    assert clay_collections() == []
+
+
+def test_the_menu_entry_is_registered():
+    fresh_file()
+    assert hasattr(bpy.types, "CLAY_OT_import_grammar")
+    assert hasattr(bpy.types, "CLAY_OT_reload")
+    assert hasattr(bpy.types, "CLAY_PT_collection")
+    assert clay_blender.bl_info["blender"] >= (4, 2, 0)
+
+
+def test_a_small_render_of_the_imported_castle(tmp_path):
+    fresh_file()
+    bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
+    out = tmp_path / "castle.png"
+    render(out, (160, 100))
+    assert png_size(out) == (160, 100)
+
+
+def test_the_docs_picture_is_there_at_its_size():
+    """docs/pictures/blender-castle.png is made by clay_blender/tests/picture.py."""
+    assert png_size(PICTURE) == PICTURE_SIZE
