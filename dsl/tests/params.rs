@@ -519,6 +519,43 @@ fn file_errors_and_override_errors_are_reported_together() {
     assert_eq!(codes, ["E071", "E011"]);
 }
 
+// ---- editors ----------------------------------------------------------------------------------
+
+#[test]
+fn the_analysis_knows_a_param_as_a_constant_and_colours_its_keywords() {
+    use clay_dsl::analysis::{Analysis, SymbolKind, TokenKind};
+    let a = Analysis::new(WALL, "wall.clay");
+    assert!(a.diagnostics().is_empty(), "{:?}", a.diagnostics().items);
+    let decl = WALL.find("param bays").unwrap() + "param ".len();
+    let used = WALL.find("x bays").unwrap() + "x ".len();
+    assert_eq!(
+        a.definition(used),
+        Some(clay_dsl::syntax::Span::new(decl, decl + 4))
+    );
+    let tokens = a.semantic_tokens();
+    let kind_at = |offset: usize| {
+        tokens
+            .iter()
+            .find(|t| t.span.start == offset)
+            .map(|t| (t.kind, t.declaration))
+    };
+    assert_eq!(
+        kind_at(WALL.find("param bays").unwrap()),
+        Some((TokenKind::Keyword, false))
+    );
+    assert_eq!(
+        kind_at(decl),
+        Some((TokenKind::Symbol(SymbolKind::Constant), true))
+    );
+    assert_eq!(
+        kind_at(WALL.find(" in 2..12").unwrap() + 1),
+        Some((TokenKind::Keyword, false))
+    );
+    // Renaming the parameter renames its uses.
+    let edits = a.rename(used, "sections").unwrap();
+    assert_eq!(edits.len(), 2);
+}
+
 // ---- formatting --------------------------------------------------------------------------------
 
 #[test]
