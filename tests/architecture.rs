@@ -1,6 +1,6 @@
 //! The architecture invariants of `docs/architecture.md` that a reading of the source can
 //! check: no import cycle between the modules of a crate (children naming their parents
-//! counted, over an import graph parsed whole with `syn`, the binary included), the library's
+//! counted, over an import graph parsed whole with `syn`, the `clayc` binary included), the library's
 //! top-level modules import one another only along the documented table of allowed edges,
 //! the editor uses only the library's surfaces (the session, rendering, authoring, and the
 //! solver's settings and report types), rules never import sessions or scripts, protocol types
@@ -67,7 +67,7 @@ fn root() -> PathBuf {
 // The import graph. Every file of a crate is parsed whole with `syn` (test modules included),
 // starting at the crate's root file and following its `mod` declarations; every `use` tree and
 // every path (in code, types, patterns and macro bodies) that begins with `crate::`, `super::`,
-// `self::`, a child module's name, or (in the binary) `clay::` is resolved to the module it
+// `self::`, a child module's name, or (in the `clayc` binary) `clay::` is resolved to the module it
 // names. A node is a file's module (`rules::cut`); an inline module (`mod tests { .. }`) counts
 // for its file. Paths through the crate root's re-exports (`crate::parse(..)` in clay-dsl)
 // count for the module the root re-exports them from.
@@ -425,18 +425,18 @@ fn imports(krate: &Crate, library: Option<&Crate>) -> Vec<Import> {
     out
 }
 
-/// The library, the binary (rooted at its `main.rs`; its `clay::` imports name `clay::X`
-/// nodes) and clay-dsl, each with its imports.
+/// The library, the `clayc` binary (its own crate in `cli/`, rooted at its `main.rs`; its
+/// `clay::` imports name `clay::X` nodes) and clay-dsl, each with its imports.
 fn crates() -> Vec<(&'static str, Crate, Vec<Import>)> {
     let library = Crate::read(&root().join("src/lib.rs"));
-    let binary = Crate::read(&root().join("src/bin/clayc/main.rs"));
+    let binary = Crate::read(&root().join("cli/src/main.rs"));
     let dsl = Crate::read(&root().join("dsl/src/lib.rs"));
     let lib_imports = imports(&library, None);
     let bin_imports = imports(&binary, Some(&library));
     let dsl_imports = imports(&dsl, None);
     vec![
         ("src", library, lib_imports),
-        ("src/bin/clayc", binary, bin_imports),
+        ("cli/src", binary, bin_imports),
         ("dsl/src", dsl, dsl_imports),
     ]
 }
@@ -517,7 +517,7 @@ const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[
     ("src", "authoring::graph", "authoring"),
     ("src", "authoring::pieces", "authoring"),
     // issue 38: the language server's shared state lives in lsp/mod.rs.
-    ("src/bin/clayc", "lsp::handlers", "lsp"),
+    ("cli/src", "lsp::handlers", "lsp"),
     // issue 38: clay-dsl's compile/mod.rs and analysis/mod.rs hold what their children share.
     ("dsl/src", "compile::assembly", "compile"),
     ("dsl/src", "compile::constants", "compile"),
@@ -791,9 +791,9 @@ fn the_editor_uses_the_librarys_surfaces_only() {
 
 #[test]
 fn protocol_types_live_only_in_the_language_server() {
-    let server = root().join("src/bin/clayc/lsp");
+    let server = root().join("cli/src/lsp");
     let mut files = Vec::new();
-    for dir in ["src", "dsl/src", "editor/src"] {
+    for dir in ["src", "dsl/src", "editor/src", "cli/src"] {
         rust_files(&root().join(dir), &mut files);
     }
     let outside: Vec<&PathBuf> = files.iter().filter(|f| !f.starts_with(&server)).collect();
@@ -803,12 +803,12 @@ fn protocol_types_live_only_in_the_language_server() {
         for name in ["lsp_types", "lsp_server"] {
             assert!(
                 !text.contains(name),
-                "{} names `{name}`: protocol types belong in src/bin/clayc/lsp",
+                "{} names `{name}`: protocol types belong in cli/src/lsp",
                 f.display()
             );
         }
     }
-    for manifest in ["dsl/Cargo.toml", "editor/Cargo.toml"] {
+    for manifest in ["Cargo.toml", "dsl/Cargo.toml", "editor/Cargo.toml"] {
         let text = std::fs::read_to_string(root().join(manifest)).unwrap();
         assert!(
             !text.contains("lsp-"),
@@ -888,17 +888,15 @@ fn a_solver_frame_changes_no_part_instance_or_connection() {
     }
 }
 
-/// Architecture Invariant: the libraries (`clay` outside its binaries, `clay-dsl`) never
-/// write to the terminal; they return text and diagnostics, and the binaries (and the editor)
+/// Architecture Invariant: the libraries (`clay`, `clay-dsl`) never write to the terminal;
+/// they return text and diagnostics, and the binaries (`clayc` in `cli/`, and the editor)
 /// decide where they go. Whole files are read, tests included.
 #[test]
 fn the_libraries_print_nothing() {
-    let bin = root().join("src/bin");
     let mut files = Vec::new();
     for dir in ["src", "dsl/src"] {
         rust_files(&root().join(dir), &mut files);
     }
-    files.retain(|f| !f.starts_with(&bin));
     assert!(files.len() > 40, "only {} files read", files.len());
     let writers = [
         "println!",

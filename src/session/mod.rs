@@ -7,7 +7,7 @@
 //! on another thread while it draws the one on screen, and swaps them when the frame is done.
 //!
 //! Architecture Invariant: nothing outside this module runs the rules after a solver frame
-//! (checked by `tests/session.rs`: `clayc run`'s counts equal the session's events).
+//! (checked by `cli/tests/session.rs`: `clayc run`'s counts equal the session's events).
 
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};

@@ -19,6 +19,7 @@ fn grammar() -> CompiledGrammar {
         format_version: FORMAT_VERSION,
         source: "square.clay".into(),
         solver: SolverParams::default(),
+        params: Vec::new(),
         site_types: vec![SiteType {
             name: "joint".into(),
             docks_with: vec![0],

@@ -14,7 +14,7 @@ use clay::synthetic;
 use serde_json::Value;
 
 fn grammar_path(name: &str) -> String {
-    format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!("{}/../grammars/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 fn temp_file(name: &str, contents: &str) -> PathBuf {
@@ -212,8 +212,8 @@ fn settings_are_validated_and_applied() {
             ch["bbox"][k].as_f64().unwrap(),
         );
         // CG stops at a relative residual of 1e-6, which the 1e6 handle rows dominate: the
-        // positions agree to centimetres, not to round-off (tests/solver_behaviour.rs compares
-        // the two tightly).
+        // positions agree to centimetres, not to round-off (the clay crate's
+        // tests/solver_behaviour.rs compares the two tightly).
         assert!((a - b).abs() < 0.1, "bbox {k}: cg {a} cholesky {b}");
     }
 }

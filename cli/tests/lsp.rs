@@ -14,7 +14,11 @@ const PATIENCE: Duration = Duration::from_secs(60);
 const URI: &str = "file:///grammars/wall.clay";
 
 fn wall() -> String {
-    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/grammars/wall.clay")).unwrap()
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../grammars/wall.clay"
+    ))
+    .unwrap()
 }
 
 /// The byte offset of the `nth` occurrence of `needle`, plus `into` bytes.
@@ -858,8 +862,8 @@ fn an_analysis_past_its_timeout_is_reported_and_the_server_answers_on() {
 
 #[test]
 fn every_advertised_capability_has_its_row_in_docs_editors_md() {
-    let doc =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/editors.md"))
+        .unwrap();
     let mut c = Client::spawn();
     let init = c.request("initialize", json!({ "capabilities": {} }));
     let caps = init["result"]["capabilities"].as_object().unwrap();
@@ -1319,8 +1323,8 @@ vim.cmd('qa!')
 
 /// The first ```` ```lua ```` block after `heading` in docs/editors.md.
 fn lua_block_after(heading: &str) -> String {
-    let doc =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/editors.md")).unwrap();
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/editors.md"))
+        .unwrap();
     let from = doc.find(heading).expect("the heading");
     let rest = &doc[from..];
     let start = rest.find("```lua\n").expect("a lua block") + "```lua\n".len();

@@ -1,5 +1,5 @@
 //! The fuzzer of the language server's message handling (issue 37): the server's own loop
-//! (`src/bin/clayc/lsp`, compiled in here as `benches/lsp.rs` compiles its `convert`) driven in
+//! (`src/lsp`, compiled in here as `benches/lsp.rs` compiles its `convert`) driven in
 //! process through a reader and a writer. Each case is a session built from one mutated grammar
 //! of the repository: `initialize`, documents opened and changed (whole texts mutated again,
 //! ranges in UTF-16 that are wrong, past the end or reversed, versions out of order), requests
@@ -37,10 +37,11 @@ macro_rules! errln {
 }
 
 #[allow(dead_code)] // the stdio entry point and the options are the binary's
-#[path = "../src/bin/clayc/lsp/mod.rs"]
+#[path = "../src/lsp/mod.rs"]
 mod lsp;
 
 #[allow(dead_code)] // the engine's plain `fuzz` is the other targets'
+#[path = "../../tests/fuzzing/mod.rs"]
 mod fuzzing;
 
 /// Sessions a plain `cargo test` runs: about 15 messages each, 2 ms a session in a debug
@@ -975,7 +976,7 @@ fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// Every grammar of the repository, and the inputs issue 37 found.
 fn corpus() -> Vec<Vec<u8>> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let mut files = Vec::new();
     for dir in ["grammars", "tests/fixtures", "dsl/tests", "docs"] {
         files_under(&root.join(dir), &mut files);

@@ -14,7 +14,7 @@ use clay_dsl::analysis::Analysis;
 use criterion::{Criterion, criterion_group, criterion_main};
 
 #[allow(dead_code)] // the bench uses the diagnostics' part of it
-#[path = "../src/bin/clayc/lsp/convert.rs"]
+#[path = "../src/lsp/convert.rs"]
 mod convert;
 
 const ROWS: usize = 60;

@@ -36,7 +36,10 @@ fn run(grammar: &PathBuf, script: &str, name: &str, set: &[&str]) -> Value {
 }
 
 fn wall_clay() -> PathBuf {
-    PathBuf::from(format!("{}/grammars/wall.clay", env!("CARGO_MANIFEST_DIR")))
+    PathBuf::from(format!(
+        "{}/../grammars/wall.clay",
+        env!("CARGO_MANIFEST_DIR")
+    ))
 }
 
 fn bricks(v: &Value) -> u64 {

@@ -1,0 +1,34 @@
+//! `clayc export` (issue 20): each format written where `-o` says, the OBJ's material file
+//! beside it, and an unknown extension refused with exit 2 and nothing written. What the
+//! exported scenes hold is `clay::export`'s, tested in the clay crate's `tests/export.rs`.
+
+#[test]
+fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
+    let dir = std::env::temp_dir().join(format!("clay-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wall = format!("{}/../grammars/wall.clay", env!("CARGO_MANIFEST_DIR"));
+    let script = format!(
+        "{}/../grammars/wall.script.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for ext in ["glb", "gltf", "obj"] {
+        let out = dir.join(format!("wall.{ext}"));
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .args(["export", &wall, "--script", &script, "-o"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{ext}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 100);
+    }
+    assert!(dir.join("wall.mtl").exists());
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("wall.fbx"))
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains(".glb, .gltf or .obj"));
+    assert!(!dir.join("wall.fbx").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
