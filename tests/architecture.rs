@@ -511,8 +511,6 @@ const ALLOWED: &[(&str, &[&str])] = &[
 const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[
     // issue 38: solver/mod.rs split pending.
     ("src", "solver::growth", "solver"),
-    ("src", "solver::cholesky::numeric", "solver::cholesky"),
-    ("src", "solver::cholesky::split", "solver::cholesky"),
     // issue 38: authoring/mod.rs holds what its children share.
     ("src", "authoring::graph", "authoring"),
     ("src", "authoring::pieces", "authoring"),

@@ -20,8 +20,9 @@
 
 use std::ops::Range;
 
+use super::layout::{FactorError, SupernodalLayout, by_width};
 use super::split::{self, Split};
-use super::{FactorError, SupernodalLayout, by_width, join};
+use crate::solver::chunks::join;
 
 /// Where each stored value of the matrix (lower triangle, original order) goes in the factor's
 /// values in solve order: built once per pattern.

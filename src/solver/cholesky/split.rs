@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use super::SupernodalLayout;
+use super::layout::SupernodalLayout;
 
 /// Below this many multiply-adds a factorisation is not split (a thread's start-up, some
 /// tens of microseconds, would cost more than half the work saves).
