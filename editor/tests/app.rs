@@ -73,7 +73,7 @@ fn dragging_a_part_sculpts_and_ctrl_z_undoes_the_gesture() {
         "the tower follows the pointer: moved {moved:?}"
     );
     assert!(after != before, "the model changed");
-    assert!(h.state().sculpt.dirty);
+    assert!(h.state().sculpt.dirty());
 
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     h.step();
@@ -231,7 +231,7 @@ fn closing_with_unsaved_changes_asks_first() {
 
     h.state_mut().command(clay_editor::sculpt::Command::Reset);
     h.step();
-    assert!(h.state().sculpt.dirty);
+    assert!(h.state().sculpt.dirty());
     request_close(&mut h);
     assert!(
         h.state().confirming(),
@@ -297,7 +297,7 @@ fn a_failed_open_keeps_the_model_and_asks_nothing() {
     h.step();
     let app = h.state();
     assert!(app.sculpt.data() == &kept, "the model stays");
-    assert!(app.sculpt.dirty, "and so does its unsaved state");
+    assert!(app.sculpt.dirty(), "and so does its unsaved state");
     assert_eq!(app.grammar_path(), None);
     let m = app.message.clone().unwrap_or_default();
     assert!(
@@ -366,7 +366,7 @@ fn save_in_the_prompt_saves_the_session_then_opens() {
         Some(other.as_path()),
         "then the other grammar opened"
     );
-    assert!(!h.state().sculpt.dirty);
+    assert!(!h.state().sculpt.dirty());
 }
 
 fn temp_dir(name: &str) -> std::path::PathBuf {
@@ -424,4 +424,72 @@ fn right_drag_turns_the_grabbed_part() {
         (turned - std::f64::consts::FRAC_PI_2).abs() < 0.15,
         "the tower turned by {turned} rad"
     );
+}
+
+/// Drags the tower by (80, -40) points with the left button, as a user would.
+fn drag_tower(h: &mut Harness<'_, EditorApp>) {
+    let part = tower(h.state());
+    let at = h.get_by_label(&format!("part {part}")).rect().center();
+    h.hover_at(at);
+    h.step();
+    h.drag_at(at);
+    h.step();
+    let to = at + Vec2::new(80.0, -40.0);
+    for k in 1..=4 {
+        h.hover_at(at + (to - at) * (k as f32 / 4.0));
+        h.step();
+    }
+    h.drop_at(to);
+    h.step();
+    settle(h);
+}
+
+/// Whether the status bar says the castle has unsaved changes (`grammars/castle.clay
+/// (unsaved)`) or not (`grammars/castle.clay`).
+fn status_unsaved(h: &Harness<'_, EditorApp>) -> bool {
+    let path = clay_editor::compile::CASTLE_PATH;
+    let unsaved = h.query_by_label(&format!("{path} (unsaved)")).is_some();
+    let saved = h.query_by_label(path).is_some();
+    assert!(unsaved != saved, "the status bar shows the file once");
+    unsaved
+}
+
+#[test]
+fn undoing_every_change_counts_as_saved() {
+    let dir = temp_dir("undo-saved");
+    let mut h = harness(EditorApp::bundled());
+    settle(&mut h);
+    drag_tower(&mut h);
+    drag_tower(&mut h);
+    assert!(h.state().sculpt.dirty());
+    assert!(status_unsaved(&h));
+
+    // Both drags undone: the model is the one opened, so nothing is unsaved.
+    for _ in 0..2 {
+        h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+        h.step();
+    }
+    assert!(!h.state().sculpt.can_undo());
+    assert!(!h.state().sculpt.dirty(), "every change undone");
+    h.step();
+    assert!(!status_unsaved(&h));
+    request_close(&mut h);
+    assert!(!h.state().confirming(), "quitting asks nothing");
+
+    // Redo one, save there: undoing it is unsaved again, redoing it saved again.
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    assert!(h.state().sculpt.dirty());
+    let session = dir.join("castle.clay-session.json");
+    h.state_mut().save_session(&session).unwrap();
+    assert!(!h.state().sculpt.dirty());
+    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    assert!(
+        h.state().sculpt.dirty(),
+        "the saved model was the one with the drag"
+    );
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    assert!(!h.state().sculpt.dirty(), "redone to the saved model");
 }

@@ -55,7 +55,7 @@ fn child(recovery: &Path, expected: &Path) -> ! {
     let mut app = EditorApp::bundled();
     app.use_recovery(recovery.to_path_buf());
     sculpt(&mut app);
-    assert!(app.sculpt.dirty);
+    assert!(app.sculpt.dirty());
     std::thread::sleep(WRITE_EVERY + Duration::from_millis(100));
     frames(&mut app, 1);
     session::write(expected, &app.session()).unwrap();
@@ -118,7 +118,7 @@ fn a_killed_editor_is_restored_by_the_next() {
         "the sculpt is restored exactly"
     );
     assert_eq!(next.sculpt.pins(), expected.pins);
-    assert!(next.sculpt.dirty, "restored work is unsaved work");
+    assert!(next.sculpt.dirty(), "restored work is unsaved work");
 }
 
 #[test]
@@ -139,6 +139,8 @@ fn the_recovery_file_follows_the_sculpt_and_leaves_on_save_and_quit() {
     frames(&mut app, 1);
     assert!(!recovery.exists(), "a save leaves nothing to recover");
 
+    // Two gestures, one undone: still unsaved, and the undo step is kept at once.
+    sculpt(&mut app);
     sculpt(&mut app);
     assert!(recovery.exists());
     app.sculpt.apply(Command::Undo);
@@ -148,10 +150,21 @@ fn the_recovery_file_follows_the_sculpt_and_leaves_on_save_and_quit() {
         &undone.assembly == app.sculpt.data(),
         "an undo step is kept at once"
     );
+    // Both undone: the model is the saved one, nothing is left to recover.
+    app.sculpt.apply(Command::Undo);
+    frames(&mut app, 1);
+    assert!(!app.sculpt.dirty());
+    assert!(
+        !recovery.exists(),
+        "back at the saved model, nothing to recover"
+    );
+    app.sculpt.apply(Command::Redo);
+    frames(&mut app, 1);
+    assert!(recovery.exists());
     app.perform(Action::Quit);
     // the unsaved prompt: discard, and the clean exit removes the file
     assert!(app.confirming());
-    app.sculpt.dirty = false;
+    app.sculpt.mark_saved();
     frames(&mut app, 1);
     assert!(
         !recovery.exists(),

@@ -75,7 +75,7 @@ fn a_drag_moves_the_part_and_undo_redo_restore_whole_gestures() {
         (moved - DVec2::new(1.5, 0.5)).length() < 0.2,
         "the grabbed tower follows the handle, moved {moved}"
     );
-    assert!(s.dirty);
+    assert!(s.dirty());
 
     s.apply(Command::Undo);
     assert!(
@@ -235,7 +235,7 @@ fn a_session_round_trips_through_a_file() {
     drag(&mut app.sculpt, other, DVec2::new(0.0, -1.0));
     let path = dir.join("s.json");
     app.save_session(&path).unwrap();
-    assert!(!app.sculpt.dirty, "saving clears the unsaved flag");
+    assert!(!app.sculpt.dirty(), "saving clears the unsaved flag");
 
     let text = std::fs::read_to_string(&path).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -311,7 +311,7 @@ fn a_failed_atomic_save_leaves_the_old_file_intact() {
     app.sculpt.apply(Command::TogglePin { part, at });
     assert!(app.save_session(&path).is_err());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "old contents");
-    assert!(app.sculpt.dirty, "a failed save keeps the unsaved flag");
+    assert!(app.sculpt.dirty(), "a failed save keeps the unsaved flag");
 
     std::fs::remove_dir(&tmp).unwrap();
     app.save_session(&path).unwrap();
@@ -367,14 +367,14 @@ fn a_reload_with_the_same_model_keeps_the_sculpt() {
     s.apply(Command::TogglePin { part, at });
     drag(&mut s, part, DVec2::new(0.0, 1.0));
     let sculpted = s.data().positions.clone();
-    let saved_dirty = s.dirty;
+    let saved_dirty = s.dirty();
 
     // The same source recompiled (as after touching the file): the sculpt stays.
     let again = compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar;
     assert!(s.replace_grammar(again));
     assert_eq!(s.data().positions, sculpted);
     assert_eq!(s.pins().len(), 1);
-    assert_eq!(s.dirty, saved_dirty, "a reload alone is not unsaved work");
+    assert_eq!(s.dirty(), saved_dirty, "a reload alone is not unsaved work");
 
     // A different model: rebuilt from the new grammar, and the reload is undoable.
     let moved = CASTLE_SOURCE.replacen(

@@ -182,7 +182,7 @@ impl EditorApp {
         match answer {
             Answer::Cancel => {}
             Answer::Discard => {
-                self.sculpt.dirty = false;
+                self.sculpt.mark_saved();
                 if quit {
                     self.quitting = true;
                 } else {

@@ -48,7 +48,7 @@ impl EditorApp {
         let name = Path::new(&shown)
             .file_name()
             .map_or(shown.clone(), |n| n.to_string_lossy().into_owned());
-        let dirty = if self.sculpt.dirty { "*" } else { "" };
+        let dirty = if self.sculpt.dirty() { "*" } else { "" };
         format!("{name}{dirty} \u{2022} {TITLE}")
     }
 
@@ -237,7 +237,7 @@ impl EditorApp {
         }
         session::write(path, &self.session()).map_err(|e| e.to_string())?;
         self.session_path = Some(path.to_path_buf());
-        self.sculpt.dirty = false;
+        self.sculpt.mark_saved();
         Ok(())
     }
 

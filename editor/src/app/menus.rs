@@ -258,7 +258,11 @@ impl EditorApp {
     pub(super) fn status_bar(&mut self, ui: &mut egui::Ui) {
         egui::Panel::bottom("status").show(ui, |ui| {
             ui.horizontal_wrapped(|ui| {
-                let dirty = if self.sculpt.dirty { " (unsaved)" } else { "" };
+                let dirty = if self.sculpt.dirty() {
+                    " (unsaved)"
+                } else {
+                    ""
+                };
                 ui.label(format!("{}{dirty}", self.display_path()));
                 ui.separator();
                 let state = if let Some(e) = self.sculpt.error() {

@@ -218,7 +218,7 @@ impl EditorApp {
                 ctx.request_repaint_after(wait);
             }
         }
-        if ctx.input(|i| i.viewport().close_requested()) && !self.quitting && self.sculpt.dirty {
+        if ctx.input(|i| i.viewport().close_requested()) && !self.quitting && self.sculpt.dirty() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.confirm = Some(Action::Quit);
         }

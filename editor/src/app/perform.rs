@@ -30,7 +30,7 @@ impl EditorApp {
             return;
         };
         let stamp = (self.sculpt.history(), self.sculpt.revision());
-        let unsaved = self.sculpt.dirty && !self.quitting;
+        let unsaved = self.sculpt.dirty() && !self.quitting;
         let savable = self.grammar_path.is_some() || self.sculpt.grammar().source == CASTLE_PATH;
         if let Some(m) = r.keep(stamp, unsaved, || savable.then(|| self.session())) {
             self.message = Some(m);
@@ -49,7 +49,7 @@ impl EditorApp {
         }
         restored?;
         self.session_path = None;
-        self.sculpt.dirty = true;
+        self.sculpt.mark_unsaved();
         Ok(Some("restored the unsaved sculpt".to_string()))
     }
 
@@ -62,7 +62,7 @@ impl EditorApp {
             action,
             Action::OpenGrammar(_) | Action::OpenSession(_) | Action::TryAuthored
         );
-        if discards && self.sculpt.dirty {
+        if discards && self.sculpt.dirty() {
             match self.precheck(&action) {
                 Ok(()) => self.confirm = Some(action),
                 Err(e) => self.fail(e),
@@ -96,7 +96,7 @@ impl EditorApp {
                 .export_3d(&p)
                 .map(|()| Some(format!("exported {}", p.display()))),
             Action::Quit => {
-                if self.sculpt.dirty {
+                if self.sculpt.dirty() {
                     self.confirm = Some(Action::Quit);
                 } else {
                     self.quitting = true;

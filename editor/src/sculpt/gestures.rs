@@ -98,7 +98,7 @@ impl Sculpt {
             }
             Err(message) => {
                 // Nothing changed: the gesture leaves no undo step.
-                self.undo.pop();
+                self.forget_checkpoint();
                 self.note(format!("cut failed: {message}"), Some(point));
             }
         }

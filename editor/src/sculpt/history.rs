@@ -19,6 +19,7 @@ impl Sculpt {
             grammar,
             pins: Vec::new(),
             log: self.log.clone(),
+            state: self.state,
         }
     }
 
@@ -31,7 +32,49 @@ impl Sculpt {
             self.undo.remove(0);
         }
         self.redo.clear();
-        self.dirty = true;
+        self.last_state += 1;
+        self.state = self.last_state;
+    }
+
+    /// Takes back the checkpoint of a gesture that changed nothing: no undo step, and the
+    /// model is in the state it was.
+    pub(super) fn forget_checkpoint(&mut self) {
+        if let Some(s) = self.undo.pop() {
+            self.state = s.state;
+        }
+    }
+
+    /// Undoes the last gesture, or redoes the last undone one.
+    pub(super) fn step_history(&mut self, redo: bool) {
+        let from = if redo { &mut self.redo } else { &mut self.undo };
+        let Some(s) = from.pop() else {
+            return;
+        };
+        let now = self.snapshot();
+        if redo {
+            self.undo.push(now);
+        } else {
+            self.redo.push(now);
+        }
+        self.history += 1;
+        self.state = s.state;
+        self.restore(s);
+    }
+
+    /// Whether the model differs from the one last saved or opened: a gesture since, or undo
+    /// and redo to another state (undoing every change since a save is no unsaved work).
+    pub fn dirty(&self) -> bool {
+        self.saved != Some(self.state)
+    }
+
+    /// The model as it is now is saved (a session written, or its changes discarded).
+    pub fn mark_saved(&mut self) {
+        self.saved = Some(self.state);
+    }
+
+    /// The model as it is now is nowhere saved (work restored after a crash).
+    pub fn mark_unsaved(&mut self) {
+        self.saved = None;
     }
 
     pub(super) fn snapshot(&self) -> Snapshot {
@@ -40,6 +83,7 @@ impl Sculpt {
             data: self.assembly.data().clone(),
             pins: self.pins(),
             log: self.log.clone(),
+            state: self.state,
         }
     }
 

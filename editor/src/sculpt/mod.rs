@@ -69,6 +69,8 @@ struct Snapshot {
     pins: Vec<Pin>,
     /// The rule log as it was: undoing a gesture takes back what its rules logged too.
     log: Vec<LogEntry>,
+    /// Which state of the history this is ([`Sculpt::dirty`] compares it with the saved one).
+    state: u64,
 }
 
 /// Why a part is in the state it is in: the session's report
@@ -93,8 +95,13 @@ pub struct Sculpt {
     grab: Option<Grab>,
     undo: Vec<Snapshot>,
     redo: Vec<Snapshot>,
-    /// Changed since the last save or open.
-    pub dirty: bool,
+    /// Which state of the undo history the model is in: a new one for every gesture, the
+    /// snapshot's own when undone or redone to.
+    state: u64,
+    /// The last state given out.
+    last_state: u64,
+    /// The state last saved or opened (`None`: none in this history, e.g. restored work).
+    saved: Option<u64>,
     /// Whether the solver still has work: a moved handle, or a frame that did not converge.
     unsettled: bool,
     /// Solver frames run so far.
@@ -137,7 +144,9 @@ impl Sculpt {
             grab: None,
             undo: Vec::new(),
             redo: Vec::new(),
-            dirty: false,
+            state: 0,
+            last_state: 0,
+            saved: Some(0),
             unsettled: true,
             frame: 0,
             revision: 0,
@@ -176,6 +185,7 @@ impl Sculpt {
             data,
             pins,
             log,
+            state: 0,
         });
         sculpt
             .assembly
@@ -296,21 +306,11 @@ impl Sculpt {
             }
             Command::Undo => {
                 self.release();
-                if let Some(s) = self.undo.pop() {
-                    self.history += 1;
-                    self.redo.push(self.snapshot());
-                    self.restore(s);
-                    self.dirty = true;
-                }
+                self.step_history(false);
             }
             Command::Redo => {
                 self.release();
-                if let Some(s) = self.redo.pop() {
-                    self.history += 1;
-                    self.undo.push(self.snapshot());
-                    self.restore(s);
-                    self.dirty = true;
-                }
+                self.step_history(true);
             }
             Command::Reset => {
                 self.release();
@@ -343,9 +343,11 @@ impl Sculpt {
         self.collect_job(true);
         self.release();
         // A reload alone is not unsaved work: the session file would restore the same sculpt.
-        let dirty = self.dirty;
+        let saved = !self.dirty();
         self.checkpoint();
-        self.dirty = dirty;
+        if saved {
+            self.mark_saved();
+        }
         self.settings = Settings {
             hysteresis: grammar.solver.hysteresis,
             norm: grammar.solver.norm,
@@ -373,6 +375,7 @@ impl Sculpt {
                 data,
                 pins: self.pins(),
                 log: self.log.clone(),
+                state: self.state,
             }
         } else {
             self.initial(grammar)

@@ -169,7 +169,13 @@ impl Sculpt {
     /// command.
     pub(super) fn recover(&mut self, error: String) {
         self.grab = None;
-        let snapshot = (self.undo.pop()).unwrap_or_else(|| self.initial(self.grammar().clone()));
+        let snapshot = match self.undo.pop() {
+            Some(s) => {
+                self.state = s.state;
+                s
+            }
+            None => self.initial(self.grammar().clone()),
+        };
         self.restore(snapshot);
         self.error = Some(error);
     }
