@@ -74,9 +74,12 @@ fn problem(ui: &mut egui::Ui, p: &Problem) -> bool {
     headline.clicked()
 }
 
-/// A read-only view of a grammar's text around one line, the span underlined.
+/// A read-only view of a grammar's text around one line, the span underlined: the line of a
+/// listed problem, shown while that problem is listed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SourceView {
+    /// The problem shown.
+    pub problem: Problem,
     pub file: String,
     pub text: String,
     /// The selected line (1-based) and the span on it (columns, 1-based, end exclusive).

@@ -286,6 +286,56 @@ fn clicking_a_diagnostic_shows_its_line_in_the_source_view() {
 }
 
 #[test]
+fn the_source_view_closes_once_its_problem_is_fixed_or_another_file_opens() {
+    let dir = scratch("source-stale");
+    let path = dir.join("castle.clay");
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+    let typo = CASTLE_SOURCE.replacen("chain wall x 4", "chain wal x 4", 1);
+    let mut h = harness(EditorApp::open(&path));
+    h.step();
+    // A typo saved, its diagnostic clicked: the Source view shows its line.
+    let show_typo = |h: &mut Harness<'_, EditorApp>| {
+        std::fs::write(&path, &typo).unwrap();
+        h.state_mut().reload();
+        h.step();
+        h.step();
+        let p = (h.state().problems.iter().find(|p| p.code == "E011"))
+            .cloned()
+            .expect("the typo is reported");
+        h.get_by_label(&p.to_string()).click();
+        h.step();
+        h.step();
+        let line = format!("{} | {}", p.line, p.snippet);
+        h.get_by_label("Source");
+        h.get_by_label(&line);
+        line
+    };
+    let line = show_typo(&mut h);
+
+    // Fixed and reloaded: "No problems", and the Source view no longer shows the old line.
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+    h.state_mut().reload();
+    h.step();
+    h.step();
+    h.get_by_label("No problems.");
+    assert!(h.state().source_view.is_none());
+    assert!(h.query_by_label("Source").is_none());
+    assert!(h.query_by_label(&line).is_none());
+
+    // The same after another grammar is opened over the broken one's view.
+    show_typo(&mut h);
+    h.state_mut()
+        .perform(clay_editor::action::Action::OpenGrammar(grammar(
+            "wall.clay",
+        )));
+    h.step();
+    h.step();
+    assert!(h.state().grammar_path().unwrap().ends_with("wall.clay"));
+    assert!(h.state().source_view.is_none());
+    assert!(h.query_by_label("Source").is_none());
+}
+
+#[test]
 fn a_cut_click_that_finds_nothing_says_why_in_the_status_bar() {
     let mut app = EditorApp::bundled();
     app.command(Command::Cut {

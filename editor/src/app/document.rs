@@ -206,6 +206,7 @@ impl EditorApp {
                 self.message = Some(m);
             }
         }
+        self.drop_stale_source();
     }
 
     /// The sculpt as a session.

@@ -327,6 +327,7 @@ impl EditorApp {
         for a in std::mem::take(&mut self.actions) {
             self.perform(a);
         }
+        self.drop_stale_source();
     }
 
     /// Queues a command as if the UI had emitted it.

@@ -102,6 +102,7 @@ impl EditorApp {
             }
         };
         self.source_view = Some(panels::SourceView {
+            problem: p.clone(),
             file: p.file.clone(),
             text,
             line: p.line,
@@ -109,5 +110,17 @@ impl EditorApp {
             end_col: p.end_col,
         });
         self.message = Some(format!("{}:{}:{}", p.file, p.line, p.col));
+    }
+
+    /// Closes the source view once its problem is no longer listed (the file was fixed, or
+    /// another one opened): it never shows a line that is no longer a problem.
+    pub(super) fn drop_stale_source(&mut self) {
+        let Some(view) = &self.source_view else {
+            return;
+        };
+        let refused = self.refused.as_ref().map_or(&[][..], |(_, p)| &p[..]);
+        if !self.problems.contains(&view.problem) && !refused.contains(&view.problem) {
+            self.source_view = None;
+        }
     }
 }
