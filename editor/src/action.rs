@@ -20,7 +20,8 @@ pub enum Action {
     Quit,
     /// Authoring: make an SVG file (metres per SVG unit) the drawing.
     ImportSvg(PathBuf, f64),
-    /// Authoring: write the grammar text to a file.
+    /// Authoring: write the grammar text to a file (one the user chose: asked for with
+    /// [`Action::Ask`] the first time).
     WriteGrammar(PathBuf),
     /// Authoring: compile the grammar and sculpt it.
     TryAuthored,
@@ -42,6 +43,7 @@ impl Action {
             FileKind::Png => Action::ExportPng(path),
             FileKind::Json => Action::ExportJson(path),
             FileKind::Model3d => Action::Export3d(path),
+            FileKind::WriteGrammar => Action::WriteGrammar(path),
         }
     }
 }

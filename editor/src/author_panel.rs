@@ -11,6 +11,7 @@ use clay::authoring::StretchChoice;
 use egui::{Color32, RichText};
 
 use crate::action::Action;
+use crate::files::FileKind;
 use clay::authoring::work::{MergeChoice, StateChoice, VariantChoice, find_site, site_names};
 
 use crate::author::{AuthorCommand, Authoring};
@@ -21,7 +22,6 @@ use crate::panels;
 pub struct AuthorForm {
     pub svg_path: String,
     pub scale: String,
-    pub write_path: String,
     pub tolerance: String,
     /// Site type name being edited, by generated name.
     names: BTreeMap<String, String>,
@@ -45,7 +45,6 @@ impl Default for AuthorForm {
         Self {
             svg_path: "tests/fixtures/authoring/wall.svg".into(),
             scale: "0.01".into(),
-            write_path: "authored.clay".into(),
             tolerance: "0.001".into(),
             names: BTreeMap::new(),
             piece_names: BTreeMap::new(),
@@ -72,9 +71,7 @@ pub fn show(
     commands: &mut Vec<AuthorCommand>,
     actions: &mut Vec<Action>,
 ) {
-    if let Some(m) = &author.message {
-        ui.label(RichText::new(m).color(Color32::from_rgb(200, 40, 40)));
-    }
+    message_slot(ui, author.message.as_deref());
     egui::CollapsingHeader::new("Drawing")
         .default_open(true)
         .show(ui, |ui| {
@@ -96,29 +93,30 @@ pub fn show(
             site_types(ui, author, form, commands);
             site_type_of_site(ui, author, canvas, form, commands);
         });
-    if design.pieces.iter().any(|p| p.stretch.is_some()) {
-        egui::CollapsingHeader::new(format!("Variants ({})", author.work().variants.len()))
-            .default_open(false)
-            .show(ui, |ui| variants(ui, author, form, commands));
-    }
+    // Every section is always there (a command never adds one above a control): Variants
+    // says what it waits for until a piece is stretchable.
+    egui::CollapsingHeader::new(format!("Variants ({})", author.work().variants.len()))
+        .default_open(false)
+        .show(ui, |ui| variants(ui, author, form, commands));
     egui::CollapsingHeader::new(format!("Rest states ({})", author.work().states.len()))
         .default_open(canvas.pose.is_some())
         .show(ui, |ui| rest_states(ui, author, canvas, form, commands));
     egui::CollapsingHeader::new(format!("Merge rules ({})", author.work().merges.len()))
         .default_open(false)
         .show(ui, |ui| merges(ui, author, form, commands));
-    if !design.notes.is_empty() {
-        egui::CollapsingHeader::new(format!("Notes ({})", design.notes.len()))
-            .default_open(true)
-            .show(ui, |ui| {
-                for n in &design.notes {
-                    ui.label(RichText::new(n).color(Color32::from_rgb(180, 120, 0)));
-                }
-            });
-    }
+    egui::CollapsingHeader::new(format!("Notes ({})", design.notes.len()))
+        .default_open(false)
+        .show(ui, |ui| {
+            if design.notes.is_empty() {
+                ui.label("Nothing to note.");
+            }
+            for n in &design.notes {
+                ui.label(RichText::new(n).color(Color32::from_rgb(180, 120, 0)));
+            }
+        });
     egui::CollapsingHeader::new("Grammar")
         .default_open(true)
-        .show(ui, |ui| grammar(ui, author, form, actions));
+        .show(ui, |ui| grammar(ui, author, actions));
 }
 
 fn drawing(
@@ -234,10 +232,6 @@ fn pieces(
                 counts[pi],
                 if counts[pi] == 1 { "" } else { "s" }
             ));
-            if let Some([from, to]) = piece.stretch {
-                let name = |s: usize| piece.sites.get(s).map_or("?", |s| s.name.as_str());
-                ui.label(format!("stretch {} -> {}", name(from), name(to)));
-            }
         });
         ui.indent(("sites", pi), |ui| {
             for s in &piece.sites {
@@ -268,6 +262,8 @@ fn pieces(
                     .picks
                     .entry(pi)
                     .or_insert(piece.stretch.map_or((0, 1), |[a, b]| (a, b)));
+                // Two rows that fit the panel: the sites, then the button and what the piece
+                // does now, which changes beside the button, never above it.
                 ui.horizontal(|ui| {
                     for (label, value) in [("from", &mut pick.0), ("to", &mut pick.1)] {
                         let l = ui.label(label);
@@ -282,6 +278,8 @@ fn pieces(
                             .response
                             .labelled_by(l.id);
                     }
+                });
+                ui.horizontal(|ui| {
                     if ui.button("Stretchable").clicked() {
                         commands.push(AuthorCommand::SetStretch(Some(StretchChoice::Sites {
                             piece: pi,
@@ -289,6 +287,15 @@ fn pieces(
                             to: pick.1,
                         })));
                     }
+                    let now = match piece.stretch {
+                        Some([from, to]) => {
+                            let name =
+                                |s: usize| piece.sites.get(s).map_or("?", |s| s.name.as_str());
+                            format!("stretches {} -> {}", name(from), name(to))
+                        }
+                        None => "not stretchable".to_string(),
+                    };
+                    ui.add(egui::Label::new(now).truncate());
                 });
             }
         });
@@ -518,6 +525,7 @@ fn variants(
         return;
     };
     let Some(sp) = design.pieces.iter().position(|p| p.stretch.is_some()) else {
+        ui.label("Mark a piece stretchable first: variants are other pieces its chains insert.");
         return;
     };
     for v in &author.work().variants {
@@ -656,24 +664,30 @@ fn rest_states(
     }
 }
 
-fn grammar(
-    ui: &mut egui::Ui,
-    author: &Authoring,
-    form: &mut AuthorForm,
-    actions: &mut Vec<Action>,
-) {
+fn grammar(ui: &mut egui::Ui, author: &Authoring, actions: &mut Vec<Action>) {
+    // Nothing is written where the user did not choose: the first write asks for the file.
+    let file = author.written.as_ref().map(|(p, _)| p);
     ui.horizontal(|ui| {
-        let l = ui.label("File:");
-        ui.add(egui::TextEdit::singleline(&mut form.write_path).desired_width(170.0))
-            .labelled_by(l.id);
+        ui.label("File:");
+        let shown = file.map_or("not written yet".to_string(), |p| p.display().to_string());
+        ui.add(egui::Label::new(shown).truncate());
     });
     ui.horizontal(|ui| {
-        if ui.button("Write grammar").clicked() {
-            actions.push(if form.write_path.trim().is_empty() {
-                Action::Report("type the file to write the grammar to first".into())
-            } else {
-                Action::WriteGrammar(PathBuf::from(form.write_path.trim()))
+        let write = ui
+            .button("Write grammar")
+            .on_hover_text("write the grammar to its file (asks which the first time)");
+        if write.clicked() {
+            actions.push(match file {
+                Some(p) => Action::WriteGrammar(p.clone()),
+                None => Action::Ask(FileKind::WriteGrammar),
             });
+        }
+        if ui
+            .button("Write as…")
+            .on_hover_text("write the grammar to another file")
+            .clicked()
+        {
+            actions.push(Action::Ask(FileKind::WriteGrammar));
         }
         if ui
             .add_enabled(author.compiles, egui::Button::new("Try it"))
@@ -684,14 +698,12 @@ fn grammar(
             actions.push(Action::TryAuthored);
         }
     });
-    if let Some((p, t)) = &author.written {
-        let same = author.text() == Some(t.as_str());
-        ui.label(format!(
-            "written to {}{}",
-            p.display(),
-            if same { "" } else { " (changed since)" }
-        ));
-    }
+    let state = match (&author.written, author.text()) {
+        (Some((_, t)), Some(text)) if t == text => "written",
+        (Some(_), _) => "changed since it was written",
+        (None, _) => "",
+    };
+    ui.label(state);
     if author.text().is_some() && !author.compiles {
         ui.label(
             RichText::new("The grammar does not compile.").color(Color32::from_rgb(200, 40, 40)),
@@ -702,9 +714,26 @@ fn grammar(
         egui::CollapsingHeader::new("Text")
             .default_open(false)
             .show(ui, |ui| {
-                egui::ScrollArea::horizontal().show(ui, |ui| {
-                    ui.add(egui::Label::new(RichText::new(text).monospace()).extend());
-                });
+                // A scroll bar of its own below the text (not floating over it or the header).
+                ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+                egui::ScrollArea::horizontal()
+                    .id_salt("grammar text")
+                    .show(ui, |ui| {
+                        ui.add(egui::Label::new(RichText::new(text).monospace()).extend());
+                    });
             });
+    }
+}
+
+/// The last command's message in a slot of one line that is always there (empty or not), so
+/// that a message never pushes the controls below it; the whole text on hover.
+fn message_slot(ui: &mut egui::Ui, message: Option<&str>) {
+    let height = ui.text_style_height(&egui::TextStyle::Body);
+    let size = egui::vec2(ui.available_width(), height);
+    let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
+    if let Some(m) = message {
+        let text = RichText::new(m).color(Color32::from_rgb(200, 40, 40));
+        ui.put(rect, egui::Label::new(text).truncate())
+            .on_hover_text(m);
     }
 }

@@ -20,6 +20,8 @@ pub enum FileKind {
     Json,
     /// The sculpted model as 3D meshes (glTF or OBJ, by extension).
     Model3d,
+    /// Authoring: the file the grammar is written to.
+    WriteGrammar,
 }
 
 impl FileKind {
@@ -31,6 +33,7 @@ impl FileKind {
             FileKind::Png => "Export view as PNG",
             FileKind::Json => "Export deformed assembly as JSON",
             FileKind::Model3d => "Export 3D model (glTF or OBJ)",
+            FileKind::WriteGrammar => "Write grammar as",
         }
     }
 
@@ -38,7 +41,11 @@ impl FileKind {
     pub fn writes(self) -> bool {
         matches!(
             self,
-            FileKind::SaveSession | FileKind::Png | FileKind::Json | FileKind::Model3d
+            FileKind::SaveSession
+                | FileKind::Png
+                | FileKind::Json
+                | FileKind::Model3d
+                | FileKind::WriteGrammar
         )
     }
 
@@ -50,6 +57,7 @@ impl FileKind {
             FileKind::Png => ("PNG image", &["png"]),
             FileKind::Json => ("JSON", &["json"]),
             FileKind::Model3d => ("3D model", &["glb", "gltf", "obj"]),
+            FileKind::WriteGrammar => ("Clay grammar", &["clay"]),
         }
     }
 }

@@ -493,3 +493,34 @@ fn undoing_every_change_counts_as_saved() {
     h.step();
     assert!(!h.state().sculpt.dirty(), "redone to the saved model");
 }
+
+#[test]
+fn a_new_session_file_is_suggested_beside_the_grammar_not_in_the_working_folder() {
+    let dir = temp_dir("session-default");
+    let path = dir.join("castle.clay");
+    std::fs::write(&path, CASTLE_SOURCE).unwrap();
+    for (app, folder) in [
+        (EditorApp::open(&path), Some(dir.clone())),
+        (EditorApp::bundled(), None),
+    ] {
+        let mut h = harness(app);
+        h.step();
+        h.get_by_label("File").click();
+        h.step();
+        h.step();
+        h.get_by_label("Save session").click();
+        for _ in 0..4 {
+            h.step();
+        }
+        h.get_by_label("Save session as");
+        let by = egui_kittest::kittest::By::new()
+            .role(egui::accesskit::Role::TextInput)
+            .label_contains("Path (relative");
+        let text = h.get(by).value().unwrap_or_default();
+        let suggested = std::path::Path::new(&text);
+        assert!(suggested.is_absolute(), "{text}");
+        if let Some(folder) = &folder {
+            assert_eq!(suggested, folder.join("castle.clay-session.json"));
+        }
+    }
+}

@@ -1276,3 +1276,128 @@ fn the_panel_renames_a_piece_and_shows_why_a_name_is_refused() {
         Some("brick_wall")
     );
 }
+
+/// Whether every control is where it was (to a tenth of a point).
+fn same_places(a: &[(String, egui::Rect)], b: &[(String, egui::Rect)]) {
+    for ((label, r), (_, s)) in a.iter().zip(b) {
+        let moved = (r.min - s.min).length().max((r.max - s.max).length());
+        assert!(moved < 0.1, "{label} moved from {r:?} to {s:?}");
+    }
+}
+
+/// The rects of the Author panel's controls that a click may aim at.
+fn control_rects(h: &Harness<'_, EditorApp>) -> Vec<(String, egui::Rect)> {
+    let mut out = Vec::new();
+    for label in [
+        "Import SVG",
+        "Clear drawing",
+        "Stretchable",
+        "Stretch: auto",
+        "No stretch",
+        "Write grammar",
+        "Try it",
+        "Text",
+    ] {
+        out.push((label.to_string(), h.get_by_label(label).rect()));
+    }
+    out
+}
+
+#[test]
+fn the_author_panels_controls_never_move_under_the_pointer() {
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().set_mode(Mode::Author);
+    h.run();
+    h.state_mut().author_form.svg_path = wall_svg().display().to_string();
+    h.get_by_label("Import SVG").click();
+    h.run();
+    let before = control_rects(&h);
+    // Every control is inside the window: none cut off at the panel's right edge.
+    for (label, r) in &before {
+        assert!(r.right() < 1200.0 - 8.0, "{label} is cut off: {r:?}");
+    }
+    // "Stretch: auto", then a message from a refused command: nothing below them moves, so a
+    // second click lands where the user aimed (not on "Write grammar").
+    h.get_by_label("Stretch: auto").click();
+    h.run();
+    h.step();
+    assert!(
+        h.state().author.design().unwrap().pieces[0]
+            .stretch
+            .is_some()
+    );
+    same_places(&before, &control_rects(&h));
+    h.state_mut().author_command(AuthorCommand::Report(
+        "a message a refused command gave".into(),
+    ));
+    h.run();
+    h.step();
+    assert!(h.state().author.message.is_some());
+    same_places(&before, &control_rects(&h));
+    assert!(h.state().author.written.is_none(), "nothing written");
+}
+
+#[test]
+fn writing_the_grammar_asks_where_the_first_time_and_never_writes_silently() {
+    let dir = TempDir::new("write-asks");
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().set_mode(Mode::Author);
+    h.run();
+    h.state_mut().author_form.svg_path = wall_svg().display().to_string();
+    h.get_by_label("Import SVG").click();
+    h.run();
+    let cwd_file = std::env::current_dir().unwrap().join("authored.clay");
+    let existed = cwd_file.exists();
+    h.get_by_label("Write grammar").click();
+    h.run();
+    h.step();
+    // Nothing written: the dialog asks, suggesting an absolute path.
+    assert!(h.state().author.written.is_none());
+    assert_eq!(
+        cwd_file.exists(),
+        existed,
+        "nothing written in the working folder"
+    );
+    h.get_by_label("Write grammar as");
+    let suggested = path_field(&h).value().unwrap_or_default();
+    assert!(Path::new(&suggested).is_absolute(), "{suggested}");
+    // Cancel writes nothing either.
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert!(h.state().author.written.is_none());
+
+    // Chosen in the dialog: written there; the next Write goes to the same file unasked.
+    h.get_by_label("Write grammar").click();
+    h.run();
+    h.step();
+    let out = dir.0.join("wall.clay");
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.step();
+    path_field(&h).type_text(&out.display().to_string());
+    h.step();
+    h.key_press(egui::Key::Enter);
+    h.run();
+    h.step();
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(Some(written.as_str()), h.state().author.text());
+    h.state_mut()
+        .author_command(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
+    h.run();
+    h.get_by_label("Write grammar").click();
+    h.run();
+    h.step();
+    assert!(
+        h.query_by_label("Write grammar as").is_none(),
+        "not asked again"
+    );
+    let again = std::fs::read_to_string(&out).unwrap();
+    assert!(again.contains("stretch brick"), "{again}");
+}
+
+/// The typed-path dialog's field.
+fn path_field<'h>(h: &'h Harness<'_, EditorApp>) -> egui_kittest::Node<'h> {
+    let by = egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::TextInput)
+        .label_contains("Path (relative");
+    h.get(by)
+}

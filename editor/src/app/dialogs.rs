@@ -91,8 +91,10 @@ impl EditorApp {
             .collect();
         let r = egui::Modal::new(egui::Id::unique("path dialog")).show(ctx, |ui| {
             ui.heading(d.kind.title());
-            ui.label("Path (relative to the folder the editor was started in):");
-            let edit = ui.add(egui::TextEdit::singleline(&mut d.text).desired_width(420.0));
+            let label = ui.label("Path (relative to the folder the editor was started in):");
+            let edit = ui
+                .add(egui::TextEdit::singleline(&mut d.text).desired_width(420.0))
+                .labelled_by(label.id);
             let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(Key::Enter));
             edit.request_focus();
             if !recent.is_empty() {

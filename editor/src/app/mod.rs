@@ -267,17 +267,26 @@ impl EditorApp {
             .exact_size(340.0)
             .show(ui, |ui| {
                 // Both ways: content wider than the panel scrolls instead of pushing it over.
-                egui::ScrollArea::both().show(ui, |ui| match self.mode {
-                    Mode::Sculpt => self.side_panels(ui),
-                    Mode::Author => author_panel::show(
-                        ui,
-                        &self.author,
-                        &mut self.author_canvas,
-                        &mut self.author_form,
-                        &mut self.author_commands,
-                        &mut self.actions,
-                    ),
-                });
+                match self.mode {
+                    Mode::Sculpt => {
+                        egui::ScrollArea::both().show(ui, |ui| self.side_panels(ui));
+                    }
+                    // Scroll bars of their own strips, never floating over the last row (the
+                    // Text header) or the right edge's buttons.
+                    Mode::Author => {
+                        ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+                        egui::ScrollArea::both().show(ui, |ui| {
+                            author_panel::show(
+                                ui,
+                                &self.author,
+                                &mut self.author_canvas,
+                                &mut self.author_form,
+                                &mut self.author_commands,
+                                &mut self.actions,
+                            )
+                        });
+                    }
+                }
             });
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)

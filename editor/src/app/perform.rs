@@ -159,23 +159,51 @@ impl EditorApp {
 
     /// Asks for a path: the desktop's file dialog where there is one, else a typed path.
     pub(super) fn ask(&mut self, kind: FileKind) {
-        let text = match kind {
-            FileKind::SaveSession | FileKind::OpenSession => self
-                .session_path
-                .as_ref()
-                .map_or("sculpt.clay-session.json".to_string(), |p| {
-                    p.display().to_string()
-                }),
-            FileKind::Grammar => self.display_path(),
-            FileKind::Png => "sculpt.png".to_string(),
-            FileKind::Json => "sculpt.assembly.json".to_string(),
-            FileKind::Model3d => "sculpt.glb".to_string(),
+        let path = match kind {
+            FileKind::Grammar => PathBuf::from(self.display_path()),
+            FileKind::OpenSession | FileKind::SaveSession => match &self.session_path {
+                Some(p) => p.clone(),
+                None => self.suggested("clay-session.json"),
+            },
+            FileKind::Png => self.suggested("png"),
+            FileKind::Json => self.suggested("assembly.json"),
+            FileKind::Model3d => self.suggested("glb"),
+            FileKind::WriteGrammar => match &self.author.written {
+                Some((p, _)) => p.clone(),
+                None => self.folder().join(crate::author::UNSAVED_NAME),
+            },
         };
+        // Absolute: the dialog shows where the file goes, whatever folder the editor runs in.
+        let path = std::path::absolute(&path).unwrap_or(path);
+        let text = path.display().to_string();
         if self.desktop.native_dialogs {
             self.native = Some(NativeDialog::open(kind, Path::new(&text)));
         } else {
             self.dialog = Some(PathDialog { kind, text });
         }
+    }
+
+    /// The folder a new file is suggested in: the grammar's, else the session's, else the
+    /// user's home (never just the folder the editor was started in).
+    fn folder(&self) -> PathBuf {
+        let beside = |p: &Path| {
+            std::path::absolute(p)
+                .ok()
+                .and_then(|p| p.parent().map(Path::to_path_buf))
+        };
+        (self.grammar_path.as_deref().and_then(beside))
+            .or_else(|| self.session_path.as_deref().and_then(beside))
+            .or_else(|| directories::UserDirs::new().map(|d| d.home_dir().to_path_buf()))
+            .unwrap_or_else(|| std::env::current_dir().unwrap_or_default())
+    }
+
+    /// A new file's suggested path: in [`Self::folder`], named after the grammar with
+    /// `extension` (`castle.png`), or `sculpt.EXTENSION` for a grammar with no file.
+    fn suggested(&self, extension: &str) -> PathBuf {
+        let stem = (self.grammar_path.as_deref())
+            .and_then(Path::file_stem)
+            .map_or("sculpt".to_string(), |s| s.to_string_lossy().into_owned());
+        self.folder().join(format!("{stem}.{extension}"))
     }
 
     /// Takes the native dialog's answer once it has one.
