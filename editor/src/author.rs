@@ -248,7 +248,7 @@ impl Authoring {
                 w.cuts.push(point);
                 self.change(w, "cut there");
                 if self.message.is_none() {
-                    self.status = Some(format!("cut at ({}, {})", point.x, point.y));
+                    self.status = Some(format!("cut at {}", coords(point)));
                 }
             }
             AuthorCommand::RemoveCut { index } => {
@@ -256,7 +256,7 @@ impl Authoring {
                     let at = w.cuts.remove(index);
                     self.change(w, "remove that cut");
                     if self.message.is_none() {
-                        self.status = Some(format!("removed the cut at ({}, {})", at.x, at.y));
+                        self.status = Some(format!("removed the cut at {}", coords(at)));
                     }
                 }
             }
@@ -548,8 +548,8 @@ impl Authoring {
                 .any(|b| (*a - *b).length() < self.work.tolerance)
             {
                 return Err(format!(
-                    "two vertices of the state are at ({}, {}): move one",
-                    a.x, a.y
+                    "two vertices of the state are at {}: move one",
+                    coords(*a)
                 ));
             }
         }
@@ -591,4 +591,17 @@ impl Authoring {
         self.recompute();
         Ok(())
     }
+}
+
+/// A coordinate in metres for messages and labels: at most four decimals (a tenth of a
+/// millimetre), no trailing zeros, so `3.4000000000000004` reads `3.4`.
+pub fn short(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+/// A point in metres as `(x, y)`, each coordinate [`short`].
+pub fn coords(p: DVec2) -> String {
+    format!("({}, {})", short(p.x), short(p.y))
 }

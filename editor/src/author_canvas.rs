@@ -14,7 +14,7 @@ use glam::DVec2;
 
 use clay::authoring::work::{Computed, SiteName};
 
-use crate::author::{AuthorCommand, Authoring};
+use crate::author::{AuthorCommand, Authoring, short};
 use crate::camera::{Camera, dv, pos};
 
 /// Pointer distance (screen points) within which a point or edge counts as under it.
@@ -170,13 +170,6 @@ fn grid_crossing(a: DVec2, b: DVec2, p: DVec2, step: f64) -> Option<DVec2> {
         }
     }
     best
-}
-
-/// A coordinate for messages and labels: at most four decimals, no trailing zeros.
-fn short(x: f64) -> String {
-    let s = format!("{x:.4}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
 }
 
 impl AuthorCanvas {
@@ -649,7 +642,7 @@ impl AuthorCanvas {
             painter.text(
                 s + Vec2::new(10.0, -10.0),
                 Align2::LEFT_BOTTOM,
-                format!("{} ({}, {})", k.label(), short(t.x), short(t.y)),
+                format!("{} {}", k.label(), crate::author::coords(t)),
                 FontId::proportional(11.0),
                 colour,
             );

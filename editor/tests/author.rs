@@ -1394,10 +1394,67 @@ fn writing_the_grammar_asks_where_the_first_time_and_never_writes_silently() {
     assert!(again.contains("stretch brick"), "{again}");
 }
 
+#[test]
+fn cut_pieces_are_named_in_order_and_the_status_bar_prints_short_coordinates() {
+    let mut h = authoring(strip(), Tool::Cut);
+    // On the grid line x = 3.4 (34 steps of 0.1, which is 3.4000000000000004 in f64).
+    let at = h.state().author_canvas.to_screen(DVec2::new(3.4, -0.02));
+    click(&mut h, at);
+    h.step();
+    assert_eq!(h.state().message.as_deref(), Some("cut at (3.4, 0)"));
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.run();
+    // Cuts clicked out of order: the four squares are still numbered left to right.
+    for x in [2.0, 1.0, 3.0] {
+        let at = h.state().author_canvas.to_screen(DVec2::new(x, -0.02));
+        click(&mut h, at);
+    }
+    let d = h.state().author.design().unwrap().clone();
+    assert_eq!(instances_of_each_piece(&h.state().author), vec![4]);
+    let mut by_x: Vec<(f64, String)> = (d.instances.iter())
+        .map(|i| (i.at.x, i.name.clone()))
+        .collect();
+    by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let names: Vec<String> = by_x.into_iter().map(|(_, n)| n).collect();
+    let piece = &d.pieces[0].name;
+    let sep = if piece.ends_with(|c: char| c.is_ascii_digit()) {
+        "_"
+    } else {
+        ""
+    };
+    let expected: Vec<String> = (0..4).map(|k| format!("{piece}{sep}{k}")).collect();
+    assert_eq!(names, expected);
+    // The canvas labels them so, left to right.
+    let painted: Vec<(f32, String)> = painted_texts(&h)
+        .into_iter()
+        .filter(|(_, t)| expected.contains(t))
+        .collect();
+    let mut painted = painted;
+    painted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let shown: Vec<String> = painted.into_iter().map(|(_, t)| t).collect();
+    assert_eq!(shown, expected);
+}
+
 /// The typed-path dialog's field.
 fn path_field<'h>(h: &'h Harness<'_, EditorApp>) -> egui_kittest::Node<'h> {
     let by = egui_kittest::kittest::By::new()
         .role(egui::accesskit::Role::TextInput)
         .label_contains("Path (relative");
     h.get(by)
+}
+
+/// Every text the last frame painted, with its left edge.
+fn painted_texts(h: &Harness<'_, EditorApp>) -> Vec<(f32, String)> {
+    fn collect(shape: &egui::Shape, out: &mut Vec<(f32, String)>) {
+        match shape {
+            egui::Shape::Text(t) => out.push((t.pos.x, t.galley.text().to_string())),
+            egui::Shape::Vec(v) => v.iter().for_each(|s| collect(s, out)),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    for s in &h.output().shapes {
+        collect(&s.shape, &mut out);
+    }
+    out
 }

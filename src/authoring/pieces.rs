@@ -367,7 +367,7 @@ pub fn find_pieces(
             vertices,
         });
     }
-    name_pieces(graph, regions, &mut design);
+    name_pieces(graph, regions, &mut design, tol);
     // Contacts -> sites (per piece, keyed by their vertex set) and docks.
     let index_of: Vec<HashMap<usize, usize>> = design
         .instances
@@ -568,7 +568,7 @@ fn new_piece(
 
 /// Names pieces after the drawing's ids (`brick3` -> `brick`) when they are unambiguous and
 /// not a keyword, else `piece1`, `piece2`, ...; instances are named by [`instance_names`].
-fn name_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
+fn name_pieces(graph: &Graph, regions: &[Region], design: &mut Design, tol: f64) {
     let mut taken: HashSet<String> = ["base".to_string()].into_iter().collect();
     let mut first = vec![None; design.pieces.len()];
     for i in &design.instances {
@@ -593,40 +593,73 @@ fn name_pieces(graph: &Graph, regions: &[Region], design: &mut Design) {
     }
     let piece_names: Vec<String> = design.pieces.iter().map(|p| p.name.clone()).collect();
     let of: Vec<usize> = design.instances.iter().map(|i| i.piece).collect();
-    for (inst, name) in design
-        .instances
-        .iter_mut()
-        .zip(instance_names(&piece_names, &of))
+    let places = instance_places(graph, design);
+    for (inst, name) in
+        design
+            .instances
+            .iter_mut()
+            .zip(instance_names(&piece_names, &of, &places, tol))
     {
         inst.name = name;
     }
 }
 
+/// Where each instance of `design` is: the centroid of its vertices in the drawing.
+pub(crate) fn instance_places(graph: &Graph, design: &Design) -> Vec<DVec2> {
+    (design.instances.iter())
+        .map(|i| {
+            let points: Vec<DVec2> = (i.vertices.iter())
+                .filter_map(|&v| graph.positions.get(v).copied())
+                .collect();
+            points.iter().sum::<DVec2>() / points.len().max(1) as f64
+        })
+        .collect()
+}
+
 /// Instance names, all different (E010): the piece's name and a count from 0 (`brick0`,
 /// `brick1`), with `_` between when the name ends in a digit (`piece1_0`: `piece10` could be
 /// `piece1`'s eleventh instance or `piece10`'s first). A name still taken (a piece renamed to
-/// end in `_`, say) gets `_2`, `_3`, ... `of[i]` is instance `i`'s piece.
-pub(crate) fn instance_names(pieces: &[String], of: &[usize]) -> Vec<String> {
+/// end in `_`, say) gets `_2`, `_3`, ... `of[i]` is instance `i`'s piece and `places[i]` where
+/// it is: each piece counts its instances in reading order (top to bottom, then left to right,
+/// places within `tol` counting as level), not in the order the drawing's regions were found.
+pub(crate) fn instance_names(
+    pieces: &[String],
+    of: &[usize],
+    places: &[DVec2],
+    tol: f64,
+) -> Vec<String> {
+    let tol = if tol.is_finite() && tol > 0.0 {
+        tol
+    } else {
+        1e-9
+    };
+    let level = |x: f64| (x / tol).round() as i64;
+    let mut order: Vec<usize> = (0..of.len()).collect();
+    order.sort_by_key(|&i| {
+        let p = places.get(i).copied().unwrap_or(DVec2::ZERO);
+        (-level(p.y), level(p.x), i)
+    });
     let mut counts = vec![0usize; pieces.len()];
     let mut taken: HashSet<String> = HashSet::new();
-    of.iter()
-        .map(|&p| {
-            let name = &pieces[p];
-            let sep = if name.ends_with(|c: char| c.is_ascii_digit()) {
-                "_"
-            } else {
-                ""
-            };
-            let base = format!("{name}{sep}{}", counts[p]);
-            counts[p] += 1;
-            let unique = std::iter::once(base.clone())
-                .chain((2..).map(|k| format!("{base}_{k}")))
-                .find(|n| !taken.contains(n))
-                .unwrap_or(base);
-            taken.insert(unique.clone());
-            unique
-        })
-        .collect()
+    let mut names = vec![String::new(); of.len()];
+    for i in order {
+        let p = of[i];
+        let name = &pieces[p];
+        let sep = if name.ends_with(|c: char| c.is_ascii_digit()) {
+            "_"
+        } else {
+            ""
+        };
+        let base = format!("{name}{sep}{}", counts[p]);
+        counts[p] += 1;
+        let unique = std::iter::once(base.clone())
+            .chain((2..).map(|k| format!("{base}_{k}")))
+            .find(|n| !taken.contains(n))
+            .unwrap_or(base);
+        taken.insert(unique.clone());
+        names[i] = unique;
+    }
+    names
 }
 
 /// The sites made so far and their types: per piece, its sites by their sorted vertices; the

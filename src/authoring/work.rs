@@ -429,10 +429,16 @@ fn name_pieces(graph: &Graph, regions: &[Region], work: &Work, design: &mut Desi
         piece.name.clone_from(name);
     }
     let of: Vec<usize> = design.instances.iter().map(|i| i.piece).collect();
+    let places = super::pieces::instance_places(graph, design);
     for (inst, name) in design
         .instances
         .iter_mut()
-        .zip(super::pieces::instance_names(&shown, &of))
+        .zip(super::pieces::instance_names(
+            &shown,
+            &of,
+            &places,
+            work.tolerance,
+        ))
     {
         inst.name = name;
     }
