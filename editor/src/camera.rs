@@ -59,15 +59,22 @@ impl Camera {
     /// The camera showing the world box `[min, max]` in a canvas of `size` points with `margin`
     /// points free on every side. An empty or broken box keeps the camera as it is.
     pub fn fit(&mut self, min: DVec2, max: DVec2, size: DVec2, margin: f64) {
+        self.fit_below(min, max, size, margin, 0.0);
+    }
+
+    /// As [`Camera::fit`], with the top `reserved` points of the canvas kept free as well (a
+    /// legend drawn there): the box is fitted into the canvas below them.
+    pub fn fit_below(&mut self, min: DVec2, max: DVec2, size: DVec2, margin: f64, reserved: f64) {
         if !(min.is_finite() && max.is_finite() && min.cmple(max).all()) {
             return;
         }
         let extent = (max - min).max(DVec2::splat(1e-6));
-        let room = (size - DVec2::splat(2.0 * margin)).max(DVec2::ONE);
+        let room = (size - DVec2::new(2.0 * margin, 2.0 * margin + reserved)).max(DVec2::ONE);
         self.scale = (room.x / extent.x)
             .min(room.y / extent.y)
             .clamp(SCALE_RANGE.0, SCALE_RANGE.1);
-        self.centre = (min + max) / 2.0;
+        // The box's middle at the room's middle, `reserved / 2` points below the canvas's.
+        self.centre = (min + max) / 2.0 + DVec2::new(0.0, reserved / 2.0 / self.scale);
     }
 }
 

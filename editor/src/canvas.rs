@@ -121,7 +121,7 @@ impl Canvas {
             self.posed = Some(key);
         }
         if self.fit_pending {
-            self.fit(data);
+            self.fit(data, overlays);
             self.fit_pending = false;
         }
         let mid = dv(self.rect.center());
@@ -157,7 +157,7 @@ impl Canvas {
             }
         }
         if keyboard_free && ui.input(|i| i.key_pressed(Key::F)) {
-            self.fit(data);
+            self.fit(data, overlays);
         }
 
         let world = pointer.map(|p| self.camera.to_world(dv(p), mid));
@@ -259,10 +259,19 @@ impl Canvas {
         self.label_parts(ui, sculpt);
     }
 
-    fn fit(&mut self, data: &AssemblyData) {
+    /// Fits the model into the view, below the strain legend while it is shown.
+    fn fit(&mut self, data: &AssemblyData, overlays: &ViewOverlays) {
         let (min, max) = clay::render::draw::bounds(&self.meshes, data);
         let size = DVec2::new(self.rect.width() as f64, self.rect.height() as f64);
-        self.camera.fit(min, max, size, 24.0);
+        let [_, y, _, height] = clay::render::draw::STRAIN_LEGEND;
+        let margin = 24.0;
+        // The legend's plate ends `y + height` points down; the margin then starts below it.
+        let legend = if overlays.strain && !self.iso {
+            (y + height) as f64
+        } else {
+            0.0
+        };
+        self.camera.fit_below(min, max, size, margin, legend);
     }
 
     fn paint(&self, painter: &egui::Painter, sculpt: &Sculpt) {

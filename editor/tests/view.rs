@@ -458,3 +458,62 @@ fn pull_tower(h: &mut Harness<'_, EditorApp>) {
     h.state_mut().command(Command::Release);
     settle(h);
 }
+
+#[test]
+fn rest_states_are_labelled_on_the_wall_and_the_castle() {
+    for app in [EditorApp::open(&grammar("wall.clay")), EditorApp::bundled()] {
+        let mut h = harness(app);
+        settle(&mut h);
+        h.state_mut().overlays.states = true;
+        h.step();
+        h.step();
+        let data = h.state().sculpt.data();
+        // Every part with alternatives: the chains' stretch parts (`one`, `two`, `three`)
+        // and pieces with more than one rest state.
+        let named: Vec<String> = (data.parts.iter())
+            .filter(|p| {
+                p.states.len() > 1 || matches!(p.kind, clay_dsl::compiled::PartKind::Stretch { .. })
+            })
+            .map(|p| p.states[p.active].name.clone())
+            .collect();
+        assert!(named.len() > 3, "{} parts with alternatives", named.len());
+        let texts = painted_texts(&h);
+        assert!(named.iter().any(|n| n == "two"), "{named:?}");
+        let mut names = named.clone();
+        names.sort();
+        names.dedup();
+        for name in &names {
+            let want = named.iter().filter(|n| *n == name).count();
+            let got = texts.iter().filter(|t| *t == name).count();
+            assert_eq!(got, want, "`{name}` on every part in it: {texts:?}");
+        }
+    }
+}
+
+#[test]
+fn after_fit_the_strain_legend_covers_none_of_the_model() {
+    let mut h = harness(EditorApp::bundled());
+    settle(&mut h);
+    h.get_by_label("View").click();
+    h.step();
+    h.step();
+    h.get_by_label("Strain").click();
+    h.step();
+    h.key_press(egui::Key::Escape);
+    h.step();
+    h.get_by_label("Fit").click();
+    h.step();
+    h.step();
+    let app = h.state();
+    let [x, y, w, ht] = clay::render::draw::STRAIN_LEGEND;
+    let legend =
+        egui::Rect::from_min_size(app.canvas.rect.min + egui::vec2(x, y), egui::vec2(w, ht));
+    assert!(painted_texts(&h).iter().any(|t| t == "strain 0"));
+    let top = (app.sculpt.data().positions.iter())
+        .map(|p| app.canvas.to_screen(*p).y)
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        top > legend.max.y,
+        "the model's top ({top}) is below the legend's plate ({legend:?})"
+    );
+}

@@ -461,10 +461,11 @@ fn draw_state_labels(
     view: &View,
 ) {
     for part in parts_of(grammar, assembly) {
-        // Stretch parts are normally in `two`; only a pending insert or removal is worth a label.
+        // Every part with alternatives: a stretch part always has them (`one`, `two`, `three`),
+        // so a chain at rest reads `two` at each joint.
         let worth = match part.kind {
             PartKind::Piece { .. } => part.states.len() > 1,
-            PartKind::Stretch { .. } => part.active != 1,
+            PartKind::Stretch { .. } => true,
         };
         let Some(state) = part.states.get(part.active).filter(|_| worth) else {
             continue;
@@ -499,13 +500,14 @@ pub fn label(canvas: &mut dyn Canvas, at: [f32; 2], size: f32, text_: &str, cent
     canvas.text([x, y], size, INK, text_);
 }
 
+/// Where the strain legend's plate sits, in pixels from the picture's top-left corner: `[x, y,
+/// width, height]` (a view that fits a model beside it keeps clear of this).
+pub const STRAIN_LEGEND: [f32; 4] = [8.0, 8.0, 128.0, 34.0];
+
 fn strain_legend(canvas: &mut dyn Canvas) {
-    let (x, y, w) = (12.0, 12.0, 120.0);
-    canvas.fill_rect(
-        [x - 4.0, y - 4.0],
-        [w + 8.0, 34.0],
-        Rgba([255, 255, 255, 220]),
-    );
+    let [px, py, pw, ph] = STRAIN_LEGEND;
+    let (x, y, w) = (px + 4.0, py + 4.0, pw - 8.0);
+    canvas.fill_rect([px, py], [pw, ph], Rgba([255, 255, 255, 220]));
     let steps = 24;
     for k in 0..steps {
         let s = STRAIN_FULL * k as f64 / (steps - 1) as f64;
