@@ -18,7 +18,8 @@ use rayon::prelude::*;
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
-use super::local::{RestCache, Switching};
+use super::local::Switching;
+use super::rest_cache::RestCache;
 
 /// Parts per chunk (fixed: the chunks, and so every sum, do not depend on the thread count).
 pub const CHUNK: usize = 512;
@@ -439,7 +440,8 @@ fn scratch_of<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::local::{RestCache, VertexParts};
+    use crate::solver::local::VertexParts;
+    use crate::solver::rest_cache::RestCache;
 
     fn same(a: DVec2, b: DVec2) -> bool {
         a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()

@@ -16,6 +16,7 @@ mod layout;
 pub(crate) mod local;
 mod measure;
 mod report;
+mod rest_cache;
 mod units;
 
 use config::cone_cosine;
@@ -45,7 +46,7 @@ struct Work {
     vertex_parts: local::VertexParts,
     /// The parts' rest data flattened for the local step (rebuilt with the generation);
     /// `None` when it could not be built, and the local step then reads the parts directly.
-    rest: Option<local::RestCache>,
+    rest: Option<rest_cache::RestCache>,
     /// Per part-edge: `R_xy (x0 - y0)`.
     targets: Vec<DVec2>,
     /// Per part: its IRLS weight (pass 1), for all its edges.
@@ -286,7 +287,7 @@ impl Solver {
         }
         self.pattern = Pattern::build(n, &asm.data().parts);
         self.work.vertex_parts = local::VertexParts::build(&asm.data().parts, n);
-        self.work.rest = local::RestCache::build(&asm.data().parts, &self.work.vertex_parts);
+        self.work.rest = rest_cache::RestCache::build(&asm.data().parts, &self.work.vertex_parts);
         self.components = follow::Components::build(&asm.data().parts, n);
         self.units = units::Units::build(&asm.data().parts, &self.components);
         self.symbolic = match self.config.kind {
