@@ -517,3 +517,53 @@ fn after_fit_the_strain_legend_covers_none_of_the_model() {
         "the model's top ({top}) is below the legend's plate ({legend:?})"
     );
 }
+
+#[test]
+fn open_recent_lists_the_command_line_grammar_and_a_tried_one() {
+    let dir = scratch("recent-cli");
+    let store = dir.join("config").join("recent-files.json");
+    let wall = grammar("wall.clay");
+    // As main.rs does: the grammar opened first, the desktop known after.
+    let mut app = EditorApp::open(&wall);
+    app.use_desktop(clay_editor::files::Desktop {
+        native_dialogs: false,
+        recent_store: Some(store.clone()),
+    });
+    let mut h = harness(app);
+    h.step();
+    h.get_by_label("File").click();
+    h.step();
+    h.step();
+    h.get_by_label("Open recent").hover();
+    h.step();
+    h.step();
+    assert!(h.query_by_label("Nothing opened yet.").is_none());
+    let shown = |p: &Path| format!("{} (grammar)", std::path::absolute(p).unwrap().display());
+    h.get_by_label(&shown(&wall));
+    h.key_press(egui::Key::Escape);
+    h.step();
+
+    // A grammar written in Author mode and opened with Try it is listed too.
+    let svg = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/authoring/wall.svg");
+    let tried = dir.join("tried.clay");
+    {
+        use clay_editor::action::Action;
+        let app = h.state_mut();
+        app.set_mode(clay_editor::app::Mode::Author);
+        app.perform(Action::ImportSvg(svg, 0.01));
+        app.perform(Action::WriteGrammar(tried.clone()));
+        app.perform(Action::TryAuthored);
+    }
+    h.step();
+    assert_eq!(h.state().grammar_path(), Some(tried.as_path()));
+    h.get_by_label("File").click();
+    h.step();
+    h.step();
+    h.get_by_label("Open recent").hover();
+    h.step();
+    h.step();
+    h.get_by_label(&shown(&tried));
+    h.get_by_label(&shown(&wall));
+    let kept = clay_editor::files::Recent::load(Some(&store));
+    assert_eq!(kept.files[0].path, std::path::absolute(&tried).unwrap());
+}

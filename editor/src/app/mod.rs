@@ -187,6 +187,10 @@ impl EditorApp {
     pub fn use_desktop(&mut self, desktop: Desktop) {
         self.recent = Recent::load(desktop.recent_store.as_deref());
         self.desktop = desktop;
+        // The grammar opened before the desktop was known (the command line's) is recent too.
+        if let Some(path) = self.grammar_path.clone() {
+            self.remember(&path, false);
+        }
     }
 
     /// Lets the file watcher wake the UI when the grammar changes on disk.

@@ -254,7 +254,10 @@ impl EditorApp {
         self.grammar_path = written.clone();
         self.session_path = None;
         match written {
-            Some(p) => self.start_watch(&p),
+            Some(p) => {
+                self.start_watch(&p);
+                self.remember(&p, false);
+            }
             None => self.watch = None,
         }
         self.mode = Mode::Sculpt;
