@@ -495,6 +495,37 @@ fn undoing_every_change_counts_as_saved() {
 }
 
 #[test]
+fn the_unsaved_prompts_buttons_stay_put_whatever_the_message() {
+    let dir = temp_dir("prompt-places");
+    let other = dir.join("other.clay");
+    std::fs::write(&other, CASTLE_SOURCE).unwrap();
+    let mut h = harness(EditorApp::bundled());
+    h.state_mut().command(clay_editor::sculpt::Command::Reset);
+    h.step();
+    let mut places = Vec::new();
+    for action in [
+        clay_editor::action::Action::Quit,
+        clay_editor::action::Action::OpenGrammar(other.clone()),
+    ] {
+        h.state_mut().perform(action);
+        assert!(h.state().confirming());
+        // A new modal is laid out invisibly on its first frame.
+        for _ in 0..4 {
+            h.step();
+        }
+        let rects: Vec<egui::Rect> = ["Save", "Discard", "Cancel"]
+            .iter()
+            .map(|b| h.get_by_label(b).rect())
+            .collect();
+        places.push(rects);
+        h.get_by_label("Cancel").click();
+        h.step();
+        assert!(!h.state().confirming());
+    }
+    assert_eq!(places[0], places[1], "the buttons sit where they sat");
+}
+
+#[test]
 fn a_new_session_file_is_suggested_beside_the_grammar_not_in_the_working_folder() {
     let dir = temp_dir("session-default");
     let path = dir.join("castle.clay");

@@ -12,6 +12,51 @@ use crate::recovery::Recovery;
 
 use super::EditorApp;
 
+/// A prompt's width, its message's height and its buttons' size, in points: fixed, so every
+/// button is at the same place whatever the message says (a click meant for Discard never
+/// lands on Save).
+const PROMPT_WIDTH: f32 = 400.0;
+const MESSAGE_HEIGHT: f32 = 54.0;
+const BUTTON: egui::Vec2 = egui::vec2(90.0, 24.0);
+
+/// A prompt's content: its heading, its message wrapped in a box of fixed size, and a row of
+/// buttons (label, hover text) of one size below it. Returns the button clicked.
+fn prompt(
+    ui: &mut egui::Ui,
+    heading: &str,
+    message: &str,
+    buttons: &[(&str, &str)],
+) -> Option<usize> {
+    ui.set_width(PROMPT_WIDTH);
+    ui.heading(heading);
+    // Painted into a rect of its own size: however many lines it takes, nothing below moves.
+    let size = egui::vec2(PROMPT_WIDTH, MESSAGE_HEIGHT);
+    let (rect, response) = ui.allocate_exact_size(size, egui::Sense::hover());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Label, true, message));
+    let colour = ui.visuals().text_color();
+    let font = egui::TextStyle::Body.resolve(ui.style());
+    let galley = ui
+        .painter()
+        .layout(message.to_string(), font, colour, PROMPT_WIDTH);
+    ui.painter()
+        .with_clip_rect(rect)
+        .galley(rect.min, galley, colour);
+
+    let mut clicked = None;
+    ui.horizontal(|ui| {
+        for (i, (label, hover)) in buttons.iter().enumerate() {
+            if ui
+                .add_sized(BUTTON, egui::Button::new(*label))
+                .on_hover_text(*hover)
+                .clicked()
+            {
+                clicked = Some(i);
+            }
+        }
+    });
+    clicked
+}
+
 /// The unsaved-changes prompt's answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Answer {
@@ -43,32 +88,33 @@ impl EditorApp {
         if self.confirm.is_some() {
             return;
         }
-        egui::Modal::new(egui::Id::unique("recovery prompt")).show(ctx, |ui| {
-            ui.heading("Restore unsaved work?");
-            let when = offer
-                .written
-                .and_then(|t| t.elapsed().ok())
-                .map_or(String::new(), |d| {
-                    format!(" {} min ago", (d.as_secs() + 30) / 60)
-                });
-            ui.label(format!(
-                "Clay closed without saving the sculpt of {} (last kept{when}).",
-                offer.grammar
-            ));
-            // the buttons first, at a fixed place, whatever the message's length
-            ui.horizontal(|ui| {
-                if ui.button("Restore").clicked() {
-                    self.actions.push(Action::RestoreRecovery);
-                }
-                if ui
-                    .button("Discard")
-                    .on_hover_text("forgets that work")
-                    .clicked()
-                {
-                    self.actions.push(Action::DiscardRecovery);
-                }
+        let when = offer
+            .written
+            .and_then(|t| t.elapsed().ok())
+            .map_or(String::new(), |d| {
+                format!(" {} min ago", (d.as_secs() + 30) / 60)
             });
+        let message = format!(
+            "Clay closed without saving the sculpt of {} (last kept{when}).",
+            offer.grammar
+        );
+        let mut answer = None;
+        egui::Modal::new(egui::Id::unique("recovery prompt")).show(ctx, |ui| {
+            answer = prompt(
+                ui,
+                "Restore unsaved work?",
+                &message,
+                &[
+                    ("Restore", "opens that sculpt as unsaved work"),
+                    ("Discard", "forgets that work"),
+                ],
+            );
         });
+        match answer {
+            Some(0) => self.actions.push(Action::RestoreRecovery),
+            Some(1) => self.actions.push(Action::DiscardRecovery),
+            _ => {}
+        }
     }
 
     /// The typed-path dialog (where the desktop has no file dialog), with the recent files.
@@ -143,35 +189,28 @@ impl EditorApp {
             return;
         };
         let mut answer = None;
+        let what = match &action {
+            Action::Quit => "quitting",
+            Action::TryAuthored => "sculpting the authored grammar",
+            _ => "opening another file",
+        };
+        let message = format!("The sculpt has unsaved changes. Save them before {what}?");
+        let save = match &self.session_path {
+            Some(p) => format!("saves the session to {}", p.display()),
+            None => "asks where to save the session".to_string(),
+        };
         egui::Modal::new(egui::Id::unique("unsaved prompt")).show(ctx, |ui| {
-            ui.heading("Unsaved changes");
-            let what = match &action {
-                Action::Quit => "quitting",
-                Action::TryAuthored => "sculpting the authored grammar",
-                _ => "opening another file",
+            let buttons = [
+                ("Save", save.as_str()),
+                ("Discard", "goes on without saving"),
+                ("Cancel", "Esc"),
+            ];
+            answer = match prompt(ui, "Unsaved changes", &message, &buttons) {
+                Some(0) => Some(Answer::Save),
+                Some(1) => Some(Answer::Discard),
+                Some(_) => Some(Answer::Cancel),
+                None => None,
             };
-            ui.label(format!(
-                "The sculpt has unsaved changes. Save them before {what}?"
-            ));
-            ui.horizontal(|ui| {
-                let save = match &self.session_path {
-                    Some(p) => format!("saves the session to {}", p.display()),
-                    None => "asks where to save the session".to_string(),
-                };
-                if ui.button("Save").on_hover_text(save).clicked() {
-                    answer = Some(Answer::Save);
-                }
-                if ui
-                    .button("Discard")
-                    .on_hover_text("goes on without saving")
-                    .clicked()
-                {
-                    answer = Some(Answer::Discard);
-                }
-                if ui.button("Cancel").on_hover_text("Esc").clicked() {
-                    answer = Some(Answer::Cancel);
-                }
-            });
             if ui.input(|i| i.key_pressed(Key::Escape)) {
                 answer = Some(Answer::Cancel);
             }
