@@ -132,6 +132,9 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         if report.pinned { ", pinned" } else { "" }
     ))
     .on_hover_text(format!("part {} of the solver", report.why.part));
+    if report.covers.contains('#') {
+        names_note(ui);
+    }
     let active_name = report
         .why
         .states
@@ -156,9 +159,14 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
             })
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
         if let Some((_, (name, d))) = best_other {
+            let active_misfit = report
+                .why
+                .states
+                .get(report.why.active)
+                .map_or(0.0, |s| s.1);
             ui.label(format!(
-                "`{name}` takes over once its misfit drops below {:.4} ({:.0}% under \
-                 `{active_name}`'s); it is {d:.4} now",
+                "`{name}` would take over once its misfit is below {:.4}, {:.0}% under \
+                 `{active_name}`'s {active_misfit:.4} (the hysteresis); `{name}`'s is {d:.4} now",
                 report.why.switch_below,
                 100.0 * report.why.hysteresis
             ));
@@ -189,6 +197,17 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
             ui.end_row();
         }
     });
+}
+
+/// What the two kinds of instance names mean, where both are shown: the grammar names a
+/// chain's elements by their place (`wall[3]`), a rule names an element it inserts by its new
+/// instance id (`wall#12`), which says nothing of where it sits in the chain.
+pub const NAMES_NOTE: &str = "`wall[3]`: element 3 (from 0) of the chain `wall` as the grammar \
+     placed it; `wall#12`: an element a rule inserted later, named by its instance id 12, not \
+     by its place in the chain.";
+
+fn names_note(ui: &mut egui::Ui) {
+    ui.label(RichText::new(NAMES_NOTE).small().weak());
 }
 
 /// Solver statistics of the last frame.
@@ -239,7 +258,7 @@ pub fn parameters(ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command
             "How much better another rest state must fit before a part switches to it \
              (0.15: 15% better); higher stops parts flickering between states",
         );
-    ui.add(egui::Slider::new(&mut s.norm, 0.1..=2.0).text("p (norm)"))
+    ui.add(egui::Slider::new(&mut s.norm, 0.1..=2.0).text("norm exponent p"))
         .on_hover_text(
             "The sparsity of the deformation: below 1 one part bends and snaps to a new state \
              while the others stay at rest; 2 spreads it over all (least squares)",
@@ -261,6 +280,9 @@ pub fn rule_log(ui: &mut egui::Ui, sculpt: &Sculpt) {
     if sculpt.log().is_empty() {
         ui.label("Nothing has fired yet.");
         return;
+    }
+    if sculpt.log().iter().any(|e| e.message.contains('#')) {
+        names_note(ui);
     }
     egui::ScrollArea::vertical()
         .id_salt("rule log")

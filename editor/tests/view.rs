@@ -519,6 +519,49 @@ fn after_fit_the_strain_legend_covers_none_of_the_model() {
 }
 
 #[test]
+fn the_inspector_and_parameters_say_what_they_mean() {
+    let mut h = harness(EditorApp::open(&grammar("bend.clay")));
+    settle(&mut h);
+    let part = 0;
+    let at = h.get_by_label(&format!("part {part}")).rect().center();
+    h.hover_at(at);
+    h.step();
+    h.step();
+    let report = h.state().sculpt.inspect(part).unwrap();
+    let active = &report.why.states[report.why.active];
+    // The sentence names the active state's misfit as the table shows it, and what the other
+    // state's must fall below: no "fits 100% better".
+    h.get_by_label_contains("would take over once its misfit is below");
+    h.get_by_label_contains(&format!(
+        "`{}`'s {:.4} (the hysteresis)",
+        active.0, active.1
+    ));
+    h.get_by_label(&format!("{:.4}", active.1));
+    assert!(h.query_by_label_contains("better").is_none());
+    // The slider says which number it is.
+    assert!(h.query_all_by_label("norm exponent p").count() > 0);
+    assert!(h.query_by_label("p (norm)").is_none());
+}
+
+#[test]
+fn inserted_elements_names_are_explained_beside_the_grammars() {
+    let mut h = harness(EditorApp::open(&grammar("wall.clay")));
+    settle(&mut h);
+    assert!(h.query_by_label(clay_editor::panels::NAMES_NOTE).is_none());
+    let at = h.state().sculpt.assembly().part_centroid(0);
+    h.state_mut().command(Command::TogglePin { part: 0, at });
+    settle(&mut h);
+    pull(&mut h, 4.0);
+    assert!(
+        (h.state().sculpt.log().iter()).any(|e| e.message.contains("wall#")),
+        "bricks were inserted"
+    );
+    h.step();
+    // The rule log says `wall#N` and `wall[N]`: the note says what each is.
+    h.get_by_label(clay_editor::panels::NAMES_NOTE);
+}
+
+#[test]
 fn open_recent_lists_the_command_line_grammar_and_a_tried_one() {
     let dir = scratch("recent-cli");
     let store = dir.join("config").join("recent-files.json");
