@@ -15,12 +15,18 @@
 //! the first part to pass the threshold is seldom where the whole of it ends up). Parts that
 //! entered the state in earlier frames keep it (with the rules off, a chain may hold many
 //! parts in `three`).
+//!
+//! A claim is sized by its chain's length ([`ChainLength`]: the chain measured in elements
+//! at rest), which lives here, beside the rule it sizes, rather than in the solver's
+//! `chains.rs` that measures it: the solver's state keeps the lengths between its steps,
+//! and the state imports no job of the frame.
 
 use std::collections::BTreeMap;
 
 use clay_dsl::compiled::{Part, PartKind, STRETCH_ONE, STRETCH_THREE};
+use glam::DVec2;
 
-use super::StateSwitch;
+use super::report::StateSwitch;
 
 /// Keeps, for every chain and each of `three` and `one`, only the best of the parts that
 /// entered that state during the frame and are still in it (see the module doc): `claims` and
@@ -101,6 +107,39 @@ pub fn one_per_chain(
     let changed = switches.len() != before || !back.is_empty();
     switches.extend(back);
     changed
+}
+
+/// A stretch chain measured in a pose, in elements at rest
+/// ([`Solver::chain_lengths`](super::state::Solver::chain_lengths)).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct ChainLength {
+    /// Along the chain: its elements' lengths summed.
+    pub(super) path: f64,
+    /// Straight from its first element's `from` site to its last element's `to` site.
+    pub(super) chord: f64,
+    /// Where the chain starts (its first element's `from` site's centre).
+    pub(super) near: DVec2,
+    /// Where the chain ends (its last element's `to` site's centre).
+    pub(super) far: DVec2,
+    /// An element's length at rest (the unit of `path` and `chord`).
+    pub(super) element: f64,
+}
+
+impl ChainLength {
+    /// The shortest the chain could be through what holds it, in elements: the polyline
+    /// from its near end through the centres of its held elements (`held`, in chain order,
+    /// positions in the measured pose) to its far end; its chord when none is held. A chain
+    /// no longer than this at rest needs no element more, however its path wanders.
+    pub(super) fn taut(&self, held: impl IntoIterator<Item = DVec2>) -> f64 {
+        let mut at = self.near;
+        let mut length = 0.0;
+        for p in held {
+            length += (p - at).length();
+            at = p;
+        }
+        length += (self.far - at).length();
+        length / self.element.max(1e-12)
+    }
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ mod anderson;
 mod cg;
 mod cholesky;
 mod chunks;
+mod clock;
 mod config;
 pub mod follow;
 mod global;
@@ -17,6 +18,7 @@ pub(crate) mod local;
 mod measure;
 mod report;
 mod rest_cache;
+mod state;
 mod units;
 
 use config::cone_cosine;
@@ -25,6 +27,7 @@ pub use measure::{
     bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
 };
 pub use report::{FrameReport, PhaseTimes, SolverError, StateSwitch};
+pub use state::Solver;
 
 use std::time::{Duration, Instant};
 
@@ -33,179 +36,16 @@ use glam::DVec2;
 
 use crate::assembly::{Assembly, Handle, HandleKind};
 use cholesky::{NumericFactor, SymbolicFactor};
+use clock::{ms_since, out_of_time};
 use global::Pattern;
+use growth::ChainLength;
+use state::Work;
 
 /// What runs between a frame's two passes ([`Solver::frame_with`]): the assembly, the report
 /// so far and the pass-1 pose.
 pub type Between<'a> = dyn FnMut(&mut Assembly, &FrameReport, &[DVec2]) + Send + 'a;
 
-/// Buffers sized once per generation and reused every frame.
-#[derive(Debug, Default)]
-struct Work {
-    rotations: Vec<DVec2>,
-    vertex_parts: local::VertexParts,
-    /// The parts' rest data flattened for the local step (rebuilt with the generation);
-    /// `None` when it could not be built, and the local step then reads the parts directly.
-    rest: Option<rest_cache::RestCache>,
-    /// Per part-edge: `R_xy (x0 - y0)`.
-    targets: Vec<DVec2>,
-    /// Per part: its IRLS weight (pass 1), for all its edges.
-    weights: Vec<f64>,
-    /// Per vertex: number of handle targets, and their sum.
-    handle_count: Vec<f64>,
-    handle_sum: Vec<DVec2>,
-    diagonal: Vec<f64>,
-    extra: Vec<DVec2>,
-    values: Vec<f64>,
-    l2_values: Vec<f64>,
-    l2_diagonal: Vec<f64>,
-    rhs: Vec<f64>,
-    /// The least-squares right-hand side, one `(x, y)` per vertex in vertex order.
-    vertex_rhs: Vec<DVec2>,
-    solution: Vec<f64>,
-    scratch: Vec<f64>,
-    cg: cg::CgWork,
-    part_sums: Vec<DVec2>,
-    /// The displayed pose at the start of the frame (then moved by rigid following).
-    warm: Vec<DVec2>,
-    /// Rotations and edge targets of the kept pass-2 iterate while the next one is judged,
-    /// and between steps those of [`Start`].
-    kept_rotations: Vec<DVec2>,
-    kept_targets: Vec<DVec2>,
-    /// The positions the last frame displayed (pass 1 continues only from them).
-    shown: Vec<DVec2>,
-    next: Vec<DVec2>,
-    /// The local step already evaluated at the pose pass 2 starts from (see [`Start`]).
-    start: Start,
-    /// Per part: the state the last local step chose, and its squared stacked residual.
-    chosen: Vec<usize>,
-    residuals: Vec<f64>,
-    /// Per part: the factor of its term in the sparse norm (the handles as outliers:
-    /// [`SolverConfig::handle_outlier`]).
-    outlier: Vec<f64>,
-    /// Per part: a stretch part's context for this frame's switching steps.
-    stretch: Vec<Option<local::StretchContext>>,
-    /// Per part: the claim of the last local step, and of pass 1's last switching step.
-    claims: Vec<i32>,
-    pass1_claims: Vec<i32>,
-    /// Per chain: its lengths where pass 1 starts (`None`: not measured).
-    chain_lengths: Vec<Option<ChainLength>>,
-    /// How far the handles moved the held vertices at the frame's start.
-    snapped_moved: f64,
-    /// The handle targets (`handle_sum`) of the last frame: still when equal.
-    last_targets: Vec<DVec2>,
-    /// How far the last frame moved the displayed pose, in its components' rest edges
-    /// ([`units::Units::max_move_in_edges`]).
-    last_moved: f64,
-    /// The elastic energy the last frame ended with, and the one before it.
-    last_energy: [f64; 2],
-    /// Other rest states were tried since the handles, the states or the structure last
-    /// changed, and none helped ([`Solver::try_states`]).
-    tried: bool,
-}
-
-/// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
-/// when a step already computed it: the first IRLS iteration of this frame (it evaluates that
-/// pose, and its rotations are those of the states it chose), or the last accepted pass-2
-/// iterate of the previous frame (the pose displayed since). Pass 2 takes it instead of
-/// evaluating the same pose again; it is the same numbers bit for bit, since the local step
-/// depends only on the pose, the active states and the settings. Its rotations and targets
-/// are kept in `Work::kept_rotations` and `Work::kept_targets` (pass 2's scratch, unused
-/// until then).
-#[derive(Debug, Default)]
-struct Start {
-    elastic: f64,
-    /// Valid for this assembly generation and settings while exactly this many state
-    /// switches have been reported in the frame (a later switch changes the rest edges).
-    valid: Option<(u64, SolverConfig, usize)>,
-}
-
-impl Work {
-    /// Keeps the accepted pass-2 iterate's evaluation (in `rotations` and `targets`, with
-    /// energy `elastic`) as the next frame's [`Start`]: valid while that pose stays shown and
-    /// the parts keep their active states (noted in `chosen`: `Assembly::set_active_state`
-    /// changes them without a new generation).
-    fn keep_start(&mut self, cfg: SolverConfig, generation: u64, parts: &[Part], elastic: f64) {
-        if cfg.l2_iterations > 0 && self.rotations.len() == parts.len() {
-            std::mem::swap(&mut self.kept_rotations, &mut self.rotations);
-            std::mem::swap(&mut self.kept_targets, &mut self.targets);
-            self.chosen.clear();
-            self.chosen.extend(parts.iter().map(|p| p.active));
-            self.start.elastic = elastic;
-            self.start.valid = Some((generation, cfg, 0));
-        } else {
-            self.start.valid = None;
-        }
-    }
-
-    /// Whether the last frame's [`Start`] holds for this one: kept under `key`, for the pose
-    /// `warm` (the one it showed) and the parts' active states.
-    fn start_holds(
-        &self,
-        key: Option<(u64, SolverConfig, usize)>,
-        warm: &[DVec2],
-        parts: &[Part],
-    ) -> bool {
-        let states = || {
-            self.chosen.len() == parts.len()
-                && parts.iter().zip(&self.chosen).all(|(p, &c)| p.active == c)
-        };
-        self.start.valid == key && self.shown == warm && states()
-    }
-}
-
-/// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
-/// and all buffers between frames; rebuilds them when the assembly's generation changes.
-#[derive(Debug)]
-pub struct Solver {
-    pub config: SolverConfig,
-    generation: Option<u64>,
-    pattern: Pattern,
-    symbolic: Option<SymbolicFactor>,
-    irls_factor: NumericFactor,
-    l2_factor: NumericFactor,
-    work: Work,
-    /// The last frame's pass-1 pose.
-    pass1_pose: Vec<DVec2>,
-    /// The connected components of the vertex graph (rigid following, free centroids).
-    components: follow::Components,
-    /// Each component's units of length: its mean rest edge in the active states when the
-    /// generation was prepared (pass 1's tolerance, the rest test of
-    /// [`Solver::try_states`]) and its size this frame (pass 2's).
-    units: units::Units,
-    /// The components with no held vertex this frame, ascending (solves shift their
-    /// centroids back).
-    free_components: Vec<usize>,
-    /// Pass 2's mixing history ([`SolverConfig::l2_anderson`]).
-    anderson: anderson::Anderson,
-    /// Per vertex, its row in the factor's fill-reducing order (the inverse of
-    /// [`SymbolicFactor::factor_order`]; empty when the factor has no such order): the
-    /// least-squares solve reads its solution from there.
-    factor_slot: Vec<usize>,
-    /// The least-squares right-hand side and solution, `(x, y)` per row in factor order.
-    ordered: Vec<[f64; 2]>,
-}
-
 impl Solver {
-    pub fn new(config: SolverConfig) -> Self {
-        Self {
-            config,
-            generation: None,
-            pattern: Pattern::default(),
-            symbolic: None,
-            irls_factor: NumericFactor::default(),
-            l2_factor: NumericFactor::default(),
-            work: Work::default(),
-            pass1_pose: Vec::new(),
-            components: follow::Components::default(),
-            free_components: Vec::new(),
-            units: units::Units::default(),
-            anderson: anderson::Anderson::default(),
-            factor_slot: Vec::new(),
-            ordered: Vec::new(),
-        }
-    }
-
     /// The pass-1 (sub-quadratic) pose of the last frame, from which the active rest states
     /// were decided; empty before the first frame.
     pub fn pass1_pose(&self) -> &[DVec2] {
@@ -247,69 +87,6 @@ impl Solver {
     /// 0 for the CG solver).
     pub fn factor_values(&self) -> usize {
         self.symbolic.as_ref().map_or(0, |s| s.stored_values())
-    }
-
-    /// Rebuilds the pattern and symbolic factorisation if the assembly changed structurally.
-    fn prepare(&mut self, asm: &Assembly) -> Result<(), SolverError> {
-        let n = asm.data().positions.len();
-        let edge_count: usize = asm.data().parts.iter().map(|p| p.edges.len()).sum();
-        let stale = self.generation != Some(asm.generation())
-            || self.pattern.n != n
-            || self.pattern.edges.len() != edge_count
-            || self
-                .work
-                .rest
-                .as_ref()
-                .is_some_and(|c| c.parts() != asm.data().parts.len());
-        if !stale {
-            return Ok(());
-        }
-        // the pattern and the rest cache keep vertex and part indices as u32
-        if u32::try_from(n).is_err() {
-            return Err(SolverError(format!(
-                "the model has {n} vertices, more than the solver can index"
-            )));
-        }
-        let part_count = asm.data().parts.len();
-        if u32::try_from(part_count).is_err() {
-            return Err(SolverError(format!(
-                "the model has {part_count} parts, more than the solver can index"
-            )));
-        }
-        for (i, p) in asm.data().parts.iter().enumerate() {
-            let m = p.vertices.len();
-            if p.vertices.iter().any(|&v| v >= n) || p.edges.iter().any(|e| e[0] >= m || e[1] >= m)
-            {
-                return Err(SolverError(format!(
-                    "part {i} refers to a vertex that does not exist"
-                )));
-            }
-        }
-        self.pattern = Pattern::build(n, &asm.data().parts);
-        self.work.vertex_parts = local::VertexParts::build(&asm.data().parts, n);
-        self.work.rest = rest_cache::RestCache::build(&asm.data().parts, &self.work.vertex_parts);
-        self.components = follow::Components::build(&asm.data().parts, n);
-        self.units = units::Units::build(&asm.data().parts, &self.components);
-        self.symbolic = match self.config.kind {
-            SolverKind::Cholesky if n > 0 => Some(
-                SymbolicFactor::analyse(n, &self.pattern.col_ptr, &self.pattern.row_idx)
-                    .map_err(|e| SolverError(e.0))?,
-            ),
-            _ => None,
-        };
-        self.factor_slot.clear();
-        if let Some(order) = self.symbolic.as_ref().and_then(|s| s.factor_order()) {
-            self.factor_slot.resize(n, 0);
-            for (i, &v) in order.iter().enumerate() {
-                self.factor_slot[v] = i;
-            }
-        }
-        self.irls_factor.invalidate();
-        self.l2_factor.invalidate();
-        self.work.l2_diagonal.clear();
-        self.generation = Some(asm.generation());
-        self.work.tried = false;
-        Ok(())
     }
 
     /// Runs one frame on `asm`: moves its positions, active states and rotations.
@@ -1900,11 +1677,6 @@ const CREEP: f64 = 0.95;
 /// first judges the pose the last frame left, the second the pose with the handles moved.
 const MIN_PASS1_ITERATIONS: usize = 2;
 
-/// Would another iteration that lasts as long as the last one overrun the deadline?
-fn out_of_time(deadline: Option<Instant>, last: Duration) -> bool {
-    deadline.is_some_and(|d| Instant::now() + last > d)
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Pass {
     Irls,
@@ -1920,38 +1692,6 @@ struct Terms {
 impl Terms {
     fn total(self) -> f64 {
         self.elastic + self.handle
-    }
-}
-
-/// A stretch chain measured in a pose, in elements at rest ([`Solver::chain_lengths`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct ChainLength {
-    /// Along the chain: its elements' lengths summed.
-    path: f64,
-    /// Straight from its first element's `from` site to its last element's `to` site.
-    chord: f64,
-    /// Where the chain starts (its first element's `from` site's centre).
-    near: DVec2,
-    /// Where the chain ends (its last element's `to` site's centre).
-    far: DVec2,
-    /// An element's length at rest (the unit of `path` and `chord`).
-    element: f64,
-}
-
-impl ChainLength {
-    /// The shortest the chain could be through what holds it, in elements: the polyline
-    /// from its near end through the centres of its held elements (`held`, in chain order,
-    /// positions in the measured pose) to its far end; its chord when none is held. A chain
-    /// no longer than this at rest needs no element more, however its path wanders.
-    fn taut(&self, held: impl IntoIterator<Item = DVec2>) -> f64 {
-        let mut at = self.near;
-        let mut length = 0.0;
-        for p in held {
-            length += (p - at).length();
-            at = p;
-        }
-        length += (self.far - at).length();
-        length / self.element.max(1e-12)
     }
 }
 
@@ -1995,10 +1735,6 @@ fn irls_weight(a: f64, p: f64) -> f64 {
     } else {
         a.powf(p - 2.0)
     }
-}
-
-fn ms_since(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
 }
 
 fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
