@@ -1,0 +1,230 @@
+//! The local step's evaluation at a pose (paper 4.1-4.3): every part's rotation, the edge
+//! targets `R_xy (x0 - y0)` and the per-part residuals into the work buffers, with the
+//! states fixed or switching (with hysteresis, one claim per chain: [`growth`]). The fast
+//! path runs [`chunks::evaluate`] over the rest cache; when the cache does not fit the
+//! assembly, the reference functions of [`local`] run part by part.
+//!
+//! Its own `impl Solver` block because both passes and the trials of other states call it,
+//! and it reads and writes only the state's buffers.
+
+use clay_dsl::compiled::Part;
+use glam::DVec2;
+
+use super::config::cone_cosine;
+use super::report::StateSwitch;
+use super::state::Solver;
+use super::{chunks, growth, local};
+
+impl Solver {
+    /// Each part's rotation onto `f` with its active state (states fixed), into
+    /// `work.rotations`.
+    fn rotations_at(&mut self, parts: &[Part], f: &[DVec2]) {
+        let w = &mut self.work;
+        match &mut w.rest {
+            Some(cache) => cache.part_rotations(parts, f, &mut w.rotations),
+            None => {
+                w.rotations.clear();
+                w.rotations
+                    .extend(parts.iter().map(|part| local::part_rotation(part, f)));
+            }
+        }
+    }
+
+    /// Whether the rest cache fits the assembly (else the reference functions run).
+    pub(super) fn cache_fits(&self, parts: usize) -> bool {
+        let edges = self.pattern.edges.len();
+        (self.work.rest.as_ref()).is_some_and(|c| c.parts() == parts && c.edges() == edges)
+    }
+
+    /// The local step at `f` with the states fixed: rotations, edge targets and per-part
+    /// residuals into the work buffers; returns the elastic energy at `f`.
+    pub(super) fn evaluate_fixed(&mut self, parts: &[Part], f: &[DVec2]) -> f64 {
+        if !self.cache_fits(parts.len()) {
+            self.rotations_at(parts, f);
+            self.edge_targets(parts);
+            return self.residuals_at(f);
+        }
+        self.evaluate(parts, f, chunks::Choice::Keep)
+    }
+
+    /// The local step at `f` with state switching (paper 4.3): as
+    /// [`Solver::evaluate_fixed`], and every part whose nearest state wins the hysteresis
+    /// switches to it (reported in part order), except that a stretch chain claims at most
+    /// one element per frame ([`growth`]).
+    pub(super) fn evaluate_switching(
+        &mut self,
+        parts: &mut [Part],
+        f: &[DVec2],
+        switches: &mut Vec<StateSwitch>,
+    ) {
+        let stretch = std::mem::take(&mut self.work.stretch);
+        let shared = std::mem::take(&mut self.work.vertex_parts);
+        let how = local::Switching {
+            hysteresis: self.config.hysteresis,
+            stretch: &stretch,
+            shared: Some(&shared),
+        };
+        let from = switches.len();
+        if self.cache_fits(parts.len()) {
+            self.evaluate(parts, f, chunks::Choice::Switch(how));
+            for (i, (part, &state)) in parts.iter_mut().zip(&self.work.chosen).enumerate() {
+                if state != part.active {
+                    switches.push(StateSwitch {
+                        part: i,
+                        from: part.active,
+                        to: state,
+                    });
+                    part.active = state;
+                }
+            }
+        } else {
+            self.local_step_switching(parts, f, how, switches);
+            self.edge_targets(parts);
+            self.residuals_at(f);
+        }
+        self.work.stretch = stretch;
+        self.work.vertex_parts = shared;
+        let w = &mut self.work;
+        std::mem::swap(&mut w.pass1_claims, &mut w.claims);
+        if growth::one_per_chain(parts, switches, from, &w.residuals, &w.pass1_claims) {
+            // the reverted parts' rotations and targets are their kept states'
+            self.evaluate_fixed(parts, f);
+        }
+    }
+
+    /// [`chunks::evaluate`] into the work buffers (the rest cache fits).
+    pub(super) fn evaluate(&mut self, parts: &[Part], f: &[DVec2], choice: chunks::Choice) -> f64 {
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let threads = self.config.thread_count();
+        let w = &mut self.work;
+        let Some(cache) = &w.rest else {
+            return 0.0;
+        };
+        let count = parts.len();
+        w.rotations.resize(count, DVec2::X);
+        w.chosen.resize(count, 0);
+        w.claims.resize(count, 0);
+        w.residuals.resize(count, 0.0);
+        // every slot is written: no clearing pass
+        w.targets.resize(cache.edges(), DVec2::ZERO);
+        let out = chunks::Outputs {
+            rotations: &mut w.rotations,
+            chosen: &mut w.chosen,
+            claims: &mut w.claims,
+            residuals: &mut w.residuals,
+            targets: &mut w.targets,
+        };
+        chunks::evaluate(cache, parts, f, choice, cos_cone, threads, out)
+    }
+
+    /// Per part, its squared stacked residual at `f` with `work.targets` (into
+    /// `work.residuals`); returns the elastic energy (the same sums as [`chunks::evaluate`]
+    /// for a model of one chunk).
+    fn residuals_at(&mut self, f: &[DVec2]) -> f64 {
+        let w = &mut self.work;
+        let edges = &self.pattern.edges;
+        w.residuals.clear();
+        w.residuals.resize(w.rotations.len(), 0.0);
+        let mut elastic = 0.0;
+        let mut k = 0;
+        while k < edges.len() {
+            let part = edges[k].part;
+            let end = k + edges[k..].iter().take_while(|e| e.part == part).count();
+            let d2: f64 = (k..end)
+                .map(|j| {
+                    let (x, y) = edges[j].ends();
+                    let r2 = (w.targets[j] - (f[x] - f[y])).length_squared();
+                    elastic += r2;
+                    r2
+                })
+                .sum();
+            if let Some(r) = w.residuals.get_mut(part as usize) {
+                *r = d2;
+            }
+            k = end;
+        }
+        elastic
+    }
+
+    /// Local step with state switching; fills `work.rotations` and `work.claims`.
+    fn local_step_switching(
+        &mut self,
+        parts: &mut [Part],
+        f: &[DVec2],
+        how: local::Switching,
+        switches: &mut Vec<StateSwitch>,
+    ) {
+        let w = &mut self.work;
+        w.rotations.clear();
+        w.claims.clear();
+        for (i, part) in parts.iter_mut().enumerate() {
+            let chosen = match &mut w.rest {
+                Some(cache) => cache.choose_state(i, part, f, how),
+                None => local::choose_state(i, part, f, how),
+            };
+            if chosen.state != part.active {
+                switches.push(StateSwitch {
+                    part: i,
+                    from: part.active,
+                    to: chosen.state,
+                });
+                part.active = chosen.state;
+            }
+            w.rotations.push(chosen.rotation);
+            w.claims.push(chosen.claim);
+        }
+    }
+
+    /// `R_xy (x0 - y0)` for every part-edge from `work.rotations` and the active states.
+    /// Same result as [`local::edge_rotation`] per edge, but each part sums its vertices'
+    /// neighbour rotations once instead of once per edge end.
+    fn edge_targets(&mut self, parts: &[Part]) {
+        let w = &mut self.work;
+        let cos_cone = cone_cosine(self.config.rotation_cone_degrees);
+        let edges = &self.pattern.edges;
+        if let Some(cache) = &mut w.rest
+            && cache.parts() == parts.len()
+            && cache.edges() == edges.len()
+        {
+            cache.edge_targets(parts, &w.rotations, cos_cone, &mut w.targets);
+            return;
+        }
+        w.targets.clear();
+        let mut k = 0;
+        for (pi, part) in parts.iter().enumerate() {
+            let own = w.rotations[pi];
+            w.part_sums.clear();
+            if cos_cone < 1.0 {
+                for &v in &part.vertices {
+                    w.part_sums.push(local::vertex_rotation_sum(
+                        &w.vertex_parts,
+                        &w.rotations,
+                        v,
+                        own,
+                        cos_cone,
+                    ));
+                }
+            }
+            let rest = part
+                .states
+                .get(part.active)
+                .map(|s| s.positions.as_slice())
+                .unwrap_or(&[]);
+            while k < edges.len() && edges[k].part as usize == pi {
+                let e = &edges[k];
+                let [a, b] = e.local.map(|i| i as usize);
+                let d0 = match (rest.get(a), rest.get(b)) {
+                    (Some(&a), Some(&b)) => a - b,
+                    _ => DVec2::ZERO,
+                };
+                let r = if cos_cone < 1.0 {
+                    local::normalised_or(w.part_sums[a] + w.part_sums[b], own)
+                } else {
+                    own
+                };
+                w.targets.push(r.rotate(d0));
+                k += 1;
+            }
+        }
+    }
+}
