@@ -22,6 +22,7 @@ from scene_tools import (  # noqa: E402
     ROOT,
     fresh_file,
     render,
+    unregister,
 )
 
 
@@ -29,6 +30,7 @@ def main():
     fresh_file()
     bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
     render(PICTURE, PICTURE_SIZE)
+    unregister()
     print(f"wrote {PICTURE.relative_to(ROOT)}")
 
 

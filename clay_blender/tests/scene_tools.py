@@ -27,6 +27,13 @@ def fresh_file():
         clay_blender.register()
 
 
+def unregister():
+    """Unregisters the add-on if it is registered: the `bpy` module (4.2) crashes at the
+    interpreter's exit while an add-on class or menu entry is still registered."""
+    if hasattr(bpy.types, "CLAY_OT_import_grammar"):
+        clay_blender.unregister()
+
+
 def bounds(objects):
     """The world-space bounding box of `objects`' vertices: (min xyz, max xyz)."""
     lo = [math.inf] * 3
