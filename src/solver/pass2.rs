@@ -1,0 +1,177 @@
+//! Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose,
+//! its local/global iteration Anderson-accelerated and taking only iterates that lower the
+//! objective; its pose is what the user sees. The evaluation of the pose it starts from may
+//! be done before pass 1 ([`Start`](super::state::Start)), whose stretch parts are measured
+//! along its rotations.
+//!
+//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+
+use std::time::{Duration, Instant};
+
+use clay_dsl::compiled::Part;
+use glam::DVec2;
+
+use super::clock::{ms_since, out_of_time};
+use super::config::SolverConfig;
+use super::global_step::Pass;
+use super::report::{FrameReport, SolverError};
+use super::state::Solver;
+use crate::assembly::Handle;
+
+impl Solver {
+    /// Evaluates the local step at the displayed pose `warm` with the states kept and keeps
+    /// it as [`Start`] under `key` (its rotations in `work.kept_rotations`).
+    pub(super) fn start_at(
+        &mut self,
+        parts: &[Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        key: Option<(u64, SolverConfig, usize)>,
+    ) {
+        let elastic = self.terms_at(parts, handles, warm).elastic;
+        let w = &mut self.work;
+        std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+        std::mem::swap(&mut w.kept_targets, &mut w.targets);
+        w.start.elastic = elastic;
+        w.start.valid = key;
+    }
+
+    /// Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose
+    /// `warm` (iterated in place), until no vertex moves more than `tolerance`, or the
+    /// configured count, or (after one iteration) the deadline. With no pass-2 iterations
+    /// configured, shows the pass-1 pose. Returns the pose, its objective's terms (its
+    /// rotations and edge targets left in the work buffers) and whether it converged.
+    pub(super) fn pass2(
+        &mut self,
+        parts: &[Part],
+        handles: &[Handle],
+        warm: Vec<DVec2>,
+        tolerance: f64,
+        deadline: Option<Instant>,
+        report: &mut FrameReport,
+    ) -> Result<(Vec<DVec2>, Terms, bool), SolverError> {
+        let cfg = self.config;
+        let mut f = warm;
+        if cfg.l2_iterations == 0 {
+            f.clear();
+            f.extend_from_slice(&self.pass1_pose);
+        }
+        let mut next = std::mem::take(&mut self.work.next);
+        next.clear();
+        next.resize(f.len(), DVec2::ZERO);
+        let t = Instant::now();
+        let w = &mut self.work;
+        let key = (
+            self.generation.unwrap_or(u64::MAX),
+            cfg,
+            report.switches.len(),
+        );
+        let mut terms = if cfg.l2_iterations > 0 && w.start.valid == Some(key) {
+            // the local step at `warm` was done already (`Start`)
+            std::mem::swap(&mut w.kept_rotations, &mut w.rotations);
+            std::mem::swap(&mut w.kept_targets, &mut w.targets);
+            w.start.valid = None;
+            Terms {
+                elastic: w.start.elastic,
+                handle: handle_term(handles, &f, cfg.handle_weight),
+            }
+        } else {
+            self.terms_at(parts, handles, &f)
+        };
+        report.warm_objective = terms.total();
+        report.phases.local += ms_since(t);
+        let mut converged = cfg.l2_iterations == 0;
+        let mut last_iteration = Duration::ZERO;
+        let mut anderson = std::mem::take(&mut self.anderson);
+        anderson.start(cfg.l2_anderson);
+        // a model nothing holds relaxes along its softest modes (a long chain unbending), which
+        // least squares takes many iterations over: more of them then
+        let iterations = if handles.is_empty() && cfg.l2_iterations > 0 {
+            cfg.l2_iterations.max(cfg.l2_iterations_free)
+        } else {
+            cfg.l2_iterations
+        };
+        for it in 0..iterations {
+            if it > 0 && out_of_time(deadline, last_iteration) {
+                report.complete = false;
+                break;
+            }
+            let iteration_start = Instant::now();
+            report.l2_iterations += 1;
+            self.solve_global(&f, &mut next, Pass::LeastSquares, report)?;
+            let t = Instant::now();
+            // f's rotations and targets aside while the next iterate is judged
+            let w = &mut self.work;
+            std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
+            std::mem::swap(&mut w.targets, &mut w.kept_targets);
+            let mixed = anderson.mix(&f, &mut next);
+            let mut next_terms = self.terms_at(parts, handles, &next);
+            // NaN does not descend either
+            let descends = next_terms.total() < terms.total();
+            if mixed && !descends {
+                // the accelerated iterate does not descend: the plain one, a fresh history
+                anderson.plain(&mut next);
+                anderson.reset();
+                next_terms = self.terms_at(parts, handles, &next);
+            }
+            report.phases.local += ms_since(t);
+            // Only an iterate that lowers the objective is taken: a frame never ends worse
+            // than it started, and a model at rest stays exactly where it is (a solve of a
+            // pose at rest only adds rounding, and a free component's rounding drifts).
+            if next_terms.total() >= terms.total() || !next_terms.total().is_finite() {
+                let w = &mut self.work;
+                std::mem::swap(&mut w.rotations, &mut w.kept_rotations);
+                std::mem::swap(&mut w.targets, &mut w.kept_targets);
+                converged = true;
+                break;
+            }
+            let delta = self.units.max_move_in_sizes(&self.components, &f, &next);
+            std::mem::swap(&mut f, &mut next);
+            terms = next_terms;
+            last_iteration = iteration_start.elapsed();
+            if delta <= tolerance {
+                converged = true;
+                break;
+            }
+        }
+        self.anderson = anderson;
+        self.work.next = next;
+        Ok((f, terms, converged))
+    }
+
+    /// Pass 2's objective at `f` (states fixed), its local step left in the work buffers.
+    pub(super) fn terms_at(&mut self, parts: &[Part], handles: &[Handle], f: &[DVec2]) -> Terms {
+        Terms {
+            elastic: self.evaluate_fixed(parts, f),
+            handle: handle_term(handles, f, self.config.handle_weight),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Terms {
+    pub(super) elastic: f64,
+    pub(super) handle: f64,
+}
+
+impl Terms {
+    pub(super) fn total(self) -> f64 {
+        self.elastic + self.handle
+    }
+}
+
+/// The handle term of the pass-2 objective at `f`.
+fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
+    let mut handle = 0.0;
+    for h in handles {
+        for (k, &v) in h.vertices.iter().enumerate() {
+            if let Some(&p) = f.get(v) {
+                let t = h.target(k);
+                if t.is_finite() {
+                    handle += (p - t).length_squared();
+                }
+            }
+        }
+    }
+    handle_weight * handle
+}
