@@ -1,0 +1,230 @@
+//! Trials of other rest states (`docs/solver.md`, "Folds"): a held model that stopped
+//! strained, or a free one that creeps, tries other assignments of rest states once (the
+//! nearest single switches, a bend handed to a neighbour, bends reverted, the rest layout),
+//! each settled by a few iterations, and keeps one that is clearly better.
+//!
+//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+
+use clay_dsl::compiled::{Part, PartKind};
+use glam::DVec2;
+
+use super::global_step::Pass;
+use super::report::{FrameReport, SolverError, StateSwitch};
+use super::state::Solver;
+use super::{chunks, layout, local};
+use crate::assembly::Handle;
+
+impl Solver {
+    /// Whether this frame tries other rest states ([`Solver::try_states`]): the handles
+    /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
+    /// pose all but still and yet not at rest, and no try since the handles, the states or
+    /// the structure last changed.
+    pub(super) fn settling(&mut self, report: &FrameReport, free: bool) -> bool {
+        let w = &mut self.work;
+        let still = w.last_targets == w.handle_sum && report.switches.is_empty();
+        if !still {
+            w.tried = false;
+        }
+        let stopped = w.last_moved <= 1e-3;
+        // nothing held and the energy all but flat: a long, thin chain unbending, which
+        // least squares would take hundreds of frames over (or a fold it never leaves)
+        let [last, before] = w.last_energy;
+        let creeping = free && last > CREEP * before;
+        let untried = !w.tried;
+        still && (stopped || creeping) && untried && self.strained(self.work.start.elastic)
+    }
+
+    /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
+    /// squared (what [`Solver::try_states`] tries to lower).
+    pub(super) fn strained(&self, elastic: f64) -> bool {
+        let edge = self.units.smallest_edge();
+        elastic > 1e-6 * edge * edge
+    }
+
+    /// A held model that does not come to rest tries other rest states (a move): the few
+    /// piece parts whose best alternative state is nearest (by its shape distance against
+    /// the active one's) switch, and a part out of its first state hands that state to a
+    /// neighbour of its piece (the sparse pass gathered a bend into the part next to the one
+    /// the gesture bends). For each move, least squares and the other parts' state choices
+    /// settle for a few iterations with the moved parts held in their states; the assignment
+    /// with the lowest energy is kept when it is below `(1 - hysteresis)` times the energy
+    /// without a move.
+    pub(super) fn try_states(
+        &mut self,
+        parts: &mut [Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        report: &mut FrameReport,
+    ) -> Result<Option<Vec<DVec2>>, SolverError> {
+        const CANDIDATES: usize = 4;
+        const ITERATIONS: usize = 3;
+        // more parts out of their first state than this: no reverting moves (each is a settle)
+        const REVERT_LIMIT: usize = 8;
+        let hysteresis = self.config.hysteresis;
+        let multi = |p: &Part| matches!(p.kind, PartKind::Piece { .. }) && p.states.len() >= 2;
+        let mut singles: Vec<(f64, usize, usize)> = Vec::new();
+        for (pi, part) in parts.iter().enumerate().filter(|(_, p)| multi(p)) {
+            let d: Vec<f64> = (part.states.iter())
+                .map(|st| crate::fit::align(&st.positions, &part.vertices, warm).distance)
+                .collect();
+            let here = d[part.active.min(d.len() - 1)];
+            if here > 0.0 {
+                for (j, &dj) in d.iter().enumerate().filter(|(j, _)| *j != part.active) {
+                    singles.push((dj / here, pi, j));
+                }
+            }
+        }
+        singles.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut moves: Vec<Vec<(usize, usize)>> = singles
+            .iter()
+            .take(CANDIDATES)
+            .map(|&(_, pi, j)| vec![(pi, j)])
+            .collect();
+        let vp = &self.work.vertex_parts;
+        for (pi, part) in parts
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| multi(p) && p.active != 0)
+        {
+            let mut neighbours: Vec<usize> = (part.vertices.iter())
+                .flat_map(|&v| vp.of(v).iter().copied())
+                .filter(|&q| q != pi && multi(&parts[q]) && parts[q].active == 0)
+                .filter(|&q| parts[q].states.len() == part.states.len())
+                .collect();
+            neighbours.sort_unstable();
+            neighbours.dedup();
+            for q in neighbours {
+                moves.push(vec![(pi, 0), (q, part.active)]);
+            }
+        }
+        // the bends gathered in the wrong parts (a pause on the way, say): all but one of
+        // the parts out of their first state back in it, and all of them
+        let bent: Vec<usize> = (0..parts.len())
+            .filter(|&pi| multi(&parts[pi]) && parts[pi].active != 0)
+            .collect();
+        if (2..=REVERT_LIMIT).contains(&bent.len()) {
+            for &keep in &bent {
+                let revert = bent.iter().filter(|&&q| q != keep).map(|&q| (q, 0));
+                moves.push(
+                    std::iter::once((keep, parts[keep].active))
+                        .chain(revert)
+                        .collect(),
+                );
+            }
+        }
+        if (1..=REVERT_LIMIT).contains(&bent.len()) {
+            moves.push(bent.iter().map(|&q| (q, 0)).collect());
+        }
+        let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
+        let baseline = self.settle(parts, handles, warm, ITERATIONS, &actives, &[])?;
+        let mut best: Option<(f64, Vec<usize>)> = None;
+        for m in &moves {
+            for (p, &a) in parts.iter_mut().zip(&actives) {
+                p.active = a;
+            }
+            for &(pi, j) in m {
+                parts[pi].active = j;
+            }
+            let forced: Vec<usize> = m.iter().map(|x| x.0).collect();
+            let e = self.settle(parts, handles, warm, ITERATIONS, &actives, &forced)?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+            }
+        }
+        // the same states from the rest layout: a fold the iteration cannot leave
+        for (p, &a) in parts.iter_mut().zip(&actives) {
+            p.active = a;
+        }
+        let w = &self.work;
+        let laid = layout::rest_layout(
+            parts,
+            &w.vertex_parts,
+            &self.components,
+            warm,
+            &w.handle_count,
+            &w.handle_sum,
+        );
+        let mut unfolded = None;
+        if laid.iter().all(|p| p.is_finite()) {
+            let e = self.settle(parts, handles, &laid, ITERATIONS, &actives, &[])?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+                unfolded = Some(laid);
+            }
+        }
+        self.work.tried = best.is_none();
+        let chosen = best.map_or(actives.clone(), |b| b.1);
+        for (pi, (p, (&from, &to))) in parts
+            .iter_mut()
+            .zip(actives.iter().zip(&chosen))
+            .enumerate()
+        {
+            p.active = to;
+            if from != to {
+                report.switches.push(StateSwitch { part: pi, from, to });
+            }
+        }
+        self.work.start.valid = None;
+        Ok(unfolded)
+    }
+
+    /// Settles a trial assignment from `warm`: `iterations` least-squares iterations in which
+    /// the piece parts but `forced` choose their states (hysteresis; the stretch parts keep
+    /// those in `keep`), then pass 2 with the states fixed, to convergence (at most
+    /// [`SETTLE_ITERATIONS`], accelerated like every pass 2). Returns its objective.
+    fn settle(
+        &mut self,
+        parts: &mut [Part],
+        handles: &[Handle],
+        warm: &[DVec2],
+        iterations: usize,
+        keep: &[usize],
+        forced: &[usize],
+    ) -> Result<f64, SolverError> {
+        let mut f = warm.to_vec();
+        let mut next = vec![DVec2::ZERO; f.len()];
+        let shared = std::mem::take(&mut self.work.vertex_parts);
+        let mut report = FrameReport::default();
+        for _ in 0..iterations {
+            let how = local::Switching {
+                hysteresis: self.config.hysteresis,
+                stretch: &[],
+                shared: Some(&shared),
+            };
+            if self.cache_fits(parts.len()) {
+                self.evaluate(parts, &f, chunks::Choice::Switch(how));
+                for (i, p) in parts.iter_mut().enumerate() {
+                    if forced.contains(&i) {
+                        continue;
+                    }
+                    if matches!(p.kind, PartKind::Piece { .. }) {
+                        p.active = self.work.chosen[i];
+                    } else {
+                        p.active = keep[i];
+                    }
+                }
+            }
+            self.evaluate_fixed(parts, &f);
+            self.solve_global(&f, &mut next, Pass::LeastSquares, &mut report)?;
+            std::mem::swap(&mut f, &mut next);
+        }
+        self.work.vertex_parts = shared;
+        let cfg = self.config;
+        self.config.l2_iterations = SETTLE_ITERATIONS;
+        self.work.start.valid = None;
+        // the sizes measured when the frame began (the same model, a pose near it)
+        let settled = self.pass2(parts, handles, f, cfg.tolerance, None, &mut report);
+        self.config = cfg;
+        let (_, terms, _) = settled?;
+        Ok(terms.total())
+    }
+}
+
+/// Most pass-2 iterations that settle one trial assignment of rest states
+/// ([`Solver::try_states`]): a bend moved to the neighbouring segment moves every segment
+/// between it and the handle, which least squares settles slowly.
+const SETTLE_ITERATIONS: usize = 60;
+
+/// A model with nothing held whose energy fell by less than this factor's complement over a
+/// frame (5%) creeps: it tries other states and the rest layout without waiting to stop.
+const CREEP: f64 = 0.95;
