@@ -1,6 +1,8 @@
-//! The handles as the frame uses them: their targets gathered per vertex, the components
-//! they move rigidly ([`follow`]), the held vertices snapped to their targets where pass 1
-//! starts, and the factors by which pass 1 weighs the stretch parts they hold as outliers.
+//! The handles as the frame uses them, and the pose each pass starts from: their targets
+//! gathered per vertex, the displayed pose with the components they move rigidly moved
+//! ([`follow`]; the frame's first step), the same again on the rules' layout when they
+//! rewrote the structure, the held vertices snapped to their targets where pass 1 starts,
+//! and the factors by which pass 1 weighs the stretch parts they hold as outliers.
 //!
 //! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
 
@@ -8,10 +10,65 @@ use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
 use super::follow;
+use super::report::SolverError;
 use super::state::Solver;
-use crate::assembly::{Handle, HandleKind};
+use crate::assembly::{Assembly, Handle, HandleKind};
 
 impl Solver {
+    /// The pose the frame starts from: the displayed one, every component whose held
+    /// vertices all moved by one rigid motion moved by it ([`Solver::follow_handles`]), after
+    /// the handles' targets are gathered, the free components found and the components'
+    /// sizes measured; the last frame's evaluation ([`Start`](super::state::Start)) is kept
+    /// only if it still holds for this pose.
+    pub(super) fn warm_start(&mut self, asm: &Assembly) -> Result<Vec<DVec2>, SolverError> {
+        let cfg = self.config;
+        let n = asm.data().positions.len();
+        self.gather_handles(asm.handles(), n);
+        self.components
+            .free(&self.work.handle_count, &mut self.free_components);
+        // Position buffers live in `work` between frames (taken here, put back at the end; an
+        // error path just drops them and the next frame reallocates).
+        let mut warm = std::mem::take(&mut self.work.warm);
+        warm.clear();
+        warm.extend_from_slice(&asm.data().positions);
+        if warm.iter().any(|p| !p.is_finite()) {
+            return Err(SolverError(
+                "the warm start has non-finite positions".into(),
+            ));
+        }
+        self.units.measure(&self.components, &warm);
+        self.follow_handles(&mut warm, cfg.tolerance);
+        let generation = self.generation.unwrap_or(u64::MAX);
+        let start_key = Some((generation, cfg, 0));
+        if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
+            self.work.start.valid = None;
+        }
+        Ok(warm)
+    }
+
+    /// After the rules rewrote the structure between the passes: the state rebuilt for the
+    /// new one ([`Solver::prepare`]), its handles' targets, free components and sizes, and
+    /// `warm` the rules' layout, where pass 2 starts; no evaluation of it is kept.
+    pub(super) fn restart(
+        &mut self,
+        asm: &Assembly,
+        warm: &mut Vec<DVec2>,
+    ) -> Result<(), SolverError> {
+        self.prepare(asm)?;
+        let n = asm.data().positions.len();
+        self.gather_handles(asm.handles(), n);
+        self.components
+            .free(&self.work.handle_count, &mut self.free_components);
+        warm.clear();
+        warm.extend_from_slice(&asm.data().positions);
+        if warm.iter().any(|p| !p.is_finite()) {
+            return Err(SolverError("a rule laid out non-finite positions".into()));
+        }
+        self.units.measure(&self.components, warm);
+        self.work.start.valid = None;
+        Ok(())
+    }
+
     /// Per part, the factor of its term in the sparse norm: for a stretch part holding a
     /// vertex of a grab, [`SolverConfig::handle_outlier`] to the power `2 - p`; of a pin only,
     /// the square root of that (the handle the user moves is the likelier place for the gap:

@@ -37,12 +37,11 @@ pub use state::Solver;
 
 use std::time::{Duration, Instant};
 
-use clay_dsl::compiled::PartKind;
 use glam::DVec2;
 
 use crate::assembly::Assembly;
 use cholesky::SymbolicFactor;
-use clock::{ms_since, out_of_time};
+use clock::ms_since;
 
 /// What runs between a frame's two passes ([`Solver::frame_with`]): the assembly, the report
 /// so far and the pass-1 pose.
@@ -162,8 +161,9 @@ impl Solver {
                 || self.symbolic.as_ref().is_some_and(SymbolicFactor::is_split))
     }
 
-    /// [`Solver::frame_within`] after [`Solver::prepare`] (`start`: when the frame began).
-    // Long because: the frame's steps in order, with the hand-over between its passes.
+    /// [`Solver::frame_within`] after [`Solver::prepare`] (`start`: when the frame began):
+    /// the frame's table of contents, its steps in order (`docs/solver.md`), each in the file
+    /// named beside it.
     fn frame_prepared(
         &mut self,
         asm: &mut Assembly,
@@ -175,153 +175,43 @@ impl Solver {
             complete: true,
             ..FrameReport::default()
         };
-        let n = asm.data().positions.len();
-        if n == 0 || asm.data().parts.is_empty() {
+        if asm.data().positions.is_empty() || asm.data().parts.is_empty() {
             report.converged = true;
             report.ms = start.elapsed().as_secs_f64() * 1e3;
             return Ok(report);
         }
-        let cfg = self.config;
-        self.gather_handles(asm.handles(), n);
-        self.components
-            .free(&self.work.handle_count, &mut self.free_components);
-        // Position buffers live in `work` between frames (taken here, put back at the end; an
-        // error path just drops them and the next frame reallocates).
-        let mut warm = std::mem::take(&mut self.work.warm);
-        warm.clear();
-        warm.extend_from_slice(&asm.data().positions);
-        if warm.iter().any(|p| !p.is_finite()) {
-            return Err(SolverError(
-                "the warm start has non-finite positions".into(),
-            ));
-        }
-        self.units.measure(&self.components, &warm);
-        self.follow_handles(&mut warm, cfg.tolerance);
-        let generation = self.generation.unwrap_or(u64::MAX);
-        let start_key = Some((generation, cfg, 0));
-        if !self.work.start_holds(start_key, &warm, &asm.data().parts) {
-            self.work.start.valid = None;
-        }
-        // Pass 1 starts from the displayed least-squares pose with the held vertices where the
-        // handles now put them, by either method: the gesture's new step is where the
-        // deformation starts, so the sparse norm gathers it next to the handle that moved,
-        // and elsewhere into the parts the least-squares pose already strains most
-        // (`docs/solver.md`).
-        let mut pose = std::mem::take(&mut self.pass1_pose);
-        pose.clone_from(&warm);
-        self.snap_held(&mut pose);
-        if self.pass1_runs() {
-            // the evaluation at the displayed pose: pass 2 starts there (`Start`), and its
-            // rotations are the directions the stretch parts' lengths are measured along
-            if self.work.start.valid.is_none() {
-                self.start_at(&asm.data().parts, asm.handles(), &warm, start_key);
-            }
-            self.stretch_contexts(asm, &pose);
-            self.outlier_factors(&asm.data().parts, asm.handles());
-        }
+        // 1. Rigid following: the displayed pose, components moved by their handles (handles.rs).
+        let mut warm = self.warm_start(asm)?;
+        // 2. Pass 1's start, the held vertices snapped, and the chains' view (pass1.rs).
+        let mut pose = self.pass1_start(asm, &warm);
         report.phases.bookkeeping += ms_since(start);
+        // 3. Pass 1: the sparse norm by IRLS; its local steps choose the states (pass1.rs).
         let pass1 = self.pass1(&mut asm.data_mut().parts, &mut pose, deadline, &mut report);
         self.pass1_pose = pose;
+        // 4. Claims: how many elements each stretched or squeezed chain gains (chains.rs).
         self.collect_claims(asm, &mut report);
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
-        let settling = self.settling(&report, asm.handles().is_empty());
-        self.work.last_targets.clone_from(&self.work.handle_sum);
-        if settling && !out_of_time(deadline, Duration::ZERO) {
-            let handles = asm.handles().to_vec();
-            let parts = &mut asm.data_mut().parts;
-            if let Some(laid) = self.try_states(parts, &handles, &warm, &mut report)? {
-                warm.copy_from_slice(&laid);
-            }
-        }
+        // 5. Trials: a held model that stopped strained tries other rest states (trials.rs).
+        self.trials(asm, &mut warm, deadline, &mut report)?;
+        // 6. The rules (`between`); pass 2 starts from their layout if they rewrote (handles.rs).
         let t = Instant::now();
         let before = asm.generation();
         between(asm, &report, &self.pass1_pose);
         if asm.generation() != before {
-            // the structure changed: pass 2 runs on the new one, from the rules' layout
-            self.prepare(asm)?;
-            let n = asm.data().positions.len();
-            self.gather_handles(asm.handles(), n);
-            self.components
-                .free(&self.work.handle_count, &mut self.free_components);
-            warm.clear();
-            warm.extend_from_slice(&asm.data().positions);
-            if warm.iter().any(|p| !p.is_finite()) {
-                return Err(SolverError("a rule laid out non-finite positions".into()));
-            }
-            self.units.measure(&self.components, &warm);
-            self.work.start.valid = None;
+            self.restart(asm, &mut warm)?;
         }
         report.phases.bookkeeping += ms_since(t);
-        let generation = self.generation.unwrap_or(u64::MAX);
-        let pass2 = self.pass2(
-            &asm.data().parts,
-            asm.handles(),
-            warm,
-            cfg.tolerance,
-            deadline,
-            &mut report,
-        );
+        // 7. Pass 2: least squares with the states fixed, from the displayed pose (pass2.rs).
+        let (parts, handles, tolerance) = (&asm.data().parts, asm.handles(), self.config.tolerance);
+        let pass2 = self.pass2(parts, handles, warm, tolerance, deadline, &mut report);
         self.work.start.valid.take_if(|_| pass2.is_err());
         let (f, terms, pass2_converged) = pass2?;
-        let t = Instant::now();
-        if f.iter().any(|p| !p.is_finite()) {
-            self.work.start.valid = None;
-            return Err(SolverError(
-                "the solve produced non-finite positions".into(),
-            ));
-        }
-        report.moved = max_move(&asm.data().positions, &f);
-        let shown = &asm.data().positions;
-        self.work.last_moved = self.units.max_move_in_edges(&self.components, shown, &f);
-        let settled =
-            self.units.max_move_in_sizes(&self.components, shown, &f) <= cfg.settle_tolerance;
-        self.work.last_energy = [terms.elastic, self.work.last_energy[0]];
-        asm.positions_mut().copy_from_slice(&f);
-        let rot = asm.rotations_mut();
-        if rot.len() == self.work.rotations.len() {
-            rot.copy_from_slice(&self.work.rotations);
-        }
-        sync_instance_states(asm);
-        self.work
-            .keep_start(cfg, generation, &asm.data().parts, terms.elastic);
-        report.energy = terms.elastic;
-        report.objective = terms.total();
-        // still and strained, other states not yet tried: the next frame tries them
-        // (`settling`), so this one is not the last (a host that stops at convergence, as the
-        // editor does, would never run it)
-        let trial_due = !self.work.tried && self.strained(terms.elastic);
-        report.converged = report.complete
-            && report.switches.is_empty()
-            && !trial_due
-            && (settled || (pass1_converged && pass2_converged));
-        // the shown pose is kept; the one shown before is the next frame's warm-start buffer
-        self.work.warm = std::mem::replace(&mut self.work.shown, f);
-        report.phases.bookkeeping += ms_since(t);
+        // 8. Pass 2's pose shown, kept for the next frame, and judged converged (pass2.rs).
+        let converged = pass1_converged && pass2_converged;
+        self.show(asm, f, terms, converged, &mut report)?;
         report.ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(report)
-    }
-}
-
-fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
-    // one square root for the largest, not one per vertex (the same value: sqrt is monotonic
-    // and correctly rounded)
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| p.distance_squared(*q))
-        .fold(0.0, f64::max)
-        .sqrt()
-}
-
-/// Piece parts carry their active state to their instance (that is the replacement rule).
-fn sync_instance_states(asm: &mut Assembly) {
-    let data = asm.data_mut();
-    for part in &data.parts {
-        if let PartKind::Piece { instance } = part.kind
-            && let Some(inst) = data.instances.get_mut(instance)
-        {
-            inst.state = part.active;
-        }
     }
 }

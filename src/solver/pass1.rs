@@ -14,8 +14,35 @@ use super::clock::{ms_since, out_of_time};
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError};
 use super::state::Solver;
+use crate::assembly::Assembly;
 
 impl Solver {
+    /// Where pass 1 starts: the displayed pose `warm` with the held vertices where the handles
+    /// now put them ([`Solver::snap_held`]; in the last pass-1 pose's buffer), and when pass 1
+    /// runs, what its local steps read: the evaluation at `warm` (kept for pass 2 as
+    /// [`Start`](super::state::Start)), the stretch parts' contexts and the outlier factors.
+    pub(super) fn pass1_start(&mut self, asm: &Assembly, warm: &[DVec2]) -> Vec<DVec2> {
+        // Pass 1 starts from the displayed least-squares pose with the held vertices where the
+        // handles now put them, by either method: the gesture's new step is where the
+        // deformation starts, so the sparse norm gathers it next to the handle that moved,
+        // and elsewhere into the parts the least-squares pose already strains most
+        // (`docs/solver.md`).
+        let mut pose = std::mem::take(&mut self.pass1_pose);
+        warm.clone_into(&mut pose);
+        self.snap_held(&mut pose);
+        if self.pass1_runs() {
+            let start_key = Some((self.generation.unwrap_or(u64::MAX), self.config, 0));
+            // the evaluation at the displayed pose: pass 2 starts there (`Start`), and its
+            // rotations are the directions the stretch parts' lengths are measured along
+            if self.work.start.valid.is_none() {
+                self.start_at(&asm.data().parts, asm.handles(), warm, start_key);
+            }
+            self.stretch_contexts(asm, &pose);
+            self.outlier_factors(&asm.data().parts, asm.handles());
+        }
+        pose
+    }
+
     /// Whether pass 1 runs at all.
     pub(super) fn pass1_runs(&self) -> bool {
         self.config.irls_iterations > 0

@@ -8,7 +8,7 @@
 
 use std::time::{Duration, Instant};
 
-use clay_dsl::compiled::Part;
+use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
 use super::clock::{ms_since, out_of_time};
@@ -16,7 +16,7 @@ use super::config::SolverConfig;
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError};
 use super::state::Solver;
-use crate::assembly::Handle;
+use crate::assembly::{Assembly, Handle};
 
 impl Solver {
     /// Evaluates the local step at the displayed pose `warm` with the states kept and keeps
@@ -146,6 +146,55 @@ impl Solver {
             handle: handle_term(handles, f, self.config.handle_weight),
         }
     }
+
+    /// Shows pass 2's pose `f` (its objective's terms `terms`): the assembly's positions,
+    /// rotations and instance states; keeps what the next frame reads (how far the pose moved,
+    /// its energy, its evaluation as [`Start`](super::state::Start)) and reports its energy
+    /// and objective and whether the frame converged (`converged`: both passes did).
+    pub(super) fn show(
+        &mut self,
+        asm: &mut Assembly,
+        f: Vec<DVec2>,
+        terms: Terms,
+        converged: bool,
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        let cfg = self.config;
+        let generation = self.generation.unwrap_or(u64::MAX);
+        let t = Instant::now();
+        if f.iter().any(|p| !p.is_finite()) {
+            self.work.start.valid = None;
+            return Err(SolverError(
+                "the solve produced non-finite positions".into(),
+            ));
+        }
+        report.moved = max_move(&asm.data().positions, &f);
+        let shown = &asm.data().positions;
+        self.work.last_moved = self.units.max_move_in_edges(&self.components, shown, &f);
+        let settled =
+            self.units.max_move_in_sizes(&self.components, shown, &f) <= cfg.settle_tolerance;
+        self.work.last_energy = [terms.elastic, self.work.last_energy[0]];
+        asm.positions_mut().copy_from_slice(&f);
+        let rot = asm.rotations_mut();
+        if rot.len() == self.work.rotations.len() {
+            rot.copy_from_slice(&self.work.rotations);
+        }
+        sync_instance_states(asm);
+        self.work
+            .keep_start(cfg, generation, &asm.data().parts, terms.elastic);
+        report.energy = terms.elastic;
+        report.objective = terms.total();
+        // still and strained, other states not yet tried: the next frame tries them
+        // (`settling`), so this one is not the last (a host that stops at convergence, as the
+        // editor does, would never run it)
+        let trial_due = !self.work.tried && self.strained(terms.elastic);
+        report.converged =
+            report.complete && report.switches.is_empty() && !trial_due && (settled || converged);
+        // the shown pose is kept; the one shown before is the next frame's warm-start buffer
+        self.work.warm = std::mem::replace(&mut self.work.shown, f);
+        report.phases.bookkeeping += ms_since(t);
+        Ok(())
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -174,4 +223,26 @@ fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
         }
     }
     handle_weight * handle
+}
+
+fn max_move(a: &[DVec2], b: &[DVec2]) -> f64 {
+    // one square root for the largest, not one per vertex (the same value: sqrt is monotonic
+    // and correctly rounded)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance_squared(*q))
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
+/// Piece parts carry their active state to their instance (that is the replacement rule).
+fn sync_instance_states(asm: &mut Assembly) {
+    let data = asm.data_mut();
+    for part in &data.parts {
+        if let PartKind::Piece { instance } = part.kind
+            && let Some(inst) = data.instances.get_mut(instance)
+        {
+            inst.state = part.active;
+        }
+    }
 }

@@ -5,16 +5,42 @@
 //!
 //! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
 
+use std::time::{Duration, Instant};
+
 use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
+use super::clock::out_of_time;
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError, StateSwitch};
 use super::state::Solver;
 use super::{chunks, layout, local};
-use crate::assembly::Handle;
+use crate::assembly::{Assembly, Handle};
 
 impl Solver {
+    /// The frame's trials: when it is [`Solver::settling`] and time is left, other rest states
+    /// are tried ([`Solver::try_states`]), and an assignment kept from the rest layout moves
+    /// `warm` (where pass 2 starts) there. Notes the handles' targets for the next frame's
+    /// stillness test.
+    pub(super) fn trials(
+        &mut self,
+        asm: &mut Assembly,
+        warm: &mut [DVec2],
+        deadline: Option<Instant>,
+        report: &mut FrameReport,
+    ) -> Result<(), SolverError> {
+        let settling = self.settling(report, asm.handles().is_empty());
+        self.work.last_targets.clone_from(&self.work.handle_sum);
+        if settling && !out_of_time(deadline, Duration::ZERO) {
+            let handles = asm.handles().to_vec();
+            let parts = &mut asm.data_mut().parts;
+            if let Some(laid) = self.try_states(parts, &handles, warm, report)? {
+                warm.copy_from_slice(&laid);
+            }
+        }
+        Ok(())
+    }
+
     /// Whether this frame tries other rest states ([`Solver::try_states`]): the handles
     /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
     /// pose all but still and yet not at rest, and no try since the handles, the states or
@@ -56,11 +82,70 @@ impl Solver {
         warm: &[DVec2],
         report: &mut FrameReport,
     ) -> Result<Option<Vec<DVec2>>, SolverError> {
-        const CANDIDATES: usize = 4;
         const ITERATIONS: usize = 3;
+        let hysteresis = self.config.hysteresis;
+        let moves = self.trial_moves(parts, warm);
+        let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
+        let baseline = self.settle(parts, handles, warm, ITERATIONS, &actives, &[])?;
+        let mut best: Option<(f64, Vec<usize>)> = None;
+        for m in &moves {
+            for (p, &a) in parts.iter_mut().zip(&actives) {
+                p.active = a;
+            }
+            for &(pi, j) in m {
+                parts[pi].active = j;
+            }
+            let forced: Vec<usize> = m.iter().map(|x| x.0).collect();
+            let e = self.settle(parts, handles, warm, ITERATIONS, &actives, &forced)?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+            }
+        }
+        // the same states from the rest layout: a fold the iteration cannot leave
+        for (p, &a) in parts.iter_mut().zip(&actives) {
+            p.active = a;
+        }
+        let w = &self.work;
+        let laid = layout::rest_layout(
+            parts,
+            &w.vertex_parts,
+            &self.components,
+            warm,
+            &w.handle_count,
+            &w.handle_sum,
+        );
+        let mut unfolded = None;
+        if laid.iter().all(|p| p.is_finite()) {
+            let e = self.settle(parts, handles, &laid, ITERATIONS, &actives, &[])?;
+            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
+                best = Some((e, parts.iter().map(|p| p.active).collect()));
+                unfolded = Some(laid);
+            }
+        }
+        self.work.tried = best.is_none();
+        let chosen = best.map_or(actives.clone(), |b| b.1);
+        for (pi, (p, (&from, &to))) in parts
+            .iter_mut()
+            .zip(actives.iter().zip(&chosen))
+            .enumerate()
+        {
+            p.active = to;
+            if from != to {
+                report.switches.push(StateSwitch { part: pi, from, to });
+            }
+        }
+        self.work.start.valid = None;
+        Ok(unfolded)
+    }
+
+    /// The moves [`Solver::try_states`] tries, each a list of `(part, state)`: the few
+    /// single switches whose state is nearest (by its shape distance at `warm` against the
+    /// active one's), every bent piece part's state handed to each straight neighbour, and
+    /// with few bent parts, all but one of them reverted (for each) and all of them.
+    fn trial_moves(&self, parts: &[Part], warm: &[DVec2]) -> Vec<Vec<(usize, usize)>> {
+        const CANDIDATES: usize = 4;
         // more parts out of their first state than this: no reverting moves (each is a settle)
         const REVERT_LIMIT: usize = 8;
-        let hysteresis = self.config.hysteresis;
         let multi = |p: &Part| matches!(p.kind, PartKind::Piece { .. }) && p.states.len() >= 2;
         let mut singles: Vec<(f64, usize, usize)> = Vec::new();
         for (pi, part) in parts.iter().enumerate().filter(|(_, p)| multi(p)) {
@@ -115,57 +200,7 @@ impl Solver {
         if (1..=REVERT_LIMIT).contains(&bent.len()) {
             moves.push(bent.iter().map(|&q| (q, 0)).collect());
         }
-        let actives: Vec<usize> = parts.iter().map(|p| p.active).collect();
-        let baseline = self.settle(parts, handles, warm, ITERATIONS, &actives, &[])?;
-        let mut best: Option<(f64, Vec<usize>)> = None;
-        for m in &moves {
-            for (p, &a) in parts.iter_mut().zip(&actives) {
-                p.active = a;
-            }
-            for &(pi, j) in m {
-                parts[pi].active = j;
-            }
-            let forced: Vec<usize> = m.iter().map(|x| x.0).collect();
-            let e = self.settle(parts, handles, warm, ITERATIONS, &actives, &forced)?;
-            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
-                best = Some((e, parts.iter().map(|p| p.active).collect()));
-            }
-        }
-        // the same states from the rest layout: a fold the iteration cannot leave
-        for (p, &a) in parts.iter_mut().zip(&actives) {
-            p.active = a;
-        }
-        let w = &self.work;
-        let laid = layout::rest_layout(
-            parts,
-            &w.vertex_parts,
-            &self.components,
-            warm,
-            &w.handle_count,
-            &w.handle_sum,
-        );
-        let mut unfolded = None;
-        if laid.iter().all(|p| p.is_finite()) {
-            let e = self.settle(parts, handles, &laid, ITERATIONS, &actives, &[])?;
-            if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
-                best = Some((e, parts.iter().map(|p| p.active).collect()));
-                unfolded = Some(laid);
-            }
-        }
-        self.work.tried = best.is_none();
-        let chosen = best.map_or(actives.clone(), |b| b.1);
-        for (pi, (p, (&from, &to))) in parts
-            .iter_mut()
-            .zip(actives.iter().zip(&chosen))
-            .enumerate()
-        {
-            p.active = to;
-            if from != to {
-                report.switches.push(StateSwitch { part: pi, from, to });
-            }
-        }
-        self.work.start.valid = None;
-        Ok(unfolded)
+        moves
     }
 
     /// Settles a trial assignment from `warm`: `iterations` least-squares iterations in which
