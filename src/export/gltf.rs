@@ -2,9 +2,12 @@
 //! data in one buffer, written as `.glb` (one binary container) or `.gltf` (JSON with the
 //! buffer embedded as a base64 data URI, so the file stands alone).
 //!
-//! One node per instance (named as in the assembly, `wall[3]`, with its piece, rest state and
-//! id as extras), one mesh per node with one primitive per material, one material per fill
-//! colour (its sRGB colour as a linear base colour factor; blended when not opaque).
+//! One root node named after the model, whose children are the instances' nodes, each at its
+//! pivot and turned as its instance (translation and rotation), named uniquely in a form
+//! importers keep, with its assembly name, piece, rest state, id and place in its stretch chain
+//! as extras. Nodes of identical instances share one mesh; a mesh has one primitive per
+//! material, with positions, normals and planar UVs in metres (`TEXCOORD_0`). One material per
+//! fill colour (its sRGB colour as a linear base colour factor; blended when not opaque).
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
@@ -42,6 +45,23 @@ impl Buffers {
             extensions: None,
             extras: Default::default(),
         })
+    }
+
+    fn vec2(&mut self, values: &[[f32; 2]]) -> json::Index<json::Accessor> {
+        let data: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let view = self.view(&data, json::buffer::Target::ArrayBuffer);
+        self.accessor(
+            view,
+            values.len(),
+            json::accessor::ComponentType::F32,
+            json::accessor::Type::Vec2,
+            None,
+            None,
+        )
     }
 
     fn vec3(&mut self, values: &[[f32; 3]], bounds: bool) -> json::Index<json::Accessor> {
@@ -155,16 +175,23 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
             ..Default::default()
         });
     }
-    let mut nodes = Vec::new();
-    for node in &scene.nodes {
+    // Each mesh once, where its first node is.
+    let mut meshes = Vec::with_capacity(scene.meshes.len());
+    for mesh in &scene.meshes {
+        let Some(node) = scene.nodes.get(mesh.node) else {
+            meshes.push(None);
+            continue;
+        };
         let mut primitives = Vec::new();
         for p in node.primitives.iter().filter(|p| !p.indices.is_empty()) {
             let position = b.vec3(&p.positions, true);
             let normal = b.vec3(&p.normals, false);
+            let uv = b.vec2(&p.uvs);
             let indices = b.indices(&p.indices);
             let mut attributes = BTreeMap::new();
             attributes.insert(Valid(json::mesh::Semantic::Positions), position);
             attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
+            attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
             primitives.push(json::mesh::Primitive {
                 attributes,
                 extensions: None,
@@ -175,31 +202,55 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
                 targets: None,
             });
         }
-        let mesh = (!primitives.is_empty()).then(|| {
+        meshes.push((!primitives.is_empty()).then(|| {
             b.root.push(json::Mesh {
                 extensions: None,
                 extras: Default::default(),
-                name: Some(node.name.clone()),
+                name: Some(mesh.name.clone()),
                 primitives,
                 weights: None,
             })
-        });
-        nodes.push(b.root.push(json::Node {
-            mesh,
-            name: Some(node.name.clone()),
-            extras: extras(serde_json::json!({
-                "piece": node.piece,
-                "state": node.state,
-                "id": node.id,
-            })),
-            ..Default::default()
         }));
     }
+    let mut children = Vec::with_capacity(scene.nodes.len());
+    for node in &scene.nodes {
+        let mut extra = serde_json::json!({
+            "instance": node.instance,
+            "piece": node.piece,
+            "state": node.state,
+            "id": node.id,
+        });
+        if let Some(c) = &node.chain {
+            extra["chain"] = c.name.clone().into();
+            extra["index"] = c.index.into();
+        }
+        let [x, y, z] = node.translation();
+        let translation = [x as f32, y as f32, z as f32];
+        let [qx, qy, qz, qw] = node.rotation();
+        let rotation = [qx as f32, qy as f32, qz as f32, qw as f32];
+        let finite = translation.iter().chain(&rotation).all(|v| v.is_finite());
+        children.push(
+            b.root.push(json::Node {
+                mesh: node.mesh.and_then(|m| meshes.get(m).copied().flatten()),
+                name: Some(node.name.clone()),
+                extras: extras(extra),
+                translation: (finite && translation != [0.0; 3]).then_some(translation),
+                rotation: (finite && rotation != [0.0, 0.0, 0.0, 1.0])
+                    .then_some(json::scene::UnitQuaternion(rotation)),
+                ..Default::default()
+            }),
+        );
+    }
+    let root = b.root.push(json::Node {
+        name: Some(scene.name.clone()),
+        children: (!children.is_empty()).then_some(children),
+        ..Default::default()
+    });
     let scene_index = b.root.push(json::Scene {
         extensions: None,
         extras: Default::default(),
-        name: Some("clay model".into()),
-        nodes,
+        name: Some(scene.name.clone()),
+        nodes: vec![root],
     });
     b.root.scene = Some(scene_index);
     while !b.bytes.len().is_multiple_of(4) {

@@ -1,8 +1,8 @@
-//! A 3D look without a 3D viewer (`clayc render --view iso`): the exported [`Scene`] drawn in
-//! an isometric projection with tiny-skia, seen from the south-east and above, faces sorted back
-//! to front (painter's algorithm) and shaded by their normal, back faces culled. The docs and
-//! tests use it to show heights; it is a picture, not a renderer: intersecting faces may sort
-//! wrongly.
+//! A 3D look without a 3D viewer (`clayc render --view iso`): the exported [`Scene`] (each
+//! node's geometry placed by its node) drawn in an isometric projection with tiny-skia, seen
+//! from the south-east and above, faces sorted back to front (painter's algorithm) and shaded
+//! by their normal, back faces culled. The docs and tests use it to show heights; it is a
+//! picture, not a renderer: intersecting faces may sort wrongly.
 
 use tiny_skia::{FillRule, Paint, PathBuilder, Pixmap, Transform};
 
@@ -54,32 +54,43 @@ pub fn iso_pixmap(scene: &Scene, width: u32, height: u32) -> Result<Pixmap, Rend
     pixmap.fill(tiny_skia::Color::from_rgba8(r, g, b, a));
     let light_len = dot(LIGHT, LIGHT).sqrt();
     let mut faces = Vec::new();
-    for p in scene.nodes.iter().flat_map(|n| &n.primitives) {
-        let colour = scene
-            .materials
-            .get(p.material)
-            .map_or([128, 128, 128, 255], |c| c.0);
-        for t in p.indices.chunks_exact(3) {
-            let Some(v) = [t[0], t[1], t[2]]
+    for node in &scene.nodes {
+        for p in &node.primitives {
+            let colour = scene
+                .materials
+                .get(p.material)
+                .map_or([128, 128, 128, 255], |c| c.0);
+            let world: Vec<[f32; 3]> = p
+                .positions
                 .iter()
-                .map(|&i| p.positions.get(i as usize).copied())
-                .collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            let Some(n) = p.normals.get(t[0] as usize).map(|n| n.map(|c| c as f64)) else {
-                continue;
-            };
-            if dot(n, TOWARDS_VIEWER) <= 1e-9 {
-                continue;
+                .map(|&q| node.to_world(q).as_vec3().to_array())
+                .collect();
+            for t in p.indices.chunks_exact(3) {
+                let Some(v) = [t[0], t[1], t[2]]
+                    .iter()
+                    .map(|&i| world.get(i as usize).copied())
+                    .collect::<Option<Vec<_>>>()
+                else {
+                    continue;
+                };
+                let Some(n) = p
+                    .normals
+                    .get(t[0] as usize)
+                    .map(|&n| node.direction_to_world(n).to_array())
+                else {
+                    continue;
+                };
+                if dot(n, TOWARDS_VIEWER) <= 1e-9 {
+                    continue;
+                }
+                let shade = 0.55 + 0.45 * (dot(n, LIGHT) / light_len).max(0.0);
+                let lit = |c: u8| (c as f64 * shade).round().clamp(0.0, 255.0) as u8;
+                faces.push(Face {
+                    corners: [project(v[0]), project(v[1]), project(v[2])],
+                    depth: (depth(v[0]) + depth(v[1]) + depth(v[2])) / 3.0,
+                    rgba: [lit(colour[0]), lit(colour[1]), lit(colour[2]), colour[3]],
+                });
             }
-            let shade = 0.55 + 0.45 * (dot(n, LIGHT) / light_len).max(0.0);
-            let lit = |c: u8| (c as f64 * shade).round().clamp(0.0, 255.0) as u8;
-            faces.push(Face {
-                corners: [project(v[0]), project(v[1]), project(v[2])],
-                depth: (depth(v[0]) + depth(v[1]) + depth(v[2])) / 3.0,
-                rgba: [lit(colour[0]), lit(colour[1]), lit(colour[2]), colour[3]],
-            });
         }
     }
     if faces.is_empty() {
