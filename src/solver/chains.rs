@@ -3,7 +3,10 @@
 //! for the switching local steps (the direction it is measured along, the states its chain's
 //! rule can honour now), and the claims pass 1 leaves, sized by the chains' lengths.
 //!
-//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+//! A file of its own because the chains are a job of their own, read at two steps of the
+//! frame (pass 1's start and the claims after it): an `impl Solver` block over the state of
+//! `state.rs`, imported from that sibling rather than from `mod.rs`, so no child imports its
+//! parent.
 
 use clay_dsl::compiled::PartKind;
 use glam::DVec2;

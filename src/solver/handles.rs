@@ -4,7 +4,9 @@
 //! rewrote the structure, the held vertices snapped to their targets where pass 1 starts,
 //! and the factors by which pass 1 weighs the stretch parts they hold as outliers.
 //!
-//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+//! A file of its own because these are the frame's first step and its restart after the
+//! rules: an `impl Solver` block over the state of `state.rs`, imported from that sibling
+//! rather than from `mod.rs`, so no child imports its parent.
 
 use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;

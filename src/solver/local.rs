@@ -244,7 +244,8 @@ pub struct StateSums {
     pub axis: DVec2,
 }
 
-/// A stretch part measured in a pose ([`RestCache::measure_stretch`](super::rest_cache::RestCache::measure_stretch)).
+/// A stretch part measured in a pose
+/// ([`RestCache::measure_stretch`](super::rest_cache::RestCache::measure_stretch)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PartMeasure {
     /// Each element's length, in elements at rest.

@@ -3,6 +3,12 @@
 //! warm-started from the previous positions. Pass 1 reweights edges for the sub-quadratic
 //! norm (IRLS) and decides the active rest states; pass 2 is plain least squares with the
 //! states fixed, and its positions are what the user sees.
+//!
+//! This file is the frame's table of contents: the module list, the public API, and
+//! `frame_prepared`, the frame's steps in order, each a call with a one-line comment naming
+//! the file it lives in. The state the steps share is `state.rs`'s; every job is a sibling
+//! with its own `impl Solver` block that imports the state (and what else it needs) from its
+//! siblings, never from here, so no child imports its parent.
 
 mod anderson;
 mod cg;
@@ -188,7 +194,7 @@ impl Solver {
         // 3. Pass 1: the sparse norm by IRLS; its local steps choose the states (pass1.rs).
         let pass1 = self.pass1(&mut asm.data_mut().parts, &mut pose, deadline, &mut report);
         self.pass1_pose = pose;
-        // 4. Claims: how many elements each stretched or squeezed chain gains (chains.rs).
+        // 4. Claims: how many elements each chain gains or loses, by its length (chains.rs).
         self.collect_claims(asm, &mut report);
         // a frame that fails leaves no evaluation to reuse (its states may have switched)
         self.work.start.valid.take_if(|_| pass1.is_err());

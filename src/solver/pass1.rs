@@ -3,7 +3,9 @@
 //! handles now put them. Its local steps choose every part's rest state (from its second
 //! iteration on); its pose decides the states and the chains' claims, and is not shown.
 //!
-//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+//! A file of its own because it is one step of the frame (`mod.rs` calls `pass1_start` and
+//! `pass1`): an `impl Solver` block over the state of `state.rs`, imported from that sibling
+//! rather than from `mod.rs`, so no child imports its parent.
 
 use std::time::{Duration, Instant};
 

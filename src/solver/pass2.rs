@@ -4,7 +4,10 @@
 //! be done before pass 1 ([`Start`](super::state::Start)), whose stretch parts are measured
 //! along its rotations.
 //!
-//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+//! A file of its own because it is one step of the frame (`mod.rs` calls `pass2`, then
+//! `show`, which puts its pose on the assembly and judges convergence): an `impl Solver`
+//! block over the state of `state.rs`, imported from that sibling rather than from `mod.rs`,
+//! so no child imports its parent.
 
 use std::time::{Duration, Instant};
 

@@ -39,8 +39,9 @@ struct Shape {
     edges: u32,
     states: u32,
     /// Into `rest`: state `j`'s centred positions at `rest + j * m`, or [`SHORT`] when a
-    /// state has fewer positions than the part has vertices ([`align`](crate::fit::align) then centres the pose
-    /// over a prefix of the vertices, so the part takes the reference path).
+    /// state has fewer positions than the part has vertices ([`align`](crate::fit::align)
+    /// then centres the pose over a prefix of the vertices, so the part takes the reference
+    /// path).
     rest: u32,
     /// Into `pp` (one per state).
     pp: u32,
@@ -59,9 +60,10 @@ const SHORT: u32 = u32::MAX;
 /// bit-identical rest data share it ([`Shape`]).
 ///
 /// Every result equals the reference functions' ([`choose_state`], [`part_rotation`],
-/// [`edge_rotation`](super::local::edge_rotation)) bit for bit: the same numbers are summed in the same order, only
-/// computed less often. The active states are read from the parts at every call, since the
-/// local step switches them; everything else must not change without a generation bump.
+/// [`edge_rotation`](super::local::edge_rotation)) bit for bit: the same numbers are summed
+/// in the same order, only computed less often. The active states are read from the parts at
+/// every call, since the local step switches them; everything else must not change without a
+/// generation bump.
 #[derive(Clone, Debug, Default)]
 pub struct RestCache {
     spans: Vec<Span>,
@@ -344,7 +346,8 @@ impl RestCache {
     }
 
     /// Gathers and centres the pose of the part with span `s` into `self.pose[..m]`;
-    /// returns its squared norm. The same expressions, in the same order, as [`align`](crate::fit::align).
+    /// returns its squared norm. The same expressions, in the same order, as
+    /// [`align`](crate::fit::align).
     fn gather_pose(&self, s: Span, m: usize, positions: &[DVec2], pose: &mut [DVec2]) -> f64 {
         let verts = &self.vertices[s.vertex as usize..][..m];
         let inv = 1.0 / m as f64;
@@ -557,8 +560,9 @@ impl RestCache {
     }
 
     /// `R_xy (x0 - y0)` for every part-edge, in the solver's edge order, into `targets`: the
-    /// same as [`edge_rotation`](super::local::edge_rotation) per edge with the active state's rest edge, but each part
-    /// sums its vertices' neighbour rotations once instead of once per edge end.
+    /// same as [`edge_rotation`](super::local::edge_rotation) per edge with the active
+    /// state's rest edge, but each part sums its vertices' neighbour rotations once instead
+    /// of once per edge end.
     ///
     /// Reads the parts' active states from the last rotation step when it noted every part
     /// (and the caller has not switched states since), else from `parts`.

@@ -3,7 +3,9 @@
 //! nearest single switches, a bend handed to a neighbour, bends reverted, the rest layout),
 //! each settled by a few iterations, and keeps one that is clearly better.
 //!
-//! One job of the frame in its own `impl Solver` block, as `mod.rs` lists them.
+//! A file of its own because it is one step of the frame (`mod.rs` calls `trials`), run
+//! seldom and long: an `impl Solver` block over the state of `state.rs`, imported from that
+//! sibling rather than from `mod.rs`, so no child imports its parent.
 
 use std::time::{Duration, Instant};
 
