@@ -16,7 +16,7 @@ use std::collections::HashSet;
 
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
-use super::{ChainPlace, Scene};
+use super::model::{ChainPlace, Scene};
 
 /// Blender's limit for object and mesh names, in bytes.
 pub const MAX_NAME_BYTES: usize = 63;

@@ -21,7 +21,7 @@ use clay_dsl::compiled::{Extrude, Rgba};
 use glam::DVec2;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
-use super::ExportOptions;
+use super::model::ExportOptions;
 use crate::render::Mesh;
 
 /// A vertex of a cap: a weighted sum of tessellation vertices, `(mesh, vertex, weight)`; all
