@@ -78,9 +78,13 @@ fn the_floor_plan_is_the_renderers_and_heights_stay_after_a_script() {
             );
             let s = scene(&g, &after, &options);
             assert_bounds_match(&s, &g, &after, name);
-            // Every height is a rest height: the base, or a layer's top.
+            // Every height is a rest height: a layer's bottom or its top (flat layer k spans
+            // k * layer to thickness + k * layer, so no two layers share a plane).
             let tops: Vec<f64> = (0..64)
-                .map(|k| options.thickness + options.layer * k as f64)
+                .flat_map(|k| {
+                    let bottom = options.layer * k as f64;
+                    [bottom, options.thickness + bottom]
+                })
                 .collect();
             for p in s
                 .nodes
@@ -90,7 +94,7 @@ fn the_floor_plan_is_the_renderers_and_heights_stay_after_a_script() {
             {
                 let y = p[1] as f64;
                 assert!(
-                    y == 0.0 || tops.iter().any(|t| (t - y).abs() < 1e-6),
+                    tops.iter().any(|t| (t - y).abs() < 1e-6),
                     "{name}: height {y} is not a rest height"
                 );
             }
@@ -139,12 +143,20 @@ fn glb_and_gltf_read_back_with_the_assemblys_nodes_names_and_triangles() {
                         .unwrap()
                 }
             };
-            let nodes: Vec<_> = doc.nodes().collect();
+            // One root, named after the grammar, whose children are the instances in order.
+            let roots: Vec<_> = doc.scenes().next().unwrap().nodes().collect();
+            let [root] = &roots[..] else {
+                panic!("{name}: one root node")
+            };
+            assert_eq!(root.name(), Some(name));
+            let nodes: Vec<_> = root.children().collect();
             assert_eq!(nodes.len(), g.assembly.instances.len(), "{name}");
-            for (node, inst) in nodes.iter().zip(&g.assembly.instances) {
-                assert_eq!(node.name(), Some(inst.name.as_str()));
+            assert_eq!(doc.nodes().count(), nodes.len() + 1, "{name}");
+            for ((node, inst), n) in nodes.iter().zip(&g.assembly.instances).zip(&s.nodes) {
+                assert_eq!(node.name(), Some(n.name.as_str()));
                 let extras: serde_json::Value =
                     serde_json::from_str(node.extras().as_ref().unwrap().get()).unwrap();
+                assert_eq!(extras["instance"], inst.name.as_str());
                 assert_eq!(extras["piece"], g.pieces[inst.piece].name.as_str());
                 assert_eq!(
                     extras["state"],
@@ -161,7 +173,8 @@ fn glb_and_gltf_read_back_with_the_assemblys_nodes_names_and_triangles() {
                     triangles += indices.len() / 3;
                 }
             }
-            assert_eq!(triangles, s.triangle_count(), "{name}");
+            // Each shared mesh is written once.
+            assert_eq!(triangles, s.mesh_triangle_count(), "{name}");
         }
     }
 }
@@ -189,8 +202,9 @@ fn obj_loads_in_tobj_with_every_triangle_and_material() {
         assert_eq!(faces, s.triangle_count(), "{name}");
         let names: std::collections::BTreeSet<&str> =
             models.iter().map(|m| m.name.as_str()).collect();
-        for inst in &g.assembly.instances {
-            assert!(names.contains(inst.name.as_str()), "{name}: {}", inst.name);
+        assert_eq!(s.nodes.len(), g.assembly.instances.len(), "{name}");
+        for node in &s.nodes {
+            assert!(names.contains(node.name.as_str()), "{name}: {}", node.name);
         }
     }
 }
@@ -237,6 +251,12 @@ fn extruded_proxies_keep_their_heights_when_the_floor_plan_deforms() {
         hs
     });
     assert_eq!(solid, vec![2.0, 8.0]);
-    // The flat proxy is the second layer: thickness plus one layer step.
-    assert_eq!(flat, vec![0.0, (options.thickness + options.layer) as f32]);
+    // The flat proxy is the second layer: one layer step up, its bottom and its top.
+    assert_eq!(
+        flat,
+        vec![
+            options.layer as f32,
+            (options.thickness + options.layer) as f32
+        ]
+    );
 }
