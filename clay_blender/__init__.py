@@ -1,8 +1,10 @@
 """Clay grammars in Blender: File > Import > Clay grammar (.clay).
 
 A grammar (and, optionally, a sculpting script) is imported as one collection: an object per
-instance at its own pivot (the instance's centroid), named as in ``clayc export``'s glTF
-(``wall[3]``), one material per fill colour, heights as ``clayc export`` gives them (metres,
+instance at its own pivot (the instance's centroid) and turned as its rest state is, named as
+in ``clayc export``'s glTF (``wall_n_4``, the fifth brick of chain ``wall_n``; custom
+properties ``clay_instance``, ``clay_piece``, ``clay_state``, ``clay_chain``, ``clay_index``),
+identical instances sharing one mesh, one material per fill colour, heights as ``clayc export`` gives them (metres,
 z up). The grammar's parameters become properties of the collection (Properties > Collection
 > Clay); Reload re-reads the grammar, with those values, and its script.
 
@@ -17,7 +19,6 @@ bl_info = {
     "blender": (4, 2, 0),
     "location": "File > Import > Clay grammar (.clay); Properties > Collection > Clay",
     "description": "Import a Clay structured-shape grammar, sculpted by a script, as a collection",
-    "doc_url": "https://example.invalid/clay/docs/blender.md",
     "category": "Import-Export",
 }
 
@@ -79,24 +80,20 @@ def material_for(colour):
     return mat
 
 
-def mesh_object(node, collection):
-    """One instance as an object at its centroid, its primitives one mesh, a material each."""
+def mesh_data(node):
+    """The node's primitives as one Blender mesh in the node's frame, a material each."""
     import numpy as np
 
-    cx, cy = node.centroid
-    if not (np.isfinite(cx) and np.isfinite(cy)):
-        cx, cy = 0.0, 0.0
-    pivot = np.array([cx, cy, 0.0], dtype=np.float64)
     verts, faces, slots = [], [], []
     base = 0
     for k, prim in enumerate(node.primitives):
-        p = np.asarray(prim.positions, dtype=np.float64) - pivot
+        p = np.asarray(prim.positions, dtype=np.float64)
         t = np.asarray(prim.triangles, dtype=np.int64) + base
         verts.append(p)
         faces.append(t)
         slots.append(np.full(len(t), k, dtype=np.int32))
         base += len(p)
-    mesh = bpy.data.meshes.new(node.name)
+    mesh = bpy.data.meshes.new(node.mesh or node.name)
     if verts:
         v = np.concatenate(verts)
         f = np.concatenate(faces)
@@ -107,11 +104,33 @@ def mesh_object(node, collection):
         mesh.polygons.foreach_set("use_smooth", np.zeros(len(f), dtype=bool))
         mesh.validate()
         mesh.update()
+    return mesh
+
+
+def mesh_object(node, collection, meshes):
+    """One instance as an object at its pivot, turned as the export's node, with the node's
+    shared mesh (`meshes`: the meshes made so far, by name)."""
+    import math
+
+    mesh = meshes.get(node.mesh) if node.mesh is not None else None
+    if mesh is None:
+        mesh = mesh_data(node)
+        if node.mesh is not None:
+            meshes[node.mesh] = mesh
     obj = bpy.data.objects.new(node.name, mesh)
-    obj.location = (cx, cy, 0.0)
+    x, y = node.pivot
+    turn = node.rotation
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(turn)):
+        x, y, turn = 0.0, 0.0, 0.0
+    obj.location = (x, y, 0.0)
+    obj.rotation_euler = (0.0, 0.0, turn)
+    obj["clay_instance"] = node.instance
     obj["clay_piece"] = node.piece
     obj["clay_state"] = node.state
     obj["clay_id"] = node.id
+    if node.chain is not None:
+        obj["clay_chain"] = node.chain
+        obj["clay_index"] = node.index
     collection.objects.link(obj)
     return obj
 
@@ -141,8 +160,9 @@ def build(collection, path, script, params, thickness):
         bpy.data.objects.remove(obj, do_unlink=True)
         if mesh is not None and mesh.users == 0:
             bpy.data.meshes.remove(mesh)
+    meshes = {}
     for node in nodes:
-        mesh_object(node, collection)
+        mesh_object(node, collection, meshes)
     collection[PATH] = str(path)
     collection[SCRIPT] = str(script or "")
     collection[THICKNESS] = float(thickness)

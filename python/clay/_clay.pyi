@@ -173,7 +173,7 @@ class Primitive:
         """Shape (m, 3), counter-clockwise seen from outside."""
 
 class SceneNode:
-    """One instance's 3D meshes, named as ``clayc export`` names its node."""
+    """One instance's 3D meshes as ``clayc export`` writes its node: name, pivot, turn, mesh."""
 
     @property
     def name(self) -> str: ...
@@ -184,10 +184,26 @@ class SceneNode:
     @property
     def id(self) -> int: ...
     @property
-    def centroid(self) -> tuple[float, float]:
-        """The instance's centroid (x, y): a pivot for the node."""
+    def instance(self) -> str:
+        """The instance's name in the model (``wall[3]``), as ``Session.instances`` has it."""
     @property
-    def primitives(self) -> list[Primitive]: ...
+    def chain(self) -> str | None:
+        """The stretch chain's name in the export (``wall_n``), or None."""
+    @property
+    def index(self) -> int | None:
+        """The instance's place in its chain (0 at its ``from`` end), or None."""
+    @property
+    def pivot(self) -> tuple[float, float]:
+        """Where the node stands (x, y), metres: the centroid of the instance's vertices."""
+    @property
+    def rotation(self) -> float:
+        """The node's turn about the vertical, radians, counter-clockwise from above."""
+    @property
+    def mesh(self) -> str | None:
+        """The shared mesh's name (``brick__rest``); nodes with one mesh have equal primitives."""
+    @property
+    def primitives(self) -> list[Primitive]:
+        """In the node's frame: a point ``p`` is at ``pivot + R(rotation) p[:2]``, height ``p[2]``."""
 
 class Session:
     """A sculpting session on a grammar's model; the script vocabulary as methods.

@@ -118,15 +118,30 @@ pub struct Primitive {
     pub triangles: Py<PyAny>,
 }
 
-/// One instance's 3D meshes, as `clayc export` writes its node (same name).
+/// One instance's 3D meshes, as `clayc export` writes its node: the same name, pivot, turn
+/// and local geometry.
 #[pyclass(module = "clay", frozen, get_all)]
 pub struct SceneNode {
+    /// The export's node name: letters, digits and `_`, unique (`wall_n_4`, `gate_0`).
     pub name: String,
+    /// The instance's name in the model (`wall[3]`, `wall#12`), as `Session.instances` has it.
+    pub instance: String,
     pub piece: String,
     pub state: String,
     pub id: u64,
-    /// The instance's centroid (x, y) in metres: a pivot for the node.
-    pub centroid: (f64, f64),
+    /// The stretch chain's name in the export (`wall_n`), or `None`.
+    pub chain: Option<String>,
+    /// The instance's place in that chain (0 at its `from` end), or `None`.
+    pub index: Option<usize>,
+    /// Where the node stands (x, y) in metres: the centroid of the instance's vertices.
+    pub pivot: (f64, f64),
+    /// The node's turn about the vertical, radians, counter-clockwise seen from above.
+    pub rotation: f64,
+    /// The shared mesh's name (`brick__rest`): nodes with the same mesh have the same
+    /// primitives, `None` for an instance without geometry.
+    pub mesh: Option<String>,
+    /// In the node's frame: a point `p` of a primitive is at `pivot + R(rotation) p[:2]`,
+    /// height `p[2]`.
     pub primitives: Vec<Py<Primitive>>,
 }
 
@@ -709,27 +724,21 @@ impl Session {
     }
 
     /// The model's 3D meshes as `clayc export` builds them, for a host application (the
-    /// Blender add-on): one clay.SceneNode per instance, in the instances' order, each with
-    /// one clay.Primitive per fill colour, in metres with z up.
+    /// Blender add-on): one clay.SceneNode per instance, in the instances' order, each at its
+    /// pivot and turned as the export's node, with one clay.Primitive per fill colour in the
+    /// node's frame, in metres with z up.
     #[pyo3(signature = (thickness = None))]
     fn scene(&self, py: Python<'_>, thickness: Option<f64>) -> PyResult<Vec<SceneNode>> {
         let options = export_options(thickness)?;
-        let (built, centroids) = py.detach(|| {
+        let built = py.detach(|| {
             guard("the scene", || {
                 let st = self.lock()?;
-                let built = scene(&self.grammar, st.asm.data(), &options);
-                let centroids: Vec<(f64, f64)> = (0..built.nodes.len())
-                    .map(|i| {
-                        st.asm
-                            .instance_centroid(i)
-                            .map_or((f64::NAN, f64::NAN), |c| (c.x, c.y))
-                    })
-                    .collect();
-                Ok((built, centroids))
+                Ok(scene(&self.grammar, st.asm.data(), &options))
             })
         })?;
+        let mesh_names: Vec<&str> = built.meshes.iter().map(|m| m.name.as_str()).collect();
         let mut nodes = Vec::with_capacity(built.nodes.len());
-        for (node, centroid) in built.nodes.into_iter().zip(centroids) {
+        for node in built.nodes {
             let mut primitives = Vec::with_capacity(node.primitives.len());
             for p in node
                 .primitives
@@ -754,12 +763,24 @@ impl Session {
                     },
                 )?);
             }
+            let (chain, index) = match node.chain {
+                Some(c) => (Some(c.name), Some(c.index)),
+                None => (None, None),
+            };
             nodes.push(SceneNode {
                 name: node.name,
+                instance: node.instance,
                 piece: node.piece,
                 state: node.state,
                 id: node.id,
-                centroid,
+                chain,
+                index,
+                pivot: (node.pivot.x, node.pivot.y),
+                rotation: node.turn.y.atan2(node.turn.x),
+                mesh: node
+                    .mesh
+                    .and_then(|m| mesh_names.get(m))
+                    .map(|m| m.to_string()),
                 primitives,
             });
         }

@@ -405,11 +405,15 @@ def test_exports_load(grammars, tmp_path):
     chunk_len, chunk_type = struct.unpack("<I4s", glb[12:20])
     doc = json.loads(glb[20 : 20 + chunk_len])
     assert chunk_type == b"JSON"
-    names = [n["name"] for n in doc["nodes"]]
-    assert names == [i.name for i in s.instances]
+    # One root named after the grammar; its children the instances, in order, each naming
+    # its instance in extras.
+    [root] = doc["scenes"][0]["nodes"]
+    assert doc["nodes"][root]["name"] == "castle"
+    children = [doc["nodes"][k] for k in doc["nodes"][root]["children"]]
+    assert [c["extras"]["instance"] for c in children] == [i.name for i in s.instances]
     gltf = json.loads((tmp_path / "castle.gltf").read_text())
     assert gltf["asset"]["version"] == "2.0"
-    assert len(gltf["nodes"]) == len(s.instances)
+    assert len(gltf["nodes"]) == len(s.instances) + 1
     assert (tmp_path / "castle.mtl").is_file()
     obj = (tmp_path / "castle.obj").read_text()
     assert "mtllib castle.mtl" in obj
@@ -432,15 +436,58 @@ def test_export_errors(grammars, tmp_path):
         s.export(tmp_path / "wall.glb", thickness=-1)
 
 
-def test_the_scene_is_the_exports_meshes_with_z_up(grammars, tmp_path):
+def test_the_scene_is_the_exports_nodes_and_meshes_with_z_up(grammars, tmp_path):
     s = clay.Session(clay.Grammar.open(grammars / "keep.clay"))
     nodes = s.scene()
-    assert [n.name for n in nodes] == [i.name for i in s.instances]
+    assert [n.instance for n in nodes] == [i.name for i in s.instances]
     s.export(tmp_path / "keep.gltf")
     doc = json.loads((tmp_path / "keep.gltf").read_text())
-    # The glTF's accessor bounds are y-up (x, height, -north); the scene's z-up.
+    # The glTF's root has one child per instance, in the instances' order: same name, the
+    # translation at the pivot (y up: x, 0, -north) and the turn about y.
+    [root] = doc["scenes"][0]["nodes"]
+    children = [doc["nodes"][k] for k in doc["nodes"][root]["children"]]
+    assert [c["name"] for c in children] == [n.name for n in nodes]
+    for n, c in zip(nodes, children):
+        x, y, z = c.get("translation", [0, 0, 0])
+        assert (x, -z, y) == pytest.approx((*n.pivot, 0), abs=1e-9)
+        q = c.get("rotation", [0, 0, 0, 1])
+        assert 2 * math.atan2(q[1], q[3]) == pytest.approx(n.rotation, abs=1e-9)
+        assert c["extras"]["piece"] == n.piece and c["extras"]["state"] == n.state
+        assert c["extras"].get("chain") == n.chain and c["extras"].get("index") == n.index
+        if n.mesh is not None:
+            assert doc["meshes"][c["mesh"]]["name"] == n.mesh
+    # A point of a primitive is placed by its node: the walls' bricks lie along their chains
+    # in world space, and nodes of one mesh have the same primitives.
+    by_mesh = {}
+    for n in nodes:
+        for p in n.primitives:
+            by_mesh.setdefault((n.mesh, p.colour), []).append(p.positions)
+    for arrays in by_mesh.values():
+        assert all(np.array_equal(a, arrays[0]) for a in arrays)
+    # A point of a primitive placed by its node is where the OBJ export (which writes world
+    # coordinates, y up: x, height, -north) has it.
+    s.export(tmp_path / "keep.obj")
+    obj_vertices, current = {}, None
+    for line in (tmp_path / "keep.obj").read_text().splitlines():
+        if line.startswith("o "):
+            current = obj_vertices.setdefault(line[2:].strip(), [])
+        elif line.startswith("v "):
+            current.append([float(v) for v in line.split()[1:4]])
+    for n in nodes:
+        c, sn = math.cos(n.rotation), math.sin(n.rotation)
+        world = [
+            np.column_stack([np.array(n.pivot) + local[:, :2] @ np.array([[c, sn], [-sn, c]]), local[:, 2]])
+            for local in (p.positions.astype(np.float64) for p in n.primitives)
+        ]
+        world = np.concatenate(world) if world else np.zeros((0, 3))
+        expected = np.array(obj_vertices.get(n.name, []), dtype=np.float64).reshape(-1, 3)
+        expected = expected[:, [0, 2, 1]] * [1, -1, 1]
+        assert world.shape == expected.shape, n.name
+        assert world == pytest.approx(expected, abs=1e-4), n.name
+    # The glTF's accessor bounds are y-up (x, height, -north); the scene's z-up; a shared mesh
+    # is written once.
     tops = [doc["accessors"][p["attributes"]["POSITION"]]["max"][1] for m in doc["meshes"] for p in m["primitives"]]
-    zs = [float(p.positions[:, 2].max()) for n in nodes for p in n.primitives]
+    zs = [float(ps[0][:, 2].max()) for ps in by_mesh.values()]
     assert sorted(zs) == pytest.approx(sorted(tops), abs=1e-6)
     prim = next(p for n in nodes for p in n.primitives)
     assert prim.positions.dtype == np.float32 and prim.positions.shape[1] == 3
