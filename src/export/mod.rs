@@ -2,7 +2,7 @@
 //! Export). Paper 6: "the computed deformation only affects two out of three coordinates (the
 //! floor-plan, leaving the height unchanged)": every proxy of every instance is posed exactly
 //! as the renderer poses it (`render::pose`), then extruded between its base and top heights
-//! into a closed solid ([`solid`]). Flat proxy geometry gets a small default thickness so
+//! into a closed solid (`solid.rs`). Flat proxy geometry gets a small default thickness so
 //! nothing is invisible, each later proxy of a piece a little higher than the one before (as it
 //! is drawn on top in 2D). A mesh asset (`mesh "tower.glb"`) is written as its own triangles,
 //! every vertex at its posed floor-plan point and the height it has in the asset.
