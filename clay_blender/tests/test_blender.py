@@ -94,6 +94,39 @@ def test_reload_rebuilds_from_the_file_and_keeps_the_collection():
     assert not [o for o in bpy.data.objects if o.users == 0]
 
 
+def test_an_exported_glb_imports_with_an_origin_per_instance(tmp_path):
+    """Issue 40: Blender's own glTF importer reads `clayc export`'s file as a root with an
+    object per instance at its pivot, named as the export names it, identical instances
+    sharing one mesh, and the same world-space geometry as the add-on's import."""
+    fresh_file()
+    session = clay.Session(clay.Grammar.open(CASTLE))
+    session.run_script(CASTLE_SCRIPT)
+    glb = tmp_path / "castle.glb"
+    session.export(glb)
+    assert bpy.ops.import_scene.gltf(filepath=str(glb)) == {"FINISHED"}
+    nodes = {n.name: n for n in session.scene()}
+    [root] = [o for o in bpy.data.objects if o.parent is None]
+    assert root.name == "castle"
+    children = [o for o in bpy.data.objects if o.parent == root]
+    assert sorted(o.name for o in children) == sorted(nodes)
+    for obj in children:
+        node = nodes[obj.name]
+        w = obj.matrix_world.translation
+        assert (w.x, w.y, w.z) == pytest.approx((*node.pivot, 0), abs=1e-4)
+        assert obj["instance"] == node.instance and obj["piece"] == node.piece
+        assert obj.get("index") == node.index
+    assert len({tuple(round(c, 3) for c in o.matrix_world.translation) for o in children}) == len(
+        children
+    ), "two instances at one origin"
+    assert len({o.data.name for o in children}) == len({n.mesh for n in nodes.values()})
+    imported = bounds(children)
+    bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
+    [coll] = clay_collections()
+    added = bounds(list(coll.objects))
+    for a, b in zip(imported, added):
+        assert a == pytest.approx(b, abs=1e-4)
+
+
 FENCE = """\
 param bays = 4 in 2..12
 param width = 1 in 0.5..2
