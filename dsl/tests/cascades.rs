@@ -101,3 +101,88 @@ fn a_frequency_out_of_range_is_one_error_not_also_a_wrong_sum() {
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].0, "E013", "{e:?}");
 }
+
+/// The fixture `tests/fixtures/invalid/NAME.clay`.
+fn fixture(name: &str) -> String {
+    std::fs::read_to_string(format!(
+        "{}/../tests/fixtures/invalid/{name}.clay",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+#[test]
+fn a_misspelt_name_in_a_stretch_piece_is_one_error_not_also_a_variant_shape() {
+    for (name, message) in [
+        ("E011-variant-site-type", "unknown site type `rial`"),
+        (
+            "E011-variant-edge-vertex",
+            "unknown vertex `tx` in piece `sleeper`",
+        ),
+    ] {
+        let e = errors(&fixture(name));
+        assert_eq!(e.len(), 1, "{name}: {e:?}");
+        assert_eq!(e[0].0, "E011", "{name}: {e:?}");
+        assert!(e[0].1.contains(message), "{name}: {e:?}");
+    }
+}
+
+#[test]
+fn a_misspelt_name_in_a_variant_is_one_error_not_also_a_variant_shape() {
+    let src = fixture("E011-variant-site-type").replacen("rial", "rail", 1);
+    // The same typo in the variant `worn` (its second `west` site line) instead.
+    let at = src.find("piece worn").unwrap();
+    let src = format!(
+        "{}{}",
+        &src[..at],
+        src[at..].replacen("west: rail", "west: rial", 1)
+    );
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E011", "{e:?}");
+    let src = fixture("E011-variant-edge-vertex").replacen("tx-ne", "sw-ne", 1);
+    let at = src.find("piece worn").unwrap();
+    let src = format!("{}{}", &src[..at], src[at..].replacen("sw-ne", "sw-tx", 1));
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E011", "{e:?}");
+}
+
+#[test]
+fn a_variant_of_another_shape_is_still_reported_when_its_piece_is_whole() {
+    // The control: without the typo, an edge the variant lacks is E041.
+    let src = fixture("E011-variant-edge-vertex").replacen("tx-ne", "sw-ne", 1);
+    let at = src.find("piece worn").unwrap();
+    let src = format!("{}{}", &src[..at], src[at..].replacen(", sw-ne", "", 1));
+    let e = errors(&src);
+    assert_eq!(e.len(), 1, "{e:?}");
+    assert_eq!(e[0].0, "E041", "{e:?}");
+    assert!(e[0].1.contains("variant `worn`"), "{e:?}");
+}
+
+#[test]
+fn a_misspelt_vertex_in_edges_is_one_error_not_also_a_state_with_other_edges() {
+    // A state restating the piece's edges, written right, and the piece's own line with a typo
+    // (and the other way round): one E011, no E021.
+    let state = "    state tall {\n        sw (0, 0) se (1, 0) ne (1, 1) nw (0, 1)\n        \
+                 edges sw-se-ne-nw-sw, sw-ne\n    }\n}";
+    let piece = fixture("E011-variant-edge-vertex");
+    let end = piece.find("\n}\n").unwrap();
+    let one = format!(
+        "site type rail\n{}{}\n\nmodel {{\n    s = sleeper\n}}\n",
+        &piece[piece.find("piece sleeper").unwrap()..end],
+        &format!("\n{state}")
+    );
+    let e = errors(&one);
+    assert_eq!(e.len(), 1, "{one}\n{e:?}");
+    assert_eq!(e[0].0, "E011", "{e:?}");
+    let other = one.replacen("tx-ne", "sw-ne", 1).replacen(
+        "edges sw-se-ne-nw-sw, sw-ne\n    }",
+        "edges sw-se-ne-nw-sw, tx-ne\n    }",
+        1,
+    );
+    assert_ne!(other, one);
+    let e = errors(&other);
+    assert_eq!(e.len(), 1, "{other}\n{e:?}");
+    assert_eq!(e[0].0, "E011", "{e:?}");
+}

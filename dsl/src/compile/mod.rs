@@ -245,6 +245,11 @@ pub(crate) struct PieceSpans {
     pub sound: bool,
     /// Sites declared with errors (already reported): a later use of one is not "unknown".
     pub failed_sites: Vec<String>,
+    /// A vertex, edge or site written in the piece was dropped for an error reported there (an
+    /// unknown vertex or site type, say): the piece is not the shape its author wrote, so no
+    /// comparison of its shape with another's (a variant's, E041; a restated edge list's,
+    /// E021) is reported on top of that error.
+    pub partial: bool,
     /// A piece extending one that failed (extends.rs): nothing is reported about it.
     pub poisoned: bool,
 }

@@ -39,6 +39,7 @@ impl Compiler {
             if let PieceStmt::Vertex(v) = s {
                 if let Some(i) = piece.vertices.iter().position(|n| *n == v.name.name) {
                     self.duplicate("vertex", &v.name, spans.vertices[i]);
+                    spans.partial = true;
                     continue;
                 }
                 piece.vertices.push(v.name.name.clone());
@@ -64,12 +65,15 @@ impl Compiler {
             match s {
                 PieceStmt::Edges(e) => {
                     let mut edges = std::mem::take(&mut piece.edges);
-                    self.edges(&piece, e, &mut edges, &mut edge_spans);
+                    if !self.edges(&piece, e, &mut edges, &mut edge_spans) {
+                        spans.partial = true;
+                    }
                     piece.edges = edges;
                 }
                 PieceStmt::Site(site) => {
                     if let Some(i) = piece.sites.iter().position(|x| x.name == site.name.name) {
                         self.duplicate("site", &site.name, spans.sites[i]);
+                        spans.partial = true;
                         continue;
                     }
                     match self.site(&piece, site) {
@@ -77,7 +81,10 @@ impl Compiler {
                             piece.sites.push(compiled);
                             spans.sites.push(site.name.span);
                         }
-                        None => spans.failed_sites.push(site.name.name.clone()),
+                        None => {
+                            spans.failed_sites.push(site.name.name.clone());
+                            spans.partial = true;
+                        }
                     }
                 }
                 PieceStmt::Axis(a) => {
@@ -266,16 +273,20 @@ impl Compiler {
     }
 
     /// Adds the edges of one `edges` statement, reporting unknown vertices, loops and repeats.
+    /// False when an edge written was dropped for an error (an unknown vertex, a loop); a
+    /// repeat is only a warning and drops nothing.
     pub(super) fn edges(
         &mut self,
         piece: &Piece,
         e: &syntax::EdgesDecl,
         edges: &mut Vec<[usize; 2]>,
         spans: &mut Vec<Span>,
-    ) {
+    ) -> bool {
+        let mut whole = true;
         for path in &e.paths {
             let ids: Vec<Option<usize>> =
                 path.iter().map(|v| self.vertex_index(piece, v)).collect();
+            whole &= ids.iter().all(Option::is_some);
             for k in 0..path.len().saturating_sub(1) {
                 let (Some(a), Some(b)) = (ids[k], ids[k + 1]) else {
                     continue;
@@ -291,6 +302,7 @@ impl Compiler {
                         )
                         .with_hint("remove the repeated vertex from the path"),
                     );
+                    whole = false;
                     continue;
                 }
                 if let Some(i) = edges
@@ -317,6 +329,7 @@ impl Compiler {
                 spans.push(span);
             }
         }
+        whole
     }
 
     pub(super) fn site(&mut self, piece: &Piece, s: &syntax::SiteDecl) -> Option<Site> {
@@ -630,7 +643,11 @@ impl Compiler {
         for e in &st.edges {
             let mut list = Vec::new();
             let mut espans = Vec::new();
-            self.edges(piece, e, &mut list, &mut espans);
+            // An edge dropped here or in the piece was reported where it was written: the two
+            // lists then differ by that mistake, not by a second one.
+            if !self.edges(piece, e, &mut list, &mut espans) || spans.partial {
+                continue;
+            }
             let key = |[a, b]: [usize; 2]| [a.min(b), a.max(b)];
             let mine: Vec<[usize; 2]> = piece.edges.iter().map(|&e| key(e)).collect();
             let theirs: Vec<[usize; 2]> = list.iter().map(|&e| key(e)).collect();

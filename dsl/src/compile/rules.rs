@@ -305,9 +305,14 @@ impl Compiler {
     }
 
     /// Variants share vertex names (in order), edges and site names (in order) with the piece.
+    /// Silent (and false) when either piece lost a vertex, edge or site to an error reported
+    /// in it: their shapes then differ by that mistake, not by a second one.
     fn same_shape(&mut self, pi: usize, vi: usize, span: Span) -> bool {
         if pi == vi {
             return true;
+        }
+        if self.piece_spans[pi].partial || self.piece_spans[vi].partial {
+            return false;
         }
         let (p, v) = (&self.pieces[pi], &self.pieces[vi]);
         let key = |e: &[usize; 2]| [e[0].min(e[1]), e[0].max(e[1])];
