@@ -3,8 +3,11 @@
 //! idle or hovered, to check the claim that a 10k-part model still redraws at 60 frames per
 //! second (issue 6).
 //!
-//! Run: `cargo bench -p clay-editor --bench drag` (1k and 10k parts), or
-//! `cargo bench -p clay-editor --bench drag -- 2000 20000` for other sizes.
+//! Run: `cargo bench -p clay-editor --bench drag` (the city at 1k and 10k parts, the walls at
+//! 1k, 5k and 10k), or `cargo bench -p clay-editor --bench drag -- walls 2000 20000` for one
+//! model at other sizes. Besides the frame times it prints the drag latency: from a pointer
+//! move to the end of the UI frame that draws the dragged part there (median and p95), and in
+//! which UI frame of the drag the part is grabbed and first drawn moved.
 //!
 //! Each UI frame is what eframe does per frame short of the GPU: one `egui::Context::run_ui`
 //! pass with the real `EditorApp::logic` (hot reload; the solver on the UI thread within its
@@ -64,6 +67,52 @@ struct FrameTime {
     vertices: usize,
 }
 
+/// The models measured: the synthetic city (streets, junctions, one long wall) and a
+/// chain-heavy model of rows of 50-brick walls (`grammars/wall.clay`'s brick, one chain per
+/// row; issue 40 measured 100 such rows trailing the pointer by a second).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Model {
+    City,
+    Walls,
+}
+
+impl Model {
+    fn name(self) -> &'static str {
+        match self {
+            Model::City => "city",
+            Model::Walls => "walls",
+        }
+    }
+
+    fn grammar(self, parts: usize) -> clay_dsl::compiled::CompiledGrammar {
+        match self {
+            Model::City => synthetic::city(parts),
+            Model::Walls => walls(parts),
+        }
+    }
+}
+
+/// Bricks per row of the walls model (49 two-brick parts per row).
+const BRICKS_PER_ROW: usize = 50;
+
+/// `grammars/wall.clay` with its model replaced by enough rows of [`BRICKS_PER_ROW`] bricks,
+/// 1.5 m apart, for about `parts` parts.
+fn walls(parts: usize) -> clay_dsl::compiled::CompiledGrammar {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../grammars/wall.clay");
+    let text = std::fs::read_to_string(path).expect("grammars/wall.clay");
+    let head = &text[..text.find("model {").expect("wall.clay has a model")];
+    let rows = parts.div_ceil(BRICKS_PER_ROW - 1).max(1);
+    let mut source = format!("{head}model {{\n");
+    for r in 0..rows {
+        let y = 1.5 * r as f64;
+        source += &format!("    row{r} = chain brick x {BRICKS_PER_ROW} at (0, {y})\n");
+    }
+    source += "}\n";
+    clay_dsl::compile(&source, "walls.clay")
+        .map(|c| c.grammar)
+        .expect("the walls model compiles")
+}
+
 /// The editor inside a bare egui context, stepped one frame at a time.
 struct Window {
     ctx: egui::Context,
@@ -72,10 +121,10 @@ struct Window {
 }
 
 impl Window {
-    /// The editor on a city of about `parts` parts, fitted in the window.
-    fn city(parts: usize) -> Self {
+    /// The editor on `model` of about `parts` parts, fitted in the window.
+    fn open(model: Model, parts: usize) -> Self {
         let mut app = EditorApp::bundled();
-        app.sculpt = Sculpt::new(Arc::new(synthetic::city(parts)));
+        app.sculpt = Sculpt::new(Arc::new(model.grammar(parts)));
         app.canvas.grammar_changed();
         app.canvas.request_fit();
         Self {
@@ -152,22 +201,53 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// The part nearest the top-right corner of the street grid (the wall lies below `y = 0`), and
-/// the model's diagonal.
-fn corner_part(app: &EditorApp) -> Option<(usize, f64)> {
+/// The part to drag, and the model's diagonal: on the city the part nearest the top-right
+/// corner of the street grid (the wall lies below `y = 0`); on the walls the east end of the
+/// middle row.
+fn part_to_drag(app: &EditorApp, model: Model) -> Option<(usize, f64)> {
     let asm = app.sculpt.assembly();
     let (lo, hi) = asm.data().positions.iter().fold(
         (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
-    let top = asm
-        .data()
-        .positions
-        .iter()
-        .filter(|p| p.y >= 0.0)
-        .fold(DVec2::splat(f64::MIN), |m, &p| m.max(p));
-    let part = asm.part_nearest(top)?;
+    let target = match model {
+        Model::City => asm
+            .data()
+            .positions
+            .iter()
+            .filter(|p| p.y >= 0.0)
+            .fold(DVec2::splat(f64::MIN), |m, &p| m.max(p)),
+        Model::Walls => {
+            let rows = ((hi.y - lo.y) / 1.5).round() as usize + 1;
+            DVec2::new(hi.x, 1.5 * (rows / 2) as f64 + 0.25)
+        }
+    };
+    let part = asm.part_nearest(target)?;
     Some((part, (hi - lo).length()))
+}
+
+/// Drag latency: for each pointer move of the drag (frame `k`, its target `s[k]` along the
+/// drag), the time from the start of frame `k` to the end of the first frame `j >= k` whose
+/// drawn part has come within half a move (or `tol`) of that target (`shown[j]`); moves never
+/// caught up with are left out and counted.
+fn latencies(
+    begin: &[Instant],
+    end: &[Instant],
+    target: &[f64],
+    shown: &[f64],
+    tol: f64,
+) -> (Vec<f64>, usize) {
+    let mut out = Vec::new();
+    let mut missed = 0;
+    for k in 1..target.len() {
+        let slack = (0.5 * (target[k] - target[k - 1]).abs()).max(tol);
+        match (k..shown.len()).find(|&j| shown[j] >= target[k] - slack) {
+            Some(j) => out.push(ms(end[j] - begin[k])),
+            None => missed += 1,
+        }
+    }
+    out.sort_by(f64::total_cmp);
+    (out, missed)
 }
 
 /// Nearest-rank percentile of sorted values.
@@ -218,20 +298,21 @@ fn row(parts: usize, scenario: &str, frames: &[FrameTime]) {
     );
 }
 
-fn run(parts: usize) {
+fn run(model: Model, parts: usize) {
+    let name = model.name();
     let built = Instant::now();
-    let mut w = Window::city(parts);
+    let mut w = Window::open(model, parts);
     let n = w.app.sculpt.data().parts.len();
     let build = built.elapsed();
     let Some((settle_frames, settle_time)) = w.settle() else {
         println!(
-            "{parts:>6} city ({n} parts): did not settle within {} s; skipped",
+            "{parts:>6} {name} ({n} parts): did not settle within {} s; skipped",
             SETTLE_LIMIT.as_secs()
         );
         return;
     };
     eprintln!(
-        "city({parts}): {n} parts, built in {:.0} ms, settled in {settle_frames} UI frames ({:.1} s)",
+        "{name}({parts}): {n} parts, built in {:.0} ms, settled in {settle_frames} UI frames ({:.1} s)",
         ms(build),
         settle_time.as_secs_f64()
     );
@@ -239,8 +320,8 @@ fn run(parts: usize) {
     // Idle: the settled model redrawn with no input (what any repaint costs).
     let idle: Vec<FrameTime> = (0..FRAMES).map(|_| w.frame(Vec::new())).collect();
 
-    let Some((part, diagonal)) = corner_part(&w.app) else {
-        println!("{parts:>6} city: no part to drag");
+    let Some((part, diagonal)) = part_to_drag(&w.app, model) else {
+        println!("{parts:>6} {name}: no part to drag");
         return;
     };
     let centre = w.app.sculpt.assembly().part_centroid(part);
@@ -277,12 +358,46 @@ fn run(parts: usize) {
         }
         t
     };
+    // Per frame of the gesture: when it began and ended, where the pointer's move puts the
+    // part along the drag (world metres from its start), and where the drawn part is.
+    let unit = (w.app.canvas.to_world(to) - w.app.canvas.to_world(from)).normalize_or_zero();
+    let shown_at = |w: &Window| {
+        let asm = w.app.sculpt.assembly();
+        let c = if part < asm.data().parts.len() {
+            asm.part_centroid(part)
+        } else {
+            centre
+        };
+        (c - centre).dot(unit)
+    };
+    let (mut begin, mut end, mut target, mut shown) = (vec![], vec![], vec![0.0], vec![0.0]);
+    begin.push(Instant::now());
     let mut drag = vec![paced(&mut w, vec![button(true)])];
+    end.push(Instant::now());
     let mut grabbed = None;
+    let mut grab_frames = None;
     for k in 1..=FRAMES {
         let at = from + dir * DRAG_START_JUMP + (to - from) * (k as f32 / FRAMES as f32);
+        target.push((w.app.canvas.to_world(at) - w.app.canvas.to_world(from)).dot(unit));
+        begin.push(Instant::now());
         drag.push(paced(&mut w, vec![Event::PointerMoved(at)]));
+        end.push(Instant::now());
+        shown.push(shown_at(&w));
         grabbed = grabbed.or(w.app.sculpt.grabbed());
+        if grab_frames.is_none() && grabbed.is_some() {
+            grab_frames = Some(k);
+        }
+    }
+    // Moves not caught up with by the release get a further second of frames (the pointer
+    // still, at its last place) to be drawn.
+    for _ in 0..60 {
+        if shown.last() >= target.last() {
+            break;
+        }
+        begin.push(Instant::now());
+        paced(&mut w, Vec::new());
+        end.push(Instant::now());
+        shown.push(shown_at(&w));
     }
     let release = Event::PointerButton {
         pos: to + dir * DRAG_START_JUMP,
@@ -291,9 +406,27 @@ fn run(parts: usize) {
         modifiers: Modifiers::NONE,
     };
     drag.push(w.frame(vec![release]));
+    let tol = 1e-3 * diagonal;
+    let (lat, missed) = latencies(&begin, &end, &target, &shown, tol);
+    let first_shown = (1..shown.len()).find(|&j| shown[j] > tol);
+    if lat.is_empty() {
+        println!("{parts:>6} {name}: the part never caught up with the pointer");
+    } else {
+        println!(
+            "{parts:>6} {name:<6} drag latency (pointer move to the part drawn there): median \
+             {:.1} ms, p95 {:.1} ms, max {:.1} ms over {} moves ({missed} never caught up); \
+             grabbed in UI frame {} of the drag, part first drawn moved in frame {}",
+            percentile(&lat, 0.5),
+            percentile(&lat, 0.95),
+            lat[lat.len() - 1],
+            lat.len(),
+            grab_frames.map_or("never".into(), |k| k.to_string()),
+            first_shown.map_or("never".into(), |k| k.to_string()),
+        );
+    }
     let moved = w.app.sculpt.assembly().part_centroid(part) - centre;
     eprintln!(
-        "city({parts}): dragged part {part} (grabbed {grabbed:?}) by {:.0} pt = {:.2} m \
+        "{name}({parts}): dragged part {part} (grabbed {grabbed:?}) by {:.0} pt = {:.2} m \
          ({:.1}% of the {:.0} m model); it moved {:.2} m by the release",
         (to - from).length() + DRAG_START_JUMP,
         step.length(),
@@ -302,7 +435,7 @@ fn run(parts: usize) {
         moved.length(),
     );
     if grabbed.is_none() {
-        println!("{parts:>6} city: the drag grabbed no part; the drag row measures a pan");
+        println!("{parts:>6} {name}: the drag grabbed no part; the drag row measures a pan");
     }
 
     // The canvas re-poses every instance whenever the solver moved the model; timed alone here
@@ -319,7 +452,7 @@ fn run(parts: usize) {
         .collect();
     pose.sort_by(f64::total_cmp);
     eprintln!(
-        "city({parts}): pose_assembly alone (in `ui` on every solver frame): median {:.2} ms",
+        "{name}({parts}): pose_assembly alone (in `ui` on every solver frame): median {:.2} ms",
         percentile(&pose, 0.5)
     );
 
@@ -329,15 +462,21 @@ fn run(parts: usize) {
 }
 
 fn main() {
-    // `cargo bench` passes `--bench`; any number is a part count.
-    let mut sizes: Vec<usize> = std::env::args()
-        .skip(1)
+    // `cargo bench` passes `--bench`; `city` and `walls` choose models, numbers part counts.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut sizes: Vec<usize> = args
+        .iter()
         .filter_map(|a| a.parse().ok())
         .filter(|&n| n >= 10)
         .collect();
-    if sizes.is_empty() {
-        sizes = vec![1_000, 10_000];
+    let mut models: Vec<Model> = [Model::City, Model::Walls]
+        .into_iter()
+        .filter(|m| args.iter().any(|a| a == m.name()))
+        .collect();
+    if models.is_empty() {
+        models = vec![Model::City, Model::Walls];
     }
+    let default_sizes = sizes.is_empty();
     println!(
         "UI frame time (ms, CPU: egui run_ui + tessellate; {BUDGET_MS:.1} ms = 60 fps), \
          {FRAMES} frames per scenario, window {}x{} pt",
@@ -351,7 +490,15 @@ fn main() {
         " parts scene     n  median     p90     max   <16.7 |  logic     ui   tess \
          | sf/UI   complete pass1    l2 |   verts"
     );
-    for parts in sizes {
-        run(parts);
+    for model in models {
+        if default_sizes {
+            sizes = match model {
+                Model::City => vec![1_000, 10_000],
+                Model::Walls => vec![1_000, 5_000, 10_000],
+            };
+        }
+        for &parts in &sizes {
+            run(model, parts);
+        }
     }
 }
