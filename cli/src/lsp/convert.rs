@@ -14,10 +14,6 @@ use clay_dsl::syntax::Span;
 use clay_dsl::{Diagnostic, Severity, SourceMap};
 use lsp_types as lsp;
 
-/// Where the table of diagnostic codes lives; each code's row has the anchor `#e011` (the code
-/// in lower case). The repository address is the workspace's `repository` in `Cargo.toml`.
-pub const CODES_URL: &str = concat!(env!("CARGO_PKG_REPOSITORY"), "/blob/main/docs/language.md");
-
 /// The file-system path of a document, for the compiler (its folder is where `import`s are
 /// read from): a `file://` URI percent-decoded, anything else as it is.
 pub fn file_path(uri: &str) -> String {
@@ -49,11 +45,6 @@ pub fn range(index: &LineIndex, span: Span) -> lsp::Range {
 pub fn span(index: &LineIndex, range: lsp::Range) -> Span {
     let (a, b) = (offset(index, range.start), offset(index, range.end));
     Span::new(a.min(b), a.max(b))
-}
-
-/// The link to a code's row in docs/language.md.
-pub fn code_url(code: &str) -> Option<lsp::Uri> {
-    lsp::Uri::from_str(&format!("{CODES_URL}#{}", code.to_ascii_lowercase())).ok()
 }
 
 /// Characters escaped when a file path becomes a `file://` URI.
@@ -157,7 +148,8 @@ pub fn diagnostic(
             Severity::Warning => lsp::DiagnosticSeverity::WARNING,
         }),
         code: Some(lsp::NumberOrString::String(d.code.to_string())),
-        code_description: code_url(d.code).map(|href| lsp::CodeDescription { href }),
+        // No link: Clay has no public address its docs could be linked at (issue 40).
+        code_description: None,
         source: Some("clay".into()),
         message,
         related_information: (!related.is_empty()).then_some(related),
