@@ -5,8 +5,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::out;
+use crate::params::ParamArgs;
 use clay_dsl::codes::UNREADABLE;
-use clay_dsl::{Diagnostics, Severity, compile_bytes};
+use clay_dsl::{Diagnostics, Severity, compile_bytes_with_options};
 use clay_dsl::{JsonDiagnostic, JsonLabel, JsonPos};
 
 /// How diagnostics are printed.
@@ -27,6 +28,9 @@ pub struct CheckArgs {
     /// Output format of the diagnostics.
     #[arg(long, value_enum, default_value_t = Format::Human)]
     pub format: Format,
+    // Parameter values, the same for every file checked.
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 #[derive(clap::Args)]
@@ -40,6 +44,8 @@ pub struct BuildArgs {
     /// 20 MB compact).
     #[arg(long)]
     pub pretty: bool,
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 /// Colour only on a terminal, and never when NO_COLOR is set (<https://no-color.org>).
@@ -133,6 +139,7 @@ pub fn check(args: CheckArgs) -> u8 {
         files: args.files.len(),
         ..Counts::default()
     };
+    let options = args.params.options();
     for file in &args.files {
         let bytes = match read(file) {
             Ok(b) => b,
@@ -147,7 +154,7 @@ pub fn check(args: CheckArgs) -> u8 {
             }
         };
         let path = file.display().to_string();
-        let diags = match compile_bytes(&bytes, &path) {
+        let diags = match compile_bytes_with_options(&bytes, &path, &options) {
             Ok(c) => c.warnings,
             Err(d) => d,
         };
@@ -232,7 +239,7 @@ pub fn build(args: BuildArgs) -> u8 {
         }
     };
     let path = args.file.display().to_string();
-    let compiled = match compile_bytes(&bytes, &path) {
+    let compiled = match compile_bytes_with_options(&bytes, &path, &args.params.options()) {
         Ok(c) => c,
         Err(diags) => {
             print_human(&diags, &bytes, &path);

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use clay::export::{ExportOptions, gltf, obj, scene};
 
 use crate::out::{IO_ERROR, write_output};
+use crate::params::ParamArgs;
 use crate::render::{load, replay};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -33,6 +34,8 @@ pub struct ExportArgs {
     /// Height given to flat proxy geometry, in metres.
     #[arg(long, default_value_t = ExportOptions::default().thickness, value_parser = parse_thickness)]
     pub thickness: f64,
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 fn parse_thickness(s: &str) -> Result<f64, String> {
@@ -67,7 +70,7 @@ pub fn export(args: ExportArgs) -> u8 {
             return IO_ERROR;
         }
     };
-    let grammar = match load(&args.file) {
+    let grammar = match load(&args.file, &args.params) {
         Ok(g) => g,
         Err(code) => return code,
     };

@@ -16,6 +16,7 @@ mod check;
 mod export;
 mod fmt;
 mod lsp;
+mod params;
 mod render;
 mod run;
 

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::out;
+use crate::params::ParamArgs;
 
 use clay::assembly::{Assembly, HandleKind};
 use clay::render::{Overlays, RenderOptions, render_png, render_svg, sheet_png, sheet_svg};
@@ -53,6 +54,8 @@ pub struct RenderArgs {
     /// shown, PNG only, no overlays).
     #[arg(long, value_enum, default_value_t = ViewKind::Plan)]
     pub view: ViewKind,
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -99,8 +102,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 const INPUT_ERROR: u8 = 1;
 use crate::out::IO_ERROR;
 
-/// Loads and compiles a grammar; on failure prints why and gives the exit code.
-pub(crate) fn load(path: &Path) -> Result<CompiledGrammar, u8> {
+/// Loads and compiles a grammar with the parameter values `params`; on failure prints why and
+/// gives the exit code. A compiled grammar (.json) has its parameters' values already: giving
+/// it `--param` is a usage error.
+pub(crate) fn load(path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u8> {
     let source = std::fs::read_to_string(path).map_err(|e| {
         errln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
@@ -109,20 +114,28 @@ pub(crate) fn load(path: &Path) -> Result<CompiledGrammar, u8> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     {
+        if !params.is_empty() {
+            errln!(
+                "error: --param sets the parameters of a grammar (.clay) as it is compiled; {} is \
+                 compiled already (build it again with `clayc build --param`)",
+                path.display()
+            );
+            return Err(IO_ERROR);
+        }
         return serde_json::from_str(&source).map_err(|e| {
             errln!("error: {} is not a compiled grammar: {e}", path.display());
             INPUT_ERROR
         });
     }
-    compile(&source, path)
+    compile(&source, path, params)
 }
 
-fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, u8> {
+fn compile(source: &str, path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u8> {
     let name = path.display().to_string();
     // Colour only on a terminal that has not opted out.
     let color = std::io::IsTerminal::is_terminal(&std::io::stderr())
         && std::env::var_os("NO_COLOR").is_none();
-    match clay_dsl::compile(source, &name) {
+    match clay_dsl::compile_with_options(source, &name, &params.options()) {
         Ok(compiled) => {
             err!(
                 "{}",
@@ -182,7 +195,7 @@ pub fn render(args: RenderArgs) -> u8 {
         errln!("error: the iso view is a PNG without overlays: drop --svg, .svg and --overlay");
         return IO_ERROR;
     }
-    let grammar = match load(&args.file) {
+    let grammar = match load(&args.file, &args.params) {
         Ok(g) => g,
         Err(code) => return code,
     };
@@ -246,7 +259,7 @@ pub fn render(args: RenderArgs) -> u8 {
 }
 
 pub fn sheet(args: SheetArgs) -> u8 {
-    let grammar = match load(&args.file) {
+    let grammar = match load(&args.file, &ParamArgs::default()) {
         Ok(g) => g,
         Err(code) => return code,
     };

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::out;
+use crate::params::ParamArgs;
 use clay::assembly::Assembly;
 use clay::script::{Script, ScriptError};
 use clay::session::{Session, configure, replay};
@@ -23,6 +24,8 @@ pub struct RunArgs {
     /// irls_iterations, l2_iterations, l2_anderson, handle_weight, solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    #[command(flatten)]
+    pub params: ParamArgs,
 }
 
 /// The message for a malformed script: `error: FILE:LINE:COLUMN: step N: ...` and its hint.
@@ -56,13 +59,14 @@ pub fn run(args: RunArgs) -> u8 {
         },
     };
     let text = String::from_utf8_lossy(&source);
-    let compiled = match clay_dsl::compile_bytes(&source, &path) {
-        Ok(c) => c,
-        Err(diagnostics) => {
-            err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
-            return 1;
-        }
-    };
+    let compiled =
+        match clay_dsl::compile_bytes_with_options(&source, &path, &args.params.options()) {
+            Ok(c) => c,
+            Err(diagnostics) => {
+                err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
+                return 1;
+            }
+        };
     if !compiled.warnings.items.is_empty() {
         err!(
             "{}",

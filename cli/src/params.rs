@@ -1,0 +1,85 @@
+//! `--param NAME=VALUE` (issue 39): values for a grammar's `param` declarations, given to
+//! `clayc check`, `build`, `run`, `render` and `export`. The flag only reads the pair; whether
+//! the grammar has such a parameter and whether the value is in its range is the compiler's
+//! judgement (E070, E071), reported as every other diagnostic is.
+
+use clay_dsl::CompileOptions;
+
+/// The `--param` flag, flattened into each subcommand's arguments.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct ParamArgs {
+    /// Set a grammar parameter (`param NAME = ... in LO..HI`) to a number; repeatable, the
+    /// last value of a name counts. A name the grammar does not declare (E070) or a value
+    /// outside its range (E071) is an error.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    pub params: Vec<(String, f64)>,
+}
+
+impl ParamArgs {
+    /// The compile options that set these parameters (the file system as loader).
+    pub fn options(&self) -> CompileOptions<'static> {
+        CompileOptions {
+            params: self.params.clone(),
+            ..CompileOptions::default()
+        }
+    }
+
+    /// Whether no parameter was given.
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+}
+
+/// `NAME=VALUE`, a name and a finite number. clap names the flag in its message.
+pub fn parse_param(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{s}` (no `=`)"))?;
+    let (name, value) = (name.trim(), value.trim());
+    let is_name = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !is_name {
+        return Err(format!(
+            "`{name}` is not a parameter name (letters, digits and `_`, not starting with a digit)"
+        ));
+    }
+    let number: f64 = value
+        .parse()
+        .map_err(|_| format!("{name}={value}: the value must be a number"))?;
+    if !number.is_finite() {
+        return Err(format!("{name}={value}: the value must be a finite number"));
+    }
+    Ok((name.to_string(), number))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_param;
+
+    #[test]
+    fn a_pair_is_read_and_mistakes_say_what_is_wrong() {
+        assert_eq!(parse_param("bays=8"), Ok(("bays".to_string(), 8.0)));
+        assert_eq!(parse_param(" w = -1.5e0 "), Ok(("w".to_string(), -1.5)));
+        assert!(parse_param("bays").unwrap_err().contains("no `=`"));
+        assert!(
+            parse_param("=3")
+                .unwrap_err()
+                .contains("not a parameter name")
+        );
+        assert!(
+            parse_param("2x=3")
+                .unwrap_err()
+                .contains("not a parameter name")
+        );
+        assert!(
+            parse_param("bays=lots")
+                .unwrap_err()
+                .contains("must be a number")
+        );
+        assert!(parse_param("bays=inf").unwrap_err().contains("finite"));
+        assert!(parse_param("bays=NaN").unwrap_err().contains("finite"));
+    }
+}
