@@ -922,3 +922,26 @@ fn the_libraries_print_nothing() {
         }
     }
 }
+
+/// Architecture Invariant: no source file is over 900 lines outside its tests (a file has one
+/// job; issue 38). The lines from a top-level `#[cfg(test)]` module on are the file's tests.
+#[test]
+fn no_source_file_is_over_900_lines_outside_its_tests() {
+    let mut files = Vec::new();
+    for dir in ["src", "dsl/src", "editor/src", "cli/src", "python/src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    assert!(files.len() > 100, "only {} files read", files.len());
+    let mut long = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let code = (lines.windows(2))
+            .position(|w| w[0] == "#[cfg(test)]" && w[1].starts_with("mod "))
+            .unwrap_or(lines.len());
+        if code > 900 {
+            long.push(format!("{}: {code} lines", shown(&f)));
+        }
+    }
+    assert!(long.is_empty(), "over 900 lines outside tests: {long:#?}");
+}

@@ -27,6 +27,7 @@ pub mod pieces;
 mod placement;
 pub mod svg;
 pub mod work;
+mod write;
 
 use glam::DVec2;
 
