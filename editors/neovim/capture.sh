@@ -13,15 +13,18 @@ trap 'tmux kill-session -t clay-capture 2>/dev/null || true; rm -rf "$work"' EXI
 awk '/^### Neovim/{n=1} n&&/^```lua$/{p=1;next} p&&/^```$/{exit} p' docs/editors.md > "$work/init.lua"
 echo "vim.keymap.set('n', 'K', vim.lsp.buf.hover)" >> "$work/init.lua"
 sed 's/site west: joint/site west: jiont/' grammars/wall.clay > "$work/wall.clay"
+# The lines of the typo and of the chain whose `brick` is hovered, in the wall.clay of today.
+typo_line=$(grep -n 'site west: jiont' "$work/wall.clay" | cut -d: -f1)
+chain_line=$(grep -n 'chain brick' "$work/wall.clay" | cut -d: -f1)
 cd "$work"
 tmux new-session -d -s clay-capture -x 100 -y 32 \
     "env PATH=$bin:$PATH HOME=$work XDG_STATE_HOME=$work/state XDG_CACHE_HOME=$work/cache \
      CLAY_FOLLOW_DIR=$work/no-follow TERM=xterm-256color nvim -n -i NONE -u init.lua wall.clay"
 sleep 3
-tmux send-keys -t clay-capture ':23' Enter
+tmux send-keys -t clay-capture ":$typo_line" Enter
 sleep 1
 tmux capture-pane -p -t clay-capture > diagnostic.txt
-tmux send-keys -t clay-capture ':37' Enter '018l'
+tmux send-keys -t clay-capture ":$chain_line" Enter '018l'
 sleep 0.5
 tmux send-keys -t clay-capture K
 sleep 2
@@ -30,13 +33,13 @@ tmux capture-pane -p -t clay-capture > hover.txt
     echo "Neovim $(nvim --version | head -1 | cut -d' ' -f2) with \`clayc lsp\`, set up as docs/editors.md says, on"
     echo "grammars/wall.clay with a typo (\`jiont\`), in a 100 x 32 terminal captured with tmux"
     echo "(\`editors/neovim/capture.sh\` makes this file). The E in the sign column and the text after"
-    echo "line 23 are the server's diagnostic E011; then the cursor on \`brick\` of line 37 and K."
+    echo "line $typo_line are the server's diagnostic E011; then the cursor on \`brick\` of line $chain_line and K."
     echo
-    echo "== the diagnostic (cursor on line 23)"
+    echo "== the diagnostic (cursor on line $typo_line)"
     echo
     cat diagnostic.txt
     echo
-    echo "== the hover on \`chain brick\` (line 37, K)"
+    echo "== the hover on \`chain brick\` (line $chain_line, K)"
     echo
     cat hover.txt
 } > "$repo/docs/neovim-session.txt"
