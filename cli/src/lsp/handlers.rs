@@ -3,8 +3,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use clay_dsl::analysis::Analysis;
 use clay_dsl::analysis::follow::Focus;
+use clay_dsl::analysis::{Analysis, CompletionKind};
 use clay_dsl::syntax::Span;
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types as lsp;
@@ -15,6 +15,7 @@ use serde_json::Value;
 
 use super::Document;
 use super::convert;
+use super::params;
 
 type Docs = HashMap<String, Document>;
 type Answer = Result<Value, ResponseError>;
@@ -168,6 +169,12 @@ impl Open<'_> {
         })
     }
 
+    /// The text of the document's last analysis that parsed, if it has one.
+    fn last_parsed_text(&self, uri: &lsp::Uri) -> Option<&str> {
+        let doc = self.0.get(uri.as_str())?;
+        doc.last_parsed.as_deref().map(Analysis::text)
+    }
+
     fn at(&self, p: &lsp::TextDocumentPositionParams) -> Result<At<'_>, ResponseError> {
         let a = self.analysis(&p.text_document.uri)?;
         let offset = convert::offset(a.line_index(), p.position);
@@ -230,14 +237,29 @@ impl Open<'_> {
     }
 
     fn hover(&self, p: lsp::HoverParams) -> Result<Option<lsp::Hover>, ResponseError> {
+        let uri = &p.text_document_position_params.text_document.uri;
         let At { a, offset } = self.at(&p.text_document_position_params)?;
-        Ok(a.hover(offset).map(|(span, markdown)| lsp::Hover {
-            contents: lsp::HoverContents::Markup(lsp::MarkupContent {
-                kind: lsp::MarkupKind::Markdown,
-                value: markdown,
-            }),
-            range: Some(convert::range(a.line_index(), span)),
-        }))
+        // A parameter's hover adds its value, default and range.
+        let param = a.symbol_at(offset).and_then(|i| {
+            let (text, name) = params::symbol_param(a, i)?;
+            let fallback = self.last_parsed_text(uri).filter(|_| text == a.text());
+            let declared = params::declared(text).or_else(|| fallback.and_then(params::declared));
+            declared?.into_iter().find(|p| p.name == name)
+        });
+        Ok(a.hover(offset)
+            .map(|(span, mut markdown)| {
+                if let Some(p) = &param {
+                    markdown += &params::hover(p);
+                }
+                (span, markdown)
+            })
+            .map(|(span, markdown)| lsp::Hover {
+                contents: lsp::HoverContents::Markup(lsp::MarkupContent {
+                    kind: lsp::MarkupKind::Markdown,
+                    value: markdown,
+                }),
+                range: Some(convert::range(a.line_index(), span)),
+            }))
     }
 
     fn definition(
@@ -298,12 +320,27 @@ impl Open<'_> {
         p: lsp::CompletionParams,
     ) -> Result<Option<lsp::CompletionResponse>, ResponseError> {
         let At { a, offset } = self.at(&p.text_document_position)?;
-        let items = a
-            .completions(offset)
+        let completions = a.completions(offset);
+        // The parameters among the constants offered: their detail gives value and range.
+        let visible = if completions
+            .iter()
+            .any(|c| c.kind == CompletionKind::Constant)
+        {
+            params::visible(
+                a,
+                self.last_parsed_text(&p.text_document_position.text_document.uri),
+            )
+        } else {
+            Vec::new()
+        };
+        let items = completions
             .into_iter()
             .map(|c| lsp::CompletionItem {
                 kind: Some(convert::completion_kind(c.kind)),
-                detail: c.detail,
+                detail: (visible.iter())
+                    .find(|p| c.kind == CompletionKind::Constant && p.name == c.label)
+                    .map(params::detail)
+                    .or(c.detail),
                 text_edit: Some(lsp::CompletionTextEdit::Edit(lsp::TextEdit::new(
                     convert::range(a.line_index(), c.replace),
                     c.label.clone(),

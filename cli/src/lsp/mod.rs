@@ -2,7 +2,8 @@
 //!
 //! The questions are answered by `clay_dsl::analysis`; this module only speaks the protocol:
 //! `transport` frames JSON-RPC, `convert` turns byte spans into UTF-16 positions and the
-//! analysis' kinds into the protocol's, `handlers` answers requests. Protocol types live here
+//! analysis' kinds into the protocol's, `handlers` answers requests (`params` adds a grammar
+//! parameter's value, default and range to its hover and completions). Protocol types live here
 //! and nowhere else (docs/architecture.md).
 //!
 //! One thread answers everything in order. Documents are synced whole; a change only stores
@@ -17,6 +18,7 @@
 mod convert;
 mod follow;
 mod handlers;
+mod params;
 mod transport;
 mod worker;
 
