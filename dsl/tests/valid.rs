@@ -423,3 +423,43 @@ fn a_line_index_agrees_with_line_col_at_every_offset() {
         }
     }
 }
+
+#[test]
+fn statements_need_no_line_of_their_own() {
+    // docs/language.md: no terminator, no separator; a line break is whitespace. The doc's
+    // example with every line joined into one (its comment lines dropped), and with a
+    // solver block, `let`s, a listed state and model statements sharing lines too.
+    let example = doc_example();
+    let code: Vec<&str> = example
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect();
+    let (by_lines, one_line) = (code.join("\n"), code.join(" "));
+    assert!(code.len() > 20 && !one_line.contains('\n'));
+    assert_eq!(
+        serde_json::to_value(&ok(&one_line).grammar).unwrap(),
+        serde_json::to_value(&ok(&by_lines).grammar).unwrap()
+    );
+    // `clayc fmt` prints a statement a line, whichever way the text was written.
+    assert_eq!(
+        clay_dsl::format(&one_line).unwrap(),
+        clay_dsl::format(&by_lines).unwrap()
+    );
+    let packed = "let w = 1 let h = 0.5\nsolver { hysteresis = 0.2 norm = 0.6 }\n\
+                  site type joint\n\
+                  piece brick { vertex sw (0, 0) vertex se (w, 0) vertex ne (w, h) vertex nw (0, h)\n\
+                  edges sw-se-ne-nw-sw, sw-ne site west: joint [nw, sw] out (-1, 0)\n\
+                  site east: joint [se, ne] out (1, 0) state tall { sw (0, 0) se (w, 0) ne (w, 1)\n\
+                  nw (0, 1) } }\n\
+                  model { a = brick b = brick at (3, 0) dock a.east to b.west }\n";
+    let c = ok(packed);
+    let g = &c.grammar;
+    assert_eq!(g.solver.hysteresis, 0.2);
+    assert_eq!(g.solver.norm, 0.6);
+    assert_eq!(g.pieces[0].vertices, ["sw", "se", "ne", "nw"]);
+    assert_eq!(g.pieces[0].sites.len(), 2);
+    assert_eq!(g.pieces[0].states.len(), 2);
+    assert_eq!(g.pieces[0].states[1].positions[2], DVec2::new(1.0, 1.0));
+    assert_eq!(g.assembly.instances.len(), 2);
+    assert_eq!(g.assembly.docks.len(), 1);
+}

@@ -157,7 +157,7 @@ fn syntax_hint(source: &str, span: Span, positives: &[Rule]) -> Option<String> {
         ));
     }
     if text == ";" {
-        return Some("a statement ends with its line: remove the `;`".into());
+        return Some("statements need no separator: remove the `;`".into());
     }
     let digit_then_letter = text
         .char_indices()

@@ -510,3 +510,37 @@ test("plist.mjs writes the same grammar as a property list (Sublime Text, TextMa
   const fromPlist = vsctm.parseRawGrammar(toPlist(JSON.parse(grammarText)), "Clay.tmLanguage");
   assert.deepEqual(JSON.parse(JSON.stringify(fromPlist)), json);
 });
+
+test("docs/editors.md's scope table names every scope the grammar gives, and no other", () => {
+  const given = new Set();
+  const walk = (node, top) => {
+    if (Array.isArray(node)) return node.forEach((n) => walk(n, false));
+    if (node === null || typeof node !== "object") return;
+    for (const [key, value] of Object.entries(node)) {
+      if (!top && (key === "name" || key === "contentName") && typeof value === "string") given.add(value);
+      else walk(value, false);
+    }
+  };
+  walk(JSON.parse(grammarText), true);
+  const doc = readFileSync(path.join(root, "docs/editors.md"), "utf8");
+  const table = doc.slice(doc.indexOf("| what | scope |")).split("\n\n")[0].split("\n").slice(2);
+  assert.ok(table.length > 10, "the table's rows");
+  // `keyword.other.WORD.clay` stands for any word, `punctuation.section.*` for any rest.
+  const written = table.flatMap((row) => [...row.split(" | ").at(-1).matchAll(/`([a-z][a-z.*A-Z-]*)`/g)].map((m) => m[1]));
+  const pattern = (w) => new RegExp(`^${w.replaceAll(".", "\\.").replace("WORD", "[a-z-]+").replace("\\.*", "\\..+")}$`);
+  for (const scope of given) {
+    assert.ok(written.some((w) => pattern(w).test(scope)), `${scope} is not in docs/editors.md's table`);
+  }
+  for (const w of written) {
+    assert.ok([...given].some((scope) => pattern(w).test(scope)), `the table's ${w} is no scope of the grammar`);
+  }
+});
+
+test("a second statement on a line is not coloured as one (docs/editors.md)", () => {
+  const text = "piece p {\n    vertex a (0, 0) vertex b (1, 0)\n}\n";
+  expectScope(text, "vertex a", "vertex", "keyword.other.vertex.clay");
+  expectScope(text, "vertex a", "a", "entity.name.variable.vertex.clay", { nth: 0 });
+  expectScope(text, "vertex a", "vertex", "variable.other.clay", { nth: 1 });
+  expectScope(text, "vertex a", "b", "variable.other.clay");
+  expectScope(text, "vertex a", "1", "constant.numeric.decimal.clay");
+});
