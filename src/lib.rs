@@ -8,6 +8,7 @@ pub mod authoring;
 pub mod export;
 pub mod files;
 pub mod fit;
+#[cfg(feature = "testing")]
 pub mod gallery;
 pub mod plane;
 pub mod render;
@@ -16,4 +17,5 @@ pub mod script;
 pub mod session;
 pub mod solver;
 pub mod summary;
+#[cfg(any(test, feature = "testing"))]
 pub mod synthetic;

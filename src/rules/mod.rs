@@ -57,7 +57,8 @@ impl Rules {
 
     /// Applies the rules after one solver frame ([`Rules::after_pass1`] with the frame's
     /// pass-1 pose `pass1`, then [`Rules::after_pass2`]): for tests that drive the rules
-    /// around a frame of their own.
+    /// around a frame of their own (feature `testing`).
+    #[cfg(feature = "testing")]
     pub fn after_frame(
         &mut self,
         asm: &mut Assembly,

@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec2;
 
+pub mod file;
 mod gesture;
 mod settings;
 
@@ -120,7 +121,8 @@ impl Session {
         &self.solver
     }
 
-    /// The rules, for tests that drive them directly between frames.
+    /// The rules, for tests that drive them directly between frames (feature `testing`).
+    #[cfg(feature = "testing")]
     pub fn rules_mut(&mut self) -> Option<&mut Rules> {
         self.rules.as_mut()
     }
