@@ -216,7 +216,7 @@ fn the_iso_view_draws_the_scene_the_same_way_every_time() {
     let a = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
     let b = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
     assert_eq!(a.data(), b.data(), "deterministic");
-    let background = clay::render::draw::BACKGROUND.0;
+    let background = clay::render::BACKGROUND.0;
     let drawn = a.pixels().iter().filter(|p| {
         let c = p.demultiply();
         [c.red(), c.green(), c.blue()] != [background[0], background[1], background[2]]

@@ -1,9 +1,9 @@
 //! The View menu's overlays on the canvas: strain colours, active state names, docking sites,
 //! handles and pins, and part outlines. They are drawn by the same code as `clayc render
-//! --overlay` ([`clay::render::draw::draw_overlays`]) through an egui painter that implements
+//! --overlay` ([`clay::render::draw_overlays`]) through an egui painter that implements
 //! the renderer's [`clay::render::Canvas`], so the editor and the pictures never disagree.
 
-use clay::render::draw::{Overlays, View, draw_overlays};
+use clay::render::{Overlays, View, draw_overlays};
 use clay_dsl::compiled::Rgba;
 use egui::{Color32, Pos2, Rect, Shape, Stroke, Vec2};
 

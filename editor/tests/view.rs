@@ -505,7 +505,7 @@ fn after_fit_the_strain_legend_covers_none_of_the_model() {
     h.step();
     h.step();
     let app = h.state();
-    let [x, y, w, ht] = clay::render::draw::STRAIN_LEGEND;
+    let [x, y, w, ht] = clay::render::STRAIN_LEGEND;
     let legend =
         egui::Rect::from_min_size(app.canvas.rect.min + egui::vec2(x, y), egui::vec2(w, ht));
     assert!(painted_texts(&h).iter().any(|t| t == "strain 0"));

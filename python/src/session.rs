@@ -24,7 +24,7 @@ use crate::grammar::Grammar;
 use crate::{InternalError, SolverError};
 
 /// Largest picture side, as `clayc render --size` allows.
-const MAX_SIDE: u32 = clay::render::raster::MAX_SIDE;
+const MAX_SIDE: u32 = clay::render::MAX_SIDE;
 
 /// The overlays `render_png` draws, as `clayc render --overlay` names them.
 const OVERLAYS: [&str; 5] = ["graph", "sites", "strain", "handles", "states"];

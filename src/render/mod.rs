@@ -1,29 +1,33 @@
 //! Pictures of assemblies (paper 5.2, proxy geometry and skinning): tessellation of each piece's
 //! proxy geometry, posing it into the world, and drawing it with tiny-skia (PNG) or as SVG.
 //!
-//! Data flows one way: [`tessellate`] (once per piece and rest state, cached) -> [`pose`]
-//! (every frame: plain world-space triangles, [`WorldMesh`]) -> [`draw`] (overlays, labels) onto
-//! a [`Canvas`] ([`raster`] or [`svg`]); large meshes are filled by their [`contour`]s. The
+//! Data flows one way: `tessellate.rs` (once per piece and rest state, cached) -> `pose.rs`
+//! (every frame: plain world-space triangles, [`WorldMesh`]) -> `draw.rs` (overlays, labels) onto
+//! a [`Canvas`] (`raster.rs` or `svg.rs`); large meshes are filled by their [`contours`]. The
 //! editor draws the same [`WorldMesh`]es with egui.
 
-pub mod contour;
-pub mod draw;
-pub mod pick;
-pub mod pose;
-pub mod raster;
-pub mod sheet;
-pub mod svg;
-pub mod tessellate;
-pub mod text;
+pub(crate) mod contour;
+pub(crate) mod draw;
+pub(crate) mod pick;
+pub(crate) mod pose;
+pub(crate) mod raster;
+pub(crate) mod sheet;
+pub(crate) mod svg;
+pub(crate) mod tessellate;
+pub(crate) mod text;
 
+// The rendering surface: one public path per name, `clay::render::X`.
+pub use contour::{CONTOUR_MIN_TRIANGLES, contours};
 pub use draw::{
-    Canvas, Overlays, RenderOptions, View, edge_strains, site_type_colour, strain_colour,
+    BACKGROUND, Canvas, Overlays, RenderOptions, STRAIN_FULL, STRAIN_LEGEND, View, bounds,
+    draw_overlays, edge_strains, site_type_colour, strain_colour,
 };
+pub use pick::part_at;
 pub use pose::{
-    RigidMotion, SiteFrame, Skin, WorldMesh, pose_assembly, pose_instance, pose_piece,
-    rigid_motion, site_out,
+    RigidMotion, SiteFrame, Skin, WorldMesh, pose_assembly, pose_assembly_into, pose_instance,
+    pose_piece, rigid_motion, site_out,
 };
-pub use raster::{RenderError, render_pixmap, render_png};
+pub use raster::{MAX_SIDE, PixmapCanvas, RenderError, render_pixmap, render_png};
 pub use sheet::{sheet_pixmap, sheet_png, sheet_svg};
 pub use svg::render_svg;
 pub use tessellate::{
