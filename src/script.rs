@@ -347,6 +347,55 @@ impl Script {
     }
 }
 
+impl Step {
+    /// The step as a script holds it: the inverse of [`Step::from_json`] (numbers written so
+    /// they read back bit for bit).
+    pub fn to_json(&self) -> Value {
+        use serde_json::json;
+        let point = |p: DVec2| json!([p.x, p.y]);
+        let selector = |s: &Selector| match s {
+            Selector::At(p) => json!({"at": point(*p)}),
+            Selector::Extreme(dir) => json!({"extreme": match dir {
+                Compass::East => "east",
+                Compass::West => "west",
+                Compass::North => "north",
+                Compass::South => "south",
+            }}),
+        };
+        match self {
+            Step::Grab(s) => json!({"grab": selector(s)}),
+            Step::Pin(s) => json!({"pin": selector(s)}),
+            Step::Unpin(s) => json!({"unpin": selector(s)}),
+            Step::Drag {
+                motion: Motion::By(d),
+                frames,
+            } => json!({"drag": {"by": point(*d), "frames": frames}}),
+            Step::Drag {
+                motion: Motion::To(p),
+                frames,
+            } => json!({"drag": {"to": point(*p), "frames": frames}}),
+            Step::Rotate { degrees, frames } => {
+                json!({"rotate": {"degrees": degrees, "frames": frames}})
+            }
+            Step::Release => json!({"release": {}}),
+            Step::Hold { frames } => json!({"hold": {"frames": frames}}),
+            Step::Cut { at } => json!({"cut": {"at": point(*at)}}),
+        }
+    }
+}
+
+impl Script {
+    /// The script as JSON text, one step a line (`{"steps": [` ... `]}`), which
+    /// [`Script::parse`] reads back as this script.
+    pub fn to_json(&self) -> String {
+        let steps: Vec<String> = self.steps.iter().map(|s| s.to_json().to_string()).collect();
+        if steps.is_empty() {
+            return "{\"steps\": []}\n".to_string();
+        }
+        format!("{{\"steps\": [\n  {}\n]}}\n", steps.join(",\n  "))
+    }
+}
+
 /// A JSON syntax error at its 1-based line and column. serde_json counts a position at the
 /// start of a line as column 0, and its message ends with that position, which the error
 /// carries apart.
@@ -418,6 +467,47 @@ fn step_offsets(json: &str) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_script_written_as_json_reads_back_as_itself() {
+        let script = Script {
+            steps: vec![
+                Step::Pin(Selector::Extreme(Compass::West)),
+                Step::Grab(Selector::At(DVec2::new(0.1 + 0.2, -1.0 / 3.0))),
+                Step::Drag {
+                    motion: Motion::By(DVec2::new(1e-17, 4.0)),
+                    frames: 1,
+                },
+                Step::Drag {
+                    motion: Motion::To(DVec2::new(-2.5, 1e9)),
+                    frames: 0,
+                },
+                Step::Rotate {
+                    degrees: -(std::f64::consts::PI.to_degrees()),
+                    frames: 3,
+                },
+                Step::Hold { frames: MAX_FRAMES },
+                Step::Release,
+                Step::Unpin(Selector::Extreme(Compass::North)),
+                Step::Pin(Selector::Extreme(Compass::South)),
+                Step::Grab(Selector::Extreme(Compass::East)),
+                Step::Cut {
+                    at: DVec2::new(6.0, 0.0),
+                },
+            ],
+        };
+        let text = script.to_json();
+        assert_eq!(Script::parse(&text), Ok(script.clone()), "{text}");
+        assert_eq!(
+            text.lines().count(),
+            script.steps.len() + 2,
+            "one step a line"
+        );
+        assert_eq!(
+            Script::parse(&Script::default().to_json()),
+            Ok(Script::default())
+        );
+    }
 
     #[test]
     fn an_empty_or_blank_script_is_reported_at_line_1_column_1() {
