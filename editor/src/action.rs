@@ -15,6 +15,8 @@ pub enum Action {
     ExportJson(PathBuf),
     /// The sculpted model as 3D meshes: `.glb`, `.gltf` or `.obj` (with its `.mtl`).
     Export3d(PathBuf),
+    /// The gestures since the grammar's initial model as a script `clayc run --script` replays.
+    SaveGestures(PathBuf),
     /// Ask for a path first.
     Ask(FileKind),
     Quit,
@@ -44,6 +46,7 @@ impl Action {
             FileKind::Json => Action::ExportJson(path),
             FileKind::Model3d => Action::Export3d(path),
             FileKind::WriteGrammar => Action::WriteGrammar(path),
+            FileKind::GestureScript => Action::SaveGestures(path),
         }
     }
 }

@@ -22,6 +22,8 @@ pub enum FileKind {
     Model3d,
     /// Authoring: the file the grammar is written to.
     WriteGrammar,
+    /// The gestures since the initial model, as a `clayc run` script.
+    GestureScript,
 }
 
 impl FileKind {
@@ -34,6 +36,7 @@ impl FileKind {
             FileKind::Json => "Export deformed assembly as JSON",
             FileKind::Model3d => "Export 3D model (glTF or OBJ)",
             FileKind::WriteGrammar => "Write grammar as",
+            FileKind::GestureScript => "Save gestures as script",
         }
     }
 
@@ -46,6 +49,7 @@ impl FileKind {
                 | FileKind::Json
                 | FileKind::Model3d
                 | FileKind::WriteGrammar
+                | FileKind::GestureScript
         )
     }
 
@@ -58,6 +62,7 @@ impl FileKind {
             FileKind::Json => ("JSON", &["json"]),
             FileKind::Model3d => ("3D model", &["glb", "gltf", "obj"]),
             FileKind::WriteGrammar => ("Clay grammar", &["clay"]),
+            FileKind::GestureScript => ("Clay script", &["json"]),
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Exports of the sculpt: the view as PNG, the deformed assembly as JSON, the model as glTF or
-//! OBJ, each through the library code `clayc` uses.
+//! OBJ, the gestures as a script, each through the library code `clayc` uses.
 
 use std::path::Path;
 
@@ -42,6 +42,42 @@ impl EditorApp {
         let text = serde_json::to_string_pretty(self.sculpt.data()).map_err(|e| e.to_string())?;
         clay::files::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// Writes the gestures since the grammar's initial model as a script (atomically), which
+    /// `clayc run GRAMMAR --script PATH` replays. Returns the status line: what was written and
+    /// how to replay it, with the `--set`s of parameters changed from the grammar's.
+    pub fn save_gestures(&self, path: &Path) -> Result<String, String> {
+        let script = self
+            .sculpt
+            .gesture_script()
+            .map_err(|why| format!("no gestures to save: {why}"))?;
+        let text = script.to_json();
+        // What is written must read back as the same steps (a non-finite point would not).
+        match clay::script::Script::parse(&text) {
+            Ok(back) if back == script => {}
+            Ok(_) => return Err("the gestures do not read back as the same script".into()),
+            Err(e) => return Err(format!("the gestures do not make a valid script: {e}")),
+        }
+        clay::files::write_atomic(path, text.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let solver = &self.sculpt.grammar().solver;
+        let settings = self.sculpt.settings();
+        let mut sets = String::new();
+        if settings.hysteresis != solver.hysteresis {
+            sets += &format!(" --set hysteresis={}", settings.hysteresis);
+        }
+        if settings.norm != solver.norm {
+            sets += &format!(" --set norm={}", settings.norm);
+        }
+        Ok(format!(
+            "saved {} steps, {} frames, to {}; replay: clayc run {} --script {}{sets}",
+            script.steps.len(),
+            script.frame_count(),
+            path.display(),
+            self.display_path(),
+            path.display()
+        ))
     }
 
     /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from

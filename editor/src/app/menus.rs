@@ -155,6 +155,15 @@ impl EditorApp {
         if ui.button("Save session as…").clicked() {
             self.actions.push(Action::Ask(FileKind::SaveSession));
         }
+        if ui
+            .button("Save gestures as script…")
+            .on_hover_text(
+                "The gestures since the grammar's initial model, for `clayc run --script`",
+            )
+            .clicked()
+        {
+            self.actions.push(Action::Ask(FileKind::GestureScript));
+        }
         ui.separator();
         if ui
             .button("Export PNG…")

@@ -95,6 +95,7 @@ impl EditorApp {
             Action::Export3d(p) => self
                 .export_3d(&p)
                 .map(|()| Some(format!("exported {}", p.display()))),
+            Action::SaveGestures(p) => self.save_gestures(&p).map(Some),
             Action::Quit => {
                 if self.sculpt.dirty() {
                     self.confirm = Some(Action::Quit);
@@ -168,6 +169,7 @@ impl EditorApp {
             FileKind::Png => self.suggested("png"),
             FileKind::Json => self.suggested("assembly.json"),
             FileKind::Model3d => self.suggested("glb"),
+            FileKind::GestureScript => self.suggested("script.json"),
             FileKind::WriteGrammar => match &self.author.written {
                 Some((p, _)) => p.clone(),
                 None => self.folder().join(crate::author::UNSAVED_NAME),

@@ -1,9 +1,12 @@
 //! The user's gestures on the model, as the session defines them: the grab (pressed, moved,
-//! released, re-pinning a pinned part where it is dropped), pins, and cuts.
+//! released, re-pinning a pinned part where it is dropped), pins, and cuts. Each is applied
+//! here and only here, and recorded here as the script step that does the same
+//! ([`Sculpt::gesture_script`]).
 
 use std::time::Duration;
 
 use clay::assembly::HandleKind;
+use clay::script::Script;
 use clay::session::Grab;
 use glam::DVec2;
 
@@ -59,11 +62,48 @@ impl Sculpt {
 
     pub(super) fn grab(&mut self, part: usize, at: DVec2) {
         self.release();
-        if self.assembly.instance_of_part_at(part, at).is_none() {
+        let Some(instance) = self.assembly.instance_of_part_at(part, at) else {
             return;
-        }
+        };
+        let centre = self.assembly.instance_centroid(instance);
         self.checkpoint();
         self.grab = Grab::at(&mut self.assembly, part, at);
+        if self.grab.is_some()
+            && let Some(centre) = centre
+        {
+            self.record.grab(centre);
+        }
+    }
+
+    /// Moves the grab's target: its start pose moved by `translation` and turned by `angle`.
+    pub(super) fn move_grab(&mut self, translation: DVec2, angle: f64) {
+        if let Some(g) = self.grab
+            && g.move_to(&mut self.assembly, translation, angle)
+        {
+            self.record.moved(translation, angle);
+            self.unsettled = true;
+        }
+    }
+
+    /// Pins the instance of `part` nearest `at`, or unpins it if pinned.
+    pub(super) fn toggle_pin(&mut self, part: usize, at: DVec2) {
+        let Some(instance) = self.assembly.instance_of_part_at(part, at) else {
+            return;
+        };
+        self.release();
+        self.checkpoint();
+        let name = self.assembly.data().instances[instance].name.clone();
+        let centre = self.assembly.instance_centroid(instance);
+        let pinned = clay::session::toggle_pin(&mut self.assembly, instance);
+        if let Some(centre) = centre {
+            self.record.pin(centre, pinned);
+        }
+        if pinned {
+            self.note(format!("pinned {name}"), None);
+        } else {
+            self.note(format!("unpinned {name}"), None);
+        }
+        self.unsettled = true;
     }
 
     /// Ends the gesture: a pinned part stays pinned where it was dropped.
@@ -75,11 +115,13 @@ impl Sculpt {
             // The last moves came while a background frame ran: solve once more here, so the
             // part is dropped where the pointer let go, not a frame behind it.
             self.moved_while_solving = false;
+            self.record.frame_starts();
             let outcome = solve_frame(&mut self.assembly, &mut self.session, Duration::MAX);
             self.integrate(outcome);
         }
         if let Some(g) = self.grab.take() {
             g.release(&mut self.assembly);
+            self.record.release();
         }
         self.unsettled = true;
     }
@@ -88,6 +130,7 @@ impl Sculpt {
         self.checkpoint();
         match self.session.cut(&mut self.assembly, point) {
             Ok(e) => {
+                self.record.cut(point);
                 self.session.clear_rule_log();
                 self.revision += 1;
                 self.note(
@@ -102,6 +145,14 @@ impl Sculpt {
                 self.note(format!("cut failed: {message}"), Some(point));
             }
         }
+    }
+
+    /// The gestures since the grammar's initial model (opened, reset, or rebuilt by a
+    /// reload) as a script: replayed on that model by `clayc run` or
+    /// [`clay::session::replay`], it makes this sculpt. Gestures undone are not in it. `Err`
+    /// says why there is none (a sculpt opened from a session).
+    pub fn gesture_script(&self) -> Result<Script, String> {
+        self.record.script()
     }
 
     /// After a rule renumbered the parts, the grabbed part is the one the handle still holds.

@@ -1,12 +1,13 @@
 //! The undo history: the model as it was before each gesture, taken and restored (with the
-//! rule log of the gestures, but not what happened outside them).
+//! rule log of the gestures, but not what happened outside them, and with the gestures recorded
+//! as a script up to it).
 
 use std::sync::Arc;
 
 use clay::assembly::Assembly;
 use clay_dsl::compiled::CompiledGrammar;
 
-use super::{LogEntry, Sculpt, Snapshot};
+use super::{LogEntry, Recording, Sculpt, Snapshot};
 
 /// Most gestures kept for undo.
 const UNDO_LIMIT: usize = 200;
@@ -20,6 +21,7 @@ impl Sculpt {
             pins: Vec::new(),
             log: self.log.clone(),
             state: self.state,
+            record: Recording::new(),
         }
     }
 
@@ -84,6 +86,7 @@ impl Sculpt {
             pins: self.pins(),
             log: self.log.clone(),
             state: self.state,
+            record: self.record.clone(),
         }
     }
 
@@ -100,6 +103,7 @@ impl Sculpt {
         self.log = s.log;
         self.log.extend(outside);
         self.log.sort_by_key(|e| e.seq);
+        self.record = s.record;
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
             clay::session::pin_at(&mut self.assembly, pin.vertices, &pin.at);

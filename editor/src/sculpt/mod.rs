@@ -17,10 +17,12 @@ mod gestures;
 mod history;
 mod inspect;
 mod log;
+mod record;
 mod solving;
 mod worker;
 
 use frame::{Job, Request};
+use record::Recording;
 use worker::Worker;
 
 /// What the user asks of the model. The UI emits these; [`Sculpt::apply`] applies them after
@@ -71,6 +73,8 @@ struct Snapshot {
     log: Vec<LogEntry>,
     /// Which state of the history this is ([`Sculpt::dirty`] compares it with the saved one).
     state: u64,
+    /// The gestures recorded as a script up to the gesture (undo takes the gesture's steps out).
+    record: Recording,
 }
 
 /// Why a part is in the state it is in: the session's report
@@ -93,6 +97,8 @@ pub struct Sculpt {
     session: Session,
     settings: Settings,
     grab: Option<Grab>,
+    /// The gestures since the grammar's initial model, as a script ([`Sculpt::gesture_script`]).
+    record: Recording,
     undo: Vec<Snapshot>,
     redo: Vec<Snapshot>,
     /// Which state of the undo history the model is in: a new one for every gesture, the
@@ -142,6 +148,7 @@ impl Sculpt {
             assembly,
             settings,
             grab: None,
+            record: Recording::new(),
             undo: Vec::new(),
             redo: Vec::new(),
             state: 0,
@@ -186,6 +193,11 @@ impl Sculpt {
             pins,
             log,
             state: 0,
+            record: Recording::unknown(
+                "the sculpt was opened from a session, so the gestures that made it are not known; \
+                 Edit > Reset starts a new recording from the grammar's initial model"
+                    .to_string(),
+            ),
         });
         sculpt
             .assembly
@@ -278,28 +290,9 @@ impl Sculpt {
         }
         match command {
             Command::Grab { part, at } => self.grab(part, at),
-            Command::MoveGrab { translation, angle } => {
-                if let Some(g) = self.grab
-                    && g.move_to(&mut self.assembly, translation, angle)
-                {
-                    self.unsettled = true;
-                }
-            }
+            Command::MoveGrab { translation, angle } => self.move_grab(translation, angle),
             Command::Release => self.release(),
-            Command::TogglePin { part, at } => {
-                let Some(instance) = self.assembly.instance_of_part_at(part, at) else {
-                    return;
-                };
-                self.release();
-                self.checkpoint();
-                let name = self.assembly.data().instances[instance].name.clone();
-                if clay::session::toggle_pin(&mut self.assembly, instance) {
-                    self.note(format!("pinned {name}"), None);
-                } else {
-                    self.note(format!("unpinned {name}"), None);
-                }
-                self.unsettled = true;
-            }
+            Command::TogglePin { part, at } => self.toggle_pin(part, at),
             Command::Cut { point } => {
                 self.release();
                 self.cut(point);
@@ -376,6 +369,8 @@ impl Sculpt {
                 pins: self.pins(),
                 log: self.log.clone(),
                 state: self.state,
+                // The same model block: the gestures replay on the new pieces.
+                record: self.record.clone(),
             }
         } else {
             self.initial(grammar)

@@ -22,6 +22,7 @@ impl Sculpt {
             // finish in time stops early with a proper least-squares pose and continues on the
             // next call, so a large model never blocks the window.
             let left = budget.saturating_sub(start.elapsed());
+            self.record.frame_starts();
             let outcome = solve_frame(&mut self.assembly, &mut self.session, left);
             self.integrate(outcome);
             if start.elapsed() >= budget {
@@ -65,6 +66,8 @@ impl Sculpt {
             }
             None => self.assembly.clone(),
         };
+        // The frame sees the grab where it is now: its last move is recorded before it.
+        self.record.frame_starts();
         let placeholder = Session::new(self.session.config());
         let session = std::mem::replace(&mut self.session, placeholder);
         let stale = self.stale.take();
@@ -140,6 +143,7 @@ impl Sculpt {
         match outcome.report {
             Ok(report) => {
                 self.frame += 1;
+                self.record.frame();
                 self.revision += 1;
                 self.frames_last_step += 1;
                 for (message, at) in outcome.notes {

@@ -1,0 +1,214 @@
+//! The gestures recorded as a script (File > Save gestures as script): since the grammar's
+//! initial model (opened, reset or rebuilt by a reload), every grab, move and turn of the
+//! grab, release, pin, unpin and cut, and the solver frames run between them, as steps of
+//! `clay::script`. `clayc run GRAMMAR --script FILE` (or `clay::session::replay` on the
+//! grammar's initial model) then does what the editor did: the same steps through the same
+//! gesture functions, one solver frame per frame the editor ran.
+//!
+//! The recording is part of the undo history: a [`super::Snapshot`] keeps the recording as
+//! it was before its gesture, so undoing a gesture takes its steps out of the script and redo
+//! puts them back; the frames run after the undo are held from where the model went back to.
+
+use clay::script::{Motion, Script, Selector, Step};
+use glam::DVec2;
+
+/// Most frames one `hold` step may ask for; longer waits are split.
+const MAX_HOLD: u64 = clay::script::MAX_FRAMES;
+
+/// The steps that make the sculpt from the grammar's initial model.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Recording {
+    steps: Vec<Step>,
+    /// Solver frames run since the last step, not yet written as a `hold`.
+    held: u64,
+    /// The grab's target (translation, angle in radians) as the steps have placed it.
+    target: (DVec2, f64),
+    /// The grab's target as the user last moved it, not yet seen by a solver frame.
+    pending: Option<(DVec2, f64)>,
+    /// Why the steps do not make the sculpt from the grammar's initial model (it was opened
+    /// from a session, or restored after a crash): nothing is recorded then.
+    unknown_start: Option<String>,
+}
+
+impl Recording {
+    /// An empty recording, from the grammar's initial model.
+    pub(super) fn new() -> Self {
+        Self {
+            steps: Vec::new(),
+            held: 0,
+            target: (DVec2::ZERO, 0.0),
+            pending: None,
+            unknown_start: None,
+        }
+    }
+
+    /// No recording: the sculpt did not start from the grammar's initial model (`why`).
+    pub(super) fn unknown(why: String) -> Self {
+        Self {
+            unknown_start: Some(why),
+            ..Self::new()
+        }
+    }
+
+    fn on(&self) -> bool {
+        self.unknown_start.is_none()
+    }
+
+    /// Writes the frames held since the last step, then `step`.
+    fn push(&mut self, step: Step) {
+        if !self.on() {
+            return;
+        }
+        self.write_held();
+        self.steps.push(step);
+    }
+
+    fn write_held(&mut self) {
+        while self.held > 0 {
+            let frames = self.held.min(MAX_HOLD);
+            self.steps.push(Step::Hold { frames });
+            self.held -= frames;
+        }
+    }
+
+    /// A grab of the instance whose centroid is `centre` (the script selects the instance
+    /// nearest a point: its own centroid).
+    pub(super) fn grab(&mut self, centre: DVec2) {
+        self.pending = None;
+        self.push(Step::Grab(Selector::At(centre)));
+        self.target = (DVec2::ZERO, 0.0);
+    }
+
+    /// The grab's target moved (applied from the next solver frame on).
+    pub(super) fn moved(&mut self, translation: DVec2, angle: f64) {
+        self.pending = Some((translation, angle));
+    }
+
+    /// A solver frame starts: the grab's last move is what it sees, so it becomes steps now
+    /// (a drag and a turn that jump, without a frame of their own).
+    pub(super) fn frame_starts(&mut self) {
+        let Some((translation, angle)) = self.pending.take() else {
+            return;
+        };
+        let (t0, a0) = self.target;
+        self.target = (translation, angle);
+        if translation != t0 {
+            self.push(Step::Drag {
+                motion: Motion::By(translation - t0),
+                frames: 0,
+            });
+        }
+        if angle != a0 {
+            self.push(Step::Rotate {
+                degrees: (angle - a0).to_degrees(),
+                frames: 0,
+            });
+        }
+    }
+
+    /// A solver frame ran. Right after a move it is that move's frame (`"frames": 1` runs the
+    /// frame after the jump, as a jump and a held frame do).
+    pub(super) fn frame(&mut self) {
+        if self.held == 0
+            && let Some(Step::Drag { frames, .. } | Step::Rotate { frames, .. }) =
+                self.steps.last_mut()
+            && *frames == 0
+        {
+            *frames = 1;
+            return;
+        }
+        self.held += 1;
+    }
+
+    /// The grab was let go (a pinned instance is pinned again where it is dropped, as the
+    /// script's `release` does through the same gesture).
+    pub(super) fn release(&mut self) {
+        self.frame_starts();
+        self.push(Step::Release);
+    }
+
+    /// The instance whose centroid is `centre` was pinned (`true`) or unpinned.
+    pub(super) fn pin(&mut self, centre: DVec2, pinned: bool) {
+        let sel = Selector::At(centre);
+        self.push(if pinned {
+            Step::Pin(sel)
+        } else {
+            Step::Unpin(sel)
+        });
+    }
+
+    /// A cut at `point` that cut a connection.
+    pub(super) fn cut(&mut self, point: DVec2) {
+        self.push(Step::Cut { at: point });
+    }
+
+    /// The script so far, the frames held since the last step and a move not yet solved
+    /// included. `Err` says why there is none.
+    pub(super) fn script(&self) -> Result<Script, String> {
+        if let Some(why) = &self.unknown_start {
+            return Err(why.clone());
+        }
+        let mut done = self.clone();
+        done.frame_starts();
+        done.write_held();
+        Ok(Script { steps: done.steps })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moves_become_steps_when_a_frame_sees_them() {
+        let mut r = Recording::new();
+        r.frame();
+        r.frame();
+        r.grab(DVec2::new(7.0, 0.0));
+        // Two moves before a frame: only the last is seen.
+        r.moved(DVec2::new(0.5, 0.0), 0.0);
+        r.moved(DVec2::new(1.0, 0.0), 0.0);
+        r.frame_starts();
+        r.frame();
+        r.frame_starts();
+        r.frame();
+        r.moved(DVec2::new(1.0, 0.5), 0.25);
+        r.frame_starts();
+        r.frame();
+        r.release();
+        r.pin(DVec2::new(8.0, 0.0), true);
+        r.frame();
+        let steps = r.script().unwrap().steps;
+        assert_eq!(
+            steps,
+            vec![
+                Step::Hold { frames: 2 },
+                Step::Grab(Selector::At(DVec2::new(7.0, 0.0))),
+                Step::Drag {
+                    motion: Motion::By(DVec2::new(1.0, 0.0)),
+                    frames: 1
+                },
+                Step::Hold { frames: 1 },
+                Step::Drag {
+                    motion: Motion::By(DVec2::new(0.0, 0.5)),
+                    frames: 0
+                },
+                Step::Rotate {
+                    degrees: 0.25f64.to_degrees(),
+                    frames: 1
+                },
+                Step::Release,
+                Step::Pin(Selector::At(DVec2::new(8.0, 0.0))),
+                Step::Hold { frames: 1 },
+            ]
+        );
+    }
+
+    #[test]
+    fn a_sculpt_from_elsewhere_has_no_script() {
+        let mut r = Recording::unknown("opened from a session".into());
+        r.grab(DVec2::ZERO);
+        r.frame();
+        assert_eq!(r.script(), Err("opened from a session".to_string()));
+    }
+}
