@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use clay::authoring::svg::drawing_from_svg;
+use clay::authoring::drawing_from_svg;
 use clay::authoring::{AuthorOptions, Drawing, Polyline, StretchChoice, author};
 use glam::DVec2;
 
@@ -231,7 +231,7 @@ fn the_editor_refuses_every_keyword_of_the_grammar_as_a_name() {
     assert!(keywords.len() > 30 && keywords.contains(&"bend"));
     for k in keywords {
         assert!(
-            clay::authoring::work::KEYWORDS.contains(&k),
+            clay::authoring::KEYWORDS.contains(&k),
             "`{k}` is a keyword of grammar.pest but not in authoring::work::KEYWORDS"
         );
     }
@@ -242,15 +242,15 @@ fn the_editor_refuses_every_keyword_of_the_grammar_as_a_name() {
 
 /// The CLI's steps on an SVG fixture: the grammar `work::compute` makes (which must check
 /// clean), or its error.
-fn author_fixture(name: &str, stretch: bool) -> Result<clay::authoring::work::Computed, String> {
+fn author_fixture(name: &str, stretch: bool) -> Result<clay::authoring::Computed, String> {
     let svg = std::fs::read_to_string(fixture(name)).unwrap();
     let drawing = drawing_from_svg(&svg, 0.01).map_err(|e| e.to_string())?;
-    let work = clay::authoring::work::Work {
+    let work = clay::authoring::Work {
         drawing,
         stretch: stretch.then_some(StretchChoice::Auto),
         ..Default::default()
     };
-    let computed = clay::authoring::work::compute(&work)?;
+    let computed = clay::authoring::compute(&work)?;
     if let Some(n) = computed
         .design
         .notes
@@ -432,12 +432,12 @@ fn generated_names_never_clash() {
         })
         .collect();
     polylines.extend((0..3).map(|k| rect(k as f64 * 2.0, 5.0, 0.3, "brick_chain")));
-    let work = clay::authoring::work::Work {
+    let work = clay::authoring::Work {
         drawing: Drawing { polylines },
         stretch: Some(StretchChoice::Auto),
         ..Default::default()
     };
-    let c = clay::authoring::work::compute(&work).unwrap();
+    let c = clay::authoring::compute(&work).unwrap();
     assert!(
         c.text.contains("brick_chain = chain brick x 4")
             && c.text.contains("brick_chain3 = chain brick x 4")

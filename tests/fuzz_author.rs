@@ -19,9 +19,9 @@ mod fuzzing;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use clay::authoring::svg::drawing_from_svg;
-use clay::authoring::work::{Work, compute};
+use clay::authoring::drawing_from_svg;
 use clay::authoring::{AuthorOptions, StretchChoice, author};
+use clay::authoring::{Work, compute};
 use glam::DVec2;
 use proptest::prelude::RngExt;
 use proptest::test_runner::TestRng;

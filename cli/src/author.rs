@@ -1,16 +1,16 @@
 //! `clayc author DRAWING.svg -o OUT.clay [--cut x,y]... [--stretch] [--variant P=F]...
 //! [--merge A.s:B.t[:J.u]]... [--state P:NAME:x,y;x,y;...]... [--tolerance T] [--scale S]`:
-//! turns an SVG drawing into a grammar through `clay::authoring::work::compute`, the same
+//! turns an SVG drawing into a grammar through `clay::authoring::compute`, the same
 //! steps as the editor's author mode. Exit codes: 0 written, 1 the drawing or a declaration
 //! cannot become a grammar, 2 usage or I/O.
 
 use std::path::PathBuf;
 
 use crate::out;
-use clay::authoring::graph::MIN_TOLERANCE;
-use clay::authoring::svg::{drawing_from_svg, line_of_id as svg_line_of_id};
-use clay::authoring::work::{MergeChoice, SiteName, StateChoice, VariantChoice, Work, compute};
+use clay::authoring::MIN_TOLERANCE;
+use clay::authoring::{MergeChoice, SiteName, StateChoice, VariantChoice, Work, compute};
 use clay::authoring::{StretchChoice, check_authored};
+use clay::authoring::{drawing_from_svg, line_of_id as svg_line_of_id};
 use glam::DVec2;
 
 #[derive(clap::Args)]

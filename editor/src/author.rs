@@ -1,12 +1,12 @@
-//! Authoring mode's state: the author's work (`clay::authoring::work::Work`: the drawing, its
+//! Authoring mode's state: the author's work (`clay::authoring::Work`: the drawing, its
 //! cuts and the rule declarations) with its undo history, the grammar the library computes
-//! from it (`clay::authoring::work::compute`, the same steps as `clayc author`) with the
+//! from it (`clay::authoring::compute`, the same steps as `clayc author`) with the
 //! compiler's diagnostics, and what the last command has to say. Every change is an
 //! [`AuthorCommand`]; changes to the work are undoable as whole steps.
 
 use std::path::{Path, PathBuf};
 
-use clay::authoring::work::{
+use clay::authoring::{
     Computed, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name, compute,
     docked_sites, find_site, site_names, variant_map,
 };
@@ -572,7 +572,7 @@ impl Authoring {
             ));
         }
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let drawing = clay::authoring::svg::drawing_from_svg(&text, scale)
+        let drawing = clay::authoring::drawing_from_svg(&text, scale)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         self.apply(AuthorCommand::SetDrawing(drawing));
         Ok(())

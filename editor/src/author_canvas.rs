@@ -12,7 +12,7 @@ use clay::plane::nearest_on_segment;
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
-use clay::authoring::work::{Computed, SiteName};
+use clay::authoring::{Computed, SiteName};
 
 use crate::author::{AuthorCommand, Authoring, short};
 use crate::camera::{Camera, dv, pos};

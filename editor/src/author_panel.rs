@@ -12,7 +12,7 @@ use egui::{Color32, RichText};
 
 use crate::action::Action;
 use crate::files::FileKind;
-use clay::authoring::work::{MergeChoice, StateChoice, VariantChoice, find_site, site_names};
+use clay::authoring::{MergeChoice, StateChoice, VariantChoice, find_site, site_names};
 
 use crate::author::{AuthorCommand, Authoring};
 use crate::author_canvas::{AuthorCanvas, Tool, piece_colour, site_colour};
@@ -250,7 +250,7 @@ fn pieces(
                         .on_hover_text("pick this site to set its type")
                         .clicked()
                     {
-                        canvas.selected_site = Some(clay::authoring::work::SiteName {
+                        canvas.selected_site = Some(clay::authoring::SiteName {
                             piece: piece.name.clone(),
                             site: s.name.clone(),
                         });
@@ -533,7 +533,7 @@ fn variants(
     }
     ui.label("Pieces with the same vertices, edges and sites; frequencies are normalised:");
     for (pi, piece) in design.pieces.iter().enumerate() {
-        let fits = pi == sp || clay::authoring::work::variant_map(design, sp, pi).is_ok();
+        let fits = pi == sp || clay::authoring::variant_map(design, sp, pi).is_ok();
         ui.horizontal(|ui| {
             let mut on = form.variants.contains_key(&piece.name);
             let r = ui.add_enabled(

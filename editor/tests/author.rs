@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clay::authoring::work::Work;
+use clay::authoring::Work;
 use clay::authoring::{Drawing, Polyline, StretchChoice};
 use clay_editor::EditorApp;
 use clay_editor::action::Action;
@@ -390,7 +390,7 @@ fn tab_switches_modes_without_moving_the_keyboard_focus() {
 
 #[test]
 fn a_merge_rule_is_written_compiles_and_undoes() {
-    use clay::authoring::work::{MergeChoice, SiteName};
+    use clay::authoring::{MergeChoice, SiteName};
     let site = |piece: &str, site: &str| SiteName {
         piece: piece.into(),
         site: site.into(),
@@ -421,8 +421,8 @@ fn a_merge_rule_is_written_compiles_and_undoes() {
     assert!(!a.text().unwrap().contains("merge"));
 }
 
-fn site(piece: &str, site: &str) -> clay::authoring::work::SiteName {
-    clay::authoring::work::SiteName {
+fn site(piece: &str, site: &str) -> clay::authoring::SiteName {
+    clay::authoring::SiteName {
         piece: piece.into(),
         site: site.into(),
     }
@@ -490,7 +490,7 @@ fn squares_and_a_long_one() -> Authoring {
 
 #[test]
 fn a_congruent_graph_piece_becomes_a_stretch_variant_with_normalised_frequencies() {
-    use clay::authoring::work::VariantChoice;
+    use clay::authoring::VariantChoice;
     let mut a = squares_and_a_long_one();
     assert_eq!(instances_of_each_piece(&a).len(), 2, "{:?}", a.design());
     let d = a.design().unwrap().clone();
@@ -583,7 +583,7 @@ fn a_congruent_graph_piece_becomes_a_stretch_variant_with_normalised_frequencies
 
 #[test]
 fn a_piece_of_another_shape_cannot_be_a_variant() {
-    use clay::authoring::work::VariantChoice;
+    use clay::authoring::VariantChoice;
     // Two unit squares and, at the end, a unit square with a fifth vertex on its top edge.
     let mut a = Authoring::default();
     a.apply(AuthorCommand::AddPolyline(Polyline::polygon(vec![
@@ -623,7 +623,7 @@ fn a_piece_of_another_shape_cannot_be_a_variant() {
 
 #[test]
 fn a_posed_copy_becomes_a_second_rest_state_of_the_compiled_piece() {
-    use clay::authoring::work::StateChoice;
+    use clay::authoring::StateChoice;
     let mut a = wall();
     let brick = a.design().unwrap().pieces[0].clone();
     // Shear the brick: the top vertices move 0.25 m east.
@@ -833,7 +833,7 @@ fn a_variant_with_a_rest_state_is_refused_with_e047() {
     // A chain element's own rest states could never become active (the chain is covered by
     // two-element parts with one/two/three states), so the language rejects them (E047): the
     // author panel shows that problem for a variant given a state, naming the state.
-    use clay::authoring::work::{StateChoice, VariantChoice};
+    use clay::authoring::{StateChoice, VariantChoice};
     let mut a = squares_and_a_long_one();
     a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
     let d = a.design().unwrap().clone();

@@ -5,8 +5,8 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::DVec2;
 
+use super::drawing::{AuthorError, Drawing};
 use super::grid::{PointGrid, self_crossing};
-use super::{AuthorError, Drawing};
 
 /// Largest absolute coordinate accepted (metres). The compiler takes coordinates up to 1e9 m;
 /// a piece is written relative to its lower-left corner and an instance's `at` is where that

@@ -2,67 +2,45 @@
 //! functions on plain data, so the CLI (`clayc author`) and the editor's authoring mode share
 //! them:
 //!
-//! 1. [`svg::drawing_from_svg`] (or a [`Drawing`] built in code): polylines in metres, y up;
-//! 2. [`graph::Graph::build`]: vertices snapped within a tolerance, edges, T-junctions split;
-//! 3. [`graph::Graph::cut`] at each cut point: the cut section's vertices are duplicated, one copy
+//! 1. [`drawing_from_svg`] (or a [`Drawing`] built in code): polylines in metres, y up;
+//! 2. [`Graph::build`]: vertices snapped within a tolerance, edges, T-junctions split;
+//! 3. [`Graph::cut`] at each cut point: the cut section's vertices are duplicated, one copy
 //!    per side, and the pair becomes a contact (two docking sites);
-//! 4. [`graph::Graph::regions`]: the regions between cuts (or, with no cut, every closed path)
-//!    and the [`graph::Contact`]s where regions touch; an outline that crosses or touches
+//! 4. [`Graph::regions`]: the regions between cuts (or, with no cut, every closed path)
+//!    and the [`Contact`]s where regions touch; an outline that crosses or touches
 //!    itself is an error naming the path and the place, a closed path with no area and a copy
 //!    drawn on top of another are left out with a note;
-//! 5. [`pieces::find_pieces`]: regions equal up to a rigid motion become one piece with several
+//! 5. [`find_pieces`]: regions equal up to a rigid motion become one piece with several
 //!    instances; contacts become typed docking sites, each docked once, and docked only where
 //!    docking keeps the instances where they are drawn;
 //! 6. [`Design::fit_docks`]: the model placed as the compiler places it, and a dock whose
 //!    vertices would not meet left out with a note;
-//! 7. [`pieces::Design::to_syntax`]: the grammar as a syntax tree, printed by
+//! 7. [`Design::to_syntax`]: the grammar as a syntax tree, printed by
 //!    [`clay_dsl::print_file`].
 //!
 //! [`author`] runs them all; the grammar they write checks clean (issue 37), and
 //! [`check_authored`] is `clayc author`'s last check before writing one.
 
-pub mod graph;
+mod drawing;
+pub(crate) mod graph;
 mod grid;
-pub mod pieces;
+pub(crate) mod pieces;
 mod placement;
-pub mod svg;
-pub mod work;
+pub(crate) mod svg;
+pub(crate) mod work;
 mod write;
 
 use glam::DVec2;
 
-pub use graph::{Contact, Graph, Region};
-pub use pieces::{Design, PieceDesign, StretchChoice};
-
-/// One stroke of a drawing, in metres with y up.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Polyline {
-    pub points: Vec<DVec2>,
-    /// The last point joins the first.
-    pub closed: bool,
-    /// Fill colour as drawn (`#rrggbb`), if any.
-    pub fill: Option<[u8; 3]>,
-    /// The drawing's name for it (an SVG `id`), used to name pieces.
-    pub name: Option<String>,
-}
-
-impl Polyline {
-    /// A closed polygon without colour or name.
-    pub fn polygon(points: Vec<DVec2>) -> Self {
-        Self {
-            points,
-            closed: true,
-            fill: None,
-            name: None,
-        }
-    }
-}
-
-/// A drawing: the input of authoring.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Drawing {
-    pub polylines: Vec<Polyline>,
-}
+// The authoring surface: one public path per name, `clay::authoring::X`.
+pub use drawing::{AuthorError, Drawing, Polyline};
+pub use graph::{Contact, Graph, MIN_TOLERANCE, Region};
+pub use pieces::{Design, PieceDesign, StretchChoice, find_pieces};
+pub use svg::{drawing_from_svg, line_of_id};
+pub use work::{
+    Computed, KEYWORDS, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name,
+    compute, docked_sites, find_site, site_names, variant_map,
+};
 
 /// Everything authoring needs besides the drawing.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,18 +69,6 @@ impl Default for AuthorOptions {
         }
     }
 }
-
-/// Why a drawing could not become a grammar.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AuthorError(pub String);
-
-impl std::fmt::Display for AuthorError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for AuthorError {}
 
 /// The result of [`author`]: the design (pieces, instances, docks) and the grammar text.
 #[derive(Clone, Debug)]

@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet};
 
 use glam::DVec2;
 
-use super::AuthorError;
+use super::drawing::AuthorError;
 use super::graph::{Contact, Graph, Region};
 
 /// Fill of regions drawn without one.

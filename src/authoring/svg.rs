@@ -10,7 +10,7 @@
 
 use glam::DVec2;
 
-use super::{AuthorError, Drawing, Polyline};
+use super::drawing::{AuthorError, Drawing, Polyline};
 
 /// Straight segments per Bezier curve segment.
 pub const CURVE_SEGMENTS: usize = 8;

@@ -8,8 +8,9 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::DVec2;
 
+use super::drawing::Drawing;
 use super::graph::{Graph, Region};
-use super::{Design, Drawing, StretchChoice};
+use super::pieces::{Design, StretchChoice};
 
 /// The author's work: everything undo and redo restore.
 #[derive(Clone, Debug, PartialEq)]
@@ -488,10 +489,10 @@ pub fn docked_sites(design: &Design, start: (usize, usize)) -> Vec<(usize, usize
 /// library adds its own diagonals to make an outline rigid, and the variant takes the
 /// stretch piece's), otherwise all of them.
 fn reference_edges(
-    a: &super::PieceDesign,
-    b: &super::PieceDesign,
+    a: &super::pieces::PieceDesign,
+    b: &super::pieces::PieceDesign,
 ) -> (Vec<[usize; 2]>, Vec<[usize; 2]>) {
-    let edges = |x: &super::PieceDesign| -> Vec<[usize; 2]> {
+    let edges = |x: &super::pieces::PieceDesign| -> Vec<[usize; 2]> {
         let mut e: Vec<[usize; 2]> = match (&a.outline, &b.outline, &x.outline) {
             (Some(_), Some(_), Some(o)) => {
                 (0..o.len()).map(|k| [o[k], o[(k + 1) % o.len()]]).collect()

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use clay_dsl::syntax::*;
 use glam::DVec2;
 
-use super::AuthorError;
+use super::drawing::AuthorError;
 use super::pieces::*;
 
 /// Width (metres) of the polylines that draw regions without a closed outline.
