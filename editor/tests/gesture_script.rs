@@ -1,6 +1,8 @@
 //! File > Save gestures as script (issue 40): the gestures made in the real editor, driven
 //! headless through egui_kittest, saved as a script that the library replays from the
-//! grammar's initial model into the same sculpt; undone gestures are not in it.
+//! grammar's initial model into the same sculpt; undone gestures are not in it; moves made
+//! while a background solver frame runs are recorded for the frame that sees them; a sculpt
+//! opened from a session has no script until Reset.
 
 mod common;
 
@@ -252,4 +254,101 @@ fn an_undone_gesture_is_not_in_the_saved_script_and_a_redone_one_is() {
     assert_eq!(count(&script, |s| matches!(s, Step::Grab(_))), 1);
     assert_eq!(count(&script, |s| matches!(s, Step::Release)), 1);
     assert_same_sculpt(h.state().sculpt.data(), &replayed(&script).0);
+}
+
+fn wall_sculpt() -> clay_editor::sculpt::Sculpt {
+    let source = std::fs::read_to_string(wall_path()).unwrap();
+    let compiled = clay_editor::compile::compile(&source, "wall.clay").unwrap();
+    clay_editor::sculpt::Sculpt::new(compiled.grammar)
+}
+
+/// Solver frames on the background thread until the model settles.
+fn settle_in_background(s: &mut clay_editor::sculpt::Sculpt) {
+    for _ in 0..20_000 {
+        if !s.step_in_background(std::time::Duration::from_secs(1)) {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    panic!("the background solver did not settle");
+}
+
+#[test]
+fn moves_made_while_a_background_frame_runs_are_recorded_for_the_next_frame() {
+    use clay_editor::sculpt::Command;
+    let mut s = wall_sculpt();
+    settle_in_background(&mut s);
+    let west = s.assembly().instance_nearest(DVec2::new(0.0, 0.0)).unwrap();
+    let part = s.assembly().piece_part(west).unwrap_or(0);
+    let at = s.assembly().instance_centroid(west).unwrap();
+    s.apply(Command::TogglePin { part, at });
+    let east = DVec2::new(7.5, 0.25);
+    let part = (0..s.data().parts.len())
+        .rev()
+        .find(|&p| {
+            s.data()
+                .part_instances(p)
+                .iter()
+                .any(|&i| s.assembly().instance_centroid(i).unwrap().distance(east) < 1e-3)
+        })
+        .unwrap();
+    s.apply(Command::Grab { part, at: east });
+    for k in 1..=12 {
+        // A frame starts on the model as it is (or the last one is still running); the
+        // pointer moves on while it runs, so that frame does not see the move, the next does.
+        std::thread::sleep(std::time::Duration::from_millis(1));
+        s.step_in_background(std::time::Duration::from_secs(1));
+        assert!(s.solving_in_background());
+        s.apply(Command::MoveGrab {
+            translation: DVec2::new(0.2 * k as f64, 0.05 * k as f64),
+            angle: 0.02 * k as f64,
+        });
+    }
+    // Let go while a frame runs: the release waits for it and solves once more.
+    s.apply(Command::Release);
+    // Before the model settles: the same frames in the same order give the same model.
+    let script = s.gesture_script().unwrap();
+    assert!(count(&script, |st| matches!(st, Step::Rotate { .. })) >= 1);
+    // The first frame after the grab started before the first move: it holds the grab still.
+    let grab = script
+        .steps
+        .iter()
+        .position(|st| matches!(st, Step::Grab(_)));
+    assert_eq!(
+        script.steps.get(grab.unwrap() + 1),
+        Some(&Step::Hold { frames: 1 }),
+        "{:?}",
+        script.steps
+    );
+    let (model, frames) = replayed(&script);
+    assert_eq!(frames, s.frame(), "one script frame per solver frame");
+    assert_same_sculpt(s.data(), &model);
+
+    settle_in_background(&mut s);
+    // and a cut between two bricks
+    s.apply(Command::Cut {
+        point: DVec2::new(3.0, 0.0),
+    });
+    settle_in_background(&mut s);
+
+    let script = s.gesture_script().unwrap();
+    assert_eq!(count(&script, |st| matches!(st, Step::Cut { .. })), 1);
+    let (model, frames) = replayed(&script);
+    assert_eq!(frames, s.frame(), "one script frame per solver frame");
+    assert_same_sculpt(s.data(), &model);
+}
+
+#[test]
+fn a_sculpt_opened_from_a_session_has_no_script_until_reset() {
+    use clay_editor::sculpt::{Command, Sculpt};
+    let s = wall_sculpt();
+    let grammar = s.grammar().clone();
+    let mut opened =
+        Sculpt::from_saved(grammar, s.data().clone(), Vec::new(), None, Vec::new()).unwrap();
+    let why = opened.gesture_script().unwrap_err();
+    assert!(why.contains("opened from a session"), "{why}");
+    opened.apply(Command::Reset);
+    assert_eq!(opened.gesture_script(), Ok(Script::default()));
+    opened.apply(Command::Undo);
+    assert!(opened.gesture_script().is_err(), "undoing the reset");
 }
