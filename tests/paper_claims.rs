@@ -11,7 +11,7 @@ use std::sync::Arc;
 use clay::assembly::Assembly;
 use clay::rules::RuleKind;
 use clay::script::Script;
-use clay::solver::follow::Components;
+use clay::solver::Components;
 use clay::solver::{SolverConfig, bbox, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;

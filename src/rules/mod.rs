@@ -16,7 +16,7 @@
 
 pub mod cut;
 pub mod merge;
-pub mod proximity;
+pub(crate) mod proximity;
 pub mod replace;
 mod rewrite;
 mod sites;

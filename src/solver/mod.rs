@@ -18,7 +18,7 @@ mod chunks;
 mod clock;
 mod config;
 mod evaluate;
-pub mod follow;
+pub(crate) mod follow;
 mod global;
 mod global_step;
 mod growth;
@@ -35,6 +35,7 @@ mod trials;
 mod units;
 
 pub use config::{SolverConfig, SolverKind};
+pub use follow::Components;
 pub use measure::{
     bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
 };
