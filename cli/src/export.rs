@@ -7,7 +7,7 @@ use clay::export::{ExportOptions, gltf, obj, scene};
 
 use crate::out::{IO_ERROR, write_output};
 use crate::params::ParamArgs;
-use crate::render::{load, replay};
+use crate::render::sculpted;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
@@ -18,8 +18,13 @@ pub enum Format {
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
-    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`).
-    pub file: PathBuf,
+    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`); not with --session.
+    #[arg(required_unless_present = "session", conflicts_with = "session")]
+    pub file: Option<PathBuf>,
+    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
+    /// settings; a --script goes on from it.
+    #[arg(long, value_name = "SESSION.json")]
+    pub session: Option<PathBuf>,
     /// The file to write: .glb, .gltf or .obj (the .mtl is written beside an .obj); `-` writes
     /// to standard output (glb unless --format says otherwise; an .obj's materials are then
     /// not written).
@@ -28,7 +33,8 @@ pub struct ExportArgs {
     /// The format, when the output's extension does not say it.
     #[arg(long, value_enum)]
     pub format: Option<Format>,
-    /// Replay this sculpting script first and export the assembly it ends with.
+    /// Replay this sculpting script first (on the session's sculpt, with --session) and export
+    /// the assembly it ends with.
     #[arg(long)]
     pub script: Option<PathBuf>,
     /// Height given to flat proxy geometry, in metres.
@@ -70,16 +76,14 @@ pub fn export(args: ExportArgs) -> u8 {
             return IO_ERROR;
         }
     };
-    let grammar = match load(&args.file, &args.params) {
-        Ok(g) => g,
+    let (grammar, assembly, _, _) = match sculpted(
+        args.file.as_deref(),
+        args.session.as_deref(),
+        args.script.as_deref(),
+        &args.params,
+    ) {
+        Ok(model) => model,
         Err(code) => return code,
-    };
-    let assembly = match &args.script {
-        None => grammar.assembly.clone(),
-        Some(script) => match replay(grammar.clone(), script) {
-            Ok((assembly, _, _)) => assembly,
-            Err(code) => return code,
-        },
     };
     let options = ExportOptions {
         thickness: args.thickness,

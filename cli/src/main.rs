@@ -15,6 +15,7 @@ mod bench;
 mod check;
 mod export;
 mod fmt;
+mod from_session;
 mod lsp;
 mod params;
 mod render;

@@ -3,7 +3,10 @@
 //! the grammar has such a parameter and whether the value is in its range is the compiler's
 //! judgement (E070, E071), reported as every other diagnostic is.
 
+use std::path::Path;
+
 use clay_dsl::CompileOptions;
+use clay_dsl::compiled::CompiledGrammar;
 
 /// The `--param` flag, flattened into each subcommand's arguments.
 #[derive(clap::Args, Clone, Debug, Default)]
@@ -53,6 +56,28 @@ pub fn parse_param(s: &str) -> Result<(String, f64), String> {
         return Err(format!("{name}={value}: the value must be a finite number"));
     }
     Ok((name.to_string(), number))
+}
+
+/// Compiles the grammar `source` (the file `path`) with these parameters, printing its
+/// diagnostics; on errors gives the exit code 1.
+pub fn compile(source: &str, path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u8> {
+    let name = path.display().to_string();
+    // Colour only on a terminal that has not opted out.
+    let color = std::io::IsTerminal::is_terminal(&std::io::stderr())
+        && std::env::var_os("NO_COLOR").is_none();
+    match clay_dsl::compile_with_options(source, &name, &params.options()) {
+        Ok(compiled) => {
+            err!(
+                "{}",
+                clay_dsl::render(&compiled.warnings, source, &name, color)
+            );
+            Ok(compiled.grammar)
+        }
+        Err(diagnostics) => {
+            err!("{}", clay_dsl::render(&diagnostics, source, &name, color));
+            Err(1)
+        }
+    }
 }
 
 #[cfg(test)]

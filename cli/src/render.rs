@@ -32,13 +32,19 @@ pub enum OverlayKind {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`).
-    pub file: PathBuf,
+    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`); not with --session.
+    #[arg(required_unless_present = "session", conflicts_with = "session")]
+    pub file: Option<PathBuf>,
+    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
+    /// settings; a --script goes on from it.
+    #[arg(long, value_name = "SESSION.json")]
+    pub session: Option<PathBuf>,
     /// The picture to write (.png, or .svg for SVG; `-` writes PNG, or SVG with --svg, to
     /// standard output).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Replay this sculpting script first and render the assembly it ends with.
+    /// Replay this sculpting script first (on the session's sculpt, with --session) and render
+    /// the assembly it ends with.
     #[arg(long)]
     pub script: Option<PathBuf>,
     /// Image size in pixels.
@@ -86,12 +92,12 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .trim()
             .parse()
             .map_err(|_| format!("`{v}` is not a whole number of pixels"))?;
-        if (1..=clay::render::raster::MAX_SIDE).contains(&n) {
+        if (1..=clay::render::MAX_SIDE).contains(&n) {
             Ok(n)
         } else {
             Err(format!(
                 "{n} is not between 1 and {}",
-                clay::render::raster::MAX_SIDE
+                clay::render::MAX_SIDE
             ))
         }
     };
@@ -127,49 +133,52 @@ pub(crate) fn load(path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u
             INPUT_ERROR
         });
     }
-    compile(&source, path, params)
+    crate::params::compile(&source, path, params)
 }
 
-fn compile(source: &str, path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u8> {
-    let name = path.display().to_string();
-    // Colour only on a terminal that has not opted out.
-    let color = std::io::IsTerminal::is_terminal(&std::io::stderr())
-        && std::env::var_os("NO_COLOR").is_none();
-    match clay_dsl::compile_with_options(source, &name, &params.options()) {
-        Ok(compiled) => {
-            err!(
-                "{}",
-                clay_dsl::render(&compiled.warnings, source, &name, color)
-            );
-            Ok(compiled.grammar)
+/// The model to draw or export: the grammar (`file`, or the one a saved `session` names) and
+/// its assembly (the initial one, or the session's), after the sculpting `script` if one is
+/// given (solver and rules, as `clayc run` does); with the global vertices of its grab
+/// handles and of its pins. On failure prints why and gives the exit code.
+pub(crate) fn sculpted(
+    file: Option<&Path>,
+    session: Option<&Path>,
+    script: Option<&Path>,
+    params: &ParamArgs,
+) -> Result<(CompiledGrammar, AssemblyData, Vec<usize>, Vec<usize>), u8> {
+    let (grammar, mut assembly, config) = match (session, file) {
+        (Some(session), _) => {
+            let loaded = crate::from_session::load(session, params, &[])?;
+            (loaded.grammar, loaded.assembly, loaded.config)
         }
-        Err(diagnostics) => {
-            err!("{}", clay_dsl::render(&diagnostics, source, &name, color));
-            Err(INPUT_ERROR)
+        (None, Some(file)) => {
+            let grammar = load(file, params)?;
+            if script.is_none() {
+                let initial = grammar.assembly.clone();
+                return Ok((grammar, initial, Vec::new(), Vec::new()));
+            }
+            let config = SolverConfig::from_params(&grammar.solver);
+            let assembly = Assembly::new(Arc::new(grammar.clone()));
+            (grammar, assembly, config)
         }
-    }
-}
-
-/// Replays a sculpting script on the grammar's initial assembly (solver and rules, as
-/// `clayc run` does); gives the final assembly and the global vertices of its grab handles and
-/// of its pins.
-pub(crate) fn replay(
-    grammar: CompiledGrammar,
-    path: &Path,
-) -> Result<(AssemblyData, Vec<usize>, Vec<usize>), u8> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        errln!("error: cannot read {}: {e}", path.display());
-        IO_ERROR
-    })?;
-    let script = Script::parse(&text).map_err(|e| {
-        errln!("{}", crate::run::script_error(path, &e));
-        INPUT_ERROR
-    })?;
-    let config = SolverConfig::from_params(&grammar.solver);
-    let mut assembly = Assembly::new(Arc::new(grammar));
-    if let Err(e) = clay::session::replay(&mut assembly, &script, &mut Session::new(config)) {
-        errln!("error: {}: {e}", path.display());
-        return Err(INPUT_ERROR);
+        (None, None) => {
+            errln!("error: name a grammar FILE or a --session");
+            return Err(IO_ERROR);
+        }
+    };
+    if let Some(path) = script {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            errln!("error: cannot read {}: {e}", path.display());
+            IO_ERROR
+        })?;
+        let script = Script::parse(&text).map_err(|e| {
+            errln!("{}", e.located(path));
+            INPUT_ERROR
+        })?;
+        if let Err(e) = clay::session::replay(&mut assembly, &script, &mut Session::new(config)) {
+            errln!("error: {}: {e}", path.display());
+            return Err(INPUT_ERROR);
+        }
     }
     let vertices = |kind: HandleKind| -> Vec<usize> {
         assembly
@@ -180,7 +189,7 @@ pub(crate) fn replay(
             .collect()
     };
     let (handles, pins) = (vertices(HandleKind::Grab), vertices(HandleKind::Pin));
-    Ok((assembly.into_data(), handles, pins))
+    Ok((grammar, assembly.into_data(), handles, pins))
 }
 
 fn wants_svg(output: &Path, flag: bool) -> bool {
@@ -195,16 +204,14 @@ pub fn render(args: RenderArgs) -> u8 {
         errln!("error: the iso view is a PNG without overlays: drop --svg, .svg and --overlay");
         return IO_ERROR;
     }
-    let grammar = match load(&args.file, &args.params) {
-        Ok(g) => g,
+    let (grammar, assembly, handles, pins) = match sculpted(
+        args.file.as_deref(),
+        args.session.as_deref(),
+        args.script.as_deref(),
+        &args.params,
+    ) {
+        Ok(model) => model,
         Err(code) => return code,
-    };
-    let (assembly, handles, pins) = match &args.script {
-        None => (grammar.assembly.clone(), Vec::new(), Vec::new()),
-        Some(script) => match replay(grammar.clone(), script) {
-            Ok(replayed) => replayed,
-            Err(code) => return code,
-        },
     };
     if args.view == ViewKind::Iso {
         let scene = clay::export::scene(&grammar, &assembly, &Default::default());

@@ -1,5 +1,6 @@
-//! `clayc run FILE [--script SCRIPT.json] [--json] [--set NAME=VALUE]...`: compiles a grammar,
-//! replays a scripted sculpting session headlessly and prints its summary.
+//! `clayc run FILE|--session SESSION.json [--script SCRIPT.json] [--json] [--set NAME=VALUE]...
+//! [--param NAME=VALUE]...`: compiles a grammar (or rebuilds a saved sculpt), replays a
+//! scripted sculpting session headlessly and prints its summary.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -12,8 +13,13 @@ use clay::session::{Session, configure, replay};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
-    /// The grammar (.clay) whose model is sculpted.
-    pub file: PathBuf,
+    /// The grammar (.clay) whose model is sculpted; not with --session.
+    #[arg(required_unless_present = "session", conflicts_with = "session")]
+    pub file: Option<PathBuf>,
+    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
+    /// settings; the script goes on from it.
+    #[arg(long, value_name = "SESSION.json")]
+    pub session: Option<PathBuf>,
     /// The session script (JSON, {"steps": [...]}); without it the initial assembly is reported.
     #[arg(long)]
     pub script: Option<PathBuf>,
@@ -33,15 +39,54 @@ pub fn script_error(path: &Path, e: &ScriptError) -> String {
     e.located(path)
 }
 
-pub fn run(args: RunArgs) -> u8 {
-    let path = args.file.display().to_string();
-    let source = match std::fs::read(&args.file) {
+/// The grammar `file`'s initial assembly and the solver settings (its own, with `settings`).
+fn initial(
+    file: &Path,
+    params: &ParamArgs,
+    settings: Vec<(&str, &str)>,
+) -> Result<(Assembly, clay::solver::SolverConfig), u8> {
+    let path = file.display().to_string();
+    let source = match std::fs::read(file) {
         Ok(bytes) => bytes,
         Err(e) => {
             errln!("error: cannot read {path}: {e}");
-            return 2;
+            return Err(2);
         }
     };
+    let text = String::from_utf8_lossy(&source);
+    let compiled = match clay_dsl::compile_bytes_with_options(&source, &path, &params.options()) {
+        Ok(c) => c,
+        Err(diagnostics) => {
+            err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
+            return Err(1);
+        }
+    };
+    if !compiled.warnings.items.is_empty() {
+        err!(
+            "{}",
+            clay_dsl::render(&compiled.warnings, &text, &path, false)
+        );
+    }
+    let mut grammar = compiled.grammar;
+    let config = match configure(&mut grammar, settings) {
+        Ok(config) => config,
+        Err(e) => {
+            errln!("error: --set {e}");
+            return Err(2);
+        }
+    };
+    let assembly = Assembly::new(Arc::new(grammar));
+    if let Err(problems) = assembly.validate() {
+        errln!(
+            "error: the compiled assembly is inconsistent:\n  {}",
+            problems.join("\n  ")
+        );
+        return Err(1);
+    }
+    Ok((assembly, config))
+}
+
+pub fn run(args: RunArgs) -> u8 {
     let script = match &args.script {
         None => Script::default(),
         Some(p) => match std::fs::read_to_string(p) {
@@ -58,22 +103,6 @@ pub fn run(args: RunArgs) -> u8 {
             },
         },
     };
-    let text = String::from_utf8_lossy(&source);
-    let compiled =
-        match clay_dsl::compile_bytes_with_options(&source, &path, &args.params.options()) {
-            Ok(c) => c,
-            Err(diagnostics) => {
-                err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));
-                return 1;
-            }
-        };
-    if !compiled.warnings.items.is_empty() {
-        err!(
-            "{}",
-            clay_dsl::render(&compiled.warnings, &text, &path, false)
-        );
-    }
-    let mut grammar = compiled.grammar;
     let mut settings = Vec::with_capacity(args.set.len());
     for s in &args.set {
         match s.split_once('=') {
@@ -84,21 +113,20 @@ pub fn run(args: RunArgs) -> u8 {
             }
         }
     }
-    let config = match configure(&mut grammar, settings) {
-        Ok(config) => config,
-        Err(e) => {
-            errln!("error: --set {e}");
+    let (mut assembly, config) = match (&args.session, &args.file) {
+        (Some(session), _) => match crate::from_session::load(session, &args.params, &settings) {
+            Ok(loaded) => (loaded.assembly, loaded.config),
+            Err(code) => return code,
+        },
+        (None, Some(file)) => match initial(file, &args.params, settings) {
+            Ok(model) => model,
+            Err(code) => return code,
+        },
+        (None, None) => {
+            errln!("error: name a grammar FILE or a --session");
             return 2;
         }
     };
-    let mut assembly = Assembly::new(Arc::new(grammar));
-    if let Err(problems) = assembly.validate() {
-        errln!(
-            "error: the compiled assembly is inconsistent:\n  {}",
-            problems.join("\n  ")
-        );
-        return 1;
-    }
     let mut session = Session::new(config);
     let summary = match replay(&mut assembly, &script, &mut session) {
         Ok(r) => r,
