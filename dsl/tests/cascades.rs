@@ -167,12 +167,9 @@ fn a_misspelt_vertex_in_edges_is_one_error_not_also_a_state_with_other_edges() {
     let state = "    state tall {\n        sw (0, 0) se (1, 0) ne (1, 1) nw (0, 1)\n        \
                  edges sw-se-ne-nw-sw, sw-ne\n    }\n}";
     let piece = fixture("E011-variant-edge-vertex");
-    let end = piece.find("\n}\n").unwrap();
-    let one = format!(
-        "site type rail\n{}{}\n\nmodel {{\n    s = sleeper\n}}\n",
-        &piece[piece.find("piece sleeper").unwrap()..end],
-        &format!("\n{state}")
-    );
+    // The fixture's `sleeper` (with its typo) up to its closing brace, then the state.
+    let body = &piece[piece.find("piece sleeper").unwrap()..piece.find("\n}\n").unwrap()];
+    let one = format!("site type rail\n{body}\n{state}\n\nmodel {{\n    s = sleeper\n}}\n");
     let e = errors(&one);
     assert_eq!(e.len(), 1, "{one}\n{e:?}");
     assert_eq!(e[0].0, "E011", "{e:?}");
