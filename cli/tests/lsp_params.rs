@@ -58,7 +58,11 @@ fn pos(text: &str, offset: usize) -> Value {
 }
 
 fn at_pos(text: &str, offset: usize) -> Value {
-    json!({ "textDocument": { "uri": URI }, "position": pos(text, offset) })
+    at_pos_in(URI, text, offset)
+}
+
+fn at_pos_in(uri: &str, text: &str, offset: usize) -> Value {
+    json!({ "textDocument": { "uri": uri }, "position": pos(text, offset) })
 }
 
 struct Client {
@@ -153,9 +157,13 @@ impl Client {
     }
 
     fn open(&mut self, text: &str) {
+        self.open_at(URI, text);
+    }
+
+    fn open_at(&mut self, uri: &str, text: &str) {
         self.notify(
             "textDocument/didOpen",
-            json!({ "textDocument": { "uri": URI, "languageId": "clay", "version": 1, "text": text } }),
+            json!({ "textDocument": { "uri": uri, "languageId": "clay", "version": 1, "text": text } }),
         );
     }
 
@@ -280,4 +288,44 @@ fn while_the_text_does_not_parse_the_last_parsed_parameters_are_offered() {
         detail(&offered, "bays"),
         "parameter = 6 (default 6, range 2..40)"
     );
+}
+
+#[test]
+fn an_imported_parameter_is_hovered_and_offered_with_its_range() {
+    let dir = std::env::temp_dir().join(format!("clay-lsp-params-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("lib.clay"),
+        "let half = 0.5\nparam gap = 0.25 in 0..half\n",
+    )
+    .unwrap();
+    let text = format!(
+        "import \"lib.clay\"\n{}",
+        FENCE.replace("(bay_width, post)", "(bay_width + gap, post)")
+    );
+    let uri = format!("file://{}", dir.join("main.clay").display());
+    let mut c = Client::start();
+    c.open_at(&uri, &text);
+    let hover = c.result(
+        "textDocument/hover",
+        at_pos_in(&uri, &text, at(&text, "+ gap", 0, 3)),
+    );
+    let md = hover["contents"]["value"].as_str().unwrap_or_default();
+    assert!(
+        md.contains("value `0.25`, default `0.25`, range `0..0.5`"),
+        "{hover}"
+    );
+    let list = c.result(
+        "textDocument/completion",
+        at_pos_in(&uri, &text, at(&text, "x bays", 0, 2)),
+    );
+    let gap = (list.as_array().unwrap().iter())
+        .find(|i| i["label"] == "gap")
+        .unwrap_or_else(|| panic!("gap is offered: {list}"));
+    assert_eq!(
+        gap["detail"],
+        "parameter = 0.25 (default 0.25, range 0..0.5)"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
