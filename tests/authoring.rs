@@ -231,8 +231,8 @@ fn the_editor_refuses_every_keyword_of_the_grammar_as_a_name() {
     assert!(keywords.len() > 30 && keywords.contains(&"bend"));
     for k in keywords {
         assert!(
-            clay::authoring::KEYWORDS.contains(&k),
-            "`{k}` is a keyword of grammar.pest but not in authoring::work::KEYWORDS"
+            clay_dsl::analysis::KEYWORDS.contains(&k),
+            "`{k}` is a keyword of grammar.pest but not in clay_dsl::analysis::KEYWORDS"
         );
     }
 }

@@ -38,8 +38,8 @@ pub use graph::{Contact, Graph, MIN_TOLERANCE, Region};
 pub use pieces::{Design, PieceDesign, StretchChoice, find_pieces};
 pub use svg::{drawing_from_svg, line_of_id};
 pub use work::{
-    Computed, KEYWORDS, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name,
-    compute, docked_sites, find_site, site_names, variant_map,
+    Computed, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name, compute,
+    docked_sites, find_site, site_names, variant_map,
 };
 
 /// Everything authoring needs besides the drawing.

@@ -134,7 +134,7 @@ pub struct Computed {
 
 /// The grammar's keywords (docs/language.md). They are contextual, but a name that spells one
 /// reads badly (`piece piece {`), so the editor refuses them as names.
-pub use clay_dsl::analysis::KEYWORDS;
+use clay_dsl::analysis::KEYWORDS;
 
 /// Why `s` cannot be a name in the grammar: an ASCII letter or `_`, then letters, digits and
 /// `_`, and not a keyword.

@@ -34,8 +34,9 @@ use std::collections::HashMap;
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, Instance, Rgba};
 use glam::{DVec2, DVec3};
 
+use crate::fit::rigid_motion;
 use crate::render::tessellate::shown_geometry;
-use crate::render::{Mesh, Solid, TessellationCache, WorldMesh, pose_assembly, rigid_motion};
+use crate::render::{Mesh, Solid, TessellationCache, WorldMesh, pose_assembly};
 use solid::{Blend, Prism, Shape};
 
 pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh};

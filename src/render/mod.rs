@@ -24,8 +24,8 @@ pub use draw::{
 };
 pub use pick::part_at;
 pub use pose::{
-    RigidMotion, SiteFrame, Skin, WorldMesh, pose_assembly, pose_assembly_into, pose_instance,
-    pose_piece, rigid_motion, site_out,
+    SiteFrame, Skin, WorldMesh, pose_assembly, pose_assembly_into, pose_instance, pose_piece,
+    site_out,
 };
 pub use raster::{MAX_SIDE, PixmapCanvas, RenderError, render_pixmap, render_png};
 pub use sheet::{sheet_pixmap, sheet_png, sheet_svg};

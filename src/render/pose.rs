@@ -9,7 +9,7 @@ use clay_dsl::compiled::{AssemblyData, Binding, CompiledGrammar, Extrude, Rgba};
 use glam::DVec2;
 
 use super::tessellate::{Mesh, Solid, TessellationCache, shown_geometry};
-pub use crate::fit::{RigidMotion, rigid_motion};
+use crate::fit::rigid_motion;
 
 /// The frame of one axis site: its vertex centroid and its tangent (first to last site vertex),
 /// at rest and now. Mapping through it keeps the tangential coordinate scaled by the site's
