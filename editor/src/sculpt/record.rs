@@ -8,6 +8,10 @@
 //! The recording is part of the undo history: a [`super::Snapshot`] keeps the recording as
 //! it was before its gesture, so undoing a gesture takes its steps out of the script and redo
 //! puts them back; the frames run after the undo are held from where the model went back to.
+//! The steps are kept in shared chunks, so the copies in the undo history share them: a long
+//! session's recording is in memory once, not once per undo step.
+
+use std::sync::Arc;
 
 use clay::script::{Motion, Script, Selector, Step};
 use glam::DVec2;
@@ -15,9 +19,15 @@ use glam::DVec2;
 /// Most frames one `hold` step may ask for; longer waits are split.
 const MAX_HOLD: u64 = clay::script::MAX_FRAMES;
 
+/// Steps kept unshared at most: more are frozen into a chunk the copies share.
+const CHUNK: usize = 256;
+
 /// The steps that make the sculpt from the grammar's initial model.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Recording {
+    /// The steps before `steps`, in chunks shared with the copies in the undo history.
+    frozen: Vec<Arc<[Step]>>,
+    /// The latest steps (at most [`CHUNK`]).
     steps: Vec<Step>,
     /// Solver frames run since the last step, not yet written as a `hold`.
     held: u64,
@@ -34,6 +44,7 @@ impl Recording {
     /// An empty recording, from the grammar's initial model.
     pub(super) fn new() -> Self {
         Self {
+            frozen: Vec::new(),
             steps: Vec::new(),
             held: 0,
             target: (DVec2::ZERO, 0.0),
@@ -60,13 +71,21 @@ impl Recording {
             return;
         }
         self.write_held();
+        self.append(step);
+    }
+
+    fn append(&mut self, step: Step) {
+        if self.steps.len() >= CHUNK {
+            let chunk: Arc<[Step]> = std::mem::take(&mut self.steps).into();
+            self.frozen.push(chunk);
+        }
         self.steps.push(step);
     }
 
     fn write_held(&mut self) {
         while self.held > 0 {
             let frames = self.held.min(MAX_HOLD);
-            self.steps.push(Step::Hold { frames });
+            self.append(Step::Hold { frames });
             self.held -= frames;
         }
     }
@@ -148,10 +167,23 @@ impl Recording {
         if let Some(why) = &self.unknown_start {
             return Err(why.clone());
         }
-        let mut done = self.clone();
+        // The move not yet solved and the frames held, as steps after the recorded ones.
+        let mut done = Self {
+            frozen: Vec::new(),
+            steps: Vec::new(),
+            held: self.held,
+            target: self.target,
+            pending: self.pending,
+            unknown_start: None,
+        };
         done.frame_starts();
         done.write_held();
-        Ok(Script { steps: done.steps })
+        let steps = (self.frozen.iter().flat_map(|c| c.iter()))
+            .chain(&self.steps)
+            .chain(&done.steps)
+            .cloned()
+            .collect();
+        Ok(Script { steps })
     }
 }
 
@@ -202,6 +234,32 @@ mod tests {
                 Step::Hold { frames: 1 },
             ]
         );
+    }
+
+    #[test]
+    fn copies_share_the_steps_and_the_script_keeps_their_order() {
+        let mut r = Recording::new();
+        for k in 0..(3 * CHUNK + 5) {
+            r.pin(DVec2::new(k as f64, 0.0), k % 2 == 0);
+            r.frame();
+        }
+        let copy = r.clone();
+        // a pin and a held frame each, less the last frame (held, not yet a step)
+        let recorded = 2 * (3 * CHUNK + 5) - 1;
+        assert_eq!(r.frozen.len(), recorded / CHUNK);
+        assert!((r.frozen.iter().zip(&copy.frozen)).all(|(a, b)| Arc::ptr_eq(a, b)));
+        assert!(copy.steps.len() <= CHUNK);
+        let steps = copy.script().unwrap().steps;
+        assert_eq!(steps.len(), 2 * (3 * CHUNK + 5));
+        for (k, pair) in steps.chunks(2).enumerate() {
+            let sel = Selector::At(DVec2::new(k as f64, 0.0));
+            let pin = if k % 2 == 0 {
+                Step::Pin(sel)
+            } else {
+                Step::Unpin(sel)
+            };
+            assert_eq!(pair, [pin, Step::Hold { frames: 1 }]);
+        }
     }
 
     #[test]
