@@ -481,7 +481,7 @@ fn top(m: &str) -> String {
 const ALLOWED: &[(&str, &[&str])] = &[
     ("assembly", &["fit"]),
     ("authoring", &["plane"]),
-    ("export", &["render"]),
+    ("export", &["fit", "render"]),
     ("files", &[]),
     ("fit", &[]),
     (
