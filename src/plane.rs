@@ -52,6 +52,21 @@ pub fn triangle_area(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a) / 2.0
 }
 
+/// The barycentric weights of `p` in the triangle `a, b, c` (they sum to 1, and all lie in
+/// `0..=1` exactly when `p` is inside or on the boundary), or `None` for a triangle without
+/// area.
+pub fn barycentric(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> Option<[f64; 3]> {
+    let area = (b - a).perp_dot(c - a);
+    if area == 0.0 {
+        return None;
+    }
+    Some([
+        (b - p).perp_dot(c - p) / area,
+        (p - a).perp_dot(c - a) / area,
+        (b - a).perp_dot(p - a) / area,
+    ])
+}
+
 /// Whether `p` is inside the triangle `a, b, c` or on its boundary, whatever its winding.
 pub fn triangle_contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
     let d1 = (b - a).perp_dot(p - a);

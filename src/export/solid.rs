@@ -22,6 +22,7 @@ use glam::DVec2;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use super::model::ExportOptions;
+use crate::plane::{barycentric, triangle_area};
 use crate::render::Mesh;
 
 /// A vertex of a cap: a weighted sum of tessellation vertices, `(mesh, vertex, weight)`; all
@@ -202,10 +203,6 @@ fn boundary(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
         .collect()
 }
 
-fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    (b - a).perp_dot(c - a)
-}
-
 /// Whether welded triangles form a clean triangulation of their region: every triangle
 /// counter-clockwise with area, no directed edge used twice, and no vertex inside an outline
 /// edge (a T-junction, where the walls on both sides would not meet).
@@ -213,7 +210,7 @@ fn clean(points: &[DVec2], triangles: &[[u32; 3]]) -> bool {
     let p = |i: u32| points[i as usize];
     if triangles
         .iter()
-        .any(|t| cross(p(t[0]), p(t[1]), p(t[2])) <= 0.0)
+        .any(|t| triangle_area(p(t[0]), p(t[1]), p(t[2])) <= 0.0)
     {
         return false;
     }
@@ -241,7 +238,9 @@ fn clean(points: &[DVec2], triangles: &[[u32; 3]]) -> bool {
             let q = p(v);
             let d = b - a;
             let along = (q - a).dot(d);
-            if along > 0.0 && along < d.length_squared() && cross(a, b, q).abs() <= tol * d.length()
+            if along > 0.0
+                && along < d.length_squared()
+                && (2.0 * triangle_area(a, b, q)).abs() <= tol * d.length()
             {
                 return false;
             }
@@ -287,7 +286,7 @@ fn union(points: &[DVec2], triangles: &[[u32; 3]]) -> Option<(Vec<Weights>, Vec<
     for face in cdt.inner_faces() {
         let corners = face.vertices();
         let pos = corners.map(|v| DVec2::new(v.position().x, v.position().y));
-        let area = cross(pos[0], pos[1], pos[2]);
+        let area = 2.0 * triangle_area(pos[0], pos[1], pos[2]);
         if area.abs() <= f64::EPSILON * pos.iter().map(|q| q.length_squared()).fold(1.0, f64::max) {
             continue;
         }
@@ -413,15 +412,9 @@ impl Grid {
         for &k in &self.cells[y * self.n[0] + x] {
             let t = triangles[k as usize];
             let [a, b, c] = t.map(|i| points[i as usize]);
-            let area = cross(a, b, c);
-            if area == 0.0 {
+            let Some(w) = barycentric(a, b, c, p) else {
                 continue;
-            }
-            let w = [
-                cross(p, b, c) / area,
-                cross(a, p, c) / area,
-                cross(a, b, p) / area,
-            ];
+            };
             let worst = w[0].min(w[1]).min(w[2]);
             if best.is_none_or(|(_, bw)| worst > bw[0].min(bw[1]).min(bw[2])) {
                 best = Some((k as usize, w));
@@ -501,7 +494,7 @@ mod tests {
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| at(&p.vertices[i as usize]));
-                cross(a, b, c) / 2.0
+                triangle_area(a, b, c)
             })
             .sum()
     }
@@ -599,7 +592,7 @@ mod tests {
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| meshes[0].vertices[i as usize]);
-                cross(a, b, c) / 2.0
+                triangle_area(a, b, c)
             })
             .sum();
         assert!(area(&p, at) < sum - 1e-6);
