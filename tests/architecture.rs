@@ -481,7 +481,7 @@ fn top(m: &str) -> String {
 const ALLOWED: &[(&str, &[&str])] = &[
     ("assembly", &["fit"]),
     ("authoring", &["plane"]),
-    ("export", &["fit", "render"]),
+    ("export", &["fit", "plane", "render"]),
     ("files", &[]),
     ("fit", &[]),
     (
