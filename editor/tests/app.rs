@@ -415,8 +415,15 @@ fn right_drag_turns_the_grabbed_part() {
         h.hover_at(centre + Vec2::new(30.0 * a.cos(), -30.0 * a.sin()));
         h.step();
     }
-    // The solver follows the last move in the next frame.
-    h.step();
+    // The solver catches up with the last move while the button is held: within a frame when
+    // the machine is idle, a few more when a loaded one cuts frames at the UI's time budget
+    // (how fast is the drag bench's question, not this test's).
+    for _ in 0..200 {
+        h.step();
+        if !h.state().sculpt.needs_work() {
+            break;
+        }
+    }
     let turned = e0.angle_to(edge(&h));
     h.event(button(centre + Vec2::new(0.0, -30.0), false));
     h.step();
