@@ -1437,3 +1437,187 @@ fn an_open_library_is_read_from_its_buffer_and_its_change_rechecks_the_importer(
     assert_eq!(c.published(&l.main_uri, None)["diagnostics"], json!([]));
     assert!(c.shutdown_and_exit().success());
 }
+
+// Grammar parameters (`param NAME = DEFAULT in LO..HI`, issue 39): a hover on a parameter's
+// name, at its declaration or a use, shows its value, default and range; where a number goes,
+// completion offers the parameters as it offers `let` constants, with their value and range as
+// detail, also while the text does not parse.
+
+/// The fence of docs/language.md: two parameters, a `let` that uses one.
+const FENCE: &str = "\
+param bays = 6 in 2..40 // a chain count
+param bay_width = 2 in 1..4 // metres
+param lean = 0.5 // no range
+let post = bay_width / 10
+
+site type rail
+
+piece bay {
+    vertex sw (0, 0)
+    vertex se (bay_width, lean * 0)
+    vertex ne (bay_width, post)
+    vertex nw (0, post)
+    edges sw-se-ne-nw-sw, sw-ne
+    site west: rail [nw, sw] out (-1, 0)
+    site east: rail [se, ne] out (1, 0)
+}
+
+stretch bay from west to east
+
+model {
+    fence = chain bay x bays at (0, 0)
+}
+";
+
+fn at_pos_in(uri: &str, text: &str, offset: usize) -> Value {
+    json!({ "textDocument": { "uri": uri }, "position": pos(text, offset) })
+}
+
+/// The hover's markdown at `offset`.
+fn hover(c: &mut Client, text: &str, offset: usize) -> String {
+    let hover = c.result("textDocument/hover", at_pos(text, offset));
+    hover["contents"]["value"]
+        .as_str()
+        .unwrap_or_else(|| panic!("a hover at {offset}: {hover}"))
+        .to_string()
+}
+
+/// The completions at `offset`: label and item.
+fn completions(c: &mut Client, text: &str, offset: usize) -> Vec<(String, Value)> {
+    let list = c.result("textDocument/completion", at_pos(text, offset));
+    let items = list
+        .as_array()
+        .or_else(|| list["items"].as_array())
+        .unwrap();
+    items
+        .iter()
+        .map(|i| (i["label"].as_str().unwrap().to_string(), i.clone()))
+        .collect()
+}
+
+fn detail<'a>(items: &'a [(String, Value)], label: &str) -> &'a str {
+    let (_, item) = items
+        .iter()
+        .find(|(l, _)| l == label)
+        .unwrap_or_else(|| panic!("`{label}` is offered: {items:?}"));
+    item["detail"].as_str().unwrap_or("")
+}
+
+#[test]
+fn a_parameters_hover_shows_its_value_default_and_range_at_its_declaration_and_uses() {
+    let mut c = Client::start();
+    c.open(FENCE);
+    let declaration = hover(&mut c, FENCE, at(FENCE, "param bays", 0, 7));
+    assert!(
+        declaration.contains("value `6`, default `6`, range `2..40`"),
+        "{declaration}"
+    );
+    assert!(declaration.contains("--param bays=VALUE"), "{declaration}");
+    let used = hover(&mut c, FENCE, at(FENCE, "x bays", 0, 3));
+    assert!(
+        used.contains("value `6`, default `6`, range `2..40`"),
+        "{used}"
+    );
+    let width = hover(&mut c, FENCE, at(FENCE, "(bay_width, post)", 0, 2));
+    assert!(
+        width.contains("value `2`, default `2`, range `1..4`"),
+        "{width}"
+    );
+    let lean = hover(&mut c, FENCE, at(FENCE, "lean * 0", 0, 1));
+    assert!(
+        lean.contains("value `0.5`, default `0.5`, range any finite number"),
+        "{lean}"
+    );
+    // A `let` is no parameter: its hover has its value only.
+    let post = hover(&mut c, FENCE, at(FENCE, "let post", 0, 5));
+    assert!(post.contains("= `0.2`"), "{post}");
+    assert!(!post.contains("parameter"), "{post}");
+}
+
+#[test]
+fn completion_offers_the_parameters_where_a_number_goes_with_their_range() {
+    let mut c = Client::start();
+    c.open(FENCE);
+    // A chain's count.
+    let count = completions(&mut c, FENCE, at(FENCE, "x bays", 0, 2));
+    assert_eq!(
+        detail(&count, "bays"),
+        "parameter = 6 (default 6, range 2..40)"
+    );
+    assert_eq!(
+        detail(&count, "bay_width"),
+        "parameter = 2 (default 2, range 1..4)"
+    );
+    assert_eq!(
+        detail(&count, "lean"),
+        "parameter = 0.5 (default 0.5, range any finite number)"
+    );
+    // The `let` is offered as before, with its value.
+    assert_eq!(detail(&count, "post"), "= 0.2");
+    // A coordinate, as the `let` constants are.
+    let coordinate = completions(&mut c, FENCE, at(FENCE, "vertex ne (", 0, 11));
+    assert!(detail(&coordinate, "bays").starts_with("parameter = 6"));
+    // Not where a site type goes.
+    let site = completions(&mut c, FENCE, at(FENCE, "west: rail", 0, 6));
+    assert!(site.iter().all(|(l, _)| l != "bays"), "{site:?}");
+}
+
+#[test]
+fn while_the_text_does_not_parse_the_last_parsed_parameters_are_offered() {
+    let mut c = Client::start();
+    c.open(FENCE);
+    // The analysis of the good text first.
+    let _ = hover(&mut c, FENCE, at(FENCE, "param bays", 0, 7));
+    let marker = "    vertex nw (0, post)\n";
+    let typing = FENCE.replace(marker, &format!("{marker}    vertex mid (\n"));
+    c.change(2, &typing);
+    let end = at(&typing, "vertex mid (", 0, 12);
+    let offered = completions(&mut c, &typing, end);
+    assert_eq!(
+        detail(&offered, "bays"),
+        "parameter = 6 (default 6, range 2..40)"
+    );
+}
+
+#[test]
+fn an_imported_parameter_is_hovered_and_offered_with_its_range() {
+    let dir = std::env::temp_dir().join(format!("clay-lsp-params-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("lib.clay"),
+        "let half = 0.5\nparam gap = 0.25 in 0..half\n",
+    )
+    .unwrap();
+    let text = format!(
+        "import \"lib.clay\"\n{}",
+        FENCE.replace("(bay_width, post)", "(bay_width + gap, post)")
+    );
+    let uri = format!("file://{}", dir.join("main.clay").display());
+    let mut c = Client::start();
+    c.notify(
+        "textDocument/didOpen",
+        json!({ "textDocument": { "uri": uri, "languageId": "clay", "version": 1, "text": text } }),
+    );
+    let hover = c.result(
+        "textDocument/hover",
+        at_pos_in(&uri, &text, at(&text, "+ gap", 0, 3)),
+    );
+    let md = hover["contents"]["value"].as_str().unwrap_or_default();
+    assert!(
+        md.contains("value `0.25`, default `0.25`, range `0..0.5`"),
+        "{hover}"
+    );
+    let list = c.result(
+        "textDocument/completion",
+        at_pos_in(&uri, &text, at(&text, "x bays", 0, 2)),
+    );
+    let gap = (list.as_array().unwrap().iter())
+        .find(|i| i["label"] == "gap")
+        .unwrap_or_else(|| panic!("gap is offered: {list}"));
+    assert_eq!(
+        gap["detail"],
+        "parameter = 0.25 (default 0.25, range 0..0.5)"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
