@@ -13,8 +13,8 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use super::Document;
 use super::convert;
+use super::document::Document;
 use super::params;
 
 type Docs = HashMap<String, Document>;

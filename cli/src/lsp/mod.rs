@@ -16,6 +16,7 @@
 //! and the server goes on. The server stops at `exit` or when its input ends.
 
 mod convert;
+mod document;
 mod follow;
 mod handlers;
 mod params;
@@ -28,12 +29,13 @@ use std::sync::Arc;
 use std::sync::mpsc::RecvTimeoutError;
 use std::time::{Duration, Instant};
 
-use clay_dsl::analysis::{Analysis, LineIndex};
+use clay_dsl::analysis::LineIndex;
 use clay_dsl::{FsLoader, Loader};
 use lsp_server::{ErrorCode, Message, Notification, Request, RequestId, Response, ResponseError};
 use lsp_types as lsp;
 use lsp_types::notification::Notification as _;
 
+use document::{Document, Published};
 use transport::{Input, Writer};
 
 /// Quiet time after a change before the document is checked.
@@ -112,75 +114,6 @@ pub fn serve<R: std::io::BufRead + Send + 'static, W: std::io::Write>(
         }
     }
 }
-
-/// An open document.
-pub struct Document {
-    pub uri: lsp::Uri,
-    pub text: String,
-    pub version: i32,
-    /// The analysis of `text` (of an earlier text while `dirty` or `late`).
-    pub analysis: Option<Arc<Analysis>>,
-    /// The last analysis whose text parsed: it answers for what lies after a syntax error.
-    pub last_parsed: Option<Arc<Analysis>>,
-    pub dirty: bool,
-    /// An analysis that outlasted the timeout and runs on (of `text` unless `dirty`).
-    late: Option<worker::Job>,
-}
-
-impl Document {
-    fn new(uri: lsp::Uri, text: String, version: i32) -> Self {
-        Self {
-            uri,
-            text,
-            version,
-            analysis: None,
-            last_parsed: None,
-            dirty: true,
-            late: None,
-        }
-    }
-
-    /// Starts analysing the present text, imports read through `loader`.
-    fn start(&mut self, loader: Arc<dyn Loader + Send + Sync>) -> worker::Job {
-        self.dirty = false;
-        worker::Job::start(worker::Work {
-            text: self.text.clone(),
-            path: convert::file_path(self.uri.as_str()),
-            previous: self.last_parsed.clone(),
-            loader,
-        })
-    }
-
-    /// Takes the finished analysis of the present text; gives what to publish.
-    fn finished(&mut self, a: Box<Analysis>) -> Published {
-        let a = Arc::new(*a);
-        if a.parses() {
-            self.last_parsed = Some(a.clone());
-        }
-        let diagnostics = convert::diagnostics(&self.uri, a.line_index(), a.diagnostics());
-        self.analysis = Some(a);
-        (self.uri.clone(), diagnostics, self.version)
-    }
-
-    /// What to publish when the analysis outlasts `timeout`: one warning at the start.
-    fn timed_out(&self, timeout: Duration) -> Published {
-        let message = format!(
-            "analysis timed out after {} ms: it goes on in the background and its diagnostics \
-             replace this one when it ends; until then, answers are about the last text analysed",
-            timeout.as_millis()
-        );
-        let warning = lsp::Diagnostic {
-            severity: Some(lsp::DiagnosticSeverity::WARNING),
-            source: Some("clay".into()),
-            message,
-            ..Default::default()
-        };
-        (self.uri.clone(), vec![warning], self.version)
-    }
-}
-
-/// Diagnostics to publish: the document, its diagnostics and the version they are of.
-type Published = (lsp::Uri, Vec<lsp::Diagnostic>, i32);
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum State {
