@@ -319,3 +319,37 @@ fn parses_tells_a_whole_parse_from_a_prefix() {
     let previous = Analysis::new(&good, "wall.clay");
     assert!(!Analysis::with_previous(&broken, "wall.clay", &previous).parses());
 }
+
+/// An imported piece's place (file and span) answers, also from the last good text while the
+/// text does not parse (moved from analysis/imports.rs, which no longer reaches its parent).
+#[test]
+fn an_imported_piece_answers_also_while_the_text_does_not_parse() {
+    let dir = std::env::temp_dir().join(format!("clay-analysis-imports-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let lib = "site type joint\npiece brick {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \
+               vertex c (1, 1)\n    edges a-b-c-a\n}\n";
+    std::fs::write(dir.join("lib.clay"), lib).unwrap();
+    let path = dir.join("main.clay").display().to_string();
+    let main = "import \"lib.clay\"\n\nmodel {\n    b = brick\n}\n";
+    let good = Analysis::new(main, &path);
+    let use_at = main.find("= brick").unwrap() + 2;
+    let def = good.definition(use_at).unwrap();
+    let place = good.place(def);
+    assert_eq!(place.file, 1);
+    assert!(good.path(1).ends_with("/lib.clay"), "{}", good.path(1));
+    let decl = lib.find("brick").unwrap();
+    assert_eq!((place.span.start, place.span.end), (decl, decl + 5));
+    assert_eq!(
+        good.declared_at(good.path(1), place.span),
+        good.symbol_at(use_at)
+    );
+
+    // A syntax error before the model: the imports of the last good text still answer.
+    let broken = main.replace("\n\nmodel", "\npiece {\n\nmodel");
+    let a = Analysis::with_previous(&broken, &path, &good);
+    assert!(!a.parses());
+    let use_at = broken.find("= brick").unwrap() + 2;
+    let place = a.place(a.definition(use_at).expect("the imported brick"));
+    assert_eq!((place.file, place.span.start), (1, decl));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

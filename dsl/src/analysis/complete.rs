@@ -2,7 +2,8 @@
 //! and the blocks it is inside (read from the text itself, so it works while the text does not
 //! parse), and offered from the symbol table.
 
-use super::{Analysis, SymbolKind};
+use super::analysed::Analysis;
+use super::symbols::SymbolKind;
 use crate::syntax::Span;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -17,6 +17,7 @@
 //! to its file, and [`Analysis::declared_at`] finds a declaration of another file's analysis
 //! here (how `clayc lsp` gathers references and renames over every open file).
 
+mod analysed;
 mod complete;
 pub mod follow;
 mod imports;
@@ -26,6 +27,7 @@ mod tokens;
 use std::collections::HashMap;
 
 pub use crate::line_index::{LineIndex, LinePos};
+pub use analysed::{Analysis, KEYWORDS};
 pub use complete::{Completion, CompletionKind};
 pub use imports::Place;
 pub use symbols::{Reference, Symbol, SymbolKind, Symbols};
@@ -35,15 +37,6 @@ use crate::compile::Loader;
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::syntax::{File, Item, Span};
 use imports::Imported;
-
-/// Keywords of the language (contextual: a name may spell one). A rename to one is refused.
-pub const KEYWORDS: &[&str] = &[
-    "let", "solver", "site", "type", "docks", "piece", "vertex", "edges", "out", "axis", "polygon",
-    "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
-    "min", "max", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x",
-    "along", "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude",
-    "above", "mesh", "param", "in",
-];
 
 /// Words that start a top-level item, where a parsed prefix may end.
 const ITEM_STARTS: &[&str] = &[
@@ -67,22 +60,6 @@ pub struct Outline {
 pub struct Fix {
     pub title: String,
     pub edits: Vec<(Span, String)>,
-}
-
-/// One text, analysed.
-#[derive(Clone, Debug)]
-pub struct Analysis {
-    index: LineIndex,
-    /// The analysed file's path, normalised as import paths are.
-    path: String,
-    imported: Imported,
-    tree: Option<File>,
-    /// The text up to here is described by `tree` (the whole text when it parses).
-    parsed_to: usize,
-    symbols: Symbols,
-    diagnostics: Diagnostics,
-    /// Folded values of the constants (for hovers).
-    values: HashMap<String, f64>,
 }
 
 impl Analysis {

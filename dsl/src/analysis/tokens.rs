@@ -3,7 +3,8 @@
 
 use std::collections::HashMap;
 
-use super::{Analysis, KEYWORDS, SymbolKind};
+use super::analysed::{Analysis, KEYWORDS};
+use super::symbols::SymbolKind;
 use crate::syntax::Span;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
