@@ -507,17 +507,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
 /// Children that still import their parent's items while the parent imports them, so that
 /// the two import each other. The cycle check over the full module graph leaves these edges
 /// out (and only these); `the_pending_exceptions_still_close_a_cycle` fails for an entry
-/// that no longer does, so the list only shrinks.
-const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[
-    // issue 38: clay-dsl's compile/mod.rs holds what its children share.
-    ("dsl/src", "compile::assembly", "compile"),
-    ("dsl/src", "compile::constants", "compile"),
-    ("dsl/src", "compile::extends", "compile"),
-    ("dsl/src", "compile::mesh_files", "compile"),
-    ("dsl/src", "compile::meshes", "compile"),
-    ("dsl/src", "compile::rules", "compile"),
-    ("dsl/src", "compile::usage", "compile"),
-];
+/// that no longer does, so the list only shrinks. Empty since issue 38: every child imports
+/// its siblings (a `state.rs`, `drawing.rs`, `analysed.rs` or `document.rs` holding what they
+/// share), never its parent.
+const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[];
 
 /// The strict graph: a crate's graph without the pending exceptions.
 fn strict(

@@ -6,8 +6,10 @@ use std::collections::{HashMap, HashSet, VecDeque};
 
 use glam::DVec2;
 
+use super::codes;
+use super::limits::{DOCK_TOLERANCE, MAX_MODEL_INSTANCES};
 use super::rules::{dock_motion, rotate, site_centre};
-use super::{Compiler, DOCK_TOLERANCE, MAX_MODEL_INSTANCES, codes, fmt};
+use super::state::{Compiler, fmt};
 use crate::compiled::*;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, ElementIndexKind, ModelStmt, Span};

@@ -10,7 +10,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{Compiler, codes};
+use super::codes;
+use super::state::{Compiler, Constant, Dependency, Kind, Touch};
 use crate::compiled::Param;
 use crate::diagnostic::Diagnostic;
 use crate::format::format_number;
@@ -36,13 +37,6 @@ const FUNCTIONS: [(&str, Option<usize>, &str); 11] = [
     ("max", None, "max(a, b, ...)"),
 ];
 
-/// What declared a constant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    Let,
-    Param,
-}
-
 impl Kind {
     fn word(self) -> &'static str {
         match self {
@@ -57,57 +51,6 @@ impl Kind {
             Kind::Param => "param",
         }
     }
-}
-
-/// A parameter a value depends on: its name and the name in its `param`.
-#[derive(Clone, Debug)]
-struct Dependency {
-    param: String,
-    decl: Span,
-}
-
-/// One `let` or `param`.
-#[derive(Clone, Debug)]
-struct Constant {
-    /// `None` when its expression failed (reported there): the constant is poisoned.
-    value: Option<f64>,
-    /// The name in its declaration.
-    span: Span,
-    /// Uses at or after this byte see it (the end of its declaration).
-    visible_from: usize,
-    used: bool,
-    kind: Kind,
-    /// The parameter its value depends on (a parameter depends on itself), if any.
-    depends: Option<Dependency>,
-}
-
-/// A use of a parameter, directly or through a `let`, seen while folding.
-#[derive(Clone, Debug)]
-struct Touch {
-    dep: Dependency,
-    /// The name used, where it was used.
-    used: Ident,
-}
-
-/// The `let` constants and `param` parameters of a file, the parameters' overrides, and which
-/// expressions were already reported.
-#[derive(Debug, Default)]
-pub(crate) struct Constants {
-    table: HashMap<String, Constant>,
-    /// Every `let` and `param` name with its span and kind, known before any is evaluated,
-    /// so that a use before the declaration is told apart from an unknown name.
-    declared: HashMap<String, (Span, Kind)>,
-    /// Spans of expressions already evaluated with an error: a pass that reads an expression
-    /// again stays silent.
-    failed: HashSet<(usize, usize)>,
-    /// Constants already reported as used before their `let`.
-    early: HashSet<String>,
-    /// The values given for parameters, by name, in the order given (the last one counts).
-    pub overrides: Vec<(String, f64)>,
-    /// The parameters that compiled, in declaration order, for the compiled grammar.
-    pub params: Vec<Param>,
-    /// The first parameter the expression being folded depends on.
-    touched: Option<Touch>,
 }
 
 /// Why evaluation stopped; the diagnostic (if any) is already pushed.

@@ -14,7 +14,9 @@ use crate::compiled::*;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, DeriveKind};
 
-use super::{COINCIDENT_EPS, Compiler, PieceSpans, codes, fmt};
+use super::codes;
+use super::limits::COINCIDENT_EPS;
+use super::state::{Compiler, PieceSpans, fmt};
 
 /// Largest turn, in degrees, of one straight segment of bent proxy geometry: a polygon or
 /// polyline edge alongside the axis is cut into pieces that each turn by at most this much (16

@@ -16,8 +16,9 @@
 
 use std::collections::HashMap;
 
-use super::{Compiler, codes};
-use crate::diagnostic::{Diagnostic, Diagnostics};
+use super::codes;
+use super::state::{Child, Compiler, Inheritance};
+use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, Ident, Item, PieceDecl, PieceStmt, Span};
 
 /// Deepest `extends` chain accepted (a piece extending a piece ... this many times).
@@ -27,29 +28,6 @@ pub const MAX_INHERITED: usize = 1_000_000;
 
 /// Most pieces of an `extends` cycle named in its message and labels.
 const MAX_CYCLE_SHOWN: usize = 8;
-
-/// What the compiler keeps about a piece that extends another.
-#[derive(Clone, Debug)]
-pub(crate) struct Child {
-    /// The child's own declaration: its statements lie inside, the inherited ones outside.
-    pub own: Span,
-    pub base: String,
-    /// 1 for a piece extending a plain piece, 2 for its child, ...
-    pub depth: usize,
-    /// The pieces it inherits from, nearest first, with their declarations.
-    pub ancestors: Vec<(String, Span)>,
-    /// The base is unknown, has errors, or is in a cycle: the child stays silent.
-    pub poisoned: bool,
-    /// Errors of the child itself were reported while resolving (the piece is not sound).
-    pub failed: bool,
-}
-
-#[derive(Debug, Default)]
-pub(crate) struct Inheritance {
-    pub children: HashMap<String, Child>,
-    /// Each child's diagnostics, held back until its base is known to be sound.
-    pending: Vec<(String, Diagnostics)>,
-}
 
 impl Inheritance {
     /// The piece (the child itself or an ancestor) whose declaration holds `span`.

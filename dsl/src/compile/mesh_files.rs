@@ -16,8 +16,9 @@ use base64::Engine;
 use glam::{DMat4, DVec2, DVec3};
 use gltf::mesh::Mode;
 
+use super::imports::Loader;
 use super::imports::resolve;
-use super::{Loader, MAX_COORDINATE};
+use super::limits::MAX_COORDINATE;
 use crate::compiled::{ProxyShape, Rgba};
 
 /// Largest mesh asset file, with its external buffers (16 MiB).

@@ -11,23 +11,17 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use super::Loader;
 use super::codes;
+use super::imports::Loader;
 use super::imports::resolve;
 use super::mesh_files::{self, AssetPart, Budget, Problem};
 pub use super::mesh_files::{
     MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES,
 };
+use super::state::Meshes;
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::source_map::SourceMap;
 use crate::syntax::{self, Item, PieceStmt, ShapeDecl, Span};
-
-/// The decoded assets, by the global start of the `mesh` statement's path string (a piece
-/// copied by `extends` shares its base's statements and so its asset).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Meshes {
-    by_path_start: HashMap<usize, Arc<[AssetPart]>>,
-}
 
 impl Meshes {
     /// The asset of the `mesh` statement whose path string is at `path`; `None` when it failed

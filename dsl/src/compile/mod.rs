@@ -1,9 +1,13 @@
 //! The compiler: syntax tree -> [`CompiledGrammar`]. This file drives the passes and compiles
-//! the declarations (solver, site types, pieces); `constants.rs` folds `let` constants,
+//! the declarations (solver, site types, pieces); `state.rs` holds the compiler's state and
+//! `limits.rs` its limits, which every pass imports instead of this file; `constants.rs` folds `let` constants,
 //! `param` parameters (with their overrides) and every expression; `rules.rs` compiles stretch, merge and cut
 //! rules, `assembly.rs` places the model, and `usage.rs` finds unused pieces and dead rules.
 
 pub mod codes;
+
+mod limits;
+mod state;
 
 mod assembly;
 mod constants;
@@ -30,7 +34,10 @@ use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
 pub(crate) use imports::regular_file;
 pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
+pub use limits::{MAX_COORDINATE, MAX_INSTANCES, MAX_MODEL_INSTANCES};
 pub use meshes::{MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
+use state::Compiler;
+use state::{Constants, Inheritance, Meshes};
 
 /// The result of a successful compilation: the grammar, and the warnings found on the way.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,22 +53,6 @@ impl Compiled {
         self.warnings.sources.files.iter().map(|f| f.path.as_str())
     }
 }
-
-/// Largest absolute coordinate accepted, in metres; keeps every later computation finite.
-pub const MAX_COORDINATE: f64 = 1e9;
-/// Largest `extrude` height or base, in metres (the tallest building is under 1 km).
-pub const MAX_HEIGHT: f64 = 10_000.0;
-/// Most instances a model may grow to while it is sculpted (the stretch rule inserts no more).
-pub const MAX_INSTANCES: usize = 1_000_000;
-/// Most instances a grammar's model may declare (E014, chains included): what `clayc check`,
-/// `run` and `build` handle in seconds (a 100,000-element chain: check 0.3 s, build 2.1 s and
-/// 300 MB of JSON, a solver frame 0.2 s). A million took 3.7 s to check, 36 s and 4.5 GB to
-/// build.
-pub const MAX_MODEL_INSTANCES: usize = 100_000;
-/// Distance below which two positions count as the same place.
-pub const COINCIDENT_EPS: f64 = 1e-9;
-/// Tolerance for docked vertices meeting after placement, in metres.
-pub const DOCK_TOLERANCE: f64 = 1e-4;
 
 /// How to compile a grammar: where its imported files and mesh assets are read from, and the
 /// values of its parameters. `CompileOptions::default()` reads the file system and sets no
@@ -231,62 +222,6 @@ pub fn compile_bytes_with_options(
     }
 }
 
-/// Where things were declared, for secondary labels.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct PieceSpans {
-    pub name: Span,
-    pub vertices: Vec<Span>,
-    pub sites: Vec<Span>,
-    /// Where each of the piece's edges was written.
-    pub edges: Vec<Span>,
-    /// `state NAME` of each alternative rest state that was compiled, in order.
-    pub states: Vec<Span>,
-    /// False when the piece had errors: later passes skip geometric checks on it.
-    pub sound: bool,
-    /// Sites declared with errors (already reported): a later use of one is not "unknown".
-    pub failed_sites: Vec<String>,
-    /// A vertex, edge or site written in the piece was dropped for an error reported there (an
-    /// unknown vertex or site type, say): the piece is not the shape its author wrote, so no
-    /// comparison of its shape with another's (a variant's, E041; a restated edge list's,
-    /// E021) is reported on top of that error.
-    pub partial: bool,
-    /// A piece extending one that failed (extends.rs): nothing is reported about it.
-    pub poisoned: bool,
-}
-
-pub(crate) struct Compiler {
-    pub path: String,
-    pub diags: Diagnostics,
-    pub solver: SolverParams,
-    pub site_types: Vec<SiteType>,
-    pub site_type_spans: Vec<Span>,
-    pub pieces: Vec<Piece>,
-    pub piece_spans: Vec<PieceSpans>,
-    pub piece_index: HashMap<String, usize>,
-    pub stretch_rules: Vec<StretchRule>,
-    pub stretch_spans: Vec<Span>,
-    pub merge_rules: Vec<MergeRule>,
-    pub merge_spans: Vec<Span>,
-    pub cut_rules: Vec<CutRule>,
-    pub cut_spans: Vec<Span>,
-    /// The first merge rule of each (mover, target, `within` bits): finds a shadowed rule
-    /// (W006) without a scan of the earlier rules.
-    pub merge_first: HashMap<(SiteRef, SiteRef, Option<u64>), usize>,
-    /// The cut rule of each junction site (`cut_rules` index).
-    pub cut_index: HashMap<SiteRef, usize>,
-    /// Pieces named by a stretch rule (written, even if the rule had errors).
-    pub stretch_named: Vec<bool>,
-    /// Set when a `dock` statement had errors: unplaced instances are then not reported.
-    pub dock_failed: bool,
-    /// Pieces declared with `extends` (extends.rs).
-    pub inheritance: extends::Inheritance,
-    pub grammar: Option<CompiledGrammar>,
-    /// The `let` constants, read by every expression.
-    pub consts: constants::Constants,
-    /// The decoded `mesh` assets, by the global start of their path string (meshes.rs).
-    pub meshes: meshes::Meshes,
-}
-
 impl Compiler {
     fn new(path: &str) -> Self {
         Self {
@@ -308,10 +243,10 @@ impl Compiler {
             cut_index: HashMap::new(),
             stretch_named: Vec::new(),
             dock_failed: false,
-            inheritance: extends::Inheritance::default(),
+            inheritance: Inheritance::default(),
             grammar: None,
-            consts: constants::Constants::default(),
-            meshes: meshes::Meshes::default(),
+            consts: Constants::default(),
+            meshes: Meshes::default(),
         }
     }
 
@@ -730,13 +665,6 @@ impl Compiler {
             }
         }
     }
-}
-
-/// Formats a number for messages: short, no trailing zeros.
-pub(crate) fn fmt(x: f64) -> String {
-    let r = (x * 1e4).round() / 1e4;
-    let r = if r == 0.0 { 0.0 } else { r };
-    format!("{r}")
 }
 
 impl CompiledGrammar {

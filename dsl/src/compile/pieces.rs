@@ -7,7 +7,9 @@ use crate::suggest::closest;
 use crate::syntax::{self, Ident, PieceStmt, Span};
 use glam::DVec2;
 
-use super::{COINCIDENT_EPS, Compiler, MAX_COORDINATE, MAX_HEIGHT, PieceSpans, codes, derive, fmt};
+use super::limits::{COINCIDENT_EPS, MAX_COORDINATE, MAX_HEIGHT};
+use super::state::{Compiler, PieceSpans, fmt};
+use super::{codes, derive};
 
 /// The colour of a `mesh` whose asset gives none and that has no `fill` (a light stone grey).
 const MESH_FILL: Rgba = Rgba([0xb8, 0xb2, 0xa7, 0xff]);

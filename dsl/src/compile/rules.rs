@@ -3,7 +3,9 @@
 
 use glam::DVec2;
 
-use super::{Compiler, DOCK_TOLERANCE, codes, fmt};
+use super::codes;
+use super::limits::DOCK_TOLERANCE;
+use super::state::{Compiler, fmt};
 use crate::compiled::*;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, Item, Span};

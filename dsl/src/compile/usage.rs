@@ -1,6 +1,7 @@
 //! Finds pieces nothing uses (W001) and rules that can never fire (W002).
 
-use super::{Compiler, codes};
+use super::codes;
+use super::state::Compiler;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, Item, ModelStmt};
 
