@@ -504,37 +504,14 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("synthetic", &[]),
 ];
 
-/// Children that still import their parent's items while the parent imports them, so that
-/// the two import each other. The cycle check over the full module graph leaves these edges
-/// out (and only these); `the_pending_exceptions_still_close_a_cycle` fails for an entry
-/// that no longer does, so the list only shrinks. Empty since issue 38: every child imports
-/// its siblings (a `state.rs`, `drawing.rs`, `analysed.rs` or `document.rs` holding what they
-/// share), never its parent.
-const CHILD_TO_PARENT_PENDING: &[(&str, &str, &str)] = &[];
-
-/// The strict graph: a crate's graph without the pending exceptions.
-fn strict(
-    name: &str,
-    g: &BTreeMap<String, BTreeSet<String>>,
-) -> BTreeMap<String, BTreeSet<String>> {
-    let mut g = g.clone();
-    for (krate, from, to) in CHILD_TO_PARENT_PENDING {
-        if *krate == name
-            && let Some(edges) = g.get_mut(*from)
-        {
-            edges.remove(*to);
-        }
-    }
-    g
-}
-
 #[test]
 fn no_module_imports_one_that_imports_it_back() {
     for (name, krate, imports) in crates() {
         let g = graph_of(&krate, &imports);
         assert!(g.len() > 5, "{name}: only {} modules read", g.len());
-        // Every module, children naming their parents counted.
-        if let Some(c) = cycle(&strict(name, &g)) {
+        // Every module, children naming their parents counted: what siblings share lives in a
+        // sibling (a `state.rs`, `drawing.rs`, `analysed.rs`, `document.rs`), never the parent.
+        if let Some(c) = cycle(&g) {
             let at: Vec<String> = c
                 .iter()
                 .zip(c.iter().cycle().skip(1))
@@ -559,35 +536,6 @@ fn no_module_imports_one_that_imports_it_back() {
                 c.join(" -> ")
             );
         }
-    }
-}
-
-/// Whether `to` is reachable from `from`.
-fn reaches(g: &BTreeMap<String, BTreeSet<String>>, from: &str, to: &str) -> bool {
-    let mut seen = BTreeSet::new();
-    let mut stack = vec![from.to_string()];
-    while let Some(m) = stack.pop() {
-        if m == to {
-            return true;
-        }
-        if seen.insert(m.clone()) {
-            stack.extend(g.get(&m).into_iter().flatten().cloned());
-        }
-    }
-    false
-}
-
-#[test]
-fn the_pending_exceptions_still_close_a_cycle() {
-    let crates = crates();
-    for (krate, from, to) in CHILD_TO_PARENT_PENDING {
-        let (_, c, imports) = crates.iter().find(|c| c.0 == *krate).unwrap();
-        let g = graph_of(c, imports);
-        assert!(
-            g.get(*from).is_some_and(|t| t.contains(*to)) && reaches(&g, to, from),
-            "{krate}: `{from}` -> `{to}` no longer closes an import cycle: remove it from \
-             CHILD_TO_PARENT_PENDING"
-        );
     }
 }
 
