@@ -106,11 +106,22 @@ pub struct Compiled {
 /// A panic in the compiler is caught and reported as a problem at 1:1 (the caller keeps the
 /// last good model): the editor never exits on what a user wrote.
 pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
+    compile_with_params(source, path, &[])
+}
+
+/// [`compile`] with values for the grammar's parameters (`param NAME = ...`) replacing their
+/// defaults, by name: what the Grammar parameters panel sets. A compiled grammar in JSON has
+/// its parameters' values already, and takes none.
+pub fn compile_with_params(
+    source: &str,
+    path: &str,
+    params: &[(String, f64)],
+) -> Result<Compiled, Vec<Problem>> {
     let compiled = crate::guard::catching(|| {
         if source.trim_start().starts_with('{') {
             compile_json(source, path)
         } else {
-            compile_clay(source, path)
+            compile_clay(source, path, params)
         }
     });
     compiled.unwrap_or_else(|why| {
@@ -173,8 +184,16 @@ fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
     })
 }
 
-fn compile_clay(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
-    match clay_dsl::compile(source, path) {
+fn compile_clay(
+    source: &str,
+    path: &str,
+    params: &[(String, f64)],
+) -> Result<Compiled, Vec<Problem>> {
+    let options = clay_dsl::CompileOptions {
+        params: params.to_vec(),
+        ..Default::default()
+    };
+    match clay_dsl::compile_with_options(source, path, &options) {
         Ok(c) => Ok(Compiled {
             imports: c.imported_files().map(str::to_string).collect(),
             warnings: problems(&c.warnings, source, path),

@@ -274,6 +274,86 @@ pub fn parameters(ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command
     }
 }
 
+/// What the Grammar parameters panel asks for: a value for one of the grammar's parameters
+/// (`param NAME = ...`), or its default back. The app recompiles the grammar with it after
+/// the frame, keeping the sculpt where the structure allows, as hot reload does.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamChange {
+    Set(String, f64),
+    Reset(String),
+}
+
+/// The grammar's parameters: a slider per ranged one (a number field for one without a
+/// range), its default shown and a button back to it. A value is emitted once the slider is
+/// released or the field committed, not on every pointer move: each one recompiles.
+pub fn grammar_parameters(
+    ui: &mut egui::Ui,
+    params: &[clay_dsl::compiled::Param],
+    changes: &mut Vec<ParamChange>,
+) {
+    egui::Grid::new("grammar parameters")
+        .num_columns(3)
+        .show(ui, |ui| {
+            for p in params {
+                let id = egui::Id::unique(("grammar parameter", &p.name));
+                let mut v = ui.data(|d| d.get_temp::<f64>(id)).unwrap_or(p.value);
+                let whole = |x: f64| x.fract() == 0.0;
+                let integral =
+                    whole(p.default) && p.range.is_none_or(|[lo, hi]| whole(lo) && whole(hi));
+                let r = match p.range {
+                    Some([lo, hi]) => {
+                        let mut slider = egui::Slider::new(&mut v, lo..=hi)
+                            .text(&p.name)
+                            .update_while_editing(false);
+                        if integral {
+                            slider = slider.step_by(1.0);
+                        }
+                        ui.add(slider)
+                    }
+                    None => {
+                        ui.horizontal(|ui| {
+                            let field = egui::DragValue::new(&mut v)
+                                .speed(if integral { 1.0 } else { 0.01 })
+                                .update_while_editing(false);
+                            let r = ui.add(field);
+                            ui.label(&p.name);
+                            r
+                        })
+                        .inner
+                    }
+                };
+                let r = r.on_hover_text(format!(
+                    "`param {}` of the grammar{}: a change recompiles it, keeping the \
+                     sculpt where the structure allows",
+                    p.name,
+                    p.range
+                        .map_or(String::new(), |[lo, hi]| format!(", in {lo}..{hi}"))
+                ));
+                let released = r.drag_stopped()
+                    || r.clicked()
+                    || (r.changed() && !r.is_pointer_button_down_on());
+                if released {
+                    ui.data_mut(|d| d.remove::<f64>(id));
+                    if v != p.value && v.is_finite() {
+                        changes.push(ParamChange::Set(p.name.clone(), v));
+                    }
+                } else if r.changed() || r.is_pointer_button_down_on() {
+                    ui.data_mut(|d| d.insert_temp(id, v));
+                } else {
+                    ui.data_mut(|d| d.remove::<f64>(id));
+                }
+                ui.label(RichText::new(format!("default {}", p.default)).weak());
+                let reset = ui
+                    .add_enabled(p.value != p.default, egui::Button::new("reset"))
+                    .on_hover_text(format!("Back to the default, {}", p.default));
+                if reset.clicked() {
+                    changes.push(ParamChange::Reset(p.name.clone()));
+                }
+                ui.end_row();
+            }
+        });
+}
+
 /// The rule log, newest first: what the rules did, in the words of the grammar's names. It
 /// follows undo and redo (an undone gesture's lines go with it).
 pub fn rule_log(ui: &mut egui::Ui, sculpt: &Sculpt) {

@@ -83,6 +83,7 @@ impl EditorApp {
                 self.stale = true;
                 self.grammar_path = Some(path.to_path_buf());
                 self.session_path = None;
+                self.param_overrides.clear();
                 self.sculpt = Sculpt::new(empty_grammar(&shown));
                 self.canvas.grammar_changed();
                 self.start_watch(path);
@@ -111,8 +112,9 @@ impl EditorApp {
         }
     }
 
-    /// A good compile becomes the model: a new sculpt, the view fitted.
+    /// A good compile becomes the model: a new sculpt, the view fitted, no parameter set.
     pub(super) fn adopt(&mut self, compiled: Compiled) {
+        self.param_overrides.clear();
         self.watch_imports(compiled.imports.clone());
         self.problems = compiled.warnings;
         self.stale = false;
@@ -126,6 +128,7 @@ impl EditorApp {
         match compile::compile(source, shown) {
             Ok(c) => self.adopt(c),
             Err(problems) => {
+                self.param_overrides.clear();
                 self.imports.clear();
                 self.problems = problems;
                 self.stale = true;
@@ -168,11 +171,27 @@ impl EditorApp {
     /// Recompiles the grammar file: a good compile replaces the model (keeping the view, as
     /// one undoable step); a bad one keeps the last good model and shows the errors.
     pub fn reload(&mut self) {
-        let Some(path) = self.grammar_path.clone() else {
+        if self.grammar_path.is_some() {
+            self.recompile(None);
+        }
+    }
+
+    /// Recompiles the open grammar with the parameters' overrides, for hot reload (`change`
+    /// `None`) or for a change of a parameter (`change` says which). A good compile replaces
+    /// the model, keeping the sculpt where the structure allows; a bad one keeps the last
+    /// good model and shows the errors.
+    pub(super) fn recompile(&mut self, change: Option<&str>) {
+        let path = self.grammar_path.clone();
+        let shown = self.display_path();
+        if path.is_none() && shown != CASTLE_PATH {
+            self.message = Some(
+                "write the authored grammar to a file first (Author mode, Write grammar) to set its parameters"
+                    .into(),
+            );
             return;
-        };
-        let shown = path.display().to_string();
-        match check_grammar(&path) {
+        }
+        let mut notes = Vec::new();
+        match self.compile_current(path.as_deref(), &mut notes) {
             Ok(c) => {
                 self.watch_imports(c.imports.clone());
                 self.problems = c.warnings;
@@ -183,11 +202,17 @@ impl EditorApp {
                 if first_good {
                     self.canvas.request_fit();
                 }
-                self.message = Some(if kept {
-                    format!("reloaded {shown}; sculpt kept")
+                let what = change.map_or_else(|| format!("reloaded {shown}"), str::to_string);
+                let mut m = if kept {
+                    format!("{what}; sculpt kept")
                 } else {
-                    format!("reloaded {shown}; model rebuilt")
-                });
+                    format!("{what}; model rebuilt")
+                };
+                for n in notes {
+                    m.push_str("; ");
+                    m.push_str(&n);
+                }
+                self.message = Some(m);
             }
             Err(problems) => {
                 let first = problems.first().map_or(String::new(), |p| {
@@ -200,7 +225,10 @@ impl EditorApp {
                 } else {
                     "the last good model stays"
                 };
-                let m = format!("{shown} does not compile{first}; {what}");
+                let mut m = format!("{shown} does not compile{first}; {what}");
+                if let Some(c) = change {
+                    m = format!("{c}: {m}");
+                }
                 self.sculpt
                     .note_outside_history(format!("reload failed: {m}"));
                 self.message = Some(m);
@@ -247,6 +275,7 @@ impl EditorApp {
     pub fn open_session(&mut self, path: &Path) -> Result<(), String> {
         let loaded = load_session(path)?;
         self.sculpt = loaded.sculpt;
+        self.param_overrides.clear();
         self.problems = loaded.warnings;
         self.stale = false;
         self.refused = None;

@@ -273,6 +273,10 @@ impl EditorApp {
                     ""
                 };
                 ui.label(format!("{}{dirty}", self.display_path()));
+                if let Some(p) = self.params_status() {
+                    ui.separator();
+                    ui.label(p);
+                }
                 ui.separator();
                 let state = if let Some(e) = self.sculpt.error() {
                     format!("solver stopped: {e}")

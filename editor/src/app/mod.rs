@@ -4,14 +4,16 @@
 //! and [`EditorApp::apply`] applies them after the frame (as egui's demos and rerun do).
 //!
 //! The jobs are in the children: `document` (the open grammar, hot reload, sessions),
-//! `perform` (file actions), `export`, `menus` (menu bar, shortcuts, status bar), `dialogs`
-//! (modal prompts) and `sculpt_view` (sculpt mode's canvas and side panels). They import this
-//! module; it imports none of them.
+//! `params` (the grammar's parameters set from the editor), `perform` (file actions),
+//! `export`, `menus` (menu bar, shortcuts, status bar), `dialogs` (modal prompts) and
+//! `sculpt_view` (sculpt mode's canvas and side panels). They import this module; it imports
+//! none of them.
 
 mod dialogs;
 mod document;
 mod export;
 mod menus;
+mod params;
 mod perform;
 mod sculpt_view;
 
@@ -117,6 +119,10 @@ pub struct EditorApp {
     pub source_view: Option<panels::SourceView>,
     /// Following the text editor's cursor (`--follow`).
     pub follow: Option<crate::follow::Follow>,
+    /// Values the user set for the grammar's parameters (the Grammar parameters panel), by
+    /// name: the open document's, kept across hot reloads, dropped when another grammar opens.
+    param_overrides: Vec<(String, f64)>,
+    param_changes: Vec<panels::ParamChange>,
 }
 
 impl EditorApp {
@@ -171,6 +177,8 @@ impl EditorApp {
             refused: None,
             source_view: None,
             follow: None,
+            param_overrides: Vec::new(),
+            param_changes: Vec::new(),
         }
     }
 
@@ -330,6 +338,9 @@ impl EditorApp {
             {
                 self.message = Some(e.message.clone());
             }
+        }
+        for c in std::mem::take(&mut self.param_changes) {
+            self.apply_param_change(c);
         }
         for c in std::mem::take(&mut self.author_commands) {
             self.author.apply(c);

@@ -1,5 +1,6 @@
 //! Sculpt mode's part of the window: the model's canvas (a panic while drawing caught) and the
-//! side panels (diagnostics, source, inspector, solver, parameters, rule log).
+//! side panels (diagnostics, source, inspector, solver, parameters, grammar
+//! parameters, rule log).
 
 use crate::compile::{CASTLE_PATH, CASTLE_SOURCE, Problem, Severity};
 use crate::panels;
@@ -85,6 +86,17 @@ impl EditorApp {
             .show(ui, |ui| {
                 panels::parameters(ui, &self.sculpt, &mut self.commands)
             });
+        if !self.sculpt.grammar().params.is_empty() {
+            egui::CollapsingHeader::new("Grammar parameters")
+                .default_open(true)
+                .show(ui, |ui| {
+                    panels::grammar_parameters(
+                        ui,
+                        &self.sculpt.grammar().params,
+                        &mut self.param_changes,
+                    )
+                });
+        }
         egui::CollapsingHeader::new("Rule log")
             .default_open(true)
             .show(ui, |ui| panels::rule_log(ui, &self.sculpt));

@@ -1,0 +1,221 @@
+//! The Grammar parameters panel (issue 39): a grammar's `param`s shown as sliders; a value set
+//! recompiles the grammar as hot reload does; the value survives hot reloads of the file (fitted
+//! to what the file declares) and goes when another grammar opens.
+
+mod common;
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use clay_editor::EditorApp;
+use clay_editor::action::Action;
+use clay_editor::panels::ParamChange;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+use common::{harness, settle};
+
+/// `bays` posts in a chain, `bays` a parameter in 2..12.
+fn posts(range: &str, colour: &str) -> String {
+    format!(
+        "\
+param bays = 4{range}
+
+site type joint
+
+piece post {{
+    vertex sw (0, 0)
+    vertex se (1, 0)
+    vertex ne (1, 0.5)
+    vertex nw (0, 0.5)
+    edges sw-se-ne-nw-sw, sw-ne, se-nw
+    site west: joint [nw, sw] out (-1, 0)
+    site east: joint [se, ne] out (1, 0)
+    polygon skinned fill {colour} {{
+        (0, 0) (1, 0) (1, 0.5) (0, 0.5)
+    }}
+}}
+
+stretch post from west to east
+
+model {{
+    row = chain post x bays at (0, 0)
+}}
+"
+    )
+}
+
+const RANGE: &str = " in 2..12";
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("clay-editor-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The parameter's slider.
+fn slider() -> egui_kittest::kittest::By<'static> {
+    egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::Slider)
+        .label("bays")
+}
+
+fn instances(h: &Harness<'_, EditorApp>) -> usize {
+    h.state().sculpt.data().instances.len()
+}
+
+fn overrides(h: &Harness<'_, EditorApp>) -> Vec<(String, f64)> {
+    h.state().param_overrides().to_vec()
+}
+
+/// Rewrites the grammar file by rename (as editors save) and steps until hot reload took it.
+fn rewrite(h: &mut Harness<'_, EditorApp>, path: &Path, text: &str) {
+    let before = h.state().sculpt.grammar().clone();
+    let tmp = path.with_extension("clay.new");
+    std::fs::write(&tmp, text).unwrap();
+    std::fs::rename(&tmp, path).unwrap();
+    let start = Instant::now();
+    while std::sync::Arc::ptr_eq(&before, h.state().sculpt.grammar())
+        && start.elapsed() < Duration::from_secs(5)
+    {
+        std::thread::sleep(Duration::from_millis(50));
+        h.step();
+    }
+    assert!(
+        !std::sync::Arc::ptr_eq(&before, h.state().sculpt.grammar()),
+        "hot reload took the new file"
+    );
+}
+
+#[test]
+fn a_grammar_parameter_is_set_from_the_panel_and_kept_across_hot_reloads() {
+    let dir = temp_dir("params");
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    assert!(h.state().problems.is_empty(), "{:?}", h.state().problems);
+    assert_eq!(instances(&h), 4);
+    h.get_by_label_contains("Grammar parameters");
+    h.get(slider());
+    h.get_by_label("default 4");
+
+    // The panel's widget: the slider focused, the right arrow key one step up (a change not
+    // made by the pointer is committed at once).
+    h.get(slider()).focus();
+    h.step();
+    h.key_press(egui::Key::ArrowRight);
+    h.step();
+    h.step();
+    assert_eq!(overrides(&h), [("bays".to_string(), 5.0)]);
+    assert_eq!(instances(&h), 5);
+
+    // What the panel emits on release: bays = 6.
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    h.step();
+    settle(&mut h);
+    assert_eq!(instances(&h), 6, "six posts");
+    assert_eq!(overrides(&h), [("bays".to_string(), 6.0)]);
+    assert!(
+        h.state()
+            .message
+            .as_deref()
+            .unwrap_or("")
+            .starts_with("bays = 6"),
+        "{:?}",
+        h.state().message
+    );
+    h.get_by_label("parameters: bays = 6");
+
+    // The file changed outside the editor: the value stays.
+    rewrite(&mut h, &path, &posts(RANGE, "#8b4513"));
+    settle(&mut h);
+    assert_eq!(overrides(&h), [("bays".to_string(), 6.0)]);
+    assert_eq!(instances(&h), 6, "the override survives hot reload");
+
+    // A narrower range: the value is clamped, and the status says so.
+    rewrite(&mut h, &path, &posts(" in 2..5", "#8b4513"));
+    assert_eq!(overrides(&h), [("bays".to_string(), 5.0)]);
+    assert_eq!(instances(&h), 5);
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("clamped to 5"), "{m}");
+
+    // Back to the default with the reset button.
+    h.step();
+    h.get_by_label("reset").click();
+    h.step();
+    h.step();
+    assert!(overrides(&h).is_empty());
+    assert_eq!(instances(&h), 4);
+
+    // A value outside the range (a command, not the slider): clamped into it.
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 9.0));
+    h.step();
+    assert!(!h.state().stale);
+    assert_eq!(overrides(&h), [("bays".to_string(), 5.0)]);
+    assert_eq!(instances(&h), 5);
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 3.0));
+    h.step();
+    assert_eq!(instances(&h), 3);
+
+    // A broken file: the errors are listed, the last good model and the value stay.
+    std::fs::write(
+        &path,
+        format!("{}\npiece broken {{\n", posts(RANGE, "#8b4513")),
+    )
+    .unwrap();
+    let start = Instant::now();
+    while !h.state().stale && start.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(50));
+        h.step();
+    }
+    assert!(h.state().stale && !h.state().problems.is_empty());
+    assert_eq!(instances(&h), 3, "the last good model stays");
+    assert_eq!(overrides(&h), [("bays".to_string(), 3.0)]);
+
+    // The file no longer declares it: the value is dropped.
+    rewrite(
+        &mut h,
+        &path,
+        &posts("", "#8b4513").replace("param bays = 4\n", "let bays = 4\n"),
+    );
+    assert!(overrides(&h).is_empty());
+    assert_eq!(instances(&h), 4);
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("no longer a parameter"), "{m}");
+    h.step();
+    assert!(h.query_by_label_contains("Grammar parameters").is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn opening_another_grammar_clears_the_parameters() {
+    let dir = temp_dir("params-open");
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let other = dir.join("other.clay");
+    std::fs::write(&other, posts(RANGE, "#8b4513")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    h.step();
+    assert_eq!(instances(&h), 6);
+    h.state_mut().perform(Action::OpenGrammar(other.clone()));
+    if h.state().confirming() {
+        h.step();
+        h.step();
+        h.get_by_label("Discard").click();
+        h.step();
+    }
+    assert_eq!(h.state().grammar_path(), Some(other.as_path()));
+    assert!(overrides(&h).is_empty(), "{:?}", overrides(&h));
+    assert_eq!(instances(&h), 4, "the other grammar at its defaults");
+    h.step();
+    assert!(h.query_by_label_contains("parameters: bays").is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}
