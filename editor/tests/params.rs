@@ -129,6 +129,16 @@ fn a_grammar_parameter_is_set_from_the_panel_and_kept_across_hot_reloads() {
     );
     h.get_by_label("parameters: bays = 6");
 
+    // Undo takes the value back with the model it made; redo brings both again.
+    h.state_mut().command(clay_editor::sculpt::Command::Undo);
+    h.step();
+    assert_eq!(instances(&h), 5);
+    assert_eq!(overrides(&h), [("bays".to_string(), 5.0)]);
+    h.state_mut().command(clay_editor::sculpt::Command::Redo);
+    h.step();
+    assert_eq!(instances(&h), 6);
+    assert_eq!(overrides(&h), [("bays".to_string(), 6.0)]);
+
     // The file changed outside the editor: the value stays.
     rewrite(&mut h, &path, &posts(RANGE, "#8b4513"));
     settle(&mut h);

@@ -351,6 +351,7 @@ impl EditorApp {
         for a in std::mem::take(&mut self.actions) {
             self.perform(a);
         }
+        self.sync_params();
         self.drop_stale_source();
     }
 

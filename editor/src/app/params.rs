@@ -40,6 +40,29 @@ impl EditorApp {
         self.recompile(Some(&what));
     }
 
+    /// Follows the model's grammar: undo and redo bring back a grammar compiled with other
+    /// values, and the overrides are those it was compiled with. While the file does not
+    /// compile the overrides stay as set (the last good grammar is not theirs).
+    pub(super) fn sync_params(&mut self) {
+        if self.stale {
+            return;
+        }
+        let grammar = self.sculpt.grammar().clone();
+        let set: Vec<&Param> = grammar
+            .params
+            .iter()
+            .filter(|p| p.value != p.default)
+            .collect();
+        self.param_overrides
+            .retain(|(n, _)| set.iter().any(|p| p.name == *n));
+        for p in set {
+            match self.param_overrides.iter_mut().find(|(n, _)| *n == p.name) {
+                Some(o) => o.1 = p.value,
+                None => self.param_overrides.push((p.name.clone(), p.value)),
+            }
+        }
+    }
+
     /// The overrides for the status bar: `bays = 6, height = 2.5`.
     pub(super) fn params_status(&self) -> Option<String> {
         (!self.param_overrides.is_empty()).then(|| {
