@@ -79,7 +79,16 @@ pub fn load(path: &Path, params: &ParamArgs, settings: &[(&str, &str)]) -> Resul
         );
         IO_ERROR
     })?;
-    let mut grammar = crate::params::compile(&source, &grammar_file, params)?;
+    // The parameters the session was saved with, then `--param`'s (the last value counts).
+    let params = crate::params::ParamArgs {
+        params: saved
+            .params
+            .iter()
+            .map(|(n, v)| (n.clone(), *v))
+            .chain(params.params.iter().cloned())
+            .collect(),
+    };
+    let mut grammar = crate::params::compile(&source, &grammar_file, &params)?;
     saved
         .assembly
         .check(&grammar)

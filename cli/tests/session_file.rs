@@ -286,3 +286,49 @@ fn a_session_whose_grammar_is_missing_or_does_not_fit_is_refused() {
     let out = clayc(&["export", "-o", "-"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 }
+
+/// Four posts in a chain, `height` tall in 3D, a parameter.
+const POSTS: &str = "param height = 1 in 0.5..3\n\nsite type joint\n\npiece post {\n    \
+                     vertex sw (0, 0)\n    vertex se (1, 0)\n    vertex ne (1, 0.5)\n    \
+                     vertex nw (0, 0.5)\n    edges sw-se-ne-nw-sw, sw-ne, se-nw\n    \
+                     site west: joint [nw, sw] out (-1, 0)\n    site east: joint [se, ne] out (1, 0)\n    \
+                     polygon fill #777777 extrude height { (0, 0) (1, 0) (1, 0.5) (0, 0.5) }\n}\n\n\
+                     stretch post from west to east\n\nmodel {\n    row = chain post x 4\n}\n";
+
+#[test]
+fn a_session_compiles_its_grammar_with_the_parameters_it_was_saved_with() {
+    let dir = scratch("params");
+    std::fs::write(dir.join("posts.clay"), POSTS).unwrap();
+    let options = clay_dsl::CompileOptions::default().param("height", 2.5);
+    let grammar = clay_dsl::compile_with_options(POSTS, "posts.clay", &options)
+        .unwrap()
+        .grammar;
+    let mut saved = SessionFile::new("posts.clay".into(), grammar.assembly.clone(), vec![], None);
+    saved.params.insert("height".into(), 2.5);
+    let path = dir.join("tall.json");
+    file::write(&path, &saved).unwrap();
+    let shown = path.to_str().unwrap();
+    // The exported model's height: the largest y (up) of any accessor.
+    let height = |extra: &[&str]| -> f64 {
+        let mut args = vec!["export", "--session", shown, "-o", "-", "--format", "gltf"];
+        args.extend_from_slice(extra);
+        let out = clayc(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let doc = gltf_json(&out.stdout);
+        (doc["accessors"].as_array().unwrap().iter())
+            .filter_map(|a| a["max"].as_array().filter(|m| m.len() == 3))
+            .map(|m| m[1].as_f64().unwrap())
+            .fold(f64::MIN, f64::max)
+    };
+
+    // Compiled with the session's height 2.5, the posts are 2.5 m tall.
+    assert!((height(&[]) - 2.5).abs() < 1e-6, "{}", height(&[]));
+    // The same session without its parameters: the grammar's default, 1 m; `--param` gives
+    // back what the session did not say.
+    saved.params.clear();
+    file::write(&path, &saved).unwrap();
+    assert!((height(&[]) - 1.0).abs() < 1e-6, "{}", height(&[]));
+    let h = height(&["--param", "height=2.5"]);
+    assert!((h - 2.5).abs() < 1e-6, "{h}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

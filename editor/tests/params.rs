@@ -229,3 +229,39 @@ fn opening_another_grammar_clears_the_parameters() {
     assert!(h.query_by_label_contains("parameters: bays").is_none());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_saved_session_keeps_the_parameters_it_was_sculpted_with() {
+    let dir = temp_dir("params-session");
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    h.step();
+    assert_eq!(instances(&h), 6);
+    let saved = dir.join("posts.session.json");
+    h.state_mut().save_session(&saved).unwrap();
+    let text = std::fs::read_to_string(&saved).unwrap();
+    assert!(text.contains("\"params\""), "{text}");
+
+    // A fresh editor opens it: the grammar compiled with bays = 6, the model of 6 posts, and
+    // the panel's value 6 (not the file's default 4).
+    let mut fresh = harness(EditorApp::open(&path));
+    settle(&mut fresh);
+    assert_eq!(instances(&fresh), 4);
+    fresh.state_mut().open_session(&saved).unwrap();
+    fresh.step();
+    assert_eq!(instances(&fresh), 6);
+    assert_eq!(overrides(&fresh), vec![("bays".to_string(), 6.0)]);
+    let bays = fresh
+        .state()
+        .sculpt
+        .grammar()
+        .params
+        .iter()
+        .find(|p| p.name == "bays");
+    assert_eq!(bays.map(|p| p.value), Some(6.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}

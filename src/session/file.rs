@@ -4,6 +4,7 @@
 //! another kind or version says so; a JSON mistake names its line and column) and written
 //! atomically ([`crate::files::write_atomic`]).
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::fs;
 use std::io;
@@ -65,6 +66,11 @@ pub struct Session {
     /// The rule log when it was saved, so an opened session shows its history.
     #[serde(default)]
     pub log: Vec<LogEntry>,
+    /// The grammar's parameters as set when it was saved (`param NAME = ...`), by name; the
+    /// grammar is compiled with them before the assembly is checked against it. Absent or
+    /// empty: every parameter at its default.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub params: BTreeMap<String, f64>,
 }
 
 impl Session {
@@ -82,6 +88,7 @@ impl Session {
             pins,
             settings,
             log: Vec::new(),
+            params: BTreeMap::new(),
         }
     }
 }
@@ -203,6 +210,18 @@ mod tests {
         write(&path, &s).unwrap();
         assert_eq!(read(&path).unwrap(), s);
         let _ = fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn parameters_are_written_when_set_and_optional_when_read() {
+        let mut s = session();
+        let plain = serde_json::to_string(&s).unwrap();
+        assert!(!plain.contains("\"params\""), "{plain}");
+        assert_eq!(parse(&plain).unwrap().params, BTreeMap::new());
+        s.params.insert("bays".into(), 6.0);
+        let text = serde_json::to_string(&s).unwrap();
+        assert!(text.contains("\"params\":{\"bays\":6.0}"), "{text}");
+        assert_eq!(parse(&text).unwrap(), s);
     }
 
     #[test]

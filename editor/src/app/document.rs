@@ -18,6 +18,8 @@ pub(super) struct LoadedSession {
     pub(super) warnings: Vec<Problem>,
     /// The grammar's file (`None`: the bundled castle).
     pub(super) grammar_file: Option<PathBuf>,
+    /// The grammar's parameters as the session set them.
+    pub(super) params: Vec<(String, f64)>,
 }
 
 /// Reads a session and rebuilds its sculpt, touching nothing of the editor's.
@@ -29,15 +31,20 @@ pub(super) fn load_session(path: &Path) -> Result<LoadedSession, String> {
         Err(_) if s.grammar == CASTLE_PATH => (CASTLE_SOURCE.to_string(), None),
         Err(e) => return Err(format!("the session's grammar {}: {e}", s.grammar)),
     };
-    let compiled = compile::compile(&source, &s.grammar).map_err(|problems| {
-        let first = problems.first().map_or(String::new(), |p| p.to_string());
-        format!("the session's grammar does not compile: {first}")
-    })?;
+    // The parameters as set when it was saved, so the assembly fits the grammar it was made
+    // with.
+    let params: Vec<(String, f64)> = s.params.into_iter().collect();
+    let compiled =
+        compile::compile_with_params(&source, &s.grammar, &params).map_err(|problems| {
+            let first = problems.first().map_or(String::new(), |p| p.to_string());
+            format!("the session's grammar does not compile: {first}")
+        })?;
     let sculpt = Sculpt::from_saved(compiled.grammar, s.assembly, s.pins, s.settings, s.log)?;
     Ok(LoadedSession {
         sculpt,
         warnings: compiled.warnings,
         grammar_file: file,
+        params,
     })
 }
 
@@ -253,6 +260,7 @@ impl EditorApp {
             Some(self.sculpt.settings()),
         );
         session.log = self.sculpt.log().to_vec();
+        session.params = self.param_overrides.iter().cloned().collect();
         session
     }
 
@@ -275,7 +283,7 @@ impl EditorApp {
     pub fn open_session(&mut self, path: &Path) -> Result<(), String> {
         let loaded = load_session(path)?;
         self.sculpt = loaded.sculpt;
-        self.param_overrides.clear();
+        self.param_overrides = loaded.params;
         self.problems = loaded.warnings;
         self.stale = false;
         self.refused = None;
