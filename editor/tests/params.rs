@@ -265,3 +265,32 @@ fn a_saved_session_keeps_the_parameters_it_was_sculpted_with() {
     assert_eq!(bays.map(|p| p.value), Some(6.0));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn saved_gestures_say_the_parameters_to_replay_them_with() {
+    let dir = temp_dir("params-gestures");
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    h.step();
+    settle(&mut h);
+    let script = dir.join("posts.script.json");
+    let status = h.state().save_gestures(&script).unwrap();
+    assert!(status.contains("--param bays=6"), "{status}");
+    // Replayed on the grammar compiled with those values: the editor's model.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let options = clay_dsl::CompileOptions::default().param("bays", 6.0);
+    let grammar = clay_dsl::compile_with_options(&text, "posts.clay", &options)
+        .unwrap()
+        .grammar;
+    let parsed = clay::script::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();
+    let mut asm = clay::assembly::Assembly::new(std::sync::Arc::new(grammar.clone()));
+    let mut session =
+        clay::session::Session::new(clay::solver::SolverConfig::from_params(&grammar.solver));
+    clay::session::replay(&mut asm, &parsed, &mut session).unwrap();
+    assert_eq!(asm.data().instances.len(), instances(&h));
+    let _ = std::fs::remove_dir_all(&dir);
+}

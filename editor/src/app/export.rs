@@ -46,7 +46,8 @@ impl EditorApp {
 
     /// Writes the gestures since the grammar's initial model as a script (atomically), which
     /// `clayc run GRAMMAR --script PATH` replays. Returns the status line: what was written and
-    /// how to replay it, with the `--set`s of parameters changed from the grammar's.
+    /// how to replay it, with the `--set`s of solver settings changed from the grammar's and
+    /// the `--param`s of the grammar parameters set.
     pub fn save_gestures(&self, path: &Path) -> Result<String, String> {
         let script = self
             .sculpt
@@ -69,6 +70,10 @@ impl EditorApp {
         }
         if settings.norm != solver.norm {
             sets += &format!(" --set norm={}", settings.norm);
+        }
+        // The grammar's parameters as the Grammar parameters panel set them.
+        for (name, value) in &self.param_overrides {
+            sets += &format!(" --param {name}={value}");
         }
         Ok(format!(
             "saved {} steps, {} frames, to {}; replay: clayc run {} --script {}{sets}",
