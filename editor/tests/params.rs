@@ -202,6 +202,19 @@ fn a_grammar_parameter_is_set_from_the_panel_and_kept_across_hot_reloads() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The posts grammar written into `dir` and opened, `bays` set to 6 from the panel.
+fn six_bays(dir: &Path) -> (std::path::PathBuf, Harness<'static, EditorApp>) {
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    h.step();
+    assert_eq!(instances(&h), 6);
+    (path, h)
+}
+
 #[test]
 fn opening_another_grammar_clears_the_parameters() {
     let dir = temp_dir("params-open");
@@ -233,14 +246,7 @@ fn opening_another_grammar_clears_the_parameters() {
 #[test]
 fn a_saved_session_keeps_the_parameters_it_was_sculpted_with() {
     let dir = temp_dir("params-session");
-    let path = dir.join("posts.clay");
-    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
-    let mut h = harness(EditorApp::open(&path));
-    settle(&mut h);
-    h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
-    h.step();
-    assert_eq!(instances(&h), 6);
+    let (path, mut h) = six_bays(&dir);
     let saved = dir.join("posts.session.json");
     h.state_mut().save_session(&saved).unwrap();
     let text = std::fs::read_to_string(&saved).unwrap();
@@ -269,13 +275,7 @@ fn a_saved_session_keeps_the_parameters_it_was_sculpted_with() {
 #[test]
 fn saved_gestures_say_the_parameters_to_replay_them_with() {
     let dir = temp_dir("params-gestures");
-    let path = dir.join("posts.clay");
-    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
-    let mut h = harness(EditorApp::open(&path));
-    settle(&mut h);
-    h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
-    h.step();
+    let (path, mut h) = six_bays(&dir);
     settle(&mut h);
     let script = dir.join("posts.script.json");
     let status = h.state().save_gestures(&script).unwrap();
