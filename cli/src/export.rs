@@ -18,13 +18,8 @@ pub enum Format {
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
-    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`); not with --session.
-    #[arg(required_unless_present = "session", conflicts_with = "session")]
-    pub file: Option<PathBuf>,
-    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
-    /// settings; a --script goes on from it.
-    #[arg(long, value_name = "SESSION.json")]
-    pub session: Option<PathBuf>,
+    #[command(flatten)]
+    pub model: crate::from_session::ModelArgs,
     /// The file to write: .glb, .gltf or .obj (the .mtl is written beside an .obj); `-` writes
     /// to standard output (glb unless --format says otherwise; an .obj's materials are then
     /// not written).
@@ -77,8 +72,8 @@ pub fn export(args: ExportArgs) -> u8 {
         }
     };
     let (grammar, assembly, _, _) = match sculpted(
-        args.file.as_deref(),
-        args.session.as_deref(),
+        args.model.file.as_deref(),
+        args.model.session.as_deref(),
         args.script.as_deref(),
         &args.params,
     ) {

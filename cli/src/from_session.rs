@@ -17,6 +17,20 @@ use clay_dsl::compiled::CompiledGrammar;
 use crate::out::IO_ERROR;
 use crate::params::ParamArgs;
 
+/// Where a command's model comes from: a grammar FILE, or a sculpt the editor saved
+/// (`--session`), one of the two (`clayc run`, `render`, `export`).
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// A grammar (.clay; `render` and `export` also take a compiled grammar, .json from
+    /// `clayc build`); not with --session.
+    #[arg(required_unless_present = "session", conflicts_with = "session")]
+    pub file: Option<PathBuf>,
+    /// A sculpt session the editor saved (.json): its grammar (compiled with the parameters it
+    /// was saved with), sculpted assembly, pins and settings; a --script goes on from it.
+    #[arg(long, value_name = "SESSION.json")]
+    pub session: Option<PathBuf>,
+}
+
 /// Exit code of input errors (a malformed session, a grammar with errors, a misfit).
 const INPUT_ERROR: u8 = 1;
 

@@ -32,13 +32,8 @@ pub enum OverlayKind {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// A grammar (.clay) or a compiled grammar (.json from `clayc build`); not with --session.
-    #[arg(required_unless_present = "session", conflicts_with = "session")]
-    pub file: Option<PathBuf>,
-    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
-    /// settings; a --script goes on from it.
-    #[arg(long, value_name = "SESSION.json")]
-    pub session: Option<PathBuf>,
+    #[command(flatten)]
+    pub model: crate::from_session::ModelArgs,
     /// The picture to write (.png, or .svg for SVG; `-` writes PNG, or SVG with --svg, to
     /// standard output).
     #[arg(short, long)]
@@ -205,8 +200,8 @@ pub fn render(args: RenderArgs) -> u8 {
         return IO_ERROR;
     }
     let (grammar, assembly, handles, pins) = match sculpted(
-        args.file.as_deref(),
-        args.session.as_deref(),
+        args.model.file.as_deref(),
+        args.model.session.as_deref(),
         args.script.as_deref(),
         &args.params,
     ) {

@@ -13,13 +13,8 @@ use clay::session::{Session, configure, replay};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
-    /// The grammar (.clay) whose model is sculpted; not with --session.
-    #[arg(required_unless_present = "session", conflicts_with = "session")]
-    pub file: Option<PathBuf>,
-    /// A sculpt session the editor saved (.json): its grammar, sculpted assembly, pins and
-    /// settings; the script goes on from it.
-    #[arg(long, value_name = "SESSION.json")]
-    pub session: Option<PathBuf>,
+    #[command(flatten)]
+    pub model: crate::from_session::ModelArgs,
     /// The session script (JSON, {"steps": [...]}); without it the initial assembly is reported.
     #[arg(long)]
     pub script: Option<PathBuf>,
@@ -113,7 +108,7 @@ pub fn run(args: RunArgs) -> u8 {
             }
         }
     }
-    let (mut assembly, config) = match (&args.session, &args.file) {
+    let (mut assembly, config) = match (&args.model.session, &args.model.file) {
         (Some(session), _) => match crate::from_session::load(session, &args.params, &settings) {
             Ok(loaded) => (loaded.assembly, loaded.config),
             Err(code) => return code,
