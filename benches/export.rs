@@ -4,11 +4,11 @@
 
 use std::time::Duration;
 
-use clay::export::{ExportOptions, gltf, obj, scene};
+use clay::{ExportOptions, scene};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn export(c: &mut Criterion) {
-    let city = clay::synthetic::city(100_000);
+    let city = clay::testing::synthetic::city(100_000);
     let options = ExportOptions::default();
     let mut group = c.benchmark_group("export 100k-part city");
     group
@@ -16,14 +16,14 @@ fn export(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(20));
     group.bench_function("scene + glb", |b| {
         b.iter(|| {
-            gltf::to_glb(&scene(&city, &city.assembly, &options))
+            clay::to_glb(&scene(&city, &city.assembly, &options))
                 .unwrap()
                 .len()
         })
     });
     group.bench_function("scene + obj", |b| {
         b.iter(|| {
-            obj::to_obj(&scene(&city, &city.assembly, &options), "city.mtl")
+            clay::to_obj(&scene(&city, &city.assembly, &options), "city.mtl")
                 .0
                 .len()
         })

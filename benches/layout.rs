@@ -8,8 +8,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::synthetic;
+use clay::{Assembly, testing::synthetic};
 use criterion::{Criterion, criterion_group};
 use glam::DVec2;
 

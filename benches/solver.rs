@@ -8,9 +8,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::solver::{Solver, SolverConfig, SolverKind};
-use clay::synthetic;
+use clay::{Assembly, HandleKind, Solver, SolverConfig, SolverKind, testing::synthetic};
 use criterion::{Criterion, criterion_group};
 use glam::DVec2;
 
@@ -91,7 +89,7 @@ fn phases(parts: usize) {
         reports.push(solver.frame(&mut asm).unwrap());
     }
     let later = &reports[1..];
-    let mean = |f: &dyn Fn(&clay::solver::FrameReport) -> f64| {
+    let mean = |f: &dyn Fn(&clay::FrameReport) -> f64| {
         later.iter().map(f).sum::<f64>() / later.len() as f64
     };
     let mut ms: Vec<f64> = later.iter().map(|r| r.ms).collect();

@@ -1,4 +1,4 @@
-//! Writes the documentation pictures ([`clay::gallery`]): for every grammar
+//! Writes the documentation pictures ([`clay::testing::gallery`]): for every grammar
 //! `grammars/NAME.clay`, its sheet (`docs/pictures/NAME-sheet.png`), a render of its initial
 //! assembly (`docs/pictures/NAME.png`) and, with a demo script `grammars/NAME.script.json`,
 //! the assembly after the script (`docs/pictures/NAME-after.png`). `tests/doc_pictures.rs`
@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clay::script::Script;
+use clay::Script;
 use clay_dsl::compiled::CompiledGrammar;
 
 fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
@@ -27,7 +27,7 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
 }
 
 /// The pictures of the grammar at `path`, with its demo script if it has one.
-fn pictures(path: &Path, name: &str) -> Result<Vec<clay::gallery::Picture>, String> {
+fn pictures(path: &Path, name: &str) -> Result<Vec<clay::testing::gallery::Picture>, String> {
     let source = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
     let grammar = compile(&source, path)?;
     let script_path = path.with_extension("script.json");
@@ -37,7 +37,7 @@ fn pictures(path: &Path, name: &str) -> Result<Vec<clay::gallery::Picture>, Stri
     } else {
         None
     };
-    clay::gallery::pictures(name, &grammar, script.as_ref())
+    clay::testing::gallery::pictures(name, &grammar, script.as_ref())
 }
 
 fn main() -> ExitCode {

@@ -35,12 +35,6 @@ pub struct RigidMotion {
 }
 
 impl RigidMotion {
-    pub const IDENTITY: Self = Self {
-        rotation: DVec2::X,
-        from_centre: DVec2::ZERO,
-        to_centre: DVec2::ZERO,
-    };
-
     pub fn apply(&self, p: DVec2) -> DVec2 {
         self.rotation.rotate(p - self.from_centre) + self.to_centre
     }

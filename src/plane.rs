@@ -9,7 +9,7 @@ use glam::DVec2;
 /// t`). A degenerate segment (`a == b`) gives `a` and `t = 0`.
 ///
 /// ```
-/// use clay::plane::nearest_on_segment;
+/// use clay::nearest_on_segment;
 /// use glam::DVec2;
 /// let (q, t) = nearest_on_segment(DVec2::new(1.0, 5.0), DVec2::ZERO, DVec2::new(4.0, 0.0));
 /// assert_eq!((q, t), (DVec2::new(1.0, 0.0), 0.25));

@@ -7,6 +7,8 @@ use std::collections::BTreeMap;
 
 use serde::{Serialize, Serializer};
 
+use clay_dsl::compiled::AssemblyData;
+
 use crate::assembly::Assembly;
 use crate::rules::RuleKind;
 use crate::solver::follow::Components;
@@ -87,13 +89,13 @@ fn median(values: &[f64]) -> f64 {
     }
 }
 
-/// Connected components of the part graph (the solver's [`Components`], counted over the
-/// vertices that parts use).
-pub fn components(asm: &Assembly) -> usize {
-    let n = asm.data().positions.len();
-    let components = Components::build(&asm.data().parts, n);
-    let mut used: Vec<usize> = asm
-        .data()
+/// The number of connected components of an assembly: its parts joined through shared
+/// vertices (the solver's [`Components`], counted over the vertices that parts use). A cut
+/// that parts a model makes two; a merge that welds two makes one.
+pub fn connected_components(data: &AssemblyData) -> usize {
+    let n = data.positions.len();
+    let components = Components::build(&data.parts, n);
+    let mut used: Vec<usize> = data
         .parts
         .iter()
         .filter_map(|p| p.vertices.iter().copied().find(|&v| v < n))
@@ -174,7 +176,7 @@ pub fn summarize(
                 )
             })
             .collect(),
-        components: components(asm),
+        components: connected_components(asm.data()),
         bbox,
         max_edge_strain,
         energy,

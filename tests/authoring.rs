@@ -4,8 +4,10 @@
 
 use std::path::PathBuf;
 
-use clay::authoring::drawing_from_svg;
-use clay::authoring::{AuthorOptions, Drawing, Polyline, StretchChoice, author};
+use clay::{
+    authoring::AuthorOptions, authoring::Drawing, authoring::Polyline, authoring::StretchChoice,
+    authoring::author, authoring::drawing_from_svg,
+};
 use glam::DVec2;
 
 fn fixture(name: &str) -> PathBuf {

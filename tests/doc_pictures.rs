@@ -1,12 +1,12 @@
 //! The pictures in `docs/pictures/` show what the code draws today: every grammar's sheet,
-//! initial assembly and after-script assembly ([`clay::gallery`]) are drawn again and compared
+//! initial assembly and after-script assembly ([`clay::testing::gallery`]) are drawn again and compared
 //! pixel by pixel with the files (rendering and solving are deterministic). When this fails,
 //! run `cargo run --release --example pictures` and look at the new pictures before
 //! committing them.
 
 use std::path::Path;
 
-use clay::script::Script;
+use clay::Script;
 
 #[test]
 fn docs_pictures_match_what_the_code_draws() {
@@ -30,7 +30,7 @@ fn docs_pictures_match_what_the_code_draws() {
         let script = script_path
             .exists()
             .then(|| Script::parse(&std::fs::read_to_string(&script_path).unwrap()).unwrap());
-        for picture in clay::gallery::pictures(&name, &grammar, script.as_ref()).unwrap() {
+        for picture in clay::testing::gallery::pictures(&name, &grammar, script.as_ref()).unwrap() {
             checked += 1;
             let file = root.join("docs/pictures").join(&picture.file);
             let drawn = tiny_skia::Pixmap::decode_png(&picture.png).unwrap();

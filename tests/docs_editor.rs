@@ -4,11 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::render::strain_colour;
-use clay::rules::RuleKind;
-use clay::script::Script;
-use clay::solver::SolverConfig;
+use clay::{Assembly, RuleKind, Script, SolverConfig, strain_colour};
 
 /// docs/editor.md with every run of whitespace one space (its lines wrap anywhere).
 fn editor_md() -> String {
@@ -63,7 +59,7 @@ fn the_rule_logs_stretch_line_has_the_shape_docs_editor_md_quotes() {
     let json = std::fs::read_to_string(format!("{dir}/grammars/wall.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));
-    let mut session = clay::session::Session::new(SolverConfig::from_params(&g.solver));
+    let mut session = clay::Session::new(SolverConfig::from_params(&g.solver));
     for (i, s) in script.steps.iter().enumerate() {
         session.step(&mut asm, i, s).unwrap();
     }

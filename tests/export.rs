@@ -1,4 +1,4 @@
-//! `clay::export` (issue 20): every example exports to glTF that the `gltf` crate reads back
+//! `clay`'s export (issue 20): every example exports to glTF that the `gltf` crate reads back
 //! with the assembly's nodes, names and triangles, to OBJ that `tobj` loads; the floor plan is
 //! the renderer's, heights are untouched by the deformation. `clayc export` itself is tested in
 //! `cli/tests/export.rs`.
@@ -6,12 +6,10 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::export::{ExportOptions, Scene, gltf, obj, scene};
-use clay::render::{TessellationCache, pose_assembly};
-use clay::script::Script;
-use clay::session::Session;
-use clay::solver::SolverConfig;
+use clay::{
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
+    pose_assembly, scene,
+};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
 const EXAMPLES: [&str; 6] = ["wall", "castle", "streets", "centipede", "junction", "bend"];
@@ -29,7 +27,7 @@ fn sculpted(name: &str, g: &CompiledGrammar) -> Option<AssemblyData> {
     let script = Script::parse(&text).unwrap();
     let mut assembly = Assembly::new(Arc::new(g.clone()));
     let mut session = Session::new(SolverConfig::from_params(&g.solver));
-    clay::session::replay(&mut assembly, &script, &mut session).unwrap();
+    clay::replay(&mut assembly, &script, &mut session).unwrap();
     Some(assembly.into_data())
 }
 
@@ -128,7 +126,7 @@ fn glb_and_gltf_read_back_with_the_assemblys_nodes_names_and_triangles() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        for bytes in [gltf::to_glb(&s).unwrap(), gltf::to_gltf(&s).unwrap()] {
+        for bytes in [clay::to_glb(&s).unwrap(), clay::to_gltf(&s).unwrap()] {
             let doc = ::gltf::Gltf::from_slice(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
             let blob = match &doc.blob {
                 Some(b) => b.clone(),
@@ -184,7 +182,7 @@ fn obj_loads_in_tobj_with_every_triangle_and_material() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        let (obj_text, mtl_text) = obj::to_obj(&s, "model.mtl");
+        let (obj_text, mtl_text) = clay::to_obj(&s, "model.mtl");
         let (models, materials) = tobj::load_obj_buf(
             &mut obj_text.as_bytes(),
             &tobj::LoadOptions {
@@ -213,17 +211,17 @@ fn obj_loads_in_tobj_with_every_triangle_and_material() {
 fn the_iso_view_draws_the_scene_the_same_way_every_time() {
     let g = grammar("castle");
     let s = scene(&g, &g.assembly, &ExportOptions::default());
-    let a = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
-    let b = clay::export::iso::iso_pixmap(&s, 400, 300).unwrap();
+    let a = clay::iso_pixmap(&s, 400, 300).unwrap();
+    let b = clay::iso_pixmap(&s, 400, 300).unwrap();
     assert_eq!(a.data(), b.data(), "deterministic");
-    let background = clay::render::BACKGROUND.0;
+    let background = clay::BACKGROUND.0;
     let drawn = a.pixels().iter().filter(|p| {
         let c = p.demultiply();
         [c.red(), c.green(), c.blue()] != [background[0], background[1], background[2]]
     });
     let share = drawn.count() as f64 / (400.0 * 300.0);
     assert!(share > 0.05 && share < 0.9, "{share}");
-    assert!(clay::export::iso::iso_pixmap(&s, 0, 300).is_err());
+    assert!(clay::iso_pixmap(&s, 0, 300).is_err());
 }
 
 #[test]

@@ -8,12 +8,10 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::export::{ExportOptions, Scene, gltf, obj, scene, srgb_to_linear};
-use clay::render::{TessellationCache, pose_assembly};
-use clay::script::Script;
-use clay::session::Session;
-use clay::solver::SolverConfig;
+use clay::{
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
+    pose_assembly, scene, srgb_to_linear,
+};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use glam::{DQuat, DVec2, DVec3};
 
@@ -41,7 +39,7 @@ fn assemblies(name: &str, g: &CompiledGrammar) -> Vec<(&'static str, AssemblyDat
         let script = Script::parse(&text).unwrap();
         let mut assembly = Assembly::new(Arc::new(g.clone()));
         let mut session = Session::new(SolverConfig::from_params(&g.solver));
-        clay::session::replay(&mut assembly, &script, &mut session).unwrap();
+        clay::replay(&mut assembly, &script, &mut session).unwrap();
         out.push(("sculpted", assembly.into_data()));
     }
     out
@@ -290,14 +288,14 @@ fn every_example_exports_a_root_with_placed_shared_named_closed_meshes() {
             let what = format!("{name} {when}");
             check_gltf(
                 &format!("{what} .glb"),
-                &gltf::to_glb(&s).unwrap(),
+                &clay::to_glb(&s).unwrap(),
                 &g,
                 &a,
                 &s,
             );
             check_gltf(
                 &format!("{what} .gltf"),
-                &gltf::to_gltf(&s).unwrap(),
+                &clay::to_gltf(&s).unwrap(),
                 &g,
                 &a,
                 &s,
@@ -316,7 +314,7 @@ fn identical_instances_share_one_mesh() {
     assert_eq!(s.meshes[0].users, 8);
     assert_eq!(s.meshes[0].name, "brick__base");
     assert_eq!(s.triangle_count(), 8 * s.mesh_triangle_count());
-    let doc = ::gltf::Gltf::from_slice(&gltf::to_glb(&s).unwrap()).unwrap();
+    let doc = ::gltf::Gltf::from_slice(&clay::to_glb(&s).unwrap()).unwrap();
     assert_eq!(doc.meshes().count(), 1);
     let xs: Vec<f32> = doc
         .nodes()
@@ -377,7 +375,7 @@ fn chain_elements_are_named_and_numbered_in_chain_order_after_a_stretch() {
     .unwrap();
     let mut assembly = Assembly::new(Arc::new(g.clone()));
     let mut session = Session::new(SolverConfig::from_params(&g.solver));
-    clay::session::replay(&mut assembly, &script, &mut session).unwrap();
+    clay::replay(&mut assembly, &script, &mut session).unwrap();
     let after = assembly.into_data();
     assert!(after.instances.len() > 8, "the wall grows");
     let s = scene(&g, &after, &ExportOptions::default());
@@ -399,7 +397,7 @@ fn obj_has_uvs_and_glb_colours_and_the_nodes_names() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        let (obj_text, mtl_text) = obj::to_obj(&s, "model.mtl");
+        let (obj_text, mtl_text) = clay::to_obj(&s, "model.mtl");
         let (models, materials) = tobj::load_obj_buf(
             &mut obj_text.as_bytes(),
             &tobj::LoadOptions {
@@ -412,7 +410,7 @@ fn obj_has_uvs_and_glb_colours_and_the_nodes_names() {
         .unwrap();
         let materials = materials.unwrap();
         // Kd is glTF's linear base colour factor.
-        let doc = ::gltf::Gltf::from_slice(&gltf::to_glb(&s).unwrap()).unwrap();
+        let doc = ::gltf::Gltf::from_slice(&clay::to_glb(&s).unwrap()).unwrap();
         for (m, gm) in materials.iter().zip(doc.materials()) {
             let kd = m.diffuse.unwrap();
             let base = gm.pbr_metallic_roughness().base_color_factor();
@@ -498,7 +496,7 @@ fn flat_layers_share_no_face_plane_and_no_edge() {
     let s = scene(&g, &g.assembly, &ExportOptions::default());
     let node = &s.nodes[0];
     assert_eq!(node.primitives.len(), 2);
-    let heights = |p: &clay::export::Primitive| {
+    let heights = |p: &clay::Primitive| {
         let mut hs: Vec<f32> = p.positions.iter().map(|q| q[1]).collect();
         hs.sort_by(f32::total_cmp);
         hs.dedup();

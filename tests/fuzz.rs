@@ -84,7 +84,7 @@ fn script(input: &[u8]) -> Result<(), String> {
     let Ok(text) = std::str::from_utf8(input) else {
         return Ok(());
     };
-    match clay::script::Script::parse(text) {
+    match clay::Script::parse(text) {
         Ok(_) => Ok(()),
         Err(e) => match e.position {
             Some((line, col)) if line == 0 || col == 0 => {

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use base64::Engine as _;
-use clay::export::{ExportOptions, gltf, obj, scene};
+use clay::{ExportOptions, scene};
 use clay_dsl::compiled::{CompiledGrammar, ProxyShape};
 use clay_dsl::{Diagnostics, Severity};
 use fuzzing::{fuzz_cases, mutate};
@@ -854,8 +854,8 @@ fn accepted(g: &CompiledGrammar) -> Result<(), String> {
             }
         }
     }
-    gltf::to_glb(&s).map_err(|e| format!("the glTF export failed: {e}"))?;
-    let (text, _) = obj::to_obj(&s, "fuzz.mtl");
+    clay::to_glb(&s).map_err(|e| format!("the glTF export failed: {e}"))?;
+    let (text, _) = clay::to_obj(&s, "fuzz.mtl");
     let lower = text.to_ascii_lowercase();
     if lower.contains("nan") || lower.contains("inf") {
         return Err("the OBJ export writes a non-finite number".into());

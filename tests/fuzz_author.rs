@@ -19,9 +19,10 @@ mod fuzzing;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use clay::authoring::drawing_from_svg;
-use clay::authoring::{AuthorOptions, StretchChoice, author};
-use clay::authoring::{Work, compute};
+use clay::{
+    authoring::AuthorOptions, authoring::StretchChoice, authoring::Work, authoring::author,
+    authoring::compute, authoring::drawing_from_svg,
+};
 use glam::DVec2;
 use proptest::prelude::RngExt;
 use proptest::test_runner::TestRng;

@@ -6,9 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::script::Script;
-use clay::solver::SolverConfig;
+use clay::{Assembly, Script, SolverConfig};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
 /// Replays `grammars/NAME.script.json`, calling `after` with the assembly after each step.
@@ -19,7 +17,7 @@ fn replay(name: &str, mut after: impl FnMut(usize, &CompiledGrammar, &AssemblyDa
     let json = std::fs::read_to_string(format!("{dir}/grammars/{name}.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));
-    let mut session = clay::session::Session::new(SolverConfig::from_params(&g.solver));
+    let mut session = clay::Session::new(SolverConfig::from_params(&g.solver));
     // An instance keeps its name as long as it exists: no rule renames one.
     let mut names: HashMap<u64, String> = HashMap::new();
     for (i, s) in script.steps.iter().enumerate() {

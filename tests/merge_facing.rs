@@ -6,9 +6,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::{RuleKind, merge, site_centre, site_out};
-use clay::solver::SolverConfig;
+use clay::{Assembly, RuleKind, SolverConfig, site_centre, site_out, testing::merge};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, InstanceSite};
 use glam::DVec2;
 
@@ -247,11 +245,11 @@ fn drag_b(translation: DVec2, angle: f64) -> usize {
     let g = two_bricks(3.0);
     let config = SolverConfig::from_params(&g.solver);
     let mut asm = Assembly::new(Arc::new(g));
-    let mut session = clay::session::Session::new(config);
+    let mut session = clay::Session::new(config);
     let data = asm.data();
     let a = data.instances.iter().position(|i| i.name == "a").unwrap();
     let b = data.instances.iter().position(|i| i.name == "b").unwrap();
-    clay::session::pin(&mut asm, a).unwrap();
+    clay::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     let mut merges = 0;
     for k in 1..=30 {
@@ -282,7 +280,7 @@ fn a_cut_pair_turned_away_and_back_within_reach_stays_apart_until_it_parts() {
     let g = two_bricks(3.0);
     let config = SolverConfig::from_params(&g.solver);
     let mut asm = Assembly::new(Arc::new(g));
-    let mut session = clay::session::Session::new(config);
+    let mut session = clay::Session::new(config);
     let a = asm
         .data()
         .instances
@@ -295,7 +293,7 @@ fn a_cut_pair_turned_away_and_back_within_reach_stays_apart_until_it_parts() {
         .iter()
         .position(|i| i.name == "b")
         .unwrap();
-    clay::session::pin(&mut asm, a).unwrap();
+    clay::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     // `b` turned by `angle` about its west site, held at (1.2, 0.25), 0.2 m from `a`'s east
     // site: its centre starts at (3.5, 0.25), half a metre east of that site.
@@ -304,21 +302,20 @@ fn a_cut_pair_turned_away_and_back_within_reach_stays_apart_until_it_parts() {
         (centre - DVec2::new(3.5, 0.25), angle)
     };
     let mut merges = 0;
-    let mut go =
-        |session: &mut clay::session::Session, asm: &mut Assembly, poses: &[(DVec2, f64)]| {
-            for &(translation, angle) in poses {
-                session.move_grab(asm, translation, angle);
-                for _ in 0..3 {
-                    let frame = session.frame(asm).unwrap();
-                    merges += frame
-                        .events
-                        .iter()
-                        .filter(|e| e.kind == RuleKind::Merge)
-                        .count();
-                }
+    let mut go = |session: &mut clay::Session, asm: &mut Assembly, poses: &[(DVec2, f64)]| {
+        for &(translation, angle) in poses {
+            session.move_grab(asm, translation, angle);
+            for _ in 0..3 {
+                let frame = session.frame(asm).unwrap();
+                merges += frame
+                    .events
+                    .iter()
+                    .filter(|e| e.kind == RuleKind::Merge)
+                    .count();
             }
-            merges
-        };
+        }
+        merges
+    };
     let approach: Vec<(DVec2, f64)> = (0..=10)
         .map(|k| (DVec2::new(-1.8 * k as f64 / 10.0, 0.0), 0.0))
         .collect();

@@ -6,12 +6,10 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::export::{ExportOptions, Scene, gltf, scene};
-use clay::render::{TessellationCache, pose_assembly};
-use clay::script::Script;
-use clay::session::Session;
-use clay::solver::SolverConfig;
+use clay::{
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
+    pose_assembly, scene,
+};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, ProxyShape, Rgba};
 
 fn root() -> &'static Path {
@@ -31,7 +29,7 @@ fn after_script(g: &CompiledGrammar) -> AssemblyData {
     let script = Script::parse(&text).unwrap();
     let mut assembly = Assembly::new(Arc::new(g.clone()));
     let mut session = Session::new(SolverConfig::from_params(&g.solver));
-    clay::session::replay(&mut assembly, &script, &mut session).unwrap();
+    clay::replay(&mut assembly, &script, &mut session).unwrap();
     assembly.into_data()
 }
 
@@ -138,7 +136,7 @@ fn keep_with_its_roofs_reads_back_with_the_gltf_crate() {
     let g = keep();
     let after = after_script(&g);
     let s = scene(&g, &after, &ExportOptions::default());
-    for bytes in [gltf::to_glb(&s).unwrap(), gltf::to_gltf(&s).unwrap()] {
+    for bytes in [clay::to_glb(&s).unwrap(), clay::to_gltf(&s).unwrap()] {
         let doc = ::gltf::Gltf::from_slice(&bytes).unwrap();
         // One root whose children are the instances, their assembly names in the extras.
         let root = doc.default_scene().unwrap().nodes().next().unwrap();
@@ -248,7 +246,7 @@ fn a_skinned_mesh_follows_the_skin_of_its_polygon_and_keeps_its_heights() {
 fn keep_with_its_roofs_loads_as_obj_in_tobj() {
     let g = keep();
     let s = scene(&g, &after_script(&g), &ExportOptions::default());
-    let (obj_text, mtl_text) = clay::export::obj::to_obj(&s, "keep.mtl");
+    let (obj_text, mtl_text) = clay::to_obj(&s, "keep.mtl");
     let (models, materials) = tobj::load_obj_buf(
         &mut obj_text.as_bytes(),
         &tobj::LoadOptions::default(),
@@ -306,9 +304,9 @@ fn an_asset_at_the_coordinate_limit_exports_only_finite_numbers() {
                     assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
                 }
             }
-            let (obj, _) = clay::export::obj::to_obj(&s, "far.mtl");
+            let (obj, _) = clay::to_obj(&s, "far.mtl");
             assert!(!obj.contains("inf") && !obj.contains("NaN"));
-            assert!(gltf::to_glb(&s).is_ok());
+            assert!(clay::to_glb(&s).is_ok());
         }
         std::fs::remove_dir_all(dir).unwrap();
     }

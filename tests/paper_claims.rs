@@ -8,11 +8,7 @@ use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::RuleKind;
-use clay::script::Script;
-use clay::solver::Components;
-use clay::solver::{SolverConfig, bbox, max_edge_strain};
+use clay::{Assembly, Components, RuleKind, Script, SolverConfig, bbox, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
@@ -20,7 +16,7 @@ use glam::DVec2;
 struct Session {
     grammar: CompiledGrammar,
     asm: Assembly,
-    replay: clay::session::Session,
+    replay: clay::Session,
     steps: usize,
 }
 
@@ -39,7 +35,7 @@ impl Session {
         Self {
             asm: Assembly::new(Arc::new(g.clone())),
             grammar: g,
-            replay: clay::session::Session::new(config),
+            replay: clay::Session::new(config),
             steps: 0,
         }
     }

@@ -7,7 +7,7 @@ mod generated;
 use generated::{Run, step};
 use glam::DVec2;
 
-use clay::rules::RuleKind;
+use clay::RuleKind;
 
 fn fixture(name: &str) -> String {
     let dir = format!("{}/tests/fixtures/found", env!("CARGO_MANIFEST_DIR"));

@@ -1,12 +1,11 @@
 //! Tessellation of proxy geometry: exact areas for concave polygons with holes, and no panic or
 //! non-finite output on arbitrary (degenerate, self-crossing) input.
 
-use clay::plane::polygon_area;
+use clay::{polygon_area, tessellate_polygon, tessellate_polyline, tessellate_proxy};
 
 fn polygon_area_of(ring: &[glam::DVec2]) -> f64 {
     polygon_area(ring.iter().copied())
 }
-use clay::render::{tessellate_polygon, tessellate_polyline, tessellate_proxy};
 use clay_dsl::compiled::{Binding, Proxy, ProxyShape, Rgba};
 use glam::DVec2;
 use proptest::prelude::*;

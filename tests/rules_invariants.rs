@@ -3,8 +3,7 @@
 
 use std::collections::HashSet;
 
-use clay::rules::{RuleKind, cut, replace, stretch};
-use clay::solver::StateSwitch;
+use clay::{RuleKind, StateSwitch, testing::cut, testing::replace, testing::stretch};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 use proptest::prelude::*;
@@ -155,7 +154,7 @@ fn rewrite(
     g: &clay_dsl::compiled::CompiledGrammar,
     d: &mut clay_dsl::compiled::AssemblyData,
     at: (usize, usize),
-) -> Result<clay::rules::Rewrite, String> {
+) -> Result<clay::Rewrite, String> {
     let state = d
         .parts
         .iter()

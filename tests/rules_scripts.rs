@@ -4,10 +4,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::{RuleKind, cut};
-use clay::script::Script;
-use clay::solver::SolverConfig;
+use clay::{Assembly, RuleKind, Script, SolverConfig};
 
 struct Outcome {
     fired: BTreeMap<&'static str, usize>,
@@ -23,7 +20,7 @@ fn replay(name: &str) -> Outcome {
     let json = std::fs::read_to_string(format!("{dir}/grammars/{name}.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));
-    let mut session = clay::session::Session::new(SolverConfig::from_params(&g.solver));
+    let mut session = clay::Session::new(SolverConfig::from_params(&g.solver));
     for (i, s) in script.steps.iter().enumerate() {
         session.step(&mut asm, i, s).unwrap();
         asm.data().check(&g).unwrap();
@@ -51,7 +48,7 @@ fn replay(name: &str) -> Outcome {
     Outcome {
         fired,
         pieces,
-        components: cut::components(asm.data()),
+        components: clay::connected_components(asm.data()),
         notes: session.notes().to_vec(),
     }
 }

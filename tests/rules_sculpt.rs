@@ -6,10 +6,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use clay::assembly::{Assembly, Compass, HandleKind};
-use clay::rules::cut;
-use clay::script::Script;
-use clay::solver::{SolverConfig, max_edge_strain};
+use clay::{Assembly, Compass, HandleKind, Script, SolverConfig, max_edge_strain};
 use clay_dsl::compiled::CompiledGrammar;
 
 fn grammar(name: &str) -> CompiledGrammar {
@@ -24,7 +21,7 @@ fn grammar(name: &str) -> CompiledGrammar {
 /// A live session: the assembly, the replay (solver) and the rules.
 struct Session {
     asm: Assembly,
-    replay: clay::session::Session,
+    replay: clay::Session,
 }
 
 impl Session {
@@ -35,7 +32,7 @@ impl Session {
         }
         Self {
             asm: Assembly::new(Arc::new(g)),
-            replay: clay::session::Session::new(config),
+            replay: clay::Session::new(config),
         }
     }
 
@@ -57,7 +54,7 @@ impl Session {
             .count()
     }
 
-    fn fired(&self, kind: clay::rules::RuleKind) -> usize {
+    fn fired(&self, kind: clay::RuleKind) -> usize {
         self.replay
             .rule_log()
             .iter()
@@ -84,8 +81,8 @@ fn wall_dragged_to_twice_its_length_has_about_twice_the_bricks() {
     let strain = max_edge_strain(&s.asm);
     eprintln!(
         "2x: {bricks} bricks, strain {strain:.3}, stretch {} shrink {}",
-        s.fired(clay::rules::RuleKind::Stretch),
-        s.fired(clay::rules::RuleKind::Shrink)
+        s.fired(clay::RuleKind::Stretch),
+        s.fired(clay::RuleKind::Shrink)
     );
     assert!((15..=17).contains(&bricks), "{bricks} bricks at 2x");
     assert!(strain <= 0.15, "max edge strain {strain}");
@@ -121,7 +118,7 @@ fn stretch_wall(n: usize, fraction: f64, frames: u64, norm: Option<f64>) -> (usi
         .replay
         .rule_log()
         .iter()
-        .find(|e| e.kind == clay::rules::RuleKind::Stretch)
+        .find(|e| e.kind == clay::RuleKind::Stretch)
         .map(|e| e.frame);
     (s.count("brick"), first)
 }
@@ -182,10 +179,10 @@ fn handles_follow_their_bricks(norm: Option<f64>) {
         );
     }
     s.run(r#"{"steps": [{"drag": {"by": [8, 0], "frames": 120}}, {"hold": {"frames": 30}}]}"#);
-    assert!(s.fired(clay::rules::RuleKind::Stretch) >= 3);
+    assert!(s.fired(clay::RuleKind::Stretch) >= 3);
     one_brick_per_handle(&s.asm, &west_at, norm);
     s.run(r#"{"steps": [{"drag": {"by": [-8, 0], "frames": 120}}, {"hold": {"frames": 30}}]}"#);
-    assert!(s.fired(clay::rules::RuleKind::Shrink) >= 1);
+    assert!(s.fired(clay::RuleKind::Shrink) >= 1);
     one_brick_per_handle(&s.asm, &west_at, norm);
 }
 
@@ -268,16 +265,14 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
         .map(|&v| s.asm.data().positions[v])
         .collect();
     let k = stretch_part(&s.asm, 0);
-    assert!(s.asm.set_active_state(k, clay::rules::stretch::THREE));
-    let events = s.replay.rules_mut().unwrap().after_frame(
-        &mut s.asm,
-        &clay::solver::FrameReport::default(),
-        &[],
-    );
+    assert!(s.asm.set_active_state(k, clay::testing::stretch::THREE));
+    let events =
+        s.replay
+            .rules_mut()
+            .unwrap()
+            .after_frame(&mut s.asm, &clay::FrameReport::default(), &[]);
     assert!(
-        events
-            .iter()
-            .any(|e| e.kind == clay::rules::RuleKind::Stretch),
+        events.iter().any(|e| e.kind == clay::RuleKind::Stretch),
         "{events:?}"
     );
     let pin = s
@@ -311,15 +306,15 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
     let n = s.asm.data().chains[0].instances.len();
     let east_id = s.asm.data().instances[s.asm.data().chains[0].instances[n - 1]].id;
     let k = stretch_part(&s.asm, n - 2);
-    assert!(s.asm.set_active_state(k, clay::rules::stretch::ONE));
-    let events = s.replay.rules_mut().unwrap().after_frame(
-        &mut s.asm,
-        &clay::solver::FrameReport::default(),
-        &[],
-    );
+    assert!(s.asm.set_active_state(k, clay::testing::stretch::ONE));
+    let events =
+        s.replay
+            .rules_mut()
+            .unwrap()
+            .after_frame(&mut s.asm, &clay::FrameReport::default(), &[]);
     let shrink = events
         .iter()
-        .find(|e| e.kind == clay::rules::RuleKind::Shrink)
+        .find(|e| e.kind == clay::RuleKind::Shrink)
         .expect("the east pair shrank");
     assert!(shrink.instances.contains(&east_id));
     let grab = s
@@ -358,18 +353,18 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
 #[test]
 fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
     let mut s = Session::new(grammar("junction.clay"), None);
-    assert_eq!(cut::components(s.asm.data()), 2);
+    assert_eq!(clay::connected_components(s.asm.data()), 2);
     // The side street's free end is at (9, 2); the main street's north edge at y = 0.5.
     s.run(
         r#"{"steps": [{"pin": {"extreme": "west"}}, {"pin": {"at": [15, 0]}}, {"grab": {"at": [9, 3]}},
         {"drag": {"by": [0, -1.3], "frames": 40}}, {"hold": {"frames": 10}}]}"#,
     );
     assert_eq!(s.count("tee"), 1, "merged into a tee");
-    assert_eq!(cut::components(s.asm.data()), 1);
+    assert_eq!(clay::connected_components(s.asm.data()), 1);
     // Dragging on (sideways and up) does not un-merge it.
     s.run(r#"{"steps": [{"drag": {"by": [1, 1], "frames": 30}}, {"hold": {"frames": 10}}]}"#);
     assert_eq!(s.count("tee"), 1);
-    assert_eq!(cut::components(s.asm.data()), 1);
+    assert_eq!(clay::connected_components(s.asm.data()), 1);
     // Cut at the stem and pull the side street away.
     let tee = s
         .asm
@@ -384,7 +379,7 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
         .iter()
         .position(|x| x.name == "north")
         .unwrap();
-    let at = clay::rules::site_centre(
+    let at = clay::site_centre(
         g,
         s.asm.data(),
         clay_dsl::compiled::InstanceSite {
@@ -397,14 +392,9 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
         r#"{{"steps": [{{"cut": {{"at": [{}, {}]}}}}, {{"drag": {{"by": [0, 3], "frames": 30}}}}, {{"hold": {{"frames": 10}}}}]}}"#,
         at.x, at.y
     ));
-    assert_eq!(
-        s.fired(clay::rules::RuleKind::Cut),
-        1,
-        "{:?}",
-        s.replay.notes()
-    );
+    assert_eq!(s.fired(clay::RuleKind::Cut), 1, "{:?}", s.replay.notes());
     assert_eq!(s.count("tee"), 0);
-    assert_eq!(cut::components(s.asm.data()), 2);
+    assert_eq!(clay::connected_components(s.asm.data()), 2);
 }
 
 #[test]
@@ -449,7 +439,7 @@ fn the_generation_changes_only_when_a_rule_rewrites_the_structure() {
         .replay
         .rule_log()
         .iter()
-        .filter(|e| e.kind != clay::rules::RuleKind::Replace)
+        .filter(|e| e.kind != clay::RuleKind::Replace)
         .count();
     assert!(structural >= 2, "{structural} rewrites for a 3 m drag");
     assert_eq!(s.asm.generation(), structural as u64);

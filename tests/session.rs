@@ -5,11 +5,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::RuleKind;
-use clay::script::Script;
-use clay::session::{Session, replay};
-use clay::solver::SolverConfig;
+use clay::{Assembly, RuleKind, Script, Session, SolverConfig, replay};
 
 fn grammar(name: &str) -> clay_dsl::compiled::CompiledGrammar {
     let dir = env!("CARGO_MANIFEST_DIR");

@@ -4,9 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::{Assembly, Compass, HandleKind};
-use clay::solver::{Solver, SolverConfig};
-use clay::synthetic;
+use clay::{Assembly, Compass, HandleKind, Solver, SolverConfig, testing::synthetic};
 use glam::DVec2;
 use proptest::prelude::*;
 

@@ -4,9 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::solver::{Solver, SolverConfig};
-use clay::synthetic;
+use clay::{Assembly, HandleKind, Solver, SolverConfig, testing::synthetic};
 use glam::DVec2;
 
 /// Least squares only, so the start pose's evaluation comes from the previous frame.

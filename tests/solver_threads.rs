@@ -3,9 +3,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::solver::{FrameReport, Solver, SolverConfig};
-use clay::synthetic;
+use clay::{Assembly, FrameReport, HandleKind, Solver, SolverConfig, testing::synthetic};
 use glam::DVec2;
 
 /// A synthetic city of about `parts` parts, pinned at one corner and dragged at the other

@@ -7,10 +7,11 @@
 use std::path::PathBuf;
 
 use crate::out;
-use clay::authoring::MIN_TOLERANCE;
-use clay::authoring::{MergeChoice, SiteName, StateChoice, VariantChoice, Work, compute};
-use clay::authoring::{StretchChoice, check_authored};
-use clay::authoring::{drawing_from_svg, line_of_id as svg_line_of_id};
+use clay::{
+    authoring::MIN_TOLERANCE, authoring::MergeChoice, authoring::SiteName, authoring::StateChoice,
+    authoring::StretchChoice, authoring::VariantChoice, authoring::Work, authoring::check_authored,
+    authoring::compute, authoring::drawing_from_svg, authoring::line_of_id as svg_line_of_id,
+};
 use glam::DVec2;
 
 #[derive(clap::Args)]

@@ -6,10 +6,9 @@
 use std::sync::Arc;
 
 use crate::out;
-use clay::assembly::{Assembly, HandleKind};
-use clay::session::Session;
-use clay::solver::{FrameReport, SolverConfig, SolverKind};
-use clay::synthetic;
+use clay::{
+    Assembly, FrameReport, HandleKind, Session, SolverConfig, SolverKind, testing::synthetic,
+};
 use glam::DVec2;
 use serde::Serialize;
 

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clay::export::{ExportOptions, gltf, obj, scene};
+use clay::{ExportOptions, scene};
 
 use crate::out::{IO_ERROR, write_output};
 use crate::params::ParamArgs;
@@ -86,14 +86,14 @@ pub fn export(args: ExportArgs) -> u8 {
     };
     let scene = scene(&grammar, &assembly, &options);
     let bytes = match format {
-        Format::Glb => gltf::to_glb(&scene),
-        Format::Gltf => gltf::to_gltf(&scene),
+        Format::Glb => clay::to_glb(&scene),
+        Format::Gltf => clay::to_gltf(&scene),
         Format::Obj => {
             let mtl_path = args.output.with_extension("mtl");
             let mtl_name = mtl_path
                 .file_name()
                 .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-            let (obj_text, mtl_text) = obj::to_obj(&scene, &mtl_name);
+            let (obj_text, mtl_text) = clay::to_obj(&scene, &mtl_name);
             if !to_stdout {
                 let code = write_output(&mtl_path, mtl_text.as_bytes());
                 if code != 0 {

@@ -73,7 +73,7 @@ pub fn fmt(args: FmtArgs) -> u8 {
                 }
             }
         } else if args.write {
-            if changed && let Err(e) = clay::files::write_atomic(file, formatted.as_bytes()) {
+            if changed && let Err(e) = clay::write_atomic(file, formatted.as_bytes()) {
                 errln!("error: cannot write `{path}`: {e}");
                 worst = 2;
             }

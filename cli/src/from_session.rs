@@ -1,5 +1,5 @@
 //! `--session FILE.json` on `clayc run`, `render` and `export` (issue 40): a sculpt the editor
-//! saved (`clay::session::file`), replayed headlessly. The session's grammar is read from its
+//! saved (`clay::session_file`), replayed headlessly. The session's grammar is read from its
 //! path (a relative one from the session file's folder, else, as the editor opened it, from the
 //! current directory) and compiled (with `--param`s, if given); the saved assembly must fit
 //! it; its pins are held again as pins and its settings applied, so a `--script` after it goes
@@ -8,10 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::session::configure;
-use clay::session::file::{self, SessionError};
-use clay::solver::SolverConfig;
+use clay::{Assembly, SolverConfig, configure, session_file, session_file::SessionError};
 use clay_dsl::compiled::CompiledGrammar;
 
 use crate::out::IO_ERROR;
@@ -75,7 +72,7 @@ fn misfit<'a>(session: &'a Path, grammar: &'a Path) -> impl Fn(String) -> u8 + '
 /// for a JSON mistake, its line and column) and gives the exit code.
 pub fn load(path: &Path, params: &ParamArgs, settings: &[(&str, &str)]) -> Result<Loaded, u8> {
     let shown = path.display();
-    let saved = file::read(path).map_err(|e| match e {
+    let saved = session_file::read(path).map_err(|e| match e {
         SessionError::Io { error, .. } => {
             errln!("error: cannot read session {shown}: {error}");
             IO_ERROR
@@ -129,7 +126,7 @@ pub fn load(path: &Path, params: &ParamArgs, settings: &[(&str, &str)]) -> Resul
     })?;
     let mut assembly = Assembly::from_data(Arc::new(grammar.clone()), saved.assembly);
     for (k, pin) in saved.pins.into_iter().enumerate() {
-        if clay::session::pin_at(&mut assembly, pin.vertices, &pin.at).is_none() {
+        if clay::pin_at(&mut assembly, pin.vertices, &pin.at).is_none() {
             return Err(misfit(path, &grammar_file)(format!(
                 "pin {k} holds a vertex the assembly lacks"
             )));

@@ -60,7 +60,7 @@ pub fn write_output(output: &Path, bytes: &[u8]) -> u8 {
     if output.as_os_str() == "-" {
         return stdout(bytes).err().map_or(0, |stop| stop.exit(0));
     }
-    match clay::files::write_atomic(output, bytes) {
+    match clay::write_atomic(output, bytes) {
         Ok(()) => 0,
         Err(e) => {
             stderr(format_args!(

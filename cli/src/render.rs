@@ -8,11 +8,10 @@ use std::sync::Arc;
 use crate::out;
 use crate::params::ParamArgs;
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::render::{Overlays, RenderOptions, render_png, render_svg, sheet_png, sheet_svg};
-use clay::script::Script;
-use clay::session::Session;
-use clay::solver::SolverConfig;
+use clay::{
+    Assembly, HandleKind, Overlays, RenderOptions, Script, Session, SolverConfig, render_png,
+    render_svg, sheet_png, sheet_svg,
+};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
 /// An overlay that `--overlay` can ask for.
@@ -87,13 +86,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .trim()
             .parse()
             .map_err(|_| format!("`{v}` is not a whole number of pixels"))?;
-        if (1..=clay::render::MAX_SIDE).contains(&n) {
+        if (1..=clay::MAX_SIDE).contains(&n) {
             Ok(n)
         } else {
-            Err(format!(
-                "{n} is not between 1 and {}",
-                clay::render::MAX_SIDE
-            ))
+            Err(format!("{n} is not between 1 and {}", clay::MAX_SIDE))
         }
     };
     Ok((side(w)?, side(h)?))
@@ -170,7 +166,7 @@ pub(crate) fn sculpted(
             errln!("{}", e.located(path));
             INPUT_ERROR
         })?;
-        if let Err(e) = clay::session::replay(&mut assembly, &script, &mut Session::new(config)) {
+        if let Err(e) = clay::replay(&mut assembly, &script, &mut Session::new(config)) {
             errln!("error: {}: {e}", path.display());
             return Err(INPUT_ERROR);
         }
@@ -209,10 +205,10 @@ pub fn render(args: RenderArgs) -> u8 {
         Err(code) => return code,
     };
     if args.view == ViewKind::Iso {
-        let scene = clay::export::scene(&grammar, &assembly, &Default::default());
-        let png = clay::export::iso::iso_pixmap(&scene, args.size.0, args.size.1).and_then(|p| {
+        let scene = clay::scene(&grammar, &assembly, &Default::default());
+        let png = clay::iso_pixmap(&scene, args.size.0, args.size.1).and_then(|p| {
             p.encode_png()
-                .map_err(|e| clay::render::RenderError::Encode(e.to_string()))
+                .map_err(|e| clay::RenderError::Encode(e.to_string()))
         });
         return match png {
             Ok(png) => out::write_output(&args.output, &png),

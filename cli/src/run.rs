@@ -7,9 +7,7 @@ use std::sync::Arc;
 
 use crate::out;
 use crate::params::ParamArgs;
-use clay::assembly::Assembly;
-use clay::script::{Script, ScriptError};
-use clay::session::{Session, configure, replay};
+use clay::{Assembly, Script, ScriptError, Session, configure, replay};
 
 #[derive(clap::Args)]
 pub struct RunArgs {
@@ -39,7 +37,7 @@ fn initial(
     file: &Path,
     params: &ParamArgs,
     settings: Vec<(&str, &str)>,
-) -> Result<(Assembly, clay::solver::SolverConfig), u8> {
+) -> Result<(Assembly, clay::SolverConfig), u8> {
     let path = file.display().to_string();
     let source = match std::fs::read(file) {
         Ok(bytes) => bytes,

@@ -356,7 +356,7 @@ fn huge_script_coordinates_are_rejected_naming_the_step_and_its_line() {
         assert_eq!(code, Some(1), "{script}: {err}");
         assert!(err.contains(needle), "{script}: {err}");
     }
-    let script = clay::script::Script::parse(
+    let script = clay::Script::parse(
         r#"{"steps": [{"pin": {"at": [1e9, -1e9]}}, {"drag": {"to": [-1e9, 1e9], "frames": 0}}]}"#,
     );
     assert!(script.is_ok(), "{script:?}");
@@ -376,14 +376,14 @@ fn an_empty_script_is_reported_at_line_1_column_1() {
 
 #[test]
 fn script_errors_carry_the_steps_position() {
-    let e = clay::script::Script::parse(
+    let e = clay::Script::parse(
         "{\"steps\": [\n    {\"hold\": {\"frames\": 1}},\n    {\"pin\": {\"at\": [\"x\", 0]}}\n]}",
     )
     .unwrap_err();
     assert_eq!(e.step, Some(1));
     assert_eq!(e.position, Some((3, 5)));
     assert!(e.hint.is_none(), "{e:?}");
-    let e = clay::script::Script::parse("{\"steps\": [\n  {\"hold\": }\n]}").unwrap_err();
+    let e = clay::Script::parse("{\"steps\": [\n  {\"hold\": }\n]}").unwrap_err();
     assert_eq!(e.step, None);
     assert_eq!(e.position.map(|p| p.0), Some(2), "{e:?}");
 }

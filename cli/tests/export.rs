@@ -1,6 +1,6 @@
 //! `clayc export` (issue 20): each format written where `-o` says, the OBJ's material file
 //! beside it, and an unknown extension refused with exit 2 and nothing written. What the
-//! exported scenes hold is `clay::export`'s, tested in the clay crate's `tests/export.rs`.
+//! exported scenes hold is `clay`'s export's, tested in the clay crate's `tests/export.rs`.
 
 #[test]
 fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {

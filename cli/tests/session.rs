@@ -1,15 +1,11 @@
-//! `clayc run` reports what a library session counts (`clay::session::Session`, the one
+//! `clayc run` reports what a library session counts (`clay::Session`, the one
 //! definition of a frame and of a rule event): the same rules fired, parts and pieces after
 //! each example's script.
 
 use std::process::Command;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::RuleKind;
-use clay::script::Script;
-use clay::session::{Session, replay};
-use clay::solver::SolverConfig;
+use clay::{Assembly, RuleKind, Script, Session, SolverConfig, replay};
 
 /// The repository's root, where the example grammars are.
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");

@@ -1,5 +1,5 @@
 //! `clayc run|render|export --session FILE.json` (issue 40): a sculpt saved in the session file
-//! format (`clay::session::file`, what the editor writes) replayed headlessly by the real
+//! format (`clay::session_file`, what the editor writes) replayed headlessly by the real
 //! binary. The export of a saved session is the export of the sculpted assembly itself; its
 //! pins are held again, so a script after it moves the model around them; a malformed file is
 //! an error naming the file, line and column, with a non-zero exit.
@@ -8,12 +8,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Arc;
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::export::{ExportOptions, gltf, scene};
-use clay::script::Script;
-use clay::session::file::{self, Pin, Session as SessionFile, Settings};
-use clay::session::{Session, replay};
-use clay::solver::SolverConfig;
+use clay::{
+    Assembly, ExportOptions, HandleKind, Script, Session, SolverConfig, replay, scene,
+    session_file, session_file::Pin, session_file::Session as SessionFile, session_file::Settings,
+};
 use clay_dsl::compiled::CompiledGrammar;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
@@ -94,7 +92,7 @@ fn save(dir: &Path, source: &str, grammar: &CompiledGrammar, asm: &Assembly) -> 
         pins(asm),
         Some(settings),
     );
-    file::write(&path, &saved).unwrap();
+    session_file::write(&path, &saved).unwrap();
     path
 }
 
@@ -137,7 +135,7 @@ fn exporting_a_saved_session_exports_the_sculpted_assembly() {
     let cli = gltf_json(&std::fs::read(&out_path).unwrap());
 
     let direct = scene(&grammar, asm.data(), &ExportOptions::default());
-    let direct = gltf_json(&gltf::to_gltf(&direct).unwrap());
+    let direct = gltf_json(&clay::to_gltf(&direct).unwrap());
     let (cli_nodes, direct_nodes) = (nodes_with_instances(&cli), nodes_with_instances(&direct));
     assert_eq!(cli_nodes.len(), instances);
     assert_eq!(
@@ -264,9 +262,9 @@ fn a_session_whose_grammar_is_missing_or_does_not_fit_is_refused() {
     let shown = session.to_str().unwrap();
 
     // Vertices the grammar's pieces do not have.
-    let mut saved = file::read(&session).unwrap();
+    let mut saved = session_file::read(&session).unwrap();
     saved.assembly.instances[0].vertices[0] = 999_999;
-    file::write(&session, &saved).unwrap();
+    session_file::write(&session, &saved).unwrap();
     let out = clayc(&["export", "--session", shown, "-o", "-"]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
@@ -306,7 +304,7 @@ fn a_session_compiles_its_grammar_with_the_parameters_it_was_saved_with() {
     let mut saved = SessionFile::new("posts.clay".into(), grammar.assembly.clone(), vec![], None);
     saved.params.insert("height".into(), 2.5);
     let path = dir.join("tall.json");
-    file::write(&path, &saved).unwrap();
+    session_file::write(&path, &saved).unwrap();
     let shown = path.to_str().unwrap();
     // The exported model's height: the largest y (up) of any accessor.
     let height = |extra: &[&str]| -> f64 {
@@ -326,7 +324,7 @@ fn a_session_compiles_its_grammar_with_the_parameters_it_was_saved_with() {
     // The same session without its parameters: the grammar's default, 1 m; `--param` gives
     // back what the session did not say.
     saved.params.clear();
-    file::write(&path, &saved).unwrap();
+    session_file::write(&path, &saved).unwrap();
     assert!((height(&[]) - 1.0).abs() < 1e-6, "{}", height(&[]));
     let h = height(&["--param", "height=2.5"]);
     assert!((h - 2.5).abs() < 1e-6, "{h}");

@@ -6,11 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::script::Script;
-use clay::session::{Session, replay};
-use clay::solver::SolverConfig;
-use clay::synthetic;
+use clay::{Assembly, Script, Session, SolverConfig, replay, testing::synthetic};
 use serde_json::Value;
 
 fn grammar_path(name: &str) -> String {

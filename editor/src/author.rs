@@ -6,11 +6,12 @@
 
 use std::path::{Path, PathBuf};
 
-use clay::authoring::{
-    Computed, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name, compute,
-    docked_sites, find_site, site_names, variant_map,
+use clay::{
+    authoring::Computed, authoring::Design, authoring::Drawing, authoring::MergeChoice,
+    authoring::Polyline, authoring::SiteName, authoring::StateChoice, authoring::StretchChoice,
+    authoring::VariantChoice, authoring::Work, authoring::check_name, authoring::compute,
+    authoring::docked_sites, authoring::find_site, authoring::site_names, authoring::variant_map,
 };
-use clay::authoring::{Design, Drawing, Polyline, StretchChoice};
 use glam::DVec2;
 
 use crate::compile::{self, Problem};
@@ -585,7 +586,7 @@ impl Authoring {
             Ok(c) => c.text.clone(),
             Err(e) => return Err(format!("no grammar to write: {e}")),
         };
-        clay::files::write_atomic(path, text.as_bytes())
+        clay::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))?;
         self.written = Some((path.to_path_buf(), text));
         self.recompute();

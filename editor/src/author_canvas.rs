@@ -7,12 +7,12 @@
 //! copy of a piece (a rest state in the making). A click that does nothing says why. The view
 //! only fits the drawing on request, never after a stroke. It never changes the work itself.
 
-use clay::authoring::{PieceDesign, Polyline};
-use clay::plane::nearest_on_segment;
+use clay::{
+    authoring::Computed, authoring::PieceDesign, authoring::Polyline, authoring::SiteName,
+    nearest_on_segment,
+};
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
-
-use clay::authoring::{Computed, SiteName};
 
 use crate::author::{AuthorCommand, Authoring, short};
 use crate::camera::{Camera, dv, pos};
@@ -39,7 +39,7 @@ pub fn piece_colour(piece: &PieceDesign) -> Color32 {
 /// The colour a site type is drawn in: the renderer's, so a site type has one colour in the
 /// author canvas, the sculpt overlays and `clayc render --overlay sites`.
 pub fn site_colour(site_type: usize) -> Color32 {
-    let [r, g, b, a] = clay::render::site_type_colour(site_type).0;
+    let [r, g, b, a] = clay::site_type_colour(site_type).0;
     Color32::from_rgba_unmultiplied(r, g, b, a)
 }
 
@@ -728,7 +728,7 @@ impl AuthorCanvas {
             match &piece.outline {
                 Some(outline) => {
                     let ring: Vec<DVec2> = outline.iter().filter_map(|&k| world_of(k)).collect();
-                    if let Some((vs, tris)) = clay::render::tessellate_polygon(&ring, &[]) {
+                    if let Some((vs, tris)) = clay::tessellate_polygon(&ring, &[]) {
                         let mut mesh = egui::Mesh::default();
                         for &v in &vs {
                             mesh.colored_vertex(screen(v), fill);

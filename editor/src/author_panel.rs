@@ -7,12 +7,14 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use clay::authoring::StretchChoice;
+use clay::{
+    authoring::MergeChoice, authoring::StateChoice, authoring::StretchChoice,
+    authoring::VariantChoice, authoring::find_site, authoring::site_names,
+};
 use egui::{Color32, RichText};
 
 use crate::action::Action;
 use crate::files::FileKind;
-use clay::authoring::{MergeChoice, StateChoice, VariantChoice, find_site, site_names};
 
 use crate::author::{AuthorCommand, Authoring};
 use crate::author_canvas::{AuthorCanvas, Tool, piece_colour, site_colour};

@@ -2,9 +2,7 @@
 //! hovered, grabbed and pinned parts marked, finds the part or connection under the cursor, and
 //! turns pointer and key input into [`Command`]s. It never changes the model itself.
 
-use clay::render::part_at;
-use clay::render::pose_assembly_into;
-use clay::render::{TessellationCache, WorldMesh};
+use clay::{TessellationCache, WorldMesh, part_at, pose_assembly_into};
 use clay_dsl::compiled::AssemblyData;
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
@@ -261,9 +259,9 @@ impl Canvas {
 
     /// Fits the model into the view, below the strain legend while it is shown.
     fn fit(&mut self, data: &AssemblyData, overlays: &ViewOverlays) {
-        let (min, max) = clay::render::bounds(&self.meshes, data);
+        let (min, max) = clay::bounds(&self.meshes, data);
         let size = DVec2::new(self.rect.width() as f64, self.rect.height() as f64);
-        let [_, y, _, height] = clay::render::STRAIN_LEGEND;
+        let [_, y, _, height] = clay::STRAIN_LEGEND;
         let margin = 24.0;
         // The legend's plate ends `y + height` points down; the margin then starts below it.
         let legend = if overlays.strain && !self.iso {

@@ -211,8 +211,7 @@ impl Recent {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         let text = serde_json::to_string_pretty(self).map_err(|e| e.to_string())?;
-        clay::files::write_atomic(store, text.as_bytes())
-            .map_err(|e| format!("{}: {e}", store.display()))
+        clay::write_atomic(store, text.as_bytes()).map_err(|e| format!("{}: {e}", store.display()))
     }
 }
 

@@ -1,10 +1,10 @@
 //! The canvas's isometric 3D view (View > Isometric 3D, or I): the live model drawn by the same
-//! code as `clayc render --view iso` ([`clay::export::iso::iso_pixmap`] of the export's
-//! [`clay::export::scene`]) into a texture the size of the canvas. The picture is made again
+//! code as `clayc render --view iso` ([`clay::iso_pixmap`] of the export's
+//! [`clay::scene`]) into a texture the size of the canvas. The picture is made again
 //! only when the model or the canvas size changes. While it is shown the canvas takes no
 //! sculpting gestures: a point on the picture is not a point of the floor plan (docs/editor.md).
 
-use clay::export::{ExportOptions, iso::iso_pixmap, scene};
+use clay::{ExportOptions, iso_pixmap, scene};
 use egui::{Color32, ColorImage, Rect, TextureHandle, TextureOptions};
 
 use crate::sculpt::Sculpt;

@@ -1,9 +1,9 @@
 //! The View menu's overlays on the canvas: strain colours, active state names, docking sites,
 //! handles and pins, and part outlines. They are drawn by the same code as `clayc render
-//! --overlay` ([`clay::render::draw_overlays`]) through an egui painter that implements
-//! the renderer's [`clay::render::Canvas`], so the editor and the pictures never disagree.
+//! --overlay` ([`clay::draw_overlays`]) through an egui painter that implements
+//! the renderer's [`clay::Canvas`], so the editor and the pictures never disagree.
 
-use clay::render::{Overlays, View, draw_overlays};
+use clay::{Overlays, View, draw_overlays};
 use clay_dsl::compiled::Rgba;
 use egui::{Color32, Pos2, Rect, Shape, Stroke, Vec2};
 
@@ -97,7 +97,7 @@ fn colour(c: Rgba) -> Color32 {
     Color32::from_rgba_unmultiplied(r, g, b, a)
 }
 
-impl clay::render::Canvas for PainterCanvas {
+impl clay::Canvas for PainterCanvas {
     fn fill_triangles(&mut self, points: &[[f32; 2]], triangles: &[[u32; 3]], c: Rgba) {
         let mut mesh = egui::Mesh::default();
         let fill = colour(c);
@@ -125,7 +125,7 @@ impl clay::render::Canvas for PainterCanvas {
             return;
         };
         let holes: Vec<_> = holes.iter().map(ring).collect();
-        if let Some((points, triangles)) = clay::render::tessellate_polygon(&ring(outer), &holes) {
+        if let Some((points, triangles)) = clay::tessellate_polygon(&ring(outer), &holes) {
             let points: Vec<[f32; 2]> = points.iter().map(|p| [p.x as f32, p.y as f32]).collect();
             self.fill_triangles(&points, &triangles, c);
         }

@@ -4,8 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clay::authoring::Work;
-use clay::authoring::{Drawing, Polyline, StretchChoice};
+use clay::{authoring::Drawing, authoring::Polyline, authoring::StretchChoice, authoring::Work};
 use clay_editor::EditorApp;
 use clay_editor::action::Action;
 use clay_editor::app::Mode;
@@ -390,7 +389,7 @@ fn tab_switches_modes_without_moving_the_keyboard_focus() {
 
 #[test]
 fn a_merge_rule_is_written_compiles_and_undoes() {
-    use clay::authoring::{MergeChoice, SiteName};
+    use clay::{authoring::MergeChoice, authoring::SiteName};
     let site = |piece: &str, site: &str| SiteName {
         piece: piece.into(),
         site: site.into(),
@@ -833,7 +832,7 @@ fn a_variant_with_a_rest_state_is_refused_with_e047() {
     // A chain element's own rest states could never become active (the chain is covered by
     // two-element parts with one/two/three states), so the language rejects them (E047): the
     // author panel shows that problem for a variant given a state, naming the state.
-    use clay::authoring::{StateChoice, VariantChoice};
+    use clay::{authoring::StateChoice, authoring::VariantChoice};
     let mut a = squares_and_a_long_one();
     a.apply(AuthorCommand::SetStretch(Some(StretchChoice::Auto)));
     let d = a.design().unwrap().clone();

@@ -8,8 +8,7 @@ mod generated;
 
 use std::time::{Duration, Instant};
 
-use clay::assembly::HandleKind;
-use clay::script::{Motion, Script, Selector, Step};
+use clay::{HandleKind, Motion, Script, Selector, Step};
 use clay_dsl::compiled::{PartKind, STRETCH_ONE};
 use clay_editor::app::{BACKGROUND_ABOVE, BACKGROUND_BUDGET, SOLVER_BUDGET};
 use clay_editor::compile::compile;

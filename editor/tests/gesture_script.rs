@@ -9,9 +9,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::script::{Script, Step};
-use clay::session::{Session, configure, replay};
+use clay::{Assembly, Script, Session, Step, configure, replay};
 use clay_dsl::compiled::AssemblyData;
 use clay_editor::EditorApp;
 use clay_editor::action::Action;
@@ -123,7 +121,7 @@ fn assert_same_sculpt(editor: &AssemblyData, replay: &AssemblyData) {
     let states = |d: &AssemblyData| d.parts.iter().map(|p| p.active).collect::<Vec<_>>();
     assert_eq!(states(editor), states(replay), "the parts' rest states");
     assert_eq!(editor.positions.len(), replay.positions.len());
-    let size = clay::solver::bbox_diagonal(&editor.positions);
+    let size = clay::bbox_diagonal(&editor.positions);
     let gap = (editor.positions.iter().zip(&replay.positions))
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max);

@@ -286,11 +286,10 @@ fn saved_gestures_say_the_parameters_to_replay_them_with() {
     let grammar = clay_dsl::compile_with_options(&text, "posts.clay", &options)
         .unwrap()
         .grammar;
-    let parsed = clay::script::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();
-    let mut asm = clay::assembly::Assembly::new(std::sync::Arc::new(grammar.clone()));
-    let mut session =
-        clay::session::Session::new(clay::solver::SolverConfig::from_params(&grammar.solver));
-    clay::session::replay(&mut asm, &parsed, &mut session).unwrap();
+    let parsed = clay::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();
+    let mut asm = clay::Assembly::new(std::sync::Arc::new(grammar.clone()));
+    let mut session = clay::Session::new(clay::SolverConfig::from_params(&grammar.solver));
+    clay::replay(&mut asm, &parsed, &mut session).unwrap();
     assert_eq!(asm.data().instances.len(), instances(&h));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -397,12 +397,12 @@ fn the_iso_view_draws_the_live_model_as_clayc_does_and_takes_no_drags() {
     let same_as_clayc = |h: &Harness<'_, EditorApp>| {
         let app = h.state();
         let picture = app.canvas.iso_picture.as_ref().expect("a picture is shown");
-        let scene = clay::export::scene(
+        let scene = clay::scene(
             app.sculpt.grammar(),
             app.sculpt.data(),
-            &clay::export::ExportOptions::default(),
+            &clay::ExportOptions::default(),
         );
-        let want = clay::export::iso::iso_pixmap(&scene, picture.size[0], picture.size[1]).unwrap();
+        let want = clay::iso_pixmap(&scene, picture.size[0], picture.size[1]).unwrap();
         assert!(
             picture.pixels == want.data(),
             "the picture is clayc's iso view"
@@ -505,7 +505,7 @@ fn after_fit_the_strain_legend_covers_none_of_the_model() {
     h.step();
     h.step();
     let app = h.state();
-    let [x, y, w, ht] = clay::render::STRAIN_LEGEND;
+    let [x, y, w, ht] = clay::STRAIN_LEGEND;
     let legend =
         egui::Rect::from_min_size(app.canvas.rect.min + egui::vec2(x, y), egui::vec2(w, ht));
     assert!(painted_texts(&h).iter().any(|t| t == "strain 0"));

@@ -46,6 +46,6 @@ fn _clay(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<session::RuleEvent>()?;
     m.add_class::<session::SceneNode>()?;
     m.add_class::<session::Primitive>()?;
-    m.add("SOLVER_SETTINGS", clay::session::SETTING_NAMES.to_vec())?;
+    m.add("SOLVER_SETTINGS", clay::SETTING_NAMES.to_vec())?;
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `clay.Session`: a sculpting session on a grammar's model, the script vocabulary as methods
 //! (each builds the script step `clayc run` would parse and runs it through
-//! `clay::session::Session::step`), and what the session has made: its summary, positions,
+//! `clay::Session::step`), and what the session has made: its summary, positions,
 //! instances, rule log, exports and pictures.
 
 use std::path::{Path, PathBuf};
@@ -12,11 +12,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString};
 use serde_json::{Value, json};
 
-use clay::assembly::{Assembly, HandleKind};
-use clay::export::{ExportOptions, gltf, obj, scene};
-use clay::render::{Overlays, RenderOptions};
-use clay::script::{Script, Step};
-use clay::session::configure;
+use clay::{
+    Assembly, ExportOptions, HandleKind, Overlays, RenderOptions, Script, Step, configure, scene,
+};
 use clay_dsl::compiled::CompiledGrammar;
 
 use crate::convert::{finite, guard, os_error, path_of, point, type_name};
@@ -24,14 +22,14 @@ use crate::grammar::Grammar;
 use crate::{InternalError, SolverError};
 
 /// Largest picture side, as `clayc render --size` allows.
-const MAX_SIDE: u32 = clay::render::MAX_SIDE;
+const MAX_SIDE: u32 = clay::MAX_SIDE;
 
 /// The overlays `render_png` draws, as `clayc render --overlay` names them.
 const OVERLAYS: [&str; 5] = ["graph", "sites", "strain", "handles", "states"];
 
 struct State {
     asm: Assembly,
-    session: clay::session::Session,
+    session: clay::Session,
     /// Steps run so far by calls (the index notes name).
     steps: usize,
 }
@@ -278,7 +276,7 @@ impl Session {
     }
 }
 
-fn events(log: &[clay::rules::RuleEvent]) -> Vec<RuleEvent> {
+fn events(log: &[clay::RuleEvent]) -> Vec<RuleEvent> {
     log.iter()
         .map(|e| RuleEvent {
             kind: e.kind.name().to_string(),
@@ -326,7 +324,7 @@ impl Session {
                     grammar,
                     state: Mutex::new(State {
                         asm,
-                        session: clay::session::Session::new(config),
+                        session: clay::Session::new(config),
                         steps: 0,
                     }),
                 })
@@ -618,22 +616,22 @@ impl Session {
                     scene(&self.grammar, st.asm.data(), &options)
                 };
                 let encoded = match ext.as_str() {
-                    "glb" => gltf::to_glb(&scene),
-                    "gltf" => gltf::to_gltf(&scene),
+                    "glb" => clay::to_glb(&scene),
+                    "gltf" => clay::to_gltf(&scene),
                     _ => {
                         let mtl_path = path.with_extension("mtl");
                         let mtl_name = mtl_path
                             .file_name()
                             .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-                        let (obj_text, mtl_text) = obj::to_obj(&scene, &mtl_name);
-                        clay::files::write_atomic(&mtl_path, mtl_text.as_bytes())
+                        let (obj_text, mtl_text) = clay::to_obj(&scene, &mtl_name);
+                        clay::write_atomic(&mtl_path, mtl_text.as_bytes())
                             .map_err(|e| os_error(&e, &mtl_path))?;
                         Ok(obj_text.into_bytes())
                     }
                 };
                 let bytes = encoded
                     .map_err(|e| InternalError::new_err(format!("cannot encode the model: {e}")))?;
-                clay::files::write_atomic(&path, &bytes).map_err(|e| os_error(&e, &path))
+                clay::write_atomic(&path, &bytes).map_err(|e| os_error(&e, &path))
             })
         })
     }
@@ -687,9 +685,9 @@ impl Session {
                 let data = st.asm.data();
                 let result = if iso {
                     let scene = scene(&self.grammar, data, &ExportOptions::default());
-                    clay::export::iso::iso_pixmap(&scene, width, height).and_then(|p| {
+                    clay::iso_pixmap(&scene, width, height).and_then(|p| {
                         p.encode_png()
-                            .map_err(|e| clay::render::RenderError::Encode(e.to_string()))
+                            .map_err(|e| clay::RenderError::Encode(e.to_string()))
                     })
                 } else {
                     let has = |k: &str| overlays.iter().any(|o| o == k);
@@ -715,7 +713,7 @@ impl Session {
                         },
                         ..RenderOptions::default()
                     };
-                    clay::render::render_png(&self.grammar, data, &options)
+                    clay::render_png(&self.grammar, data, &options)
                 };
                 result.map_err(|e| PyValueError::new_err(format!("cannot draw the model: {e}")))
             })

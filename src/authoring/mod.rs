@@ -34,8 +34,10 @@ use glam::DVec2;
 
 // The authoring surface: one public path per name, `clay::authoring::X`.
 pub use drawing::{AuthorError, Drawing, Polyline};
-pub use graph::{Contact, Graph, MIN_TOLERANCE, Region};
-pub use pieces::{Design, PieceDesign, StretchChoice, find_pieces};
+pub use graph::{Contact, CutSection, Graph, Loop, MIN_TOLERANCE, Region, Split};
+pub use pieces::{
+    Design, DockDesign, InstanceDesign, PieceDesign, SiteDesign, StretchChoice, find_pieces,
+};
 pub use svg::{drawing_from_svg, line_of_id};
 pub use work::{
     Computed, MergeChoice, SiteName, StateChoice, VariantChoice, Work, check_name, compute,

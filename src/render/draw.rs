@@ -8,7 +8,7 @@ use glam::DVec2;
 
 use super::contour::finite;
 use super::contour::{CONTOUR_MIN_TRIANGLES, contours};
-use super::pose::{WorldMesh, site_out};
+use super::pose::{WorldMesh, drawn_site_out};
 use super::text;
 
 /// The triangles a canvas fills: those whose corners exist and are finite, all turned to one
@@ -184,7 +184,7 @@ pub fn strain_colour(strain: f64) -> Rgba {
 
 /// The strain of every part edge, as (global vertex a, global vertex b, strain); an edge shared
 /// by overlapping parts reports the largest.
-pub fn edge_strains(
+pub fn strained_edges(
     grammar: &CompiledGrammar,
     assembly: &AssemblyData,
 ) -> Vec<(usize, usize, f64)> {
@@ -328,7 +328,7 @@ pub fn draw_overlays(
             .map(|p| view.to_pixel(*p))
     };
     if overlays.strain {
-        for (a, b, strain) in edge_strains(grammar, assembly) {
+        for (a, b, strain) in strained_edges(grammar, assembly) {
             if let (Some(pa), Some(pb)) = (pos(a), pos(b)) {
                 canvas.stroke_segments(&[[pa, pb]], 3.0, strain_colour(strain));
             }
@@ -447,7 +447,7 @@ fn draw_instance_sites(
             };
             // Docked sites are joints, not open ends: marked, but without an arrow.
             let out = (!docked.contains(&(ii, si)))
-                .then(|| site_out(grammar, inst.piece, inst.state, si, &current))
+                .then(|| drawn_site_out(grammar, inst.piece, inst.state, si, &current))
                 .flatten();
             draw_site(canvas, &points, out, site_type_colour(site.site_type));
         }

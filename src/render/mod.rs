@@ -16,16 +16,15 @@ pub(crate) mod svg;
 pub(crate) mod tessellate;
 pub(crate) mod text;
 
-// The rendering surface: one public path per name, `clay::render::X`.
+// The rendering surface, re-exported once more at the crate's root as `clay::X`.
 pub use contour::{CONTOUR_MIN_TRIANGLES, contours};
 pub use draw::{
     BACKGROUND, Canvas, Overlays, RenderOptions, STRAIN_FULL, STRAIN_LEGEND, View, bounds,
-    draw_overlays, edge_strains, site_type_colour, strain_colour,
+    draw_overlays, site_type_colour, strain_colour,
 };
 pub use pick::part_at;
 pub use pose::{
     SiteFrame, Skin, WorldMesh, pose_assembly, pose_assembly_into, pose_instance, pose_piece,
-    site_out,
 };
 pub use raster::{MAX_SIDE, PixmapCanvas, RenderError, render_pixmap, render_png};
 pub use sheet::{sheet_pixmap, sheet_png, sheet_svg};

@@ -427,7 +427,11 @@ fn write_mesh(
 /// vertices turns with its first-to-last span, so the east end of a road bent a quarter turn
 /// (`state left bend 90`) points north, not halfway; a one-vertex site turns with the piece.
 /// An unknown state counts as the base state.
-pub fn site_out(
+///
+/// This is the direction drawn (arrows on the sheet and on the model), steady while a part
+/// deforms; the merge rule reads [`crate::site_out`], the fit of the site's own vertices,
+/// which follows a site through a part's deformation.
+pub fn drawn_site_out(
     grammar: &CompiledGrammar,
     piece: usize,
     state: usize,
@@ -456,6 +460,31 @@ pub fn site_out(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn site_out_arrows_turn_with_the_bent_ends() {
+        // In `left` the east end faces north and the west end still faces west; in `right` the
+        // east end faces south. The arrows follow each site's own frame, not the piece's average
+        // turn (which is 45 degrees).
+        let dir = env!("CARGO_MANIFEST_DIR");
+        // (The drawn arrow is render's own; moved here from tests/derived_states.rs when the
+        // render module became private.)
+        let src = std::fs::read_to_string(format!("{dir}/grammars/bend.clay")).unwrap();
+        let g = clay_dsl::compile(&src, "bend.clay").unwrap().grammar;
+        let road = &g.pieces[0];
+        let site = |name: &str| road.sites.iter().position(|s| s.name == name).unwrap();
+        let state = |name: &str| road.states.iter().position(|s| s.name == name).unwrap();
+        for (st, s, expected) in [
+            ("left", "east", glam::DVec2::Y),
+            ("left", "west", glam::DVec2::NEG_X),
+            ("right", "east", glam::DVec2::NEG_Y),
+            ("base", "east", glam::DVec2::X),
+        ] {
+            let rest = &road.states[state(st)].positions;
+            let out = drawn_site_out(&g, 0, state(st), site(s), rest).unwrap();
+            assert!(out.distance(expected) < 1e-9, "{st}.{s}: {out}");
+        }
+    }
 
     /// The straightforward posing the fast path replaced, kept as the reference it must match
     /// exactly: per vertex an `Option`, per mesh a filtered triangle and edge list.

@@ -8,7 +8,7 @@ use tiny_skia::Pixmap;
 use super::draw::{
     BACKGROUND, Canvas, View, draw_meshes, draw_site, label, points_bounds, site_type_colour,
 };
-use super::pose::{pose_piece, site_out};
+use super::pose::{drawn_site_out, pose_piece};
 use super::raster::{MAX_SIDE, PixmapCanvas, RenderError};
 use super::svg::SvgCanvas;
 use super::tessellate::TessellationCache;
@@ -132,7 +132,7 @@ pub fn draw_sheet(canvas: &mut dyn Canvas, grammar: &CompiledGrammar) {
                 draw_site(
                     canvas,
                     &points,
-                    site_out(grammar, pi, si, k, current),
+                    drawn_site_out(grammar, pi, si, k, current),
                     site_type_colour(site.site_type),
                 );
             }

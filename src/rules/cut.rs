@@ -130,32 +130,3 @@ pub fn cut_dock(
         Ok(finish(grammar, data, &before, &touched, event))
     })
 }
-
-/// Number of connected components of the assembly (instances connected through shared
-/// vertices).
-pub fn components(data: &AssemblyData) -> usize {
-    let n = data.positions.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for inst in &data.instances {
-        if let Some((&first, rest)) = inst.vertices.split_first() {
-            for &v in rest {
-                let (a, b) = (root(&mut parent, first), root(&mut parent, v));
-                parent[a] = b;
-            }
-        }
-    }
-    let mut roots = HashSet::new();
-    for inst in &data.instances {
-        if let Some(&v) = inst.vertices.first() {
-            roots.insert(root(&mut parent, v));
-        }
-    }
-    roots.len()
-}

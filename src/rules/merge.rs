@@ -56,7 +56,9 @@ fn docked_sites(data: &AssemblyData) -> HashSet<InstanceSite> {
 
 /// The closest mover/target pair over all merge rules, if any is within its rule's distance
 /// and the two sites face each other ([`facing`]). O(instances + docks) to list the free
-/// sites, then O(1) per free mover site (grid lookup).
+/// sites, then O(1) per free mover site (grid lookup). The rules call [`find_where`]; this
+/// is for tests.
+#[cfg(any(test, feature = "testing"))]
 pub fn find(grammar: &CompiledGrammar, data: &AssemblyData) -> Option<MergeMatch> {
     find_where(grammar, data, |_, _| true)
 }

@@ -177,7 +177,7 @@ impl Rules {
         events
     }
 
-    /// Cuts the dock nearest `point` (see [`cut::cut_at`]).
+    /// Cuts the dock nearest `point` (the cut rule's `cut_at`).
     pub fn cut(&mut self, asm: &mut Assembly, point: DVec2) -> Result<RuleEvent, String> {
         let grammar = asm.grammar_arc().clone();
         let r = cut::cut_at(&grammar, asm.data_mut(), point)?;

@@ -12,10 +12,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::rules::RuleKind;
-use clay::script::Script;
-use clay::solver::{SolverConfig, bbox, bbox_diagonal, edge_strains};
+use clay::{Assembly, RuleKind, Script, SolverConfig, bbox, bbox_diagonal, edge_strains};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
@@ -215,7 +212,7 @@ pub struct Run {
     pub text: String,
     pub grammar: Arc<CompiledGrammar>,
     pub asm: Assembly,
-    pub session: clay::session::Session,
+    pub session: clay::Session,
     pub steps: Vec<String>,
     count: usize,
 }
@@ -236,7 +233,7 @@ impl Run {
             text: text.to_string(),
             asm: Assembly::new(grammar.clone()),
             grammar,
-            session: clay::session::Session::new(config),
+            session: clay::Session::new(config),
             steps: Vec::new(),
             count: 0,
         }

@@ -18,30 +18,29 @@ impl EditorApp {
         for pin in self.sculpt.pins() {
             pins.extend(pin.vertices);
         }
-        let options = clay::render::RenderOptions {
+        let options = clay::RenderOptions {
             width,
             height,
-            view: Some(clay::render::View {
+            view: Some(clay::View {
                 scale: cam.scale,
                 world_origin: cam.centre,
                 pixel_origin: DVec2::new(width as f64 / 2.0, height as f64 / 2.0),
             }),
-            overlays: clay::render::Overlays {
+            overlays: clay::Overlays {
                 pins,
                 ..Default::default()
             },
             ..Default::default()
         };
-        let png = clay::render::render_png(self.sculpt.grammar(), self.sculpt.data(), &options)
+        let png = clay::render_png(self.sculpt.grammar(), self.sculpt.data(), &options)
             .map_err(|e| e.to_string())?;
-        clay::files::write_atomic(path, &png).map_err(|e| format!("{}: {e}", path.display()))
+        clay::write_atomic(path, &png).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Writes the deformed assembly as JSON (the contract's `AssemblyData`).
     pub fn export_json(&self, path: &Path) -> Result<(), String> {
         let text = serde_json::to_string_pretty(self.sculpt.data()).map_err(|e| e.to_string())?;
-        clay::files::write_atomic(path, text.as_bytes())
-            .map_err(|e| format!("{}: {e}", path.display()))
+        clay::write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Writes the gestures since the grammar's initial model as a script (atomically), which
@@ -55,12 +54,12 @@ impl EditorApp {
             .map_err(|why| format!("no gestures to save: {why}"))?;
         let text = script.to_json();
         // What is written must read back as the same steps (a non-finite point would not).
-        match clay::script::Script::parse(&text) {
+        match clay::Script::parse(&text) {
             Ok(back) if back == script => {}
             Ok(_) => return Err("the gestures do not read back as the same script".into()),
             Err(e) => return Err(format!("the gestures do not make a valid script: {e}")),
         }
-        clay::files::write_atomic(path, text.as_bytes())
+        clay::write_atomic(path, text.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let solver = &self.sculpt.grammar().solver;
         let settings = self.sculpt.settings();
@@ -88,7 +87,7 @@ impl EditorApp {
     /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from
     /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it).
     pub fn export_3d(&self, path: &Path) -> Result<(), String> {
-        use clay::export::{gltf, obj, scene};
+        use clay::scene;
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -99,17 +98,17 @@ impl EditorApp {
             &Default::default(),
         );
         let write = |p: &Path, bytes: &[u8]| {
-            clay::files::write_atomic(p, bytes).map_err(|e| format!("{}: {e}", p.display()))
+            clay::write_atomic(p, bytes).map_err(|e| format!("{}: {e}", p.display()))
         };
         match ext.as_deref() {
-            Some("glb") => write(path, &gltf::to_glb(&scene)?),
-            Some("gltf") => write(path, &gltf::to_gltf(&scene)?),
+            Some("glb") => write(path, &clay::to_glb(&scene)?),
+            Some("gltf") => write(path, &clay::to_gltf(&scene)?),
             Some("obj") => {
                 let mtl = path.with_extension("mtl");
                 let name = mtl
                     .file_name()
                     .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-                let (obj_text, mtl_text) = obj::to_obj(&scene, &name);
+                let (obj_text, mtl_text) = clay::to_obj(&scene, &name);
                 write(&mtl, mtl_text.as_bytes())?;
                 write(path, obj_text.as_bytes())
             }

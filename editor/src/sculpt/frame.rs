@@ -4,9 +4,7 @@
 
 use std::time::Duration;
 
-use clay::assembly::Assembly;
-use clay::session::Session;
-use clay::solver::{FrameReport, SolverError};
+use clay::{Assembly, FrameReport, Session, SolverError};
 use glam::DVec2;
 
 /// A background solver frame to run: the model, solver and rules to work on, within `budget`.

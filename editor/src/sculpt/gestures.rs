@@ -5,9 +5,7 @@
 
 use std::time::Duration;
 
-use clay::assembly::HandleKind;
-use clay::script::Script;
-use clay::session::Grab;
+use clay::{Grab, HandleKind, Script};
 use glam::DVec2;
 
 use super::Sculpt;
@@ -55,8 +53,7 @@ impl Sculpt {
     /// Whether an instance of `part` is held by a pin.
     pub fn is_pinned(&self, part: usize) -> bool {
         let asm = &self.assembly;
-        (asm.data().part_instances(part).into_iter())
-            .any(|i| clay::session::pin_of(asm, i).is_some())
+        (asm.data().part_instances(part).into_iter()).any(|i| clay::pin_of(asm, i).is_some())
             || (self.grab).is_some_and(|g| g.part() == Some(part) && g.was_pinned())
     }
 
@@ -94,7 +91,7 @@ impl Sculpt {
         self.checkpoint();
         let name = self.assembly.data().instances[instance].name.clone();
         let centre = self.assembly.instance_centroid(instance);
-        let pinned = clay::session::toggle_pin(&mut self.assembly, instance);
+        let pinned = clay::toggle_pin(&mut self.assembly, instance);
         if let Some(centre) = centre {
             self.record.pin(centre, pinned);
         }
@@ -149,7 +146,7 @@ impl Sculpt {
 
     /// The gestures since the grammar's initial model (opened, reset, or rebuilt by a
     /// reload) as a script: replayed on that model by `clayc run` or
-    /// [`clay::session::replay`], it makes this sculpt. Gestures undone are not in it. `Err`
+    /// [`clay::replay`], it makes this sculpt. Gestures undone are not in it. `Err`
     /// says why there is none (a sculpt opened from a session).
     pub fn gesture_script(&self) -> Result<Script, String> {
         self.record.script()

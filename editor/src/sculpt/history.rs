@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
+use clay::Assembly;
 use clay_dsl::compiled::CompiledGrammar;
 
 use super::{LogEntry, Recording, Sculpt, Snapshot};
@@ -106,7 +106,7 @@ impl Sculpt {
         self.record = s.record;
         self.assembly = Assembly::from_data(s.grammar, s.data);
         for pin in s.pins {
-            clay::session::pin_at(&mut self.assembly, pin.vertices, &pin.at);
+            clay::pin_at(&mut self.assembly, pin.vertices, &pin.at);
         }
         // A fresh solver: the old one's pattern belongs to another topology. The spare copy
         // belongs to it too (and a restored model counts its generations from 0 again).

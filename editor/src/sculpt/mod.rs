@@ -4,9 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::assembly::Assembly;
-use clay::session::{Grab, Session};
-use clay::solver::{FrameReport, SolverConfig};
+use clay::{Assembly, FrameReport, Grab, Session, SolverConfig};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use glam::DVec2;
 
@@ -78,7 +76,7 @@ struct Snapshot {
 }
 
 /// Why a part is in the state it is in: the session's report
-/// ([`clay::session::PartReport`]) with the names the inspector shows.
+/// ([`clay::PartReport`]) with the names the inspector shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartReport {
     /// `tower`, or `wall` for a stretch part.
@@ -87,7 +85,7 @@ pub struct PartReport {
     pub covers: String,
     pub pinned: bool,
     /// What the solver's state choice compares, from the session.
-    pub why: clay::session::PartReport,
+    pub why: clay::PartReport,
 }
 
 /// The live sculpt.

@@ -1,7 +1,7 @@
 //! The gestures recorded as a script (File > Save gestures as script): since the grammar's
 //! initial model (opened, reset or rebuilt by a reload), every grab, move and turn of the
 //! grab, release, pin, unpin and cut, and the solver frames run between them, as steps of
-//! `clay::script`. `clayc run GRAMMAR --script FILE` (or `clay::session::replay` on the
+//! `clay::Script`. `clayc run GRAMMAR --script FILE` (or `clay::replay` on the
 //! grammar's initial model) then does what the editor did: the same steps through the same
 //! gesture functions, one solver frame per frame the editor ran.
 //!
@@ -13,11 +13,11 @@
 
 use std::sync::Arc;
 
-use clay::script::{Motion, Script, Selector, Step};
+use clay::{Motion, Script, Selector, Step};
 use glam::DVec2;
 
 /// Most frames one `hold` step may ask for; longer waits are split.
-const MAX_HOLD: u64 = clay::script::MAX_FRAMES;
+const MAX_HOLD: u64 = clay::MAX_FRAMES;
 
 /// Steps kept unshared at most: more are frozen into a chunk the copies share.
 const CHUNK: usize = 256;

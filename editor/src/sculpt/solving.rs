@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use clay::session::Session;
+use clay::Session;
 
 use super::Sculpt;
 use super::frame::{FrameOutcome, Request, run_request, solve_frame};
