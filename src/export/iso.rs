@@ -52,6 +52,19 @@ pub fn iso_pixmap(scene: &Scene, width: u32, height: u32) -> Result<Pixmap, Rend
     let mut pixmap = Pixmap::new(width, height).ok_or(err)?;
     let [r, g, b, a] = BACKGROUND.0;
     pixmap.fill(tiny_skia::Color::from_rgba8(r, g, b, a));
+    let mut faces = lit_faces(scene);
+    if faces.is_empty() {
+        return Ok(pixmap);
+    }
+    let screen = ScreenFit::new(&faces, width, height);
+    // Far faces first; ties keep the scene's order, so the picture is deterministic.
+    faces.sort_by(|a, b| b.depth.total_cmp(&a.depth));
+    paint_faces(&mut pixmap, &faces, &screen);
+    Ok(pixmap)
+}
+
+/// Every triangle of the scene that faces the viewer, projected and shaded by the light.
+fn lit_faces(scene: &Scene) -> Vec<Face> {
     let light_len = dot(LIGHT, LIGHT).sqrt();
     let mut faces = Vec::new();
     for node in &scene.nodes {
@@ -93,29 +106,46 @@ pub fn iso_pixmap(scene: &Scene, width: u32, height: u32) -> Result<Pixmap, Rend
             }
         }
     }
-    if faces.is_empty() {
-        return Ok(pixmap);
-    }
-    // Fit the projected faces into the picture with a margin, y pointing down on screen.
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for c in faces.iter().flat_map(|f| f.corners) {
-        for k in 0..2 {
-            lo[k] = lo[k].min(c[k]);
-            hi[k] = hi[k].max(c[k]);
+    faces
+}
+
+/// The projected faces fitted into the picture with a margin, y pointing down on screen.
+struct ScreenFit {
+    centre: [f64; 2],
+    scale: f64,
+    size: [f64; 2],
+}
+
+impl ScreenFit {
+    fn new(faces: &[Face], width: u32, height: u32) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for c in faces.iter().flat_map(|f| f.corners) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        let margin = 24.0;
+        let scale = ((width as f64 - 2.0 * margin) / (hi[0] - lo[0]).max(1e-9))
+            .min((height as f64 - 2.0 * margin) / (hi[1] - lo[1]).max(1e-9));
+        Self {
+            centre: [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0],
+            scale,
+            size: [width as f64, height as f64],
         }
     }
-    let margin = 24.0;
-    let scale = ((width as f64 - 2.0 * margin) / (hi[0] - lo[0]).max(1e-9))
-        .min((height as f64 - 2.0 * margin) / (hi[1] - lo[1]).max(1e-9));
-    let (cx, cy) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
-    let screen = |c: [f64; 2]| {
+
+    /// A projected point in pixels.
+    fn place(&self, c: [f64; 2]) -> (f32, f32) {
         (
-            (width as f64 / 2.0 + (c[0] - cx) * scale) as f32,
-            (height as f64 / 2.0 - (c[1] - cy) * scale) as f32,
+            (self.size[0] / 2.0 + (c[0] - self.centre[0]) * self.scale) as f32,
+            (self.size[1] / 2.0 - (c[1] - self.centre[1]) * self.scale) as f32,
         )
-    };
-    // Far faces first; ties keep the scene's order, so the picture is deterministic.
-    faces.sort_by(|a, b| b.depth.total_cmp(&a.depth));
+    }
+}
+
+/// Fills each face in order, with a hairline of its colour over its seams.
+fn paint_faces(pixmap: &mut Pixmap, faces: &[Face], screen: &ScreenFit) {
     let mut paint = Paint {
         anti_alias: true,
         ..Paint::default()
@@ -125,12 +155,12 @@ pub fn iso_pixmap(scene: &Scene, width: u32, height: u32) -> Result<Pixmap, Rend
         line_join: tiny_skia::LineJoin::Round,
         ..tiny_skia::Stroke::default()
     };
-    for f in &faces {
+    for f in faces {
         let mut pb = PathBuilder::new();
-        let (x, y) = screen(f.corners[0]);
+        let (x, y) = screen.place(f.corners[0]);
         pb.move_to(x, y);
         for c in &f.corners[1..] {
-            let (x, y) = screen(*c);
+            let (x, y) = screen.place(*c);
             pb.line_to(x, y);
         }
         pb.close();
@@ -148,5 +178,4 @@ pub fn iso_pixmap(scene: &Scene, width: u32, height: u32) -> Result<Pixmap, Rend
         // one face (they would show the background through as light lines).
         pixmap.stroke_path(&path, &paint, &seam, Transform::identity(), None);
     }
-    Ok(pixmap)
 }
