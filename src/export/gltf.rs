@@ -152,6 +152,29 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
             ..Default::default()
         },
     };
+    push_materials(&mut b, scene);
+    let meshes = push_meshes(&mut b, scene);
+    let children = push_nodes(&mut b, scene, &meshes);
+    let root = b.root.push(json::Node {
+        name: Some(scene.name.clone()),
+        children: (!children.is_empty()).then_some(children),
+        ..Default::default()
+    });
+    let scene_index = b.root.push(json::Scene {
+        extensions: None,
+        extras: Default::default(),
+        name: Some(scene.name.clone()),
+        nodes: vec![root],
+    });
+    b.root.scene = Some(scene_index);
+    while !b.bytes.len().is_multiple_of(4) {
+        b.bytes.push(0);
+    }
+    (b.root, b.bytes)
+}
+
+/// A material per fill colour: its linear base colour, blended when not opaque.
+fn push_materials(b: &mut Buffers, scene: &Scene) {
     for (i, c) in scene.materials.iter().enumerate() {
         let [r, g, bl, a] = c.0;
         b.root.push(json::Material {
@@ -175,6 +198,11 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
             ..Default::default()
         });
     }
+}
+
+/// The scene's meshes, their accessors written into the buffer; `None` for a mesh without
+/// triangles (or whose node is missing).
+fn push_meshes(b: &mut Buffers, scene: &Scene) -> Vec<Option<json::Index<json::Mesh>>> {
     // Each mesh once, where its first node is.
     let mut meshes = Vec::with_capacity(scene.meshes.len());
     for mesh in &scene.meshes {
@@ -212,6 +240,15 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
             })
         }));
     }
+    meshes
+}
+
+/// A node per instance at its pivot, turned as it is, with its mesh and its extras.
+fn push_nodes(
+    b: &mut Buffers,
+    scene: &Scene,
+    meshes: &[Option<json::Index<json::Mesh>>],
+) -> Vec<json::Index<json::Node>> {
     let mut children = Vec::with_capacity(scene.nodes.len());
     for node in &scene.nodes {
         let mut extra = serde_json::json!({
@@ -241,22 +278,7 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
             }),
         );
     }
-    let root = b.root.push(json::Node {
-        name: Some(scene.name.clone()),
-        children: (!children.is_empty()).then_some(children),
-        ..Default::default()
-    });
-    let scene_index = b.root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: Some(scene.name.clone()),
-        nodes: vec![root],
-    });
-    b.root.scene = Some(scene_index);
-    while !b.bytes.len().is_multiple_of(4) {
-        b.bytes.push(0);
-    }
-    (b.root, b.bytes)
+    children
 }
 
 fn buffer(len: usize, uri: Option<String>) -> json::Buffer {
