@@ -46,12 +46,16 @@ pub const DOCKED_TWICE: &str = "E034";
 pub const SELF_DOCK: &str = "E035";
 /// A stretch piece (or axis) without two opposite sites.
 pub const NOT_OPPOSITE: &str = "E040";
-/// A stretch variant whose vertices, edges or sites differ from the rule's piece.
+/// A stretch variant whose vertices (names or places), edges or sites (names, types,
+/// vertices, directions) differ from the rule's piece.
 pub const VARIANT_SHAPE: &str = "E041";
 /// Variant frequencies that do not sum to 1.
 pub const FREQUENCIES: &str = "E042";
 /// A merge junction (or cut target) that lacks sites it must take over.
 pub const JUNCTION_SITES: &str = "E043";
+/// A merge junction (or cut piece) whose shared sites do not sit where the piece it replaces
+/// has them.
+pub const NOT_IN_PLACE: &str = "E044";
 /// A piece named by two stretch rules.
 pub const TWO_STRETCH: &str = "E045";
 /// A chain with no `along` whose piece has no stretch rule.

@@ -370,7 +370,9 @@ impl Compiler {
         } else {
             None
         };
-        let Some(problem) = problem else { return true };
+        let Some(problem) = problem else {
+            return self.same_geometry(pi, vi, span);
+        };
         let (pname, vname) = (p.name.clone(), v.name.clone());
         let def = self.piece_spans[vi].name;
         self.error(
@@ -554,6 +556,9 @@ impl Compiler {
                     );
                     return;
                 }
+                if !self.fits_in_place(target.piece, j.piece, None, jpath.piece.span) {
+                    return;
+                }
                 Some(j)
             }
         };
@@ -631,6 +636,9 @@ impl Compiler {
             );
             return;
         }
+        if !self.fits_in_place(junction.piece, into, Some(junction.site), c.into.span) {
+            return;
+        }
         self.cut_index.insert(junction, self.cut_rules.len());
         self.cut_rules.push(CutRule {
             junction,
@@ -639,6 +647,106 @@ impl Compiler {
         });
         self.cut_spans.push(c.span);
     }
+}
+
+impl Compiler {
+    /// A piece that takes another's place (a merge's junction, a cut's piece) is laid where
+    /// the other was by the best rigid fit of the sites they share by name, and takes over
+    /// their connections: unless those sites sit (in their rest states) as the other's do, the
+    /// pieces docked to them could never rest (E044). `except`: a site of `old` not taken over
+    /// (the cut one). Reports the site that sits furthest off, at `span` (where the rule
+    /// names the piece).
+    fn fits_in_place(&mut self, old: usize, new: usize, except: Option<usize>, span: Span) -> bool {
+        let (op, np) = (&self.pieces[old], &self.pieces[new]);
+        let (Some(os), Some(ns)) = (op.states.first(), np.states.first()) else {
+            return true;
+        };
+        let mut pairs = Vec::new();
+        for (k, s) in op.sites.iter().enumerate().filter(|(k, _)| Some(*k) != except) {
+            let Some(t) = np.sites.iter().find(|t| t.name == s.name) else { continue };
+            if t.vertices.len() != s.vertices.len() {
+                let problem = format!("site `{}` has {} vertices in `{}` and {} in `{}`", s.name, t.vertices.len(), np.name, s.vertices.len(), op.name);
+                let hint = format!("`{}` takes the place of `{}` and its connections by site name: the sites must have the same vertices", np.name, op.name);
+                self.error(Diagnostic::error(codes::NOT_IN_PLACE, format!("`{}` does not fit where `{}` is", np.name, op.name), span, problem).with_hint(hint));
+                return false;
+            }
+            for (&a, &b) in s.vertices.iter().zip(&t.vertices) {
+                pairs.push((k, os.positions[a], ns.positions[b]));
+            }
+        }
+        if pairs.len() < 2 {
+            return true;
+        }
+        let from: Vec<DVec2> = pairs.iter().map(|p| p.2).collect();
+        let to: Vec<DVec2> = pairs.iter().map(|p| p.1).collect();
+        let moved = rigid_fit(&from, &to);
+        let Some((k, off)) = (pairs.iter().zip(&moved))
+            .map(|(p, &m)| (p.0, m.distance(p.1)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|(_, off)| *off > DOCK_TOLERANCE)
+        else {
+            return true;
+        };
+        let (on, nn, site) = (op.name.clone(), np.name.clone(), op.sites[k].name.clone());
+        self.error(
+            Diagnostic::error(codes::NOT_IN_PLACE, format!("`{nn}` does not fit where `{on}` is"), span, format!("laid over `{on}` by their shared sites, its site `{site}` is {} m from where `{on}` has it", fmt(off)))
+                .with_secondary(self.piece_spans[new].name, format!("`{nn}` declared here"))
+                .with_hint(format!("`{nn}` takes the place of `{on}` and the connections of its sites: put those sites where `{on}` has them, relative to each other")),
+        );
+        false
+    }
+
+    /// A variant that names its piece's vertices, edges and sites must also put them where
+    /// the piece has them (its rest state) and face its sites the same way: the chain's
+    /// two-element parts are built from the rule's piece, so a variant of another shape
+    /// would be held in the piece's shape, never its own (E041). Reports the first vertex or
+    /// site that differs, at its declaration.
+    fn same_geometry(&mut self, pi: usize, vi: usize, span: Span) -> bool {
+        let (p, v) = (&self.pieces[pi], &self.pieces[vi]);
+        let (Some(ps), Some(vs)) = (p.states.first(), v.states.first()) else {
+            return true;
+        };
+        let fmt_point = |q: DVec2| format!("({}, {})", fmt(q.x), fmt(q.y));
+        let moved = (ps.positions.iter().zip(&vs.positions).enumerate())
+            .find(|(_, (a, b))| a.distance(**b) > DOCK_TOLERANCE);
+        let (problem, at) = if let Some((k, (a, b))) = moved {
+            (
+                format!("vertex `{}` is at {}, where `{}` has it at {}", v.vertices[k], fmt_point(*b), p.name, fmt_point(*a)),
+                self.piece_spans[vi].vertices.get(k).copied(),
+            )
+        } else if let Some((k, (a, b))) = (p.sites.iter().zip(&v.sites).enumerate())
+            .find(|(_, (a, b))| a.out.normalize_or_zero().distance(b.out.normalize_or_zero()) > 1e-6)
+        {
+            (
+                format!("site `{}` faces {}, where `{}`'s faces {}", b.name, fmt_point(b.out.normalize_or_zero()), p.name, fmt_point(a.out.normalize_or_zero())),
+                self.piece_spans[vi].sites.get(k).copied(),
+            )
+        } else {
+            return true;
+        };
+        let (pname, vname) = (p.name.clone(), v.name.clone());
+        let primary = at.unwrap_or(span);
+        self.error(
+            Diagnostic::error(codes::VARIANT_SHAPE, format!("variant `{vname}` does not have the shape of `{pname}`"), primary, problem)
+                .with_secondary(span, format!("`{vname}` is a variant of `{pname}` here"))
+                .with_hint(format!("a chain is solved in `{pname}`'s shape, so its variants may differ only in proxy geometry: put the vertices where `{pname}` has them, or make `{vname}` a chain of its own")),
+        );
+        false
+    }
+}
+
+/// `from` moved by the rigid motion that best takes it onto `to` (2D Procrustes).
+fn rigid_fit(from: &[DVec2], to: &[DVec2]) -> Vec<DVec2> {
+    let n = from.len().max(1) as f64;
+    let (cf, ct) = (from.iter().sum::<DVec2>() / n, to.iter().sum::<DVec2>() / n);
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for (&a, &b) in from.iter().zip(to) {
+        let (p, q) = (a - cf, b - ct);
+        dot += p.dot(q);
+        cross += p.perp_dot(q);
+    }
+    let r = DVec2::new(dot, cross).normalize_or(DVec2::X);
+    from.iter().map(|&a| ct + r.rotate(a - cf)).collect()
 }
 
 fn or_none(v: &[String]) -> String {
