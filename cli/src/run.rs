@@ -19,6 +19,10 @@ pub struct RunArgs {
     /// Print one JSON summary object instead of the human summary.
     #[arg(long)]
     pub json: bool,
+    /// Also print the rule log: every rule that fired, its frame and why (with --json, as
+    /// the summary's "log" array).
+    #[arg(long)]
+    pub log: bool,
     /// Override a solver parameter: hysteresis, norm, irls_epsilon, merge_distance,
     /// irls_iterations, l2_iterations, l2_anderson, handle_weight, solver (cholesky|cg).
     #[arg(long = "set", value_name = "NAME=VALUE")]
@@ -131,8 +135,18 @@ pub fn run(args: RunArgs) -> u8 {
     for note in session.notes() {
         errln!("note: {note}");
     }
+    let log = args.log.then(|| session.rule_log());
     let text = if args.json {
-        match serde_json::to_string_pretty(&summary) {
+        let value = serde_json::to_value(&summary).map(|mut v| {
+            if let (Some(log), Some(map)) = (log, v.as_object_mut()) {
+                let events = log.iter().map(|e| {
+                    serde_json::json!({"frame": e.frame, "kind": e.kind.name(), "detail": e.detail})
+                });
+                map.insert("log".into(), events.collect());
+            }
+            v
+        });
+        match value.and_then(|v| serde_json::to_string_pretty(&v)) {
             Ok(s) => s + "\n",
             Err(e) => {
                 errln!("error: cannot write the summary: {e}");
@@ -140,7 +154,11 @@ pub fn run(args: RunArgs) -> u8 {
             }
         }
     } else {
-        summary.human()
+        let lines = log
+            .unwrap_or_default()
+            .iter()
+            .map(|e| format!("frame {}: {}: {}\n", e.frame, e.kind.name(), e.detail));
+        lines.collect::<String>() + &summary.human()
     };
     out::stdout(text.as_bytes())
         .err()
