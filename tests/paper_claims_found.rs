@@ -110,9 +110,11 @@ fn a_far_chain_changes_nothing_of_a_buckled_one() {
 }
 
 /// The limit of the squeeze rule the cases above brought: a wall (`min 8`) pinned with its ends
-/// pushed 2 m together, then pulled out 4 m in the middle, grows to the ten bricks the V
-/// through its ends and the grab spans (it kept its 8 at strain 1.3: the chain's ends were
-/// still closer than at rest, and that alone made growing unavailable).
+/// pushed 2 m together, then pulled out 4 m in the middle, grows (it kept its 8 at strain 1.3:
+/// the chain's ends were still closer than at rest, and that alone made growing unavailable).
+/// No count rests there (the three held bricks are level, so the wall bends at each); the V
+/// through its ends and the grab spans ten bricks, and held, the relaxation (`docs/solver.md`)
+/// finds that eleven rest better: energy 14.5 against 20.0 with ten.
 #[test]
 fn a_squeezed_wall_pulled_out_in_the_middle_grows() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/grammars/wall.clay");
@@ -130,7 +132,7 @@ fn a_squeezed_wall_pulled_out_in_the_middle_grows() {
         .step(&step::grab_at(DVec2::new(3.0, 0.25)))
         .step(&step::drag(DVec2::new(0.0, 4.0), 30))
         .step(&step::hold(60));
-    assert_eq!(run.count("brick"), 10, "{}", run.repro());
+    assert_eq!(run.count("brick"), 11, "{}", run.repro());
 }
 
 /// Far pieces change nothing (issue 36): 13 bricks of 0.3 m pushed to 0.42x have 5 alone and

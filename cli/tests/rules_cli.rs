@@ -129,3 +129,59 @@ fn clayc_run_paper_fig8_holds_for_slow_drags_too() {
         assert_eq!(dense, 8, "{frames} frames: p = 2 inserted a brick");
     }
 }
+
+fn castle_clay() -> PathBuf {
+    PathBuf::from(format!(
+        "{}/../grammars/castle.clay",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+}
+
+/// Issue 46's hero case: the castle, its south-west tower pinned and the north-east one
+/// dragged out by (6, 4) and (-3, -2) over 120 frames and held, is a rectangle of rest walls
+/// 1.5x and 0.75x its size (south 7 + gate + 7 and east 10 at 1.5x; 5 + gate and 4 at
+/// 0.75x): it grows or drops walls to fill it, at rest, rather than shearing. With `--log`,
+/// the JSON summary lists every rule that fired, each with its frame and why.
+#[test]
+fn clayc_run_castle_scaled_by_two_towers_grows_walls_at_rest() {
+    for (by, walls) in [((6.0, 4.0), 50), ((-3.0, -2.0), 20)] {
+        let script = temp(
+            "castle.json",
+            &format!(
+                r#"{{"steps": [{{"pin": {{"at": [0, 0]}}}}, {{"grab": {{"at": [12, 8]}}}},
+                    {{"drag": {{"by": [{}, {}], "frames": 120}}}}, {{"hold": {{"frames": 120}}}}]}}"#,
+                by.0, by.1
+            ),
+        );
+        let out = Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .arg("run")
+            .arg(castle_clay())
+            .arg("--script")
+            .arg(&script)
+            .args(["--json", "--log"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let (n, energy) = (
+            v["pieces"]["wall"].as_u64().unwrap(),
+            v["energy"].as_f64().unwrap(),
+        );
+        assert_eq!(n, walls, "dragged by {by:?}: {n} walls, energy {energy}");
+        assert!(energy <= 1e-9, "dragged by {by:?}: energy {energy}");
+        let log = v["log"].as_array().unwrap();
+        let fired: u64 = v["rules_fired"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|x| x.as_u64().unwrap())
+            .sum();
+        assert_eq!(log.len() as u64, fired);
+        assert!(log.iter().all(|e| e["frame"].as_u64().is_some()
+            && e["detail"].as_str().is_some_and(|d| !d.is_empty())));
+    }
+}

@@ -31,7 +31,7 @@ use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
 use crate::assembly::Assembly;
-use crate::solver::FrameReport;
+use crate::solver::{FrameReport, Proposal, StateSwitch};
 
 /// Runs the rules on a live assembly after each solver frame, and the cut operation.
 #[derive(Clone, Debug, Default)]
@@ -155,6 +155,52 @@ impl Rules {
             self.carry(asm, &r);
             events.push(r.event);
         }
+        self.stamp(&grammar, asm, events)
+    }
+
+    /// Applies what the solver's relaxation proposed (a held model that stopped strained,
+    /// `docs/solver.md`): the piece parts' states (replacement), then each chain's count (a
+    /// stretch, at most doubling the chain a rewrite, or a shrink at the proposed part), laid
+    /// out from `asm`'s positions. The events are not logged: the session keeps the result
+    /// only if the model rests better with it ([`Rules::record`]).
+    pub(crate) fn restructure(&self, asm: &mut Assembly, proposal: &Proposal) -> Vec<RuleEvent> {
+        let grammar = asm.grammar_arc().clone();
+        let held: HashSet<u64> = asm
+            .handles()
+            .iter()
+            .filter_map(|h| h.held.as_ref().map(|x| x.id))
+            .collect();
+        let parts = &mut asm.data_mut().parts;
+        let switches: Vec<StateSwitch> = (proposal.states.iter())
+            .filter_map(|&(part, to)| {
+                let p = parts.get_mut(part)?;
+                let from = std::mem::replace(&mut p.active, to);
+                Some(StateSwitch { part, from, to })
+            })
+            .collect();
+        let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches);
+        for &(chain, first, count) in &proposal.counts {
+            while let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) {
+                let r = if count > n {
+                    stretch::stretch(&grammar, asm.data_mut(), chain, first, 2 + count - n)
+                } else if count < n {
+                    let elements = 2 - (n - count) as i64;
+                    stretch::shrink(&grammar, asm.data_mut(), chain, first, elements, &held)
+                } else {
+                    break;
+                };
+                let Ok(r) = r else { break };
+                self.carry(asm, &r);
+                events.push(r.event);
+            }
+        }
+        events
+    }
+
+    /// Counts the frame's `events` made outside [`Rules::after_pass1`] and
+    /// [`Rules::after_pass2`] ([`Rules::restructure`]'s, kept): stamped and logged.
+    pub(crate) fn record(&mut self, asm: &Assembly, events: Vec<RuleEvent>) -> Vec<RuleEvent> {
+        let grammar = asm.grammar_arc().clone();
         self.stamp(&grammar, asm, events)
     }
 

@@ -202,12 +202,89 @@ impl Session {
         if let Some(rules) = &mut self.rules {
             events.extend(rules.after_pass2(asm));
         }
+        let proposals = self.solver.take_proposals(asm);
+        if !proposals.is_empty() {
+            events.extend(self.try_proposals(asm, report.energy, &proposals, deadline));
+        }
         for e in &events {
             *self.rules_fired.entry(e.kind).or_default() += 1;
         }
         self.frame_ms.push(start.elapsed().as_secs_f64() * 1e3);
         self.last_report = Some(report.clone());
         Ok(Frame { report, events })
+    }
+
+    /// Tries what the solver's relaxation proposed (`relax.rs`: a held model that stopped
+    /// strained, `docs/solver.md`), each alternative on a copy of `asm`: the rules
+    /// restructure it, it settles by least squares with its states fixed, and the one with
+    /// the lowest energy replaces `asm` when that is below `(1 - hysteresis)` times the energy
+    /// of `asm` as it is, settled the same way (or `energy`, the frame's, if lower: paper 4.2,
+    /// 4.3: the structure changes where a rest state fits better, judged by energy).
+    /// Alternatives are tried while the frame's `deadline` allows. Returns the events kept.
+    fn try_proposals(
+        &mut self,
+        asm: &mut Assembly,
+        energy: f64,
+        proposals: &[crate::solver::Proposal],
+        deadline: Option<Instant>,
+    ) -> Vec<RuleEvent> {
+        let Some(rules) = &mut self.rules else {
+            return Vec::new();
+        };
+        let config = self.solver.config;
+        let settle = SolverConfig {
+            irls_iterations: 0,
+            l2_iterations: SETTLE_ITERATIONS,
+            ..config
+        };
+        let remaining = || match deadline {
+            Some(d) => d.checked_duration_since(Instant::now()),
+            None => Some(Duration::MAX),
+        };
+        // the model as it is, settled as the alternatives are: what they must beat
+        let mut current = asm.clone();
+        let Some(Ok(report)) =
+            remaining().map(|b| Solver::new(settle).frame_budgeted(&mut current, b))
+        else {
+            return Vec::new();
+        };
+        let energy = report.energy.min(energy);
+        let mut best: Option<(f64, Assembly, Vec<RuleEvent>)> = None;
+        for proposal in proposals {
+            if proposal.pose.len() != asm.data().positions.len() {
+                continue;
+            }
+            let mut trial = asm.clone();
+            trial.positions_mut().copy_from_slice(&proposal.pose);
+            let events = rules.restructure(&mut trial, proposal);
+            if events.is_empty() {
+                continue;
+            }
+            let Some(budget) = remaining() else { break };
+            let Ok(report) = Solver::new(settle).frame_budgeted(&mut trial, budget) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|b| report.energy < b.0) {
+                best = Some((report.energy, trial, events));
+            }
+        }
+        let Some((after, trial, mut events)) = best else {
+            return Vec::new();
+        };
+        let better = after < (1.0 - config.hysteresis) * energy;
+        if !better {
+            return Vec::new();
+        }
+        for e in &mut events {
+            e.detail = format!(
+                "{}: the model rests better so (energy {} -> {})",
+                e.detail,
+                crate::summary::figure(energy, 3),
+                crate::summary::figure(after, 3)
+            );
+        }
+        *asm = trial;
+        rules.record(asm, events)
     }
 
     /// Grabs `instance` ([`Grab::instance`]: its pin, if any, gives way and comes back where
@@ -317,6 +394,10 @@ impl Session {
         )
     }
 }
+
+/// Least-squares iterations that settle a restructured model before it is judged
+/// ([`Session::try_proposals`]).
+const SETTLE_ITERATIONS: usize = 200;
 
 /// A frame failed to solve during replay.
 #[derive(Clone, Debug, PartialEq)]

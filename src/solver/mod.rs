@@ -28,6 +28,7 @@ pub(crate) mod local;
 mod measure;
 mod pass1;
 mod pass2;
+mod relax;
 mod report;
 mod rest_cache;
 mod state;
@@ -39,7 +40,7 @@ pub use follow::Components;
 pub use measure::{
     bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
 };
-pub use report::{FrameReport, PhaseTimes, SolverError, StateSwitch};
+pub use report::{FrameReport, PhaseTimes, Proposal, SolverError, StateSwitch};
 pub use state::Solver;
 
 use std::time::{Duration, Instant};
@@ -85,6 +86,15 @@ impl Solver {
             shared: Some(shared),
         };
         Some(local::judge(part, p, &data.positions, how))
+    }
+
+    /// What the last frame's relaxation proposed (`relax.rs`: alternatives), when made for
+    /// `asm`'s structure; taken by the session, which tries them with the rules.
+    pub(crate) fn take_proposals(&mut self, asm: &Assembly) -> Vec<Proposal> {
+        match self.proposals.take() {
+            Some((generation, p)) if generation == asm.generation() => p,
+            _ => Vec::new(),
+        }
     }
 
     /// Number of stored entries of the normal matrix's lower triangle (after the first frame).

@@ -213,7 +213,7 @@ impl Terms {
 }
 
 /// The handle term of the pass-2 objective at `f`.
-fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
+pub(super) fn handle_term(handles: &[Handle], f: &[DVec2], handle_weight: f64) -> f64 {
     let mut handle = 0.0;
     for h in handles {
         for (k, &v) in h.vertices.iter().enumerate() {

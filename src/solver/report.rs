@@ -1,5 +1,7 @@
 //! What one solver frame reports: iterations, energies, state switches, convergence and the
-//! time spent per phase; and the solver's error.
+//! time spent per phase; what its relaxation proposes; and the solver's error.
+
+use glam::DVec2;
 
 /// A part's active rest state changed during a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,6 +72,26 @@ pub struct PhaseTimes {
     /// The rest of the frame: handle targets, the warm start and rigid following, free
     /// components' centroids, the displayed pose's copies.
     pub bookkeeping: f64,
+}
+
+/// What the relaxation proposes: per chain whose relaxed length calls for another count, the
+/// count and the part where the chain changes; per piece part whose relaxed bend is nearer
+/// another rest state, that state; and the relaxed pose, where the rules lay the change out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Proposal {
+    pub pose: Vec<DVec2>,
+    /// `(chain, first, count)`: the chain gets `count` elements, changed at its stretch part
+    /// over elements `first` and `first + 1`.
+    pub counts: Vec<(usize, usize, usize)>,
+    /// `(part, state)`.
+    pub states: Vec<(usize, usize)>,
+}
+
+impl Proposal {
+    /// Whether it changes nothing.
+    pub fn is_empty(&self) -> bool {
+        self.counts.is_empty() && self.states.is_empty()
+    }
 }
 
 /// Why a frame could not be solved (left the positions unchanged).

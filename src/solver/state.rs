@@ -49,6 +49,8 @@ pub struct Solver {
     pub(super) factor_slot: Vec<usize>,
     /// The least-squares right-hand side and solution, `(x, y)` per row in factor order.
     pub(super) ordered: Vec<[f64; 2]>,
+    /// The last relaxation's proposals and the generation they were made for (`relax.rs`).
+    pub(super) proposals: Option<(u64, Vec<super::report::Proposal>)>,
 }
 
 impl Solver {
@@ -68,6 +70,7 @@ impl Solver {
             anderson: anderson::Anderson::default(),
             factor_slot: Vec::new(),
             ordered: Vec::new(),
+            proposals: None,
         }
     }
 

@@ -33,11 +33,18 @@ impl Solver {
     ) -> Result<(), SolverError> {
         let settling = self.settling(report, asm.handles().is_empty());
         self.work.last_targets.clone_from(&self.work.handle_sum);
+        self.proposals = None;
         if settling && !out_of_time(deadline, Duration::ZERO) {
             let handles = asm.handles().to_vec();
             let parts = &mut asm.data_mut().parts;
             if let Some(laid) = self.try_states(parts, &handles, warm, report)? {
                 warm.copy_from_slice(&laid);
+            }
+            // nothing the states could do: what the relaxed model proposes (`relax.rs`); not
+            // with least squares, whose structure follows the drag alone (paper Fig. 8)
+            if self.work.tried && self.config.norm < 2.0 && !out_of_time(deadline, Duration::ZERO) {
+                let generation = asm.generation();
+                self.proposals = Some((generation, self.relax(asm, warm, deadline)?));
             }
         }
         Ok(())
