@@ -120,7 +120,7 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             to: 2,
         },
     ];
-    let events = replace::replacement_events(&g, &mut d, &switches);
+    let events = replace::replacement_events(&g, &mut d, &switches, &[]);
     assert_eq!(events.len(), 1);
     assert_eq!(events[0].kind, RuleKind::Replace);
     assert_eq!(events[0].instances, vec![d.instances[instance].id]);
@@ -144,7 +144,7 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             to: 2,
         },
     ];
-    assert!(replace::replacement_events(&g, &mut d, &back).is_empty());
+    assert!(replace::replacement_events(&g, &mut d, &back, &[]).is_empty());
     d.check(&g).unwrap();
 }
 

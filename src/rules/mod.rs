@@ -92,7 +92,8 @@ impl Rules {
     ) -> Vec<RuleEvent> {
         self.frame += 1;
         let grammar = asm.grammar_arc().clone();
-        let mut events = replace::replacement_events(&grammar, asm.data_mut(), &report.switches);
+        let mut events =
+            replace::replacement_events(&grammar, asm.data_mut(), &report.switches, pass1);
         let mut rewrites = Vec::new();
         let held: HashSet<u64> = asm
             .handles()
@@ -178,7 +179,7 @@ impl Rules {
                 Some(StateSwitch { part, from, to })
             })
             .collect();
-        let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches);
+        let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches, &[]);
         for &(chain, first, count) in &proposal.counts {
             while let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) {
                 let r = if count > n {

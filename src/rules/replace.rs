@@ -9,16 +9,19 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
 use super::rewrite::{RuleEvent, RuleKind};
-use crate::fit::align;
 use crate::solver::StateSwitch;
+use crate::solver::local::{Switching, VertexParts, judge};
 
 /// Sets each piece part's instance to the part's active state and returns one event per
 /// instance that ends the frame in a different state than it started. `switches` are the
-/// solver's state switches of the frame (several per part are possible within one frame).
+/// solver's state switches of the frame (several per part are possible within one frame);
+/// `decided` is the pose that decided them (pass 1's; the positions when empty), where the
+/// event says how much nearer the new state is, as the solver judged it.
 pub fn replacement_events(
     grammar: &CompiledGrammar,
     data: &mut AssemblyData,
     switches: &[StateSwitch],
+    decided: &[DVec2],
 ) -> Vec<RuleEvent> {
     // First `from` per part: the state it had when the frame began.
     let mut began: BTreeMap<usize, usize> = BTreeMap::new();
@@ -26,6 +29,12 @@ pub fn replacement_events(
         began.entry(s.part).or_insert(s.from);
     }
     let mut events = Vec::new();
+    let pose = if decided.len() == data.positions.len() {
+        decided
+    } else {
+        &data.positions[..]
+    };
+    let shared = (!began.is_empty()).then(|| VertexParts::build(&data.parts, pose.len()));
     for (&pi, &from) in &began {
         let Some(part) = data.parts.get(pi) else {
             continue;
@@ -45,13 +54,16 @@ pub fn replacement_events(
         let name = |s: usize| piece.states.get(s).map_or("?", |st| st.name.as_str());
         let at = centroid(&data.positions, &data.instances[instance].vertices);
         let inst = &data.instances[instance];
-        // How much better the new state fits the pose than the old one (the hysteresis makes
-        // this at least its share), so the log can say why.
-        let misfit = |s: usize| {
-            part.states.get(s).map_or(f64::NAN, |st| {
-                align(&st.positions, &part.vertices, &data.positions).distance
-            })
+        // How much nearer the new state is than the old one, as the solver's local step
+        // judged them in the pose that decided (the hysteresis makes this at least its
+        // share; a state changed for energy, by a trial, may be less), so the log says why.
+        let how = Switching {
+            hysteresis: 0.0,
+            stretch: &[],
+            shared: shared.as_ref(),
         };
+        let judged = judge(pi, part, pose, how);
+        let misfit = |s: usize| judged.distances.get(s).copied().unwrap_or(f64::NAN);
         let better = 1.0 - misfit(to) / misfit(from);
         let why = if better.is_finite() {
             format!(", {:.0}% closer to its shape", 100.0 * better)
