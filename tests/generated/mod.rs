@@ -12,6 +12,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::sync::Arc;
 
+pub mod assembly;
+
 use clay::{Assembly, RuleKind, Script, SolverConfig, bbox, bbox_diagonal, edge_strains};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
@@ -271,6 +273,15 @@ impl Run {
 
     pub fn count(&self, piece: &str) -> usize {
         self.states(piece).len()
+    }
+
+    /// The elements of the chain whose instances are named `stem[k]` or `stem#id` (a chain
+    /// of the model and the elements rules put in after its elements).
+    pub fn chain_count(&self, stem: &str) -> usize {
+        let of = |name: &str| name.split(['[', '#']).next() == Some(stem);
+        (self.asm.data().instances.iter())
+            .filter(|i| of(&i.name))
+            .count()
     }
 
     pub fn instances(&self) -> usize {
