@@ -31,6 +31,7 @@ mod pass2;
 mod relax;
 mod report;
 mod rest_cache;
+mod rounding;
 mod state;
 mod trials;
 mod units;

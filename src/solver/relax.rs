@@ -23,6 +23,7 @@ use super::global_step::Pass;
 use super::local::{self, StretchEnds};
 use super::pass2::handle_term;
 use super::report::{FrameReport, Proposal, SolverError};
+use super::rounding::{Relaxed, decide_run, runs};
 use super::state::Solver;
 use crate::assembly::Assembly;
 use crate::fit::align;
@@ -106,11 +107,13 @@ impl Family {
 
 impl Solver {
     /// The relaxation from `warm` (the displayed pose; the handles gathered this frame), and
-    /// what it proposes (empty when it changes nothing). Its chains' lengths are rounded in
-    /// rounds: each round relaxes with the chains decided so far held at their counts, then
-    /// decides the chains whose lengths are nearly whole (within [`DECIDED`] of a count) and
-    /// the one nearest a whole count, so that a change the relaxation spreads over chains in
-    /// series or round a loop ends whole in one of them rather than split and lost.
+    /// what it proposes (empty when it changes nothing), two alternatives. Its chains'
+    /// lengths are rounded in rounds: each round relaxes with the chains decided so far held
+    /// at their counts, then decides the chains whose lengths are nearly whole (within
+    /// [`DECIDED`] of a count) and the one nearest a whole count (with the chains in series
+    /// with it: `rounding.rs`), so that a change the relaxation spreads over chains in series
+    /// or round a loop ends whole in one of them rather than split and lost; and the first
+    /// round's lengths each rounded on their own (a loop that only closes evenly).
     pub(super) fn relax(
         &mut self,
         asm: &Assembly,
@@ -123,6 +126,9 @@ impl Solver {
         let hysteresis = self.config.hysteresis;
         let mut f = warm.to_vec();
         let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
+        let series = runs(asm.grammar(), data);
+        // the first relaxation's lengths each rounded on their own: the other alternative
+        let mut at_once: Option<(Vec<Option<usize>>, Vec<DVec2>)> = None;
         loop {
             let fixed = fixed_scales(asm, &decided, &held);
             self.relax_from(asm, &families, &fixed, &mut f, deadline)?;
@@ -130,6 +136,13 @@ impl Solver {
                 return Ok(Vec::new());
             }
             let lengths = relaxed_lengths(asm, &families, &f);
+            if at_once.is_none() {
+                let mut each = vec![None; data.chains.len()];
+                for r in &lengths {
+                    each[r.chain] = Some(r.decide(hysteresis));
+                }
+                at_once = Some((each, f.clone()));
+            }
             let open: Vec<&Relaxed> = lengths
                 .iter()
                 .filter(|r| decided[r.chain].is_none())
@@ -137,30 +150,54 @@ impl Solver {
             let Some(nearest) = open.iter().map(|r| r.doubt()).min_by(f64::total_cmp) else {
                 break;
             };
-            for r in open {
-                if r.doubt() <= DECIDED.max(nearest) {
-                    decided[r.chain] = Some(r.decide(hysteresis));
+            for r in &open {
+                if decided[r.chain].is_some() || r.doubt() > DECIDED.max(nearest) {
+                    continue;
+                }
+                // a chain in series with others is decided with them (`rounding.rs`)
+                let run: Option<Vec<&Relaxed>> = (series.iter().find(|g| g.contains(&r.chain)))
+                    .map(|g| {
+                        open.iter()
+                            .copied()
+                            .filter(|q| g.contains(&q.chain))
+                            .collect()
+                    });
+                match run
+                    .as_deref()
+                    .and_then(|run| Some((run, decide_run(run, hysteresis)?)))
+                {
+                    Some((run, counts)) => {
+                        for (q, n) in run.iter().zip(counts) {
+                            decided[q.chain] = Some(n);
+                        }
+                    }
+                    None => decided[r.chain] = Some(r.decide(hysteresis)),
                 }
             }
             if out_of_time(deadline, Duration::ZERO) {
                 break;
             }
         }
-        let lengths = relaxed_lengths(asm, &families, &f);
-        let counts: Vec<(usize, usize, usize)> = (lengths.iter())
-            .filter_map(|r| decided[r.chain].and_then(|want| r.towards(want)))
-            .collect();
-        let states = self.relaxed_states(&data.parts, &f);
-        let proposal = Proposal {
-            counts,
-            states,
-            pose: f,
-        };
-        Ok(if proposal.is_empty() {
-            Vec::new()
-        } else {
-            vec![proposal]
-        })
+        let mut alternatives: Vec<Proposal> = Vec::new();
+        for (decided, f) in [Some((decided, f)), at_once].into_iter().flatten() {
+            let lengths = relaxed_lengths(asm, &families, &f);
+            let counts: Vec<(usize, usize, usize)> = (lengths.iter())
+                .filter_map(|r| decided[r.chain].and_then(|want| r.towards(want)))
+                .collect();
+            let p = Proposal {
+                counts,
+                states: self.relaxed_states(&data.parts, &f),
+                pose: f,
+            };
+            if !p.is_empty()
+                && !alternatives
+                    .iter()
+                    .any(|q| q.counts == p.counts && q.states == p.states)
+            {
+                alternatives.push(p);
+            }
+        }
+        Ok(alternatives)
     }
 
     /// One relaxation from `f` (left there), every stretch part's scales fitted but the
@@ -381,54 +418,6 @@ impl Rest {
 /// Past differences the relaxation's Anderson acceleration mixes.
 const ANDERSON: usize = 3;
 
-/// A chain's relaxed length (its elements' lengths summed, in elements) against its count.
-struct Relaxed {
-    chain: usize,
-    count: usize,
-    length: f64,
-    /// Its parts, `(first, span in elements)`.
-    parts: Vec<(usize, f64)>,
-    min: usize,
-    max: Option<usize>,
-}
-
-impl Relaxed {
-    /// The count its relaxed length decides: the nearest count within the rule's bounds
-    /// when the length is nearer it than the chain's count by the `hysteresis` margin (paper
-    /// 4.3, in elements), else its count.
-    fn decide(&self, hysteresis: f64) -> usize {
-        let mut want = self.length.round().max(self.min.max(1) as f64) as usize;
-        if let Some(max) = self.max {
-            want = want.min(max);
-        }
-        let (now, then) = (self.length - self.count as f64, self.length - want as f64);
-        if then.abs() < (1.0 - hysteresis) * now.abs() {
-            want
-        } else {
-            self.count
-        }
-    }
-
-    /// `(chain, first, want)`: the change to `want` elements, at the part whose relaxed span
-    /// is furthest from two elements that way; `None` when `want` is its count.
-    fn towards(&self, want: usize) -> Option<(usize, usize, usize)> {
-        if want == self.count {
-            return None;
-        }
-        let grow = want > self.count;
-        let key = |s: f64| if grow { s } else { -s };
-        let first = (self.parts.iter())
-            .max_by(|a, b| key(a.1).total_cmp(&key(b.1)))?
-            .0;
-        Some((self.chain, first, want))
-    }
-
-    /// How far its length is from a whole count (0 to 0.5).
-    fn doubt(&self) -> f64 {
-        (self.length - self.length.round()).abs()
-    }
-}
-
 /// The stable ids of the instances the handles hold.
 fn held_elements(asm: &Assembly) -> Vec<u64> {
     (asm.handles().iter())
@@ -483,6 +472,7 @@ fn relaxed_lengths(asm: &Assembly, families: &[Option<Family>], f: &[DVec2]) -> 
                 chain,
                 count: c.instances.len(),
                 length: 0.0,
+                element: 0.0,
                 parts: Vec::new(),
                 min: rule.map_or(usize::MAX, |r| r.min),
                 max: rule.and_then(|r| r.max),
@@ -497,6 +487,7 @@ fn relaxed_lengths(asm: &Assembly, families: &[Option<Family>], f: &[DVec2]) -> 
             continue;
         };
         let [a, b] = family.lengths(part, f);
+        r.element = family.ends.element;
         r.length += a;
         if first + 2 == r.count {
             r.length += b;

@@ -570,8 +570,8 @@ impl Morph {
     /// Steps that lead the movers from configuration `from` to `to` over `frames` frames
     /// (0: a jump), in up to 40 steps along the way, each mover turned, then dragged onto
     /// its place. With several movers, each is grabbed in turn (the one let go is pinned
-    /// again where it is); the frames of a step go to its last mover's drag, the others take
-    /// one each. Starts with the
+    /// again where it is); the frames of a step go to its last mover's drag, and every mover
+    /// takes one at least. Starts with the
     /// first mover grabbed ([`Morph::hold_steps`]) and ends with the last one grabbed.
     pub fn lead(&self, from: &Config, to: &Config, frames: u64) -> Vec<String> {
         let g = &self.graph;
@@ -593,9 +593,13 @@ impl Morph {
                 if turn.abs() > 1e-9 {
                     steps.push(step::rotate(round9(turn), 0));
                 }
-                // the others take a frame each (a mover let go before a frame ran would be
-                // pinned again where it was)
-                let f = if k + 1 == self.movers.len() { share } else { 1 };
+                // with several, each takes a frame at least (a mover let go before a frame
+                // ran would be pinned again where it was)
+                let f = match (self.movers.len(), k + 1 == self.movers.len()) {
+                    (1, _) => share,
+                    (_, true) => share.max(1),
+                    (_, false) => 1,
+                };
                 steps.push(step::drag_to(g.centroid(m, next[m]), f));
             }
             at = next;
