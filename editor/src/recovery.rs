@@ -24,6 +24,25 @@ pub fn default_path() -> Option<PathBuf> {
     Some(state.join("clay").join("recovery.clay-session"))
 }
 
+/// Makes the folder `path` is to be written in, with its parents, readable by this user only
+/// where the system has such permissions (the XDG base directory specification asks that of
+/// the state folders it makes).
+fn make_folder(path: &Path) -> Result<(), String> {
+    let Some(folder) = path.parent().filter(|f| !f.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    if folder.is_dir() {
+        return Ok(());
+    }
+    let mut builder = std::fs::DirBuilder::new();
+    builder.recursive(true);
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    builder
+        .create(folder)
+        .map_err(|e| format!("cannot make the folder {}: {e}", folder.display()))
+}
+
 /// Work found in a recovery file at start: what it is, for the offer to restore it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Offer {
@@ -41,8 +60,9 @@ pub struct Recovery {
     written: Option<((u64, u64), Instant)>,
     /// Work found at start and not yet restored or discarded: nothing is written over it.
     offer: Option<Offer>,
-    /// The last write failed (reported once, until a write succeeds).
-    failing: bool,
+    /// Why the last write failed, until one succeeds: the editor shows it for as long as
+    /// unsaved work is not kept.
+    failure: Option<String>,
 }
 
 impl Recovery {
@@ -57,12 +77,17 @@ impl Recovery {
             path,
             written: None,
             offer,
-            failing: false,
+            failure: None,
         }
     }
 
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Why unsaved work is not being kept (the last write failed), until a write succeeds.
+    pub fn failure(&self) -> Option<&str> {
+        self.failure.as_deref()
     }
 
     /// The work found at start, until it is restored or discarded.
@@ -102,20 +127,23 @@ impl Recovery {
             return None;
         }
         let session = session()?;
-        match session::write(&self.path, &session) {
+        // a first-time user has no state folder yet: it is made, for this user only
+        let written = make_folder(&self.path)
+            .and_then(|()| session::write(&self.path, &session).map_err(|e| e.to_string()));
+        match written {
             Ok(()) => {
                 self.written = Some((stamp, Instant::now()));
-                self.failing = false;
+                self.failure = None;
                 None
             }
-            Err(e) if !self.failing => {
-                self.failing = true;
-                Some(format!(
-                    "crash recovery cannot write {}: {e}",
+            Err(e) => {
+                let first = self.failure.is_none();
+                self.failure = Some(format!(
+                    "crash recovery is off: cannot write {}: {e}",
                     self.path.display()
-                ))
+                ));
+                first.then(|| self.failure.clone()).flatten()
             }
-            Err(_) => None,
         }
     }
 

@@ -121,6 +121,94 @@ fn a_killed_editor_is_restored_by_the_next() {
     assert!(next.sculpt.dirty(), "restored work is unsaved work");
 }
 
+/// Set in the first-time user's child editor: its empty home.
+const FIRST: &str = "CLAY_RECOVERY_TEST_FIRST_TIME";
+
+/// A first-time user (issue 47): an empty home, no state folder, no setting. The editor
+/// finds its recovery file where `recovery::default_path` says, makes the folders it needs
+/// (for this user only), keeps the work there, and after a kill the next editor offers it.
+#[test]
+fn a_first_time_user_with_an_empty_home_is_restored() {
+    if let Some(home) = std::env::var_os(FIRST) {
+        let path = clay_editor::recovery::default_path().expect("a recovery file under HOME");
+        assert!(
+            path.starts_with(&home),
+            "{} is not under the home",
+            path.display()
+        );
+        child(&path, &PathBuf::from(home).join("expected.json"));
+    }
+    let home = scratch("first-time");
+    let mut editor = Process::new(std::env::current_exe().unwrap())
+        .args([
+            "a_first_time_user_with_an_empty_home_is_restored",
+            "--exact",
+            "--nocapture",
+        ])
+        .env(FIRST, &home)
+        .env("HOME", &home)
+        .env_remove("XDG_STATE_HOME")
+        .env_remove("CLAY_RECOVERY_FILE")
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let out = BufReader::new(editor.stdout.take().unwrap());
+    let said = out
+        .lines()
+        .map_while(Result::ok)
+        .any(|l| l.contains("sculpted"));
+    editor.kill().unwrap();
+    editor.wait().unwrap();
+    assert!(said, "the child editor sculpted");
+    let folder = home.join(".local/state/clay");
+    let recovery = folder.join("recovery.clay-session");
+    let expected = session::read(&home.join("expected.json")).unwrap();
+    assert_eq!(
+        session::read(&recovery).expect("the killed editor left its work in the new folder"),
+        expected
+    );
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&folder).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o700, "the state folder is this user's only");
+    }
+    let mut next = EditorApp::bundled();
+    next.use_recovery(recovery);
+    assert!(next.recovery().and_then(|r| r.offer()).is_some());
+    next.perform(Action::RestoreRecovery);
+    assert!(next.sculpt.data() == &expected.assembly);
+}
+
+/// Where the recovery file cannot be written (its folder is a file), the editor says so for
+/// as long as it cannot, not once in a status line that the next message replaces.
+#[test]
+fn a_recovery_file_that_cannot_be_written_is_said_until_it_can() {
+    let dir = scratch("unwritable");
+    std::fs::write(dir.join("blocked"), b"a file where the folder would be").unwrap();
+    let mut app = EditorApp::bundled();
+    app.use_recovery(dir.join("blocked").join("recovery.clay-session"));
+    sculpt(&mut app);
+    let why = app.recovery().and_then(|r| r.failure()).map(str::to_string);
+    assert!(
+        why.as_deref()
+            .is_some_and(|w| w.contains("crash recovery is off") && w.contains("blocked")),
+        "{why:?}"
+    );
+    sculpt(&mut app);
+    assert!(
+        app.recovery().and_then(|r| r.failure()).is_some(),
+        "still said after more work"
+    );
+    std::fs::remove_file(dir.join("blocked")).unwrap();
+    sculpt(&mut app);
+    assert!(
+        app.recovery().and_then(|r| r.failure()).is_none(),
+        "kept again: nothing to say"
+    );
+    assert!(dir.join("blocked").join("recovery.clay-session").exists());
+}
+
 #[test]
 fn the_recovery_file_follows_the_sculpt_and_leaves_on_save_and_quit() {
     let dir = scratch("follows");

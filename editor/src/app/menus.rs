@@ -298,6 +298,11 @@ impl EditorApp {
                     ui.separator();
                     ui.colored_label(egui::Color32::from_rgb(200, 40, 40), "grammar has errors");
                 }
+                // for as long as unsaved work is not kept: a crash would lose it
+                if let Some(why) = self.recovery.as_ref().and_then(|r| r.failure()) {
+                    ui.separator();
+                    ui.colored_label(egui::Color32::from_rgb(200, 40, 40), why);
+                }
                 if let Some(m) = &self.message {
                     ui.separator();
                     ui.label(m);
