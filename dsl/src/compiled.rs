@@ -117,12 +117,14 @@ pub struct SolverParams {
 }
 
 impl Default for SolverParams {
+    /// The defaults of the settings table (`crate::settings`).
     fn default() -> Self {
+        let default = |name| crate::settings::setting(name).map_or(0.0, |s| s.default.number());
         Self {
-            hysteresis: 0.15,
-            norm: 0.5,
-            irls_epsilon: 0.001,
-            merge_distance: 0.5,
+            hysteresis: default("hysteresis"),
+            norm: default("norm"),
+            irls_epsilon: default("irls_epsilon"),
+            merge_distance: default("merge_distance"),
         }
     }
 }

@@ -15,6 +15,7 @@ extern crate alloc;
 
 pub mod analysis;
 pub mod compiled;
+pub mod settings;
 pub mod syntax;
 
 mod compile;

@@ -6,21 +6,21 @@ use clay_dsl::compiled::CompiledGrammar;
 
 use crate::solver::{SolverConfig, SolverKind};
 
-/// Every setting's name, in the order the messages list them.
-pub const SETTING_NAMES: [&str; 9] = [
-    "hysteresis",
-    "norm",
-    "irls_epsilon",
-    "merge_distance",
-    "irls_iterations",
-    "l2_iterations",
-    "l2_anderson",
-    "handle_weight",
-    "solver",
-];
+/// Every setting's name, in the order the messages list them (`clay_dsl::settings`, the one
+/// table of names, ranges and defaults).
+pub const SETTING_NAMES: [&str; 9] = {
+    let mut names = [""; 9];
+    let mut k = 0;
+    while k < 9 {
+        names[k] = clay_dsl::settings::SETTINGS[k].name;
+        k += 1;
+    }
+    names
+};
 
-/// Applies one setting, checking the name and the range. Messages start with `NAME=VALUE:`
-/// (or `NAME:` for an unknown name); front ends prefix them with how the setting was given.
+/// Applies one setting, checking the name and the range (the one table,
+/// `clay_dsl::settings`). Messages start with `NAME=VALUE:` (or `NAME:` for an unknown name);
+/// front ends prefix them with how the setting was given.
 pub fn apply_setting(
     config: &mut SolverConfig,
     merge_distance: &mut f64,
@@ -28,70 +28,42 @@ pub fn apply_setting(
     value: &str,
 ) -> Result<(), String> {
     let (name, value) = (name.trim(), value.trim());
-    if name == "solver" {
-        config.kind = match value {
-            "cholesky" => SolverKind::Cholesky,
-            "cg" => SolverKind::Cg,
-            _ => return Err(format!("solver={value}: expected cholesky or cg")),
-        };
-        return Ok(());
-    }
-    if !SETTING_NAMES.contains(&name) {
+    let Some(setting) = clay_dsl::settings::setting(name) else {
         let (last, rest) = SETTING_NAMES.split_last().unwrap_or((&"", &[]));
         return Err(format!(
             "{name}: unknown parameter (expected {} or {last})",
             rest.join(", ")
         ));
+    };
+    let range = setting.range;
+    if let clay_dsl::settings::Range::Word(words) = range {
+        if !words.contains(&value) {
+            return Err(format!("{name}={value}: expected {}", range.words()));
+        }
+        config.kind = if value == "cg" {
+            SolverKind::Cg
+        } else {
+            SolverKind::Cholesky
+        };
+        return Ok(());
     }
     let number: f64 = value
         .parse()
         .ok()
         .filter(|x: &f64| x.is_finite())
         .ok_or_else(|| format!("{name}={value}: the value must be a finite number"))?;
-    let check = |ok: bool, range: &str| {
-        if ok {
-            Ok(())
-        } else {
-            Err(format!("{name}={value}: must be {range}"))
-        }
-    };
-    let count = |x: f64| x.fract() == 0.0 && (0.0..=1000.0).contains(&x);
+    if !range.allows(number) {
+        return Err(format!("{name}={value}: must be {}", range.interval()));
+    }
     match name {
-        "hysteresis" => {
-            check((0.0..1.0).contains(&number), "in [0, 1)")?;
-            config.hysteresis = number;
-        }
-        "norm" => {
-            check(number > 0.0 && number <= 2.0, "in (0, 2]")?;
-            config.norm = number;
-        }
-        "irls_epsilon" => {
-            check(number > 0.0 && number <= 1.0, "in (0, 1]")?;
-            config.irls_epsilon = number;
-        }
-        "merge_distance" => {
-            check(number >= 0.0, "at least 0")?;
-            *merge_distance = number;
-        }
-        "irls_iterations" => {
-            check(count(number), "an integer from 0 to 1000")?;
-            config.irls_iterations = number as usize;
-        }
-        "l2_iterations" => {
-            check(count(number), "an integer from 0 to 1000")?;
-            config.l2_iterations = number as usize;
-        }
-        "l2_anderson" => {
-            check(
-                number.fract() == 0.0 && (0.0..=16.0).contains(&number),
-                "an integer from 0 to 16",
-            )?;
-            config.l2_anderson = number as usize;
-        }
-        _ => {
-            check((1.0..=1e12).contains(&number), "in [1, 1e12]")?;
-            config.handle_weight = number;
-        }
+        "hysteresis" => config.hysteresis = number,
+        "norm" => config.norm = number,
+        "irls_epsilon" => config.irls_epsilon = number,
+        "merge_distance" => *merge_distance = number,
+        "irls_iterations" => config.irls_iterations = number as usize,
+        "l2_iterations" => config.l2_iterations = number as usize,
+        "l2_anderson" => config.l2_anderson = number as usize,
+        _ => config.handle_weight = number,
     }
     Ok(())
 }

@@ -108,7 +108,10 @@ impl Default for SolverConfig {
 
 impl SolverConfig {
     /// The defaults with the grammar's parameters.
+    /// A grammar's `solver` block, the session-only settings at the defaults of the one
+    /// table (`clay_dsl::settings`).
     pub fn from_params(params: &SolverParams) -> Self {
+        let default = |name| clay_dsl::settings::setting(name).map_or(0.0, |s| s.default.number());
         Self {
             kind: SolverKind::Cholesky,
             hysteresis: params.hysteresis,
@@ -116,11 +119,11 @@ impl SolverConfig {
             irls_epsilon: params.irls_epsilon,
             handle_outlier: 0.5,
             reversal: 0.95,
-            irls_iterations: 5,
-            l2_iterations: 5,
+            irls_iterations: default("irls_iterations") as usize,
+            l2_iterations: default("l2_iterations") as usize,
             l2_iterations_free: 20,
-            l2_anderson: 1,
-            handle_weight: 1e6,
+            l2_anderson: default("l2_anderson") as usize,
+            handle_weight: default("handle_weight"),
             rotation_cone_degrees: 0.0,
             proximal_weight: 1e-8,
             tolerance: 1e-6,

@@ -55,7 +55,9 @@ impl Solver {
     ) -> Result<(Vec<DVec2>, Terms, bool), SolverError> {
         let cfg = self.config;
         let mut f = warm;
-        if cfg.l2_iterations == 0 {
+        // without pass-2 iterations the pass-1 pose is shown, unless the rules rewrote the
+        // structure after it (it has other vertices then): their layout is
+        if cfg.l2_iterations == 0 && self.pass1_pose.len() == f.len() {
             f.clear();
             f.extend_from_slice(&self.pass1_pose);
         }

@@ -43,7 +43,6 @@ const PIECE_KEYWORDS: &[&str] = &[
     "vertex", "edges", "site", "axis", "polygon", "polyline", "mesh", "state",
 ];
 const STATE_KEYWORDS: &[&str] = &["edges", "polygon", "polyline"];
-const PARAMETERS: &[&str] = &["hysteresis", "norm", "irls_epsilon", "merge_distance"];
 
 /// An open `{` and the words before it on its line (`piece brick`, `state left`, `model`).
 struct Block<'a> {
@@ -183,8 +182,7 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
                 out.members(piece, SymbolKind::Vertex);
             }
             Some("model") => out.keyword("dock"),
-            Some("solver") => PARAMETERS
-                .iter()
+            Some("solver") => crate::settings::grammar_names()
                 .for_each(|p| out.push(p, CompletionKind::Parameter, None)),
             Some("stretch") => ["min", "max", "variants"]
                 .iter()

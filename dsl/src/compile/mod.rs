@@ -536,43 +536,21 @@ impl Compiler {
             }
             seen.insert(&e.name.name, e.name.span);
             let v = &e.value;
-            match e.name.name.as_str() {
-                "hysteresis" => {
-                    if let Some(x) = self.in_range(
-                        v,
-                        "`hysteresis`",
-                        |x| (0.0..1.0).contains(&x),
-                        "at least 0 and below 1",
-                    ) {
-                        self.solver.hysteresis = x;
-                    }
+            let name = e.name.name.as_str();
+            let Some(setting) = crate::settings::setting(name).filter(|s| s.in_grammar) else {
+                let names: Vec<&str> = crate::settings::grammar_names().collect();
+                self.unknown("solver parameter", &e.name, names, None);
+                continue;
+            };
+            let what = format!("`{name}`");
+            let range = setting.range;
+            if let Some(x) = self.in_range(v, &what, |x| range.allows(x), &range.words()) {
+                match name {
+                    "hysteresis" => self.solver.hysteresis = x,
+                    "norm" => self.solver.norm = x,
+                    "irls_epsilon" => self.solver.irls_epsilon = x,
+                    _ => self.solver.merge_distance = x,
                 }
-                "norm" => {
-                    if let Some(x) = self.in_range(
-                        v,
-                        "`norm`",
-                        |x| x > 0.0 && x <= 2.0,
-                        "above 0 and at most 2",
-                    ) {
-                        self.solver.norm = x;
-                    }
-                }
-                "irls_epsilon" => {
-                    if let Some(x) = self.in_range(v, "`irls_epsilon`", |x| x > 0.0, "above 0") {
-                        self.solver.irls_epsilon = x;
-                    }
-                }
-                "merge_distance" => {
-                    if let Some(x) = self.in_range(v, "`merge_distance`", |x| x > 0.0, "above 0") {
-                        self.solver.merge_distance = x;
-                    }
-                }
-                _ => self.unknown(
-                    "solver parameter",
-                    &e.name,
-                    ["hysteresis", "norm", "irls_epsilon", "merge_distance"],
-                    None,
-                ),
             }
         }
     }

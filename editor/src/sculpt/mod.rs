@@ -310,12 +310,12 @@ impl Sculpt {
                 self.note("reset to the initial model".to_string(), None);
             }
             Command::Settings(s) => {
-                let valid = s.hysteresis.is_finite()
-                    && (0.0..1.0).contains(&s.hysteresis)
-                    && s.norm.is_finite()
-                    && s.norm > 0.0
-                    && s.merge_distance.is_finite()
-                    && s.merge_distance >= 0.0;
+                // the one table's ranges (`clay_dsl::settings`)
+                let allows =
+                    |name, x| clay_dsl::settings::setting(name).is_some_and(|t| t.range.allows(x));
+                let valid = allows("hysteresis", s.hysteresis)
+                    && allows("norm", s.norm)
+                    && allows("merge_distance", s.merge_distance);
                 if valid && s != self.settings {
                     self.settings = s;
                     self.configure_solver();
