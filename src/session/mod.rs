@@ -195,7 +195,12 @@ impl Session {
                     Some(rules) => rules.after_pass1(asm, report, pass1),
                     None => {
                         let grammar = asm.grammar_arc().clone();
-                        replace::replacement_events(&grammar, asm.data_mut(), &report.switches, pass1)
+                        replace::replacement_events(
+                            &grammar,
+                            asm.data_mut(),
+                            &report.switches,
+                            pass1,
+                        )
                     }
                 };
             })?;

@@ -662,12 +662,37 @@ impl Compiler {
             return true;
         };
         let mut pairs = Vec::new();
-        for (k, s) in op.sites.iter().enumerate().filter(|(k, _)| Some(*k) != except) {
-            let Some(t) = np.sites.iter().find(|t| t.name == s.name) else { continue };
+        for (k, s) in op
+            .sites
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| Some(*k) != except)
+        {
+            let Some(t) = np.sites.iter().find(|t| t.name == s.name) else {
+                continue;
+            };
             if t.vertices.len() != s.vertices.len() {
-                let problem = format!("site `{}` has {} vertices in `{}` and {} in `{}`", s.name, t.vertices.len(), np.name, s.vertices.len(), op.name);
-                let hint = format!("`{}` takes the place of `{}` and its connections by site name: the sites must have the same vertices", np.name, op.name);
-                self.error(Diagnostic::error(codes::NOT_IN_PLACE, format!("`{}` does not fit where `{}` is", np.name, op.name), span, problem).with_hint(hint));
+                let problem = format!(
+                    "site `{}` has {} vertices in `{}` and {} in `{}`",
+                    s.name,
+                    t.vertices.len(),
+                    np.name,
+                    s.vertices.len(),
+                    op.name
+                );
+                let hint = format!(
+                    "`{}` takes the place of `{}` and its connections by site name: the sites must have the same vertices",
+                    np.name, op.name
+                );
+                self.error(
+                    Diagnostic::error(
+                        codes::NOT_IN_PLACE,
+                        format!("`{}` does not fit where `{}` is", np.name, op.name),
+                        span,
+                        problem,
+                    )
+                    .with_hint(hint),
+                );
                 return false;
             }
             for (&a, &b) in s.vertices.iter().zip(&t.vertices) {
@@ -711,14 +736,31 @@ impl Compiler {
             .find(|(_, (a, b))| a.distance(**b) > DOCK_TOLERANCE);
         let (problem, at) = if let Some((k, (a, b))) = moved {
             (
-                format!("vertex `{}` is at {}, where `{}` has it at {}", v.vertices[k], fmt_point(*b), p.name, fmt_point(*a)),
+                format!(
+                    "vertex `{}` is at {}, where `{}` has it at {}",
+                    v.vertices[k],
+                    fmt_point(*b),
+                    p.name,
+                    fmt_point(*a)
+                ),
                 self.piece_spans[vi].vertices.get(k).copied(),
             )
-        } else if let Some((k, (a, b))) = (p.sites.iter().zip(&v.sites).enumerate())
-            .find(|(_, (a, b))| a.out.normalize_or_zero().distance(b.out.normalize_or_zero()) > 1e-6)
+        } else if let Some((k, (a, b))) =
+            (p.sites.iter().zip(&v.sites).enumerate()).find(|(_, (a, b))| {
+                a.out
+                    .normalize_or_zero()
+                    .distance(b.out.normalize_or_zero())
+                    > 1e-6
+            })
         {
             (
-                format!("site `{}` faces {}, where `{}`'s faces {}", b.name, fmt_point(b.out.normalize_or_zero()), p.name, fmt_point(a.out.normalize_or_zero())),
+                format!(
+                    "site `{}` faces {}, where `{}`'s faces {}",
+                    b.name,
+                    fmt_point(b.out.normalize_or_zero()),
+                    p.name,
+                    fmt_point(a.out.normalize_or_zero())
+                ),
                 self.piece_spans[vi].sites.get(k).copied(),
             )
         } else {
