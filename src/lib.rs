@@ -47,6 +47,7 @@ pub use render::{
     sheet_svg, site_type_colour, strain_colour, tessellate_polygon, tessellate_polyline,
     tessellate_proxy,
 };
+pub use rules::stretch::MAX_GROWTH;
 pub use rules::{Rewrite, RuleEvent, RuleKind, Rules, site_centre, site_out};
 pub use script::{MAX_FRAMES, Motion, Script, ScriptError, Selector, Step};
 pub use session::{

@@ -185,3 +185,25 @@ fn clayc_run_castle_scaled_by_two_towers_grows_walls_at_rest() {
             && e["detail"].as_str().is_some_and(|d| !d.is_empty())));
     }
 }
+
+/// Issue 47: a 207-byte script dragging the wall's end by 1e9 m doubled the chain every frame
+/// to the million-instance cap (300 s, 2.85 GB). A rewrite now inserts at most
+/// `stretch::MAX_GROWTH` elements, so growth is linear in the frames, whatever the gesture.
+#[test]
+fn a_wall_end_thrown_a_billion_metres_grows_linearly_not_without_end() {
+    let out = run(
+        &wall_clay(),
+        r#"{"steps": [{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}},
+            {"drag": {"by": [1e9, 0], "frames": 20}}, {"hold": {"frames": 5}}]}"#,
+        "runaway.json",
+        &[],
+    );
+    let n = bricks(&out) as usize;
+    let frames = 25;
+    assert!(
+        n <= 8 + frames * clay::MAX_GROWTH,
+        "{n} bricks after {frames} frames"
+    );
+    assert!(n > 8 + 2 * clay::MAX_GROWTH, "it still grows: {n}");
+    assert!(out["energy"].as_f64().unwrap().is_finite());
+}

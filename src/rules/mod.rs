@@ -180,17 +180,21 @@ impl Rules {
             })
             .collect();
         let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches, &[]);
+        // one rewrite per chain, as a frame's rules make (a stretch inserts at most
+        // `stretch::MAX_GROWTH`): the rest of a large change waits for the next stop
         for &(chain, first, count) in &proposal.counts {
-            while let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) {
-                let r = if count > n {
-                    stretch::stretch(&grammar, asm.data_mut(), chain, first, 2 + count - n)
-                } else if count < n {
-                    let elements = 2 - (n - count) as i64;
-                    stretch::shrink(&grammar, asm.data_mut(), chain, first, elements, &held)
-                } else {
-                    break;
-                };
-                let Ok(r) = r else { break };
+            let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) else {
+                continue;
+            };
+            let r = if count > n {
+                stretch::stretch(&grammar, asm.data_mut(), chain, first, 2 + count - n)
+            } else if count < n {
+                let elements = 2 - (n - count) as i64;
+                stretch::shrink(&grammar, asm.data_mut(), chain, first, elements, &held)
+            } else {
+                continue;
+            };
+            if let Ok(r) = r {
                 self.carry(asm, &r);
                 events.push(r.event);
             }

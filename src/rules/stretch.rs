@@ -23,6 +23,10 @@ use super::rewrite::{
 };
 use crate::fit::{self, PointMap};
 
+/// The most elements one rewrite inserts into a chain (and so one frame: a chain is rewritten
+/// once a frame): growth stays linear in the frames, whatever the gesture.
+pub const MAX_GROWTH: usize = 64;
+
 /// Index of the `one`, `two` and `three` states in a stretch part.
 pub const ONE: usize = clay_dsl::compiled::STRETCH_ONE;
 pub const TWO: usize = clay_dsl::compiled::STRETCH_TWO;
@@ -297,11 +301,13 @@ pub fn stretch(
             .max
             .map_or(usize::MAX, |max| max.saturating_sub(c.instances.len()));
         let room = room.min(clay_dsl::MAX_INSTANCES.saturating_sub(data.instances.len()));
-        // at most doubling the chain in one rewrite: a hand thrown a kilometre away fills the
-        // length over a few frames, each of them bounded, not in one that never ends
+        // at most doubling the chain, and at most MAX_GROWTH elements, in one rewrite: a hand
+        // thrown a kilometre away fills the length over many frames, each of them bounded, and
+        // a chain cannot double itself frame after frame into the millions (issue 47: a wall's
+        // end dragged by 1e9 m ran to the million-instance cap)
         let inserted = count
             .saturating_sub(2)
-            .clamp(1, c.instances.len().max(1))
+            .clamp(1, c.instances.len().clamp(1, MAX_GROWTH))
             .min(room);
         if inserted == 0 {
             return Err(format!("chain {chain} is at the rule's maximum"));
