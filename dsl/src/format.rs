@@ -622,7 +622,10 @@ impl<'s> Printer<'s> {
             DeriveKind::Mirror(other) => format!("mirror {}", other.name),
         };
         let header = format!("state {} {how}", s.name.name);
-        if s.geometry.is_empty() && !self.comment_within(Span::new(d.span.end, s.span.end)) {
+        // only a comment inside the braces keeps them: one before `{` is printed before the
+        // statement, and a second `fmt` would drop the braces the first kept (issue 47)
+        let inside = Span::new(self.next_token(d.span.end), s.span.end);
+        if s.geometry.is_empty() && !self.comment_within(inside) {
             // No comment sits in an empty `{ }` (checked above), so its braces can go.
             self.stmt(indent, &header, s.span);
             return;
@@ -635,11 +638,13 @@ impl<'s> Printer<'s> {
     }
 
     /// Whether the stretch rule's body is written `{ min N }` or `{ max N }` on its line (or
-    /// has no body): one statement at most. `min` and `max` together take a line each.
+    /// has no body): one statement at most. `min` and `max` together take a line each. Only a
+    /// comment inside the braces keeps them on several lines: one before `{` is printed before
+    /// the rule, and a second `fmt` would join what the first split (issue 47).
     fn stretch_inline(&self, s: &StretchDecl) -> bool {
         s.variants.is_empty()
             && s.min.len() + s.max.len() <= 1
-            && !self.comment_within(Span::new(s.to.span.end, s.span.end))
+            && !self.comment_within(Span::new(self.next_token(s.to.span.end), s.span.end))
     }
 
     fn stretch(&mut self, s: &StretchDecl) {
@@ -692,7 +697,11 @@ impl<'s> Printer<'s> {
             .map(|e| format!("{} {}", e.piece.name, self.num(&e.frequency)))
             .collect();
         let inline = format!("variants {{ {} }}", entries.join(", "));
-        if !self.comment_within(v.span) && indent * INDENT.len() + inline.len() <= MAX_WIDTH {
+        // a comment between `variants` and `{` is printed before the statement (by `open` or
+        // `stmt`): only comments inside the braces keep the block on several lines, or a
+        // second `fmt` would join what the first split (issue 47)
+        let inside = Span::new(self.next_token(v.span.start + "variants".len()), v.span.end);
+        if !self.comment_within(inside) && indent * INDENT.len() + inline.len() <= MAX_WIDTH {
             return self.stmt(indent, &inline, v.span);
         }
         self.open(
