@@ -551,124 +551,13 @@ impl Assembly {
         }))
     }
 
-    /// Checks indices and invariants of the data, the rotations and the handles. Returns every
-    /// problem found, one line each.
-    // Long because: one short check per invariant of data, rotations and handles.
+    /// Checks indices and invariants of the data ([`AssemblyData::problems`], the one check of
+    /// an assembly's data), the rotations and the handles. Returns every problem found, one
+    /// line each.
     pub fn validate(&self) -> Result<(), Vec<String>> {
-        let mut errors = Vec::new();
         let d = &self.data;
-        let g = &self.grammar;
         let n = d.positions.len();
-        for (i, p) in d.positions.iter().enumerate() {
-            if !p.is_finite() {
-                errors.push(format!("vertex {i}: position {p} is not finite"));
-            }
-        }
-        for (ii, inst) in d.instances.iter().enumerate() {
-            let Some(piece) = g.pieces.get(inst.piece) else {
-                errors.push(format!(
-                    "instance {ii}: piece {} does not exist",
-                    inst.piece
-                ));
-                continue;
-            };
-            if inst.vertices.len() != piece.vertices.len() {
-                errors.push(format!(
-                    "instance {ii}: {} vertices, piece `{}` has {}",
-                    inst.vertices.len(),
-                    piece.name,
-                    piece.vertices.len()
-                ));
-            }
-            if inst.vertices.iter().any(|&v| v >= n) {
-                errors.push(format!("instance {ii}: vertex index out of range"));
-            }
-            if inst.state >= piece.states.len() {
-                errors.push(format!("instance {ii}: state {} out of range", inst.state));
-            }
-            if inst.id >= d.next_id {
-                errors.push(format!(
-                    "instance {ii}: id {} not below next_id {}",
-                    inst.id, d.next_id
-                ));
-            }
-        }
-        for (di, dock) in d.docks.iter().enumerate() {
-            for s in [dock.a, dock.b] {
-                let ok = d
-                    .instances
-                    .get(s.instance)
-                    .and_then(|inst| g.pieces.get(inst.piece))
-                    .is_some_and(|piece| s.site < piece.sites.len());
-                if !ok {
-                    errors.push(format!("dock {di}: site {:?} does not exist", s));
-                }
-            }
-        }
-        for (ci, chain) in d.chains.iter().enumerate() {
-            if chain.rule >= g.stretch_rules.len() {
-                errors.push(format!(
-                    "chain {ci}: stretch rule {} does not exist",
-                    chain.rule
-                ));
-            }
-            if chain.instances.iter().any(|&i| i >= d.instances.len()) {
-                errors.push(format!("chain {ci}: instance index out of range"));
-            }
-        }
-        for (pi, part) in d.parts.iter().enumerate() {
-            let m = part.vertices.len();
-            if part.vertices.iter().any(|&v| v >= n) {
-                errors.push(format!("part {pi}: vertex index out of range"));
-            }
-            if part
-                .edges
-                .iter()
-                .any(|e| e[0] >= m || e[1] >= m || e[0] == e[1])
-            {
-                errors.push(format!("part {pi}: edge index out of range or a loop"));
-            }
-            if part.states.is_empty() {
-                errors.push(format!("part {pi}: no rest state"));
-            }
-            if part.active >= part.states.len().max(1) {
-                errors.push(format!(
-                    "part {pi}: active state {} out of range",
-                    part.active
-                ));
-            }
-            for s in &part.states {
-                if s.positions.len() != m {
-                    errors.push(format!(
-                        "part {pi}: state `{}` has {} positions for {m} vertices",
-                        s.name,
-                        s.positions.len()
-                    ));
-                }
-                if s.positions.iter().any(|p| !p.is_finite()) {
-                    errors.push(format!(
-                        "part {pi}: state `{}` has a non-finite position",
-                        s.name
-                    ));
-                }
-            }
-            match part.kind {
-                PartKind::Piece { instance } if instance >= d.instances.len() => {
-                    errors.push(format!("part {pi}: instance {instance} does not exist"));
-                }
-                PartKind::Stretch { chain, first }
-                    if d.chains
-                        .get(chain)
-                        .is_none_or(|c| first + 1 >= c.instances.len()) =>
-                {
-                    errors.push(format!(
-                        "part {pi}: chain {chain} has no elements {first}, {}",
-                        first + 1
-                    ));
-                }
-                _ => {}
-            }
-        }
+        let mut errors = d.problems(&self.grammar);
         if self.rotations.len() != d.parts.len() {
             errors.push(format!(
                 "{} rotations for {} parts (topology_changed not called?)",

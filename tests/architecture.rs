@@ -954,3 +954,57 @@ fn no_source_file_is_over_900_lines_outside_its_tests() {
     }
     assert!(long.is_empty(), "over 900 lines outside tests: {long:#?}");
 }
+
+/// Architecture Invariant: every file Clay reads goes through `clay_dsl::read_input` (or its
+/// `regular_file` check before a bounded `take`), which refuses named pipes and devices before
+/// opening them and stops at a limit: no input blocks a program or eats its memory (issue 47:
+/// `clayc check /dev/zero` reached 11.5 GB; a FIFO as the editor's grammar froze its window).
+/// Files' code outside their tests is read.
+#[test]
+fn every_file_is_read_through_the_one_bounded_reader() {
+    let mut files = Vec::new();
+    for dir in ["src", "dsl/src", "editor/src", "cli/src", "python/src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    assert!(files.len() > 100, "only {} files read", files.len());
+    let readers = [
+        "fs::read(",
+        "fs::read_to_string(",
+        "File::open(",
+        "read_to_end(",
+        "read_to_string(&mut",
+    ];
+    // the reader itself, and the loaders that check `regular_file` before a bounded `take`
+    let home = ["dsl/src/input.rs", "dsl/src/compile/imports.rs"];
+    // reads that are no user's file: a folder opened to make a rename durable, and the
+    // language server's message body (bounded by its Content-Length, itself bounded)
+    let known = [
+        ("src/files.rs", "fs::File::open(&dir)"),
+        ("cli/src/lsp/transport.rs", ".take(n as u64).read_to_end("),
+    ];
+    let mut unbounded = Vec::new();
+    for f in files {
+        let name = shown(&f);
+        if home.contains(&name.as_str()) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let code = (lines.windows(2))
+            .position(|w| w[0] == "#[cfg(test)]" && w[1].starts_with("mod "))
+            .unwrap_or(lines.len());
+        for (n, line) in lines[..code].iter().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            let exempt = known.iter().any(|(f, s)| *f == name && code.contains(s));
+            if let Some(r) = readers.iter().find(|r| code.contains(*r))
+                && !exempt
+            {
+                unbounded.push(format!("{name}:{}: `{r}`", n + 1));
+            }
+        }
+    }
+    assert!(
+        unbounded.is_empty(),
+        "read without clay_dsl::read_input: {unbounded:#?}"
+    );
+}

@@ -1,6 +1,7 @@
 //! The fuzzer the project keeps (issue 37): seeded in-process mutation of every example and
 //! fixture grammar and script, fed to the grammar parser, compiler, formatter and editor
-//! analysis and to the script parser. Properties: no panic; no input that takes longer than
+//! analysis and to the script parser; and of every example's compiled grammar (`clayc
+//! build`'s JSON, issue 47), fed to what `render` and `export` do with one. Properties: no panic; no input that takes longer than
 //! `HANG` (a hang guard, not a speed bound: a case takes milliseconds); every grammar diagnostic
 //! on char boundaries of its file with a 1-based line and column, and rendered; `fmt`
 //! idempotent and meaning-preserving. `CLAY_FUZZ_CASES=N` runs N cases (default 10,000),
@@ -113,4 +114,167 @@ fn scripts_mutated_never_panic_or_hang() {
         "{\"steps\": [{\"drag\": {\"by\": [1e308, -1e308], \"frames\": 18446744073709551615}}]}",
     ];
     fuzz("script", corpus("json", &found), script);
+}
+
+/// The compiled grammars of every example, as `clayc build` writes them.
+fn compiled_corpus() -> Vec<Vec<u8>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    files_under(&root.join("grammars"), "clay", &mut files);
+    files.sort();
+    files
+        .iter()
+        .filter_map(|f| {
+            let text = std::fs::read_to_string(f).ok()?;
+            let compiled =
+                clay_dsl::compile_with(&text, &f.display().to_string(), &clay_dsl::FsLoader)
+                    .ok()?;
+            serde_json::to_vec_pretty(&compiled.grammar).ok()
+        })
+        .collect()
+}
+
+/// One mutation of a compiled grammar's JSON: a few numbers in it replaced (an index one off,
+/// zero, large, negative, not whole, huge) or an array's item dropped or doubled, anywhere in
+/// the tree; a mutant that is not JSON is the plain byte mutation's.
+fn mutate_json(
+    rng: &mut proptest::test_runner::TestRng,
+    input: &[u8],
+    corpus: &[Vec<u8>],
+) -> Vec<u8> {
+    use proptest::prelude::RngExt;
+    let Ok(mut value) = serde_json::from_slice::<serde_json::Value>(input) else {
+        return fuzzing::mutate(rng, input, corpus);
+    };
+    for _ in 0..rng.random_range(1..=3) {
+        let mut slots = Vec::new();
+        collect(&mut value, &mut slots);
+        if slots.is_empty() {
+            break;
+        }
+        let pick = rng.random_range(0..slots.len());
+        let slot: &mut serde_json::Value = at_path(&mut value, &slots[pick]);
+        match (slot, rng.random_range(0..8)) {
+            (serde_json::Value::Array(a), k) if k < 2 && !a.is_empty() => {
+                let i = rng.random_range(0..a.len());
+                if k == 0 {
+                    a.remove(i);
+                } else {
+                    let copy = a[i].clone();
+                    a.insert(i, copy);
+                }
+            }
+            (slot @ serde_json::Value::Number(_), k) => {
+                let old = slot.as_f64().unwrap_or(0.0);
+                *slot = serde_json::json!(match k {
+                    0 => old + 1.0,
+                    1 => old - 1.0,
+                    2 => 0.0,
+                    3 => 1e9,
+                    4 => -1.0,
+                    5 => old + 0.5,
+                    6 => 1e308,
+                    _ => old * 1000.0,
+                });
+            }
+            _ => {}
+        }
+    }
+    serde_json::to_vec(&value).unwrap_or_default()
+}
+
+/// The paths (object keys and array indices) to every number and array of `value`.
+fn collect(value: &mut serde_json::Value, out: &mut Vec<Vec<PathStep>>) {
+    fn walk(v: &serde_json::Value, at: &mut Vec<PathStep>, out: &mut Vec<Vec<PathStep>>) {
+        match v {
+            serde_json::Value::Number(_) => out.push(at.clone()),
+            serde_json::Value::Array(a) => {
+                out.push(at.clone());
+                for (i, x) in a.iter().enumerate() {
+                    at.push(PathStep::Index(i));
+                    walk(x, at, out);
+                    at.pop();
+                }
+            }
+            serde_json::Value::Object(o) => {
+                for (k, x) in o {
+                    at.push(PathStep::Key(k.clone()));
+                    walk(x, at, out);
+                    at.pop();
+                }
+            }
+            _ => {}
+        }
+    }
+    walk(value, &mut Vec::new(), out);
+}
+
+#[derive(Clone, Debug)]
+enum PathStep {
+    Key(String),
+    Index(usize),
+}
+
+/// The value at `path` in `value`.
+fn at_path<'a>(value: &'a mut serde_json::Value, path: &[PathStep]) -> &'a mut serde_json::Value {
+    let mut v = value;
+    for step in path {
+        v = match step {
+            PathStep::Key(k) => &mut v[k.as_str()],
+            PathStep::Index(i) => &mut v[*i],
+        };
+    }
+    v
+}
+
+/// What `clayc render` and `clayc export` do with a compiled grammar they read: refuse it with
+/// its problems, or build its model, sculpt it a few frames, draw it and export it, without
+/// panicking and without a non-finite number in a file.
+fn compiled(input: &[u8]) -> Result<(), String> {
+    let Ok(grammar) = serde_json::from_slice::<clay_dsl::CompiledGrammar>(input) else {
+        return Ok(());
+    };
+    if !grammar.problems().is_empty() {
+        return Ok(());
+    }
+    USED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let grammar = std::sync::Arc::new(grammar);
+    let mut asm = clay::Assembly::new(grammar.clone());
+    let mut session = clay::Session::new(clay::SolverConfig::from_params(&grammar.solver));
+    let script = clay::Script::parse(
+        r#"{"steps": [{"grab": {"extreme": "east"}}, {"drag": {"by": [1, 0.5], "frames": 3}}, {"hold": {"frames": 2}}]}"#,
+    )
+    .map_err(|e| e.to_string())?;
+    let _ = clay::replay(&mut asm, &script, &mut session);
+    let options = clay::RenderOptions {
+        width: 64,
+        height: 48,
+        ..Default::default()
+    };
+    let _ = clay::render_png(&grammar, asm.data(), &options);
+    let scene = clay::scene(&grammar, asm.data(), &Default::default());
+    let glb = clay::to_glb(&scene)?;
+    let (obj, _) = clay::to_obj(&scene, "fuzz.mtl");
+    if obj.contains("NaN") || obj.contains("inf") {
+        return Err("the OBJ export has a non-finite number".into());
+    }
+    let _ = glb;
+    Ok(())
+}
+
+/// How many mutants passed the checks and were sculpted, drawn and exported.
+static USED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+#[test]
+fn compiled_grammars_mutated_never_panic() {
+    let corpus = compiled_corpus();
+    assert!(corpus.len() >= 5, "every example builds");
+    let cases = fuzzing::cases_or(10_000);
+    fuzzing::fuzz_cases("compiled grammar", cases, corpus, mutate_json, compiled);
+    // the mutants must reach the code behind the checks, not only be refused by them
+    let used = USED.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(
+        used * 10 >= cases,
+        "only {used} of {cases} mutants passed the checks"
+    );
 }

@@ -175,7 +175,7 @@ pub fn author_cmd(args: AuthorArgs) -> u8 {
         }
     };
     let path = args.drawing.display().to_string();
-    let svg = match std::fs::read_to_string(&args.drawing) {
+    let svg = match clay_dsl::read_input_string(&args.drawing, clay_dsl::MAX_SOURCE_BYTES) {
         Ok(t) => t,
         Err(e) => {
             errln!("error: cannot read `{path}`: {e}");

@@ -96,7 +96,7 @@ impl Unreadable {
 
 /// The file's bytes, or why they cannot be had.
 pub fn read(path: &Path) -> Result<Vec<u8>, Unreadable> {
-    std::fs::read(path).map_err(|e| {
+    clay_dsl::read_input(path, clay_dsl::MAX_SOURCE_BYTES).map_err(|e| {
         let (why, hint) = match e.kind() {
             std::io::ErrorKind::NotFound => (
                 "no such file".to_string(),

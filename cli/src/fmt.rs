@@ -2,7 +2,6 @@
 //! `--write` rewrites them in place (temp file, then rename), or with `--check` lists the files
 //! that would change. Exit codes: 0 fine, 1 a file would change or does not parse, 2 I/O.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::out;
@@ -22,11 +21,9 @@ pub struct FmtArgs {
 
 fn read(path: &Path) -> std::io::Result<Vec<u8>> {
     if path.as_os_str() == "-" {
-        let mut bytes = Vec::new();
-        std::io::stdin().read_to_end(&mut bytes)?;
-        Ok(bytes)
+        clay_dsl::read_bounded(std::io::stdin(), clay_dsl::MAX_SOURCE_BYTES)
     } else {
-        std::fs::read(path)
+        clay_dsl::read_input(path, clay_dsl::MAX_SOURCE_BYTES)
     }
 }
 

@@ -83,13 +83,14 @@ pub fn load(path: &Path, params: &ParamArgs, settings: &[(&str, &str)]) -> Resul
         }
     })?;
     let grammar_file = grammar_path(path, &saved.grammar);
-    let source = std::fs::read_to_string(&grammar_file).map_err(|e| {
-        errln!(
-            "error: {shown}: cannot read the session's grammar {}: {e}",
-            grammar_file.display()
-        );
-        IO_ERROR
-    })?;
+    let source =
+        clay_dsl::read_input_string(&grammar_file, clay_dsl::MAX_SOURCE_BYTES).map_err(|e| {
+            errln!(
+                "error: {shown}: cannot read the session's grammar {}: {e}",
+                grammar_file.display()
+            );
+            IO_ERROR
+        })?;
     // The parameters the session was saved with, then `--param`'s (the last value counts).
     let params = crate::params::ParamArgs {
         params: saved

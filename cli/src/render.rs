@@ -103,14 +103,19 @@ use crate::out::IO_ERROR;
 /// gives the exit code. A compiled grammar (.json) has its parameters' values already: giving
 /// it `--param` is a usage error.
 pub(crate) fn load(path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u8> {
-    let source = std::fs::read_to_string(path).map_err(|e| {
+    let json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let limit = if json {
+        clay_dsl::MAX_DATA_BYTES
+    } else {
+        clay_dsl::MAX_SOURCE_BYTES
+    };
+    let source = clay_dsl::read_input_string(path, limit).map_err(|e| {
         errln!("error: cannot read {}: {e}", path.display());
         IO_ERROR
     })?;
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-    {
+    if json {
         if !params.is_empty() {
             errln!(
                 "error: --param sets the parameters of a grammar (.clay) as it is compiled; {} is \
@@ -119,10 +124,22 @@ pub(crate) fn load(path: &Path, params: &ParamArgs) -> Result<CompiledGrammar, u
             );
             return Err(IO_ERROR);
         }
-        return serde_json::from_str(&source).map_err(|e| {
+        let grammar: CompiledGrammar = serde_json::from_str(&source).map_err(|e| {
             errln!("error: {} is not a compiled grammar: {e}", path.display());
             INPUT_ERROR
-        });
+        })?;
+        // read back, not compiled: every index and number checked before anything uses it
+        let problems = grammar.problems();
+        if !problems.is_empty() {
+            errln!(
+                "error: {} is not a compiled grammar Clay can use:\n  {}",
+                path.display(),
+                problems.join("\n  ")
+            );
+            errln!("  = help: build it again from its .clay with `clayc build`");
+            return Err(INPUT_ERROR);
+        }
+        return Ok(grammar);
     }
     crate::params::compile(&source, path, params)
 }
@@ -158,7 +175,7 @@ pub(crate) fn sculpted(
         }
     };
     if let Some(path) = script {
-        let text = std::fs::read_to_string(path).map_err(|e| {
+        let text = clay_dsl::read_input_string(path, clay_dsl::MAX_SOURCE_BYTES).map_err(|e| {
             errln!("error: cannot read {}: {e}", path.display());
             IO_ERROR
         })?;

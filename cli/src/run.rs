@@ -43,7 +43,7 @@ fn initial(
     settings: Vec<(&str, &str)>,
 ) -> Result<(Assembly, clay::SolverConfig), u8> {
     let path = file.display().to_string();
-    let source = match std::fs::read(file) {
+    let source = match clay_dsl::read_input(file, clay_dsl::MAX_SOURCE_BYTES) {
         Ok(bytes) => bytes,
         Err(e) => {
             errln!("error: cannot read {path}: {e}");
@@ -86,7 +86,7 @@ fn initial(
 pub fn run(args: RunArgs) -> u8 {
     let script = match &args.script {
         None => Script::default(),
-        Some(p) => match std::fs::read_to_string(p) {
+        Some(p) => match clay_dsl::read_input_string(p, clay_dsl::MAX_SOURCE_BYTES) {
             Err(e) => {
                 errln!("error: cannot read script {}: {e}", p.display());
                 return 2;

@@ -387,3 +387,107 @@ fn script_errors_carry_the_steps_position() {
     assert_eq!(e.step, None);
     assert_eq!(e.position.map(|p| p.0), Some(2), "{e:?}");
 }
+
+/// Runs clayc with `args` in `dir`, and kills it if it has not ended within 60 s (a read that
+/// waits on a named pipe or never ends): the exit code (none when killed) and standard error.
+fn run_or_kill(dir: &Path, args: &[&str]) -> (Option<i32>, String) {
+    let mut child = clayc()
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut text = String::new();
+        let _ = stderr.read_to_string(&mut text);
+        text
+    });
+    let start = std::time::Instant::now();
+    let code = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status.code();
+        }
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    (code, reader.join().unwrap())
+}
+
+/// Issue 47: `clayc check /dev/zero` reached 11.5 GB in 8 s, and a grammar, script or session
+/// that is a named pipe blocked for ever. Every top-level input of every subcommand is read
+/// through one reader that refuses what is not a regular file, before opening it, and says so.
+#[cfg(unix)]
+#[test]
+fn dev_zero_and_a_named_pipe_are_refused_by_every_subcommand() {
+    let dir = scratch("special");
+    let fifo = dir.join("pipe.clay");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    let mut inputs = vec![("/dev/zero".to_string(), "a device")];
+    if made.is_ok_and(|s| s.success()) {
+        inputs.push((fifo.display().to_string(), "named pipe"));
+    }
+    let wall = wall();
+    for (input, kind) in &inputs {
+        let i = input.as_str();
+        let cases: Vec<Vec<&str>> = vec![
+            vec!["check", i],
+            vec!["fmt", i],
+            vec!["build", i, "-o", "out.json"],
+            vec!["render", i, "-o", "out.png"],
+            vec!["export", i, "-o", "out.glb"],
+            vec!["sheet", i, "-o", "sheet.png"],
+            vec!["run", i],
+            vec!["run", &wall, "--script", i],
+            vec!["render", "--session", i, "-o", "out.png"],
+            vec!["author", i, "-o", "out.clay"],
+        ];
+        for args in cases {
+            let (code, stderr) = run_or_kill(&dir, &args);
+            assert!(code.is_some(), "{args:?} did not end within 60 s");
+            assert!(
+                matches!(code, Some(1 | 2)),
+                "{args:?}: exit {code:?}: {stderr}"
+            );
+            assert!(stderr.contains(kind), "{args:?} says what it is: {stderr}");
+            assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        }
+    }
+    for out in ["out.json", "out.png", "out.glb", "sheet.png", "out.clay"] {
+        assert!(!dir.join(out).exists(), "{out} written");
+    }
+}
+
+/// The reader's limit: a grammar on standard input past 32 MiB is refused, not read on.
+#[test]
+fn fmt_of_standard_input_stops_at_the_limit() {
+    let mut child = clayc()
+        .args(["fmt", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        use std::io::Write;
+        let block = vec![b' '; 1 << 20];
+        // 40 MiB, or until clayc stops reading and closes the pipe
+        for _ in 0..40 {
+            if stdin.write_all(&block).is_err() {
+                break;
+            }
+        }
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("more than 32 MiB"), "{stderr}");
+}

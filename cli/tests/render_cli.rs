@@ -151,3 +151,43 @@ fn bad_input_and_io_give_the_documented_exit_codes() {
     assert_eq!(clayc(&["render", g, "-o", "/nonexistent/dir/x.png"]).0, 2);
     assert!(!out.exists());
 }
+
+/// Issue 47: a compiled grammar edited or corrupted after `build` (an index past its list, a
+/// height of 1e300) is refused with every problem named, before anything uses it; it does not
+/// panic `render` or `export`, and no file is written.
+#[test]
+fn a_corrupted_compiled_grammar_is_refused_with_its_problems() {
+    let dir = scratch("corrupt");
+    let png = dir.join("x.png");
+    let glb = dir.join("x.glb");
+    // the pieces' problems are named first (the model is read through them), then the model's
+    let mut pieces = grammar();
+    pieces.pieces[0].edges.push([0, 9]);
+    if let ProxyShape::Polygon { outer, .. } = &mut pieces.pieces[0].states[0].geometry[0].shape {
+        outer[1].x = 1e300;
+    }
+    let mut model = grammar();
+    model.assembly.instances[0].vertices[2] = 40;
+    for (g, names) in [(pieces, ["edge", "beyond"]), (model, ["instance", "40"])] {
+        let json = dir.join("corrupt.json");
+        std::fs::write(&json, serde_json::to_string(&g).unwrap()).unwrap();
+        let j = json.to_str().unwrap();
+        for (args, out) in [
+            (vec!["render", j, "-o", png.to_str().unwrap()], &png),
+            (vec!["export", j, "-o", glb.to_str().unwrap()], &glb),
+        ] {
+            let (code, stderr) = clayc(&args);
+            assert_eq!(code, 1, "{args:?}: {stderr}");
+            assert!(
+                stderr.contains("is not a compiled grammar Clay can use"),
+                "{stderr}"
+            );
+            for name in names {
+                assert!(stderr.contains(name), "`{name}` named: {stderr}");
+            }
+            assert!(stderr.contains("clayc build"), "a hint: {stderr}");
+            assert!(!stderr.contains("panicked"), "{stderr}");
+            assert!(!out.exists(), "{} written", out.display());
+        }
+    }
+}

@@ -270,6 +270,19 @@ fn a_session_whose_grammar_is_missing_or_does_not_fit_is_refused() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("does not fit its grammar"), "{err}");
 
+    // Positions of 1e308 (issue 47: they ran to an infinite energy with exit 0): refused,
+    // the vertex named.
+    let mut saved = session_file::read(&session).unwrap();
+    saved.assembly.instances[0].vertices[0] = asm.data().instances[0].vertices[0];
+    saved.assembly.positions[3].x = 1e308;
+    session_file::write(&session, &saved).unwrap();
+    for cmd in ["run", "export"] {
+        let out = clayc(&[cmd, "--session", shown, "-o", "-"][..if cmd == "run" { 3 } else { 5 }]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{cmd}: {err}");
+        assert!(err.contains("vertex 3 is at"), "{cmd}: {err}");
+    }
+
     // The grammar is gone: an I/O error naming it.
     std::fs::remove_file(dir.join("grammars/wall.clay")).unwrap();
     let out = clayc(&["run", "--session", shown]);

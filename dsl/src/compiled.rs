@@ -549,88 +549,115 @@ impl AssemblyData {
     }
 
     /// Checks the structural invariants every assembly keeps, whether the compiler or a rule made
-    /// it: indices in range, vertex counts matching pieces and rest states, docked sites sharing
-    /// their vertices in opposite order, chains docked `to` -> `from` element by element, every
-    /// position finite. Returns the first problem found, in words.
-    // Long because: one short check per invariant, in the order the invariants build on each other.
+    /// it ([`AssemblyData::problems`]); returns the first problem found, in words.
     pub fn check(&self, grammar: &CompiledGrammar) -> Result<(), String> {
+        match self.problems(grammar).into_iter().next() {
+            Some(problem) => Err(problem),
+            None => Ok(()),
+        }
+    }
+
+    /// Every problem of the structural invariants every assembly keeps, whether the compiler or
+    /// a rule made it, one line each: indices in range, vertex counts matching pieces and rest
+    /// states, docked sites sharing their vertices in opposite order, chains docked `to` ->
+    /// `from` element by element, every position finite. The one check of an assembly's data
+    /// (`clay::Assembly::validate` adds the live assembly's rotations and handles).
+    // Long because: one short check per invariant, in the order the invariants build on each other.
+    pub fn problems(&self, grammar: &CompiledGrammar) -> Vec<String> {
+        let mut out = Vec::new();
         let nv = self.positions.len();
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!("vertex {i} has a non-finite position"));
+        let far = crate::compile::MAX_MODEL_COORDINATE;
+        if let Some(i) =
+            (self.positions.iter()).position(|p| !p.is_finite() || p.abs().max_element() > far)
+        {
+            out.push(format!(
+                "vertex {i} is at {}, not a finite position within +/-{far:e} m",
+                self.positions[i]
+            ));
         }
         for (ii, inst) in self.instances.iter().enumerate() {
             let Some(piece) = grammar.pieces.get(inst.piece) else {
-                return Err(format!(
+                out.push(format!(
                     "instance {ii} ({}) names piece {} which does not exist",
                     inst.name, inst.piece
                 ));
+                continue;
             };
             if inst.vertices.len() != piece.vertices.len() {
-                return Err(format!(
+                out.push(format!(
                     "instance {ii} ({}) has {} vertices, piece `{}` has {}",
                     inst.name,
                     inst.vertices.len(),
                     piece.name,
                     piece.vertices.len()
                 ));
+                continue;
             }
             if let Some(&v) = inst.vertices.iter().find(|&&v| v >= nv) {
-                return Err(format!(
+                out.push(format!(
                     "instance {ii} ({}) uses vertex {v} of {nv}",
                     inst.name
                 ));
+                continue;
             }
             if inst.state >= piece.states.len() {
-                return Err(format!(
+                out.push(format!(
                     "instance {ii} ({}) is in state {} of {}",
                     inst.name,
                     inst.state,
                     piece.states.len()
                 ));
+                continue;
             }
             if inst.id >= self.next_id {
-                return Err(format!(
+                out.push(format!(
                     "instance {ii} ({}) has id {} but next_id is {}",
                     inst.name, inst.id, self.next_id
                 ));
+                continue;
             }
         }
         let mut ids: Vec<u64> = self.instances.iter().map(|i| i.id).collect();
         ids.sort_unstable();
         if ids.windows(2).any(|w| w[0] == w[1]) {
-            return Err("two instances share an id".to_string());
+            out.push("two instances share an id".to_string());
         }
         for (di, dock) in self.docks.iter().enumerate() {
             let sites = [dock.a, dock.b].map(|s| self.site_vertices(grammar, s));
             let (Some(a), Some(b)) = (&sites[0], &sites[1]) else {
-                return Err(format!(
+                out.push(format!(
                     "dock {di} names an instance or site that does not exist"
                 ));
+                continue;
             };
             if a.len() != b.len() {
-                return Err(format!(
+                out.push(format!(
                     "dock {di} joins sites of {} and {} vertices",
                     a.len(),
                     b.len()
                 ));
+                continue;
             }
             if a.iter().zip(b.iter().rev()).any(|(x, y)| x != y) {
-                return Err(format!(
+                out.push(format!(
                     "dock {di}: the docked sites do not share their vertices"
                 ));
+                continue;
             }
         }
         for (ci, chain) in self.chains.iter().enumerate() {
             let Some(rule) = grammar.stretch_rules.get(chain.rule) else {
-                return Err(format!(
+                out.push(format!(
                     "chain {ci} names stretch rule {} which does not exist",
                     chain.rule
                 ));
+                continue;
             };
             if let Some(&i) = chain.instances.iter().find(|&&i| i >= self.instances.len()) {
-                return Err(format!(
+                out.push(format!(
                     "chain {ci} names instance {i} which does not exist"
                 ));
+                continue;
             }
             for w in chain.instances.windows(2) {
                 let to = InstanceSite {
@@ -646,16 +673,18 @@ impl AssemblyData {
                     .iter()
                     .any(|d| (d.a == to && d.b == from) || (d.a == from && d.b == to));
                 if !docked {
-                    return Err(format!(
+                    out.push(format!(
                         "chain {ci}: elements {} and {} are not docked",
                         w[0], w[1]
                     ));
+                    continue;
                 }
             }
         }
         for (pi, part) in self.parts.iter().enumerate() {
             if let Some(&v) = part.vertices.iter().find(|&&v| v >= nv) {
-                return Err(format!("part {pi} uses vertex {v} of {nv}"));
+                out.push(format!("part {pi} uses vertex {v} of {nv}"));
+                continue;
             }
             if part
                 .edges
@@ -663,31 +692,45 @@ impl AssemblyData {
                 .flatten()
                 .any(|&e| e >= part.vertices.len())
             {
-                return Err(format!(
+                out.push(format!(
                     "part {pi} has an edge to a vertex it does not have"
                 ));
+                continue;
             }
             if part.active >= part.states.len() {
-                return Err(format!(
+                out.push(format!(
                     "part {pi} is in state {} of {}",
                     part.active,
                     part.states.len()
                 ));
+                continue;
             }
             if part
                 .states
                 .iter()
                 .any(|s| s.positions.len() != part.vertices.len())
             {
-                return Err(format!(
+                out.push(format!(
                     "part {pi} has a rest state with the wrong number of positions"
                 ));
+                continue;
+            }
+            if part
+                .states
+                .iter()
+                .any(|s| s.positions.iter().any(|p| !p.is_finite()))
+            {
+                out.push(format!(
+                    "part {pi} has a rest state with a non-finite position"
+                ));
+                continue;
             }
             match part.kind {
                 PartKind::Piece { instance } if instance >= self.instances.len() => {
-                    return Err(format!(
+                    out.push(format!(
                         "part {pi} covers instance {instance} which does not exist"
                     ));
+                    continue;
                 }
                 PartKind::Stretch { chain, first } => {
                     let ok = self
@@ -695,15 +738,16 @@ impl AssemblyData {
                         .get(chain)
                         .is_some_and(|c| first + 1 < c.instances.len());
                     if !ok {
-                        return Err(format!(
+                        out.push(format!(
                             "part {pi} covers chain {chain} elements {first}.. which do not exist"
                         ));
+                        continue;
                     }
                 }
                 PartKind::Piece { .. } => {}
             }
         }
-        Ok(())
+        out
     }
 
     /// The global vertices of an instance's site, in the site's order; `None` if out of range.

@@ -21,17 +21,19 @@ pub mod syntax;
 mod compile;
 mod diagnostic;
 mod format;
+mod input;
 mod line_index;
 mod parse;
 mod source_map;
 mod suggest;
+mod validate;
 
 pub use compile::{
     CompileOptions, Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH,
     MAX_IMPORT_BYTES, MAX_IMPORTS, MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES,
-    MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes,
-    compile, compile_bytes, compile_bytes_with, compile_bytes_with_options, compile_with,
-    compile_with_options, resolve_import,
+    MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_COORDINATE,
+    MAX_MODEL_INSTANCES, codes, compile, compile_bytes, compile_bytes_with,
+    compile_bytes_with_options, compile_with, compile_with_options, resolve_import,
 };
 pub use compiled::{AssemblyData, CompiledGrammar};
 pub use diagnostic::{
@@ -39,6 +41,10 @@ pub use diagnostic::{
     Severity, omitted_line, render, to_json,
 };
 pub use format::{comment_spans, format, format_number, print_file};
+pub use input::{
+    MAX_DATA_BYTES, MAX_SOURCE_BYTES, read_bounded, read_input, read_input_string, regular_file,
+    utf8,
+};
 pub use line_index::{LineIndex, LinePos};
 pub use parse::parse;
 pub use source_map::{Located, SourceFile, SourceMap, line_col};

@@ -572,7 +572,8 @@ impl Authoring {
                 "the scale must be a positive number, found {scale}"
             ));
         }
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = clay_dsl::read_input_string(path, clay_dsl::MAX_SOURCE_BYTES)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         let drawing = clay::authoring::drawing_from_svg(&text, scale)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         self.apply(AuthorCommand::SetDrawing(drawing));

@@ -138,7 +138,7 @@ pub fn compile_with_params(
 /// Reads and compiles a grammar file without touching the editor's state.
 pub fn check_grammar(path: &Path) -> Result<Compiled, Vec<Problem>> {
     let shown = path.display().to_string();
-    let source = std::fs::read_to_string(path)
+    let source = clay_dsl::read_input_string(path, clay_dsl::MAX_SOURCE_BYTES)
         .map_err(|e| vec![Problem::whole_file(&shown, format!("cannot read it: {e}"))])?;
     compile(&source, &shown)
 }
@@ -171,12 +171,14 @@ fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
             ..Problem::whole_file(path, format!("not a compiled grammar: {e}"))
         }]
     })?;
-    grammar.assembly.check(&grammar).map_err(|e| {
-        vec![Problem::whole_file(
-            path,
-            format!("the compiled grammar's model is inconsistent: {e}"),
-        )]
-    })?;
+    // read back, not compiled: every index and number checked before anything uses it
+    let problems = grammar.problems();
+    if !problems.is_empty() {
+        return Err(problems
+            .into_iter()
+            .map(|p| Problem::whole_file(path, format!("not a compiled grammar Clay can use: {p}")))
+            .collect());
+    }
     Ok(Compiled {
         grammar: Arc::new(grammar),
         warnings: Vec::new(),

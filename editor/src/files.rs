@@ -192,7 +192,7 @@ impl Recent {
     /// convenience, never a reason not to start).
     pub fn load(store: Option<&Path>) -> Self {
         store
-            .and_then(|p| std::fs::read_to_string(p).ok())
+            .and_then(|p| clay_dsl::read_input_string(p, clay_dsl::MAX_SOURCE_BYTES).ok())
             .and_then(|t| serde_json::from_str(&t).ok())
             .unwrap_or_default()
     }

@@ -18,15 +18,23 @@ pub fn os_error(e: &std::io::Error, path: &Path) -> PyErr {
         _ => e.to_string(),
     };
     let name = path.display().to_string();
-    match e.raw_os_error() {
+    // the reader's own refusals carry no errno: give a folder its own (Python's
+    // `IsADirectoryError`) and a file past the limit `EFBIG`
+    let errno = e.raw_os_error().or(match e.kind() {
+        std::io::ErrorKind::IsADirectory => Some(21),
+        std::io::ErrorKind::FileTooLarge => Some(27),
+        _ => None,
+    });
+    match errno {
         Some(errno) => PyOSError::new_err((errno, why, name)),
         None => PyOSError::new_err(format!("{name}: {why}")),
     }
 }
 
-/// Reads a file whole, or says why not as an `OSError`.
+/// Reads a grammar whole (a regular file of at most `clay_dsl::MAX_SOURCE_BYTES`: no named
+/// pipe is waited on, no `/dev/zero` read without end), or says why not as an `OSError`.
 pub fn read(path: &Path) -> PyResult<Vec<u8>> {
-    std::fs::read(path).map_err(|e| os_error(&e, path))
+    clay_dsl::read_input(path, clay_dsl::MAX_SOURCE_BYTES).map_err(|e| os_error(&e, path))
 }
 
 /// Runs library code, turning a panic (a bug) into `InternalError` instead of letting it

@@ -465,8 +465,8 @@ impl Session {
                     type_name(script)
                 ))
             })?;
-            let text =
-                std::fs::read_to_string(&path).map_err(|e| os_error(&e, Path::new(&path)))?;
+            let text = clay_dsl::read_input_string(Path::new(&path), clay_dsl::MAX_SOURCE_BYTES)
+                .map_err(|e| os_error(&e, Path::new(&path)))?;
             (text, path)
         };
         let script = Script::parse(&text).map_err(|e| {

@@ -3,6 +3,7 @@ diagnostics, errors, parameters, arrays, exports and pictures."""
 
 import json
 import math
+import os
 import struct
 import subprocess
 from pathlib import Path
@@ -150,6 +151,21 @@ def test_a_missing_grammar_is_file_not_found(tmp_path):
         clay.check(missing)
     with pytest.raises(IsADirectoryError):
         clay.Grammar.open(tmp_path)
+
+
+def test_a_device_or_a_named_pipe_is_refused_before_it_is_read(tmp_path, grammars):
+    # issue 47: Grammar.open('/dev/zero') grew to 23.9 GB before the kernel killed it
+    with pytest.raises(OSError, match="not a regular file but a device"):
+        clay.Grammar.open("/dev/zero")
+    with pytest.raises(OSError, match="a device"):
+        clay.check("/dev/zero")
+    fifo = tmp_path / "pipe.clay"
+    os.mkfifo(fifo)
+    with pytest.raises(OSError, match="named pipe"):
+        clay.Grammar.open(fifo)
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    with pytest.raises(OSError, match="named pipe"):
+        s.run_script(fifo)
 
 
 def test_a_path_must_be_a_path():

@@ -6,7 +6,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -150,9 +149,11 @@ pub fn parse(text: &str) -> Result<Session, SessionError> {
 
 /// Reads and parses a session file.
 pub fn read(path: &Path) -> Result<Session, SessionError> {
-    let text = fs::read_to_string(path).map_err(|error| SessionError::Io {
-        path: path.to_path_buf(),
-        error,
+    let text = clay_dsl::read_input_string(path, clay_dsl::MAX_DATA_BYTES).map_err(|error| {
+        SessionError::Io {
+            path: path.to_path_buf(),
+            error,
+        }
     })?;
     parse(&text)
 }
@@ -170,6 +171,7 @@ pub fn write(path: &Path, session: &Session) -> Result<(), SessionError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     fn assembly() -> AssemblyData {
         let source = "site type s\npiece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \

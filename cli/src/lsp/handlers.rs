@@ -135,7 +135,11 @@ pub fn declaration(docs: &Docs, focus: &Focus) -> Option<lsp::Location> {
             return open.location(uri, a, span);
         }
     }
-    let text = std::fs::read_to_string(&focus.file).ok()?;
+    let text = clay_dsl::read_input_string(
+        std::path::Path::new(&focus.file),
+        clay_dsl::MAX_SOURCE_BYTES,
+    )
+    .ok()?;
     let a = Analysis::new(&text, &focus.file);
     let span = a.declaration_of(focus)?;
     open.location(&convert::file_uri(&focus.file)?, &a, span)

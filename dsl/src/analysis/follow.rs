@@ -56,8 +56,8 @@ pub fn write(dir: &Path, name: &str, focus: &Focus) -> std::io::Result<()> {
 
 /// The focus in the file at `path`, if it holds one (a named pipe there is not waited on).
 pub fn read(path: &Path) -> Option<Focus> {
-    crate::compile::regular_file(path).ok()?;
-    serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+    let bytes = crate::input::read_input(path, crate::input::MAX_SOURCE_BYTES).ok()?;
+    serde_json::from_slice(&bytes).ok()
 }
 
 impl Analysis {

@@ -21,7 +21,7 @@ use crate::syntax::{self, ImportDecl, Item, Span};
 /// Most files one compilation may import (all levels together).
 pub const MAX_IMPORTS: usize = 256;
 /// Most bytes the imported files may have together (32 MiB).
-pub const MAX_IMPORT_BYTES: usize = 32 << 20;
+pub const MAX_IMPORT_BYTES: usize = crate::input::MAX_SOURCE_BYTES;
 
 /// Where imported files come from. `path` is already resolved against the importing file's
 /// folder (`grammars/lib/roads.clay` for `import "lib/roads.clay"` in `grammars/town.clay`).
@@ -37,50 +37,15 @@ pub struct FsLoader;
 
 impl Loader for FsLoader {
     fn load(&self, path: &str) -> std::io::Result<Vec<u8>> {
-        regular_file(Path::new(path))?;
+        // the limit and a byte more, without error: a longer file is too large, reported at
+        // its import with the others' sizes
+        crate::input::regular_file(Path::new(path))?;
         let mut bytes = Vec::new();
         std::fs::File::open(path)?
             .take(MAX_IMPORT_BYTES as u64 + 1)
             .read_to_end(&mut bytes)?;
         Ok(bytes)
     }
-}
-
-/// Refuses, before it is opened, a path (symbolic links followed) that is not a regular file:
-/// opening a named pipe waits for a writer, forever if none comes, and a device may never end.
-/// A folder is `IsADirectory`, anything else `InvalidInput` saying what it is.
-pub(crate) fn regular_file(path: &Path) -> std::io::Result<()> {
-    let kind = std::fs::metadata(path)?.file_type();
-    if kind.is_file() {
-        Ok(())
-    } else if kind.is_dir() {
-        Err(std::io::Error::new(
-            std::io::ErrorKind::IsADirectory,
-            "it is a folder, not a file",
-        ))
-    } else {
-        Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!("it is not a regular file but {}", special_kind(&kind)),
-        ))
-    }
-}
-
-/// What a file that is neither a regular file nor a folder is, in words.
-fn special_kind(kind: &std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return "a named pipe (FIFO)";
-        } else if kind.is_socket() {
-            return "a socket";
-        } else if kind.is_char_device() || kind.is_block_device() {
-            return "a device";
-        }
-    }
-    let _ = kind;
-    "a special file"
 }
 
 /// The path of `import "target"` written in the file `importer`: relative to the importer's

@@ -6,7 +6,7 @@
 
 pub mod codes;
 
-mod limits;
+pub(crate) mod limits;
 mod state;
 
 mod assembly;
@@ -32,9 +32,8 @@ use crate::suggest::closest;
 use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
 pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
-pub(crate) use imports::regular_file;
 pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
-pub use limits::{MAX_COORDINATE, MAX_INSTANCES, MAX_MODEL_INSTANCES};
+pub use limits::{MAX_COORDINATE, MAX_INSTANCES, MAX_MODEL_COORDINATE, MAX_MODEL_INSTANCES};
 pub use meshes::{MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 use state::Compiler;
 use state::{Constants, Inheritance, Meshes};

@@ -26,11 +26,12 @@ pub(super) struct LoadedSession {
 pub(super) fn load_session(path: &Path) -> Result<LoadedSession, String> {
     let s = session::read(path).map_err(|e| e.to_string())?;
     let grammar_path = PathBuf::from(&s.grammar);
-    let (source, file) = match std::fs::read_to_string(&grammar_path) {
-        Ok(text) => (text, Some(grammar_path.clone())),
-        Err(_) if s.grammar == CASTLE_PATH => (CASTLE_SOURCE.to_string(), None),
-        Err(e) => return Err(format!("the session's grammar {}: {e}", s.grammar)),
-    };
+    let (source, file) =
+        match clay_dsl::read_input_string(&grammar_path, clay_dsl::MAX_SOURCE_BYTES) {
+            Ok(text) => (text, Some(grammar_path.clone())),
+            Err(_) if s.grammar == CASTLE_PATH => (CASTLE_SOURCE.to_string(), None),
+            Err(e) => return Err(format!("the session's grammar {}: {e}", s.grammar)),
+        };
     // The parameters as set when it was saved, so the assembly fits the grammar it was made
     // with.
     let params: Vec<(String, f64)> = s.params.into_iter().collect();

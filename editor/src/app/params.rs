@@ -86,7 +86,7 @@ impl EditorApp {
         let (source, shown) = match path {
             Some(p) => {
                 let shown = p.display().to_string();
-                match std::fs::read_to_string(p) {
+                match clay_dsl::read_input_string(p, clay_dsl::MAX_SOURCE_BYTES) {
                     Ok(t) => (t, shown),
                     Err(e) => {
                         return Err(vec![Problem::whole_file(

@@ -105,7 +105,10 @@ impl EditorApp {
     /// Shows a problem's line in the source view (the file read again: the text is the one on
     /// disk now, which is what the user will edit).
     pub fn show_source(&mut self, p: &Problem) {
-        let text = match std::fs::read_to_string(&p.file) {
+        let text = match clay_dsl::read_input_string(
+            std::path::Path::new(&p.file),
+            clay_dsl::MAX_SOURCE_BYTES,
+        ) {
             Ok(t) => t,
             Err(_) if p.file == CASTLE_PATH => CASTLE_SOURCE.to_string(),
             Err(e) => {
