@@ -464,8 +464,9 @@ fn a_comment_after_any_token_keeps_fmt_idempotent() {
             tried += 1;
             let twice = format(&once).unwrap();
             if once != twice {
-                let (a, b) = (once.lines(), twice.lines());
-                let at = a.zip(b).position(|(x, y)| x != y).unwrap_or(0);
+                let at = (once.lines().zip(twice.lines()))
+                    .position(|(x, y)| x != y)
+                    .unwrap_or(0);
                 panic!(
                     "{path}: a comment at byte {i} ({:?}): not idempotent from line {}:\n{}\n---\n{}",
                     String::from_utf8_lossy(&b[i.saturating_sub(30)..i]),
