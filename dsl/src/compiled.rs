@@ -12,6 +12,12 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+/// Largest absolute position a model's vertex may have when it is read back (a session, a
+/// compiled grammar): gestures stay within the +/-1e9 m of grammars and scripts, a model
+/// sculpted by them stays well inside this, and the solver's squared distances stay far from
+/// overflow (issue 47: a session's positions of 1e308 ran to an infinite energy).
+pub const MAX_MODEL_COORDINATE: f64 = 1e12;
+
 /// Bumped whenever the JSON form changes incompatibly.
 pub const FORMAT_VERSION: u32 = 1;
 
@@ -566,7 +572,7 @@ impl AssemblyData {
     pub fn problems(&self, grammar: &CompiledGrammar) -> Vec<String> {
         let mut out = Vec::new();
         let nv = self.positions.len();
-        let far = crate::compile::MAX_MODEL_COORDINATE;
+        let far = MAX_MODEL_COORDINATE;
         if let Some(i) =
             (self.positions.iter()).position(|p| !p.is_finite() || p.abs().max_element() > far)
         {

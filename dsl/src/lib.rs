@@ -29,13 +29,13 @@ mod suggest;
 mod validate;
 
 pub use compile::{
-    CompileOptions, Compiled, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH,
+    CompileOptions, Compiled, DOCK_TOLERANCE, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH,
     MAX_IMPORT_BYTES, MAX_IMPORTS, MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES,
-    MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_COORDINATE,
-    MAX_MODEL_INSTANCES, codes, compile, compile_bytes, compile_bytes_with,
-    compile_bytes_with_options, compile_with, compile_with_options, resolve_import,
+    MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes,
+    compile, compile_bytes, compile_bytes_with, compile_bytes_with_options, compile_with,
+    compile_with_options, resolve_import,
 };
-pub use compiled::{AssemblyData, CompiledGrammar};
+pub use compiled::{AssemblyData, CompiledGrammar, MAX_MODEL_COORDINATE};
 pub use diagnostic::{
     Diagnostic, Diagnostics, JsonDiagnostic, JsonLabel, JsonPos, Label, MAX_HUMAN_DIAGNOSTICS,
     Severity, omitted_line, render, to_json,

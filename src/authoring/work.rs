@@ -510,7 +510,8 @@ fn reference_edges(
 }
 
 /// How piece `v` can be written as a variant of piece `p` (E041: the same vertices in the same
-/// order, the same edges and sites): `map[i]` is `p`'s vertex for `v`'s vertex `i`. The library
+/// order and the same places, the same edges and sites; a variant differs only in its proxy
+/// geometry, as the chain is solved in `p`'s shape): `map[i]` is `p`'s vertex for `v`'s vertex `i`. The library
 /// numbers each piece's vertices by its own geometry, so the editor matches them through the
 /// site names and the edges, and writes the variant with `p`'s graph and its own positions.
 pub fn variant_map(design: &Design, p: usize, v: usize) -> Result<Vec<usize>, String> {
@@ -599,6 +600,17 @@ pub fn variant_map(design: &Design, p: usize, v: usize) -> Result<Vec<usize>, St
     mapped.sort_unstable();
     if mapped != ea {
         return Err(other_edges());
+    }
+    // E041: in place, vertex for vertex (a 1.2 m piece among 1 m ones would be solved 1 m
+    // long, and its chain would shrink without being touched)
+    let moved = (b.positions.iter().enumerate())
+        .find(|&(i, q)| q.distance(a.positions[map[i]]) > clay_dsl::DOCK_TOLERANCE);
+    if let Some((i, q)) = moved {
+        return Err(format!(
+            "`{}` has a vertex at ({:.4}, {:.4}) where `{}` has it at ({:.4}, {:.4}): a variant \
+             differs only in its proxy geometry",
+            b.name, q.x, q.y, a.name, a.positions[map[i]].x, a.positions[map[i]].y
+        ));
     }
     Ok(map)
 }

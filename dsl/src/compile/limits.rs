@@ -3,11 +3,6 @@
 
 /// Largest absolute coordinate accepted, in metres; keeps every later computation finite.
 pub const MAX_COORDINATE: f64 = 1e9;
-/// Largest absolute position a model's vertex may have when it is read back (a session, a
-/// compiled grammar): gestures stay within [`MAX_COORDINATE`], and a model sculpted by them
-/// stays well inside this, while the solver's squared distances stay far from overflow (issue
-/// 47: a session's positions of 1e308 ran to an infinite energy).
-pub const MAX_MODEL_COORDINATE: f64 = 1e12;
 /// Largest `extrude` height or base, in metres (the tallest building is under 1 km).
 pub const MAX_HEIGHT: f64 = 10_000.0;
 /// Most instances a model may grow to while it is sculpted (the stretch rule inserts no more).

@@ -33,7 +33,7 @@ use crate::syntax::{self, Expr, Ident, Item, PieceStmt, Point, Span};
 
 pub use extends::{MAX_EXTENDS_DEPTH, MAX_INHERITED};
 pub use imports::{FsLoader, Loader, MAX_IMPORT_BYTES, MAX_IMPORTS, resolve as resolve_import};
-pub use limits::{MAX_COORDINATE, MAX_INSTANCES, MAX_MODEL_COORDINATE, MAX_MODEL_INSTANCES};
+pub use limits::{DOCK_TOLERANCE, MAX_COORDINATE, MAX_INSTANCES, MAX_MODEL_INSTANCES};
 pub use meshes::{MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 use state::Compiler;
 use state::{Constants, Inheritance, Meshes};
