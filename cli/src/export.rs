@@ -94,13 +94,12 @@ pub fn export(args: ExportArgs) -> u8 {
                 .file_name()
                 .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
             let (obj_text, mtl_text) = clay::to_obj(&scene, &mtl_name);
-            if !to_stdout {
-                let code = write_output(&mtl_path, mtl_text.as_bytes());
-                if code != 0 {
-                    return code;
-                }
+            // the .obj first: a failed export leaves the .mtl beside it as it was (issue 47)
+            let code = write_output(&args.output, obj_text.as_bytes());
+            if code != 0 || to_stdout {
+                return code;
             }
-            Ok(obj_text.into_bytes())
+            return write_output(&mtl_path, mtl_text.as_bytes());
         }
     };
     match bytes {

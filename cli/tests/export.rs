@@ -32,3 +32,31 @@ fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
     assert!(!dir.join("wall.fbx").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 47: an OBJ export that failed (its .obj could not be written) still replaced the
+/// .mtl beside it. The .obj is written first; when it fails, the .mtl stays as it was.
+#[test]
+fn a_failed_obj_export_leaves_its_mtl_as_it_was() {
+    let dir = std::env::temp_dir().join(format!("clay-export-mtl-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    // a folder where the .obj should go: it cannot be replaced by a file
+    std::fs::create_dir_all(dir.join("model.obj")).unwrap();
+    std::fs::write(dir.join("model.mtl"), "the user's materials\n").unwrap();
+    let wall = format!("{}/../grammars/wall.clay", env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("model.obj"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("model.mtl")).unwrap(),
+        "the user's materials\n"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
