@@ -297,25 +297,41 @@ impl Script {
             });
         }
         let doc: Value = serde_json::from_str(json).map_err(json_error)?;
-        let whole = |message: String| ScriptError {
+        // an error about the document is placed where it is: its first token, or the key or
+        // value it is about (issue 47: they had no line and column)
+        let keys = top_level_keys(json);
+        let start = json.len() - json.trim_start().len();
+        let whole = |message: String, at: usize| ScriptError {
             step: None,
             message,
-            position: None,
+            position: Some(clay_dsl::line_col(json, at)),
             hint: None,
         };
-        let obj = doc
-            .as_object()
-            .ok_or_else(|| whole("the script must be an object {\"steps\": [...]}".into()))?;
+        let obj = doc.as_object().ok_or_else(|| {
+            whole(
+                "the script must be an object {\"steps\": [...]}".into(),
+                start,
+            )
+        })?;
         if let Some(k) = obj.keys().find(|k| *k != "steps") {
-            return Err(whole(format!(
-                "unknown top-level field \"{k}\" (expected \"steps\")"
-            )));
+            let at = keys
+                .iter()
+                .find(|(name, ..)| name == k)
+                .map_or(start, |k| k.1);
+            return Err(whole(
+                format!("unknown top-level field \"{k}\" (expected \"steps\")"),
+                at,
+            ));
         }
+        let value_at = keys
+            .iter()
+            .find(|(name, ..)| name == "steps")
+            .map_or(start, |k| k.2);
         let steps = obj
             .get("steps")
-            .ok_or_else(|| whole("the script needs \"steps\": [...]".into()))?
+            .ok_or_else(|| whole("the script needs \"steps\": [...]".into(), start))?
             .as_array()
-            .ok_or_else(|| whole("\"steps\" must be an array".into()))?;
+            .ok_or_else(|| whole("\"steps\" must be an array".into(), value_at))?;
         let steps = steps
             .iter()
             .enumerate()
@@ -413,6 +429,41 @@ fn json_error(e: serde_json::Error) -> ScriptError {
 
 /// Byte offsets where the elements of the top-level `"steps"` array of valid JSON start (of the
 /// last such array, as serde_json keeps the last of repeated keys).
+/// The keys of the top-level object of `json` (valid JSON), each with the offsets of its
+/// opening quote and of its value's first byte. A key written with escapes is not recognised
+/// (its error is then placed at the document's start).
+fn top_level_keys(json: &str) -> Vec<(String, usize, usize)> {
+    let bytes = json.as_bytes();
+    let (mut keys, mut depth, mut i) = (Vec::new(), 0usize, 0usize);
+    // the last string at depth 1 and where it began, until a `:` makes it a key
+    let mut string: Option<(usize, usize)> = None;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'"' => {
+                let start = i;
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                if depth == 1 {
+                    string = Some((start, i.min(bytes.len())));
+                }
+            }
+            b':' if depth == 1 => {
+                if let Some((start, end)) = string.take() {
+                    let value = i + 1 + json[i + 1..].len() - json[i + 1..].trim_start().len();
+                    keys.push((json[start + 1..end].to_string(), start, value));
+                }
+            }
+            b'[' | b'{' => depth += 1,
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    keys
+}
+
 fn step_offsets(json: &str) -> Vec<usize> {
     let bytes = json.as_bytes();
     let (mut offsets, mut depth, mut i) = (Vec::new(), 0usize, 0usize);
@@ -519,6 +570,26 @@ mod tests {
                 e.message, "the script is empty: expected {\"steps\": [...]}",
                 "{text:?}"
             );
+        }
+    }
+
+    /// Issue 47: errors about the document as a whole had no line and column.
+    #[test]
+    fn errors_about_the_document_are_placed_at_what_they_are_about() {
+        for (text, at, message) in [
+            ("\n  [1, 2]", (2, 3), "must be an object"),
+            (
+                "{\n  \"steps\": [],\n  \"extra\": 1\n}",
+                (3, 3),
+                "\"extra\"",
+            ),
+            ("{\"é\": 0,\n \"stepz\": []}", (2, 2), "\"stepz\""),
+            ("{\n\"steps\":\n    3}", (3, 5), "must be an array"),
+            ("  {}", (1, 3), "needs \"steps\""),
+        ] {
+            let e = Script::parse(text).unwrap_err();
+            assert_eq!(e.position, Some(at), "{text:?}: {e:?}");
+            assert!(e.message.contains(message), "{text:?}: {e:?}");
         }
     }
 
