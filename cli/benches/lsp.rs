@@ -75,6 +75,34 @@ fn bench(c: &mut Criterion) {
         b.iter(|| clay_dsl::compile(&valid, "wall3000.clay").is_ok())
     });
     g.finish();
+
+    // Issue 47: the semantic tokens of one 200 KB line (a polygon of 12,000 points written on
+    // one line, with a non-ASCII comment before it) took 29 s while positions were counted
+    // from the line's start; counted from the line index's marks they cost their distance.
+    let long = long_line_grammar();
+    assert!(long.len() > 200_000);
+    let a = Analysis::new(&long, "long.clay");
+    assert!(a.diagnostics().is_empty(), "{:?}", a.diagnostics());
+    let mut g = c.benchmark_group("lsp_long_line");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    g.bench_function("semantic_tokens_200kb_line", |b| {
+        b.iter(|| convert::semantic_tokens(a.line_index(), &a.semantic_tokens()).len())
+    });
+    g.finish();
+}
+
+/// A piece whose polygon's 12,000 points are on one line.
+fn long_line_grammar() -> String {
+    let mut points = String::new();
+    for k in 0..12_000 {
+        let t = k as f64 / 12_000.0 * std::f64::consts::TAU;
+        let _ = write!(points, "({:.4}, {:.4}) ", t.cos(), t.sin());
+    }
+    format!(
+        "site type joint\n\npiece disc {{\n    // a disc: é\n    vertex a (0, 0)\n    \
+         vertex b (1, 0)\n    vertex c (0, 1)\n    edges a-b-c-a\n    polygon rigid fill #888888 {{ {points}}}\n}}\n\n\
+         model {{\n    d = disc\n}}\n"
+    )
 }
 
 criterion_group!(benches, bench);
