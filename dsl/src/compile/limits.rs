@@ -3,6 +3,10 @@
 
 /// Largest absolute coordinate accepted, in metres; keeps every later computation finite.
 pub const MAX_COORDINATE: f64 = 1e9;
+/// Most known names the "did you mean" search compares misspelt names against in one
+/// compilation (about 0.2 s): the first few hundred unknown names among thousands get a
+/// suggestion, and a file of thousands of misspellings is still checked in linear time.
+pub const MAX_SUGGESTION_WORK: usize = 1_000_000;
 /// Largest `extrude` height or base, in metres (the tallest building is under 1 km).
 pub const MAX_HEIGHT: f64 = 10_000.0;
 /// Most instances a model may grow to while it is sculpted (the stretch rule inserts no more).

@@ -67,6 +67,9 @@ pub(crate) struct Compiler {
     pub consts: Constants,
     /// The decoded `mesh` assets, by the global start of their path string (meshes.rs).
     pub meshes: Meshes,
+    /// Known names the "did you mean" search may still compare against in this compilation
+    /// ([`super::limits::MAX_SUGGESTION_WORK`] at the start).
+    pub suggestion_budget: usize,
 }
 
 /// Formats a number for messages: short, no trailing zeros.
