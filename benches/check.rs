@@ -1,5 +1,5 @@
 //! Criterion benchmark of `clayc check`'s work, parse and compile (`clay_dsl::compile`), on a
-//! synthetic grammar of 10,000 pieces (`clay::testing::synthetic::grammar_text`: stretch roads, tee
+//! synthetic grammar of 10,000 pieces (`clay::synthetic::grammar_text`: stretch roads, tee
 //! junctions with merge and cut rules, bendable segments and posts with a second rest state,
 //! and a model using them all), and on one of 1,000 pieces to show how the time grows. With
 //! `CLAY_GRAMMAR=<path>` set it instead writes the 10,000-piece grammar there (to time
@@ -8,7 +8,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use clay::testing::synthetic;
+use clay::synthetic;
 use criterion::{Criterion, Throughput, criterion_group};
 
 const PIECES: usize = 10_000;

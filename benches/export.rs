@@ -8,7 +8,7 @@ use clay::{ExportOptions, scene};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn export(c: &mut Criterion) {
-    let city = clay::testing::synthetic::city(100_000);
+    let city = clay::synthetic::city(100_000);
     let options = ExportOptions::default();
     let mut group = c.benchmark_group("export 100k-part city");
     group

@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, testing::synthetic};
+use clay::{Assembly, synthetic};
 use criterion::{Criterion, criterion_group};
 use glam::DVec2;
 

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use clay::{Assembly, HandleKind, Solver, SolverConfig, SolverKind, testing::synthetic};
+use clay::{Assembly, HandleKind, Solver, SolverConfig, SolverKind, synthetic};
 use criterion::{Criterion, criterion_group};
 use glam::DVec2;
 

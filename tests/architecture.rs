@@ -472,7 +472,7 @@ fn graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
 }
 
 /// `rules::cut` -> `rules`; `clay::local` -> `clay::solver`. The test helpers behind the
-/// feature `testing` count one level down (`testing::synthetic`, `testing::gallery`): they
+/// feature `testing` count one level down (`testing::gallery`): they
 /// were top-level modules before `testing` gathered them, and they import different things.
 fn top(m: &str) -> String {
     let mut parts = m.split("::");
@@ -506,8 +506,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "session",
         &["assembly", "files", "rules", "script", "solver", "summary"],
     ),
-    // `testing::synthetic`: only the tests of `solver/chunks.rs`, which build a city.
-    ("solver", &["assembly", "fit", "testing::synthetic"]),
+    // `synthetic`: only the tests of `solver/chunks.rs`, which build a city.
+    ("solver", &["assembly", "fit", "synthetic"]),
     ("summary", &["assembly", "rules", "solver"]),
     ("testing", &["rules"]),
     (
@@ -516,7 +516,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "assembly", "export", "render", "script", "session", "solver",
         ],
     ),
-    ("testing::synthetic", &[]),
+    ("synthetic", &[]),
 ];
 
 #[test]
@@ -1062,4 +1062,35 @@ fn no_module_imports_a_whole_crate_root() {
     }
     assert!(read > 150, "only {read} files read");
     assert!(found.is_empty(), "globs of a crate root: {found:#?}");
+}
+
+/// Architecture Invariant: the shipped binaries (`clayc`, the editor, the Python module) are
+/// built without the test helpers: no `[dependencies]` entry of theirs enables `clay`'s
+/// feature `testing` (issue 47: `clayc` did, for the synthetic city its bench solves, which
+/// now lives in `clay::synthetic`).
+#[test]
+fn the_shipped_binaries_are_built_without_the_test_helpers() {
+    for manifest in ["cli/Cargo.toml", "editor/Cargo.toml", "python/Cargo.toml"] {
+        let text = std::fs::read_to_string(root().join(manifest)).unwrap();
+        let mut section = "";
+        let mut clay_seen = false;
+        for line in text.lines() {
+            let line = line.trim();
+            if line.starts_with('[') {
+                section = line;
+                continue;
+            }
+            if section == "[dependencies]"
+                && line.starts_with("clay")
+                && !line.starts_with("clay-dsl")
+            {
+                clay_seen = true;
+                assert!(
+                    !line.contains("testing"),
+                    "{manifest}: `{line}` ships the test helpers"
+                );
+            }
+        }
+        assert!(clay_seen, "{manifest}: no `clay` dependency read");
+    }
 }

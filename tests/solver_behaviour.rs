@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use clay::{
     Assembly, Compass, HandleKind, Script, Session, Solver, SolverConfig, SolverKind, replay,
-    testing::synthetic,
+    synthetic,
 };
 use glam::DVec2;
 

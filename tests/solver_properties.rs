@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, Compass, HandleKind, Solver, SolverConfig, testing::synthetic};
+use clay::{Assembly, Compass, HandleKind, Solver, SolverConfig, synthetic};
 use glam::DVec2;
 use proptest::prelude::*;
 

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, HandleKind, Solver, SolverConfig, testing::synthetic};
+use clay::{Assembly, HandleKind, Solver, SolverConfig, synthetic};
 use glam::DVec2;
 
 /// Least squares only, so the start pose's evaluation comes from the previous frame.

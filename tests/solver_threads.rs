@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, FrameReport, HandleKind, Solver, SolverConfig, testing::synthetic};
+use clay::{Assembly, FrameReport, HandleKind, Solver, SolverConfig, synthetic};
 use glam::DVec2;
 
 /// A synthetic city of about `parts` parts, pinned at one corner and dragged at the other

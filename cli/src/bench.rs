@@ -6,9 +6,7 @@
 use std::sync::Arc;
 
 use crate::out;
-use clay::{
-    Assembly, FrameReport, HandleKind, Session, SolverConfig, SolverKind, testing::synthetic,
-};
+use clay::{Assembly, FrameReport, HandleKind, Session, SolverConfig, SolverKind, synthetic};
 use glam::DVec2;
 use serde::Serialize;
 

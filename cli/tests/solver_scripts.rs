@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::sync::Arc;
 
-use clay::{Assembly, Script, Session, SolverConfig, replay, testing::synthetic};
+use clay::{Assembly, Script, Session, SolverConfig, replay, synthetic};
 use serde_json::Value;
 
 fn grammar_path(name: &str) -> String {

@@ -1,4 +1,4 @@
-//! Measures the editor's UI frame time on a large synthetic city (`clay::testing::synthetic::city`) while
+//! Measures the editor's UI frame time on a large synthetic city (`clay::synthetic::city`) while
 //! a part near one corner is dragged with the mouse, and while the settled model is redrawn
 //! idle or hovered, to check the claim that a 10k-part model still redraws at 60 frames per
 //! second (issue 6).
@@ -23,7 +23,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clay::{TessellationCache, pose_assembly, testing::synthetic};
+use clay::{TessellationCache, pose_assembly, synthetic};
 use clay_editor::EditorApp;
 use clay_editor::sculpt::Sculpt;
 use egui::epaint::Primitive;

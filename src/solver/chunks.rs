@@ -474,7 +474,7 @@ mod tests {
     /// chunk) energy bit for bit, with and without a rotation cone, on a deformed city.
     #[test]
     fn chunked_step_matches_the_reference_step() {
-        let data = crate::testing::synthetic::city(400).assembly;
+        let data = crate::synthetic::city(400).assembly;
         let n = data.positions.len();
         // a shear and a wave, so parts are rotated, strained and some switch
         let positions: Vec<DVec2> = (data.positions.iter())

@@ -4,6 +4,5 @@
 
 #[cfg(feature = "testing")]
 pub mod gallery;
-pub mod synthetic;
 
 pub use crate::rules::{cut, merge, replace, stretch};

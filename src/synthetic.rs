@@ -591,7 +591,7 @@ pub fn grammar_text(pieces: usize) -> String {
     let groups = pieces.div_ceil(4).max(1);
     let mut s = String::with_capacity(groups * 2600);
     s.push_str(
-        "// A synthetic grammar for timing the compiler (clay::testing::synthetic::grammar_text).\n\
+        "// A synthetic grammar for timing the compiler (clay::synthetic::grammar_text).\n\
          solver { merge_distance = 0.5 }\n\n\
          site type lane\nsite type side docks lane\n",
     );
