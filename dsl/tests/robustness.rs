@@ -429,3 +429,35 @@ fn the_deepest_accepted_nesting_fits_a_small_thread_stack() {
         }
     }
 }
+
+/// Issue 47: 60,000 site types took 3.56 GB (an n x n matrix of docking flags) and a scan of
+/// every type per lookup. Docking is now kept as the pairs the grammar writes: 20,000 types,
+/// every odd one docking with the next, dock as written, symmetric, the even ones with
+/// themselves too.
+#[test]
+fn twenty_thousand_site_types_dock_as_written() {
+    let n = 20_000;
+    let mut src = String::new();
+    for i in 0..n {
+        if i % 2 == 1 {
+            src += &format!("site type t{i} docks t{}\n", (i + 1) % n);
+        } else {
+            src += &format!("site type t{i}\n");
+        }
+    }
+    src += "piece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    vertex c (0, 1)\n    \
+            edges a-b-c-a\n    site s: t5 [a, b] out (0, -1)\n}\n";
+    let g = clay_dsl::compile(&src, "types.clay").unwrap().grammar;
+    assert_eq!(g.site_types.len(), n);
+    for (i, t) in g.site_types.iter().enumerate() {
+        let want: Vec<usize> = if i % 2 == 1 {
+            vec![(i + 1) % n]
+        } else {
+            // itself (no `docks`), and the odd type before it that docks with it
+            let mut v = vec![i, (i + n - 1) % n];
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(t.docks_with, want, "t{i}");
+    }
+}

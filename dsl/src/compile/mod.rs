@@ -228,6 +228,7 @@ impl Compiler {
             diags: Diagnostics::new(),
             solver: SolverParams::default(),
             site_types: Vec::new(),
+            site_type_index: HashMap::new(),
             site_type_spans: Vec::new(),
             pieces: Vec::new(),
             piece_spans: Vec::new(),
@@ -381,7 +382,7 @@ impl Compiler {
     }
 
     pub fn site_type_index(&self, name: &str) -> Option<usize> {
-        self.site_types.iter().position(|t| t.name == name)
+        self.site_type_index.get(name).copied()
     }
 
     /// Resolves a piece name, reporting it when unknown.
@@ -568,14 +569,17 @@ impl Compiler {
                 self.duplicate("site type", &d.name, self.site_type_spans[i]);
                 continue;
             }
+            (self.site_type_index).insert(d.name.name.clone(), self.site_types.len());
             self.site_types.push(SiteType {
                 name: d.name.name.clone(),
                 docks_with: Vec::new(),
             });
             self.site_type_spans.push(d.name.span);
         }
+        // which types dock with which, as sorted sets: 60,000 types made a 3.6 GB matrix of
+        // n x n flags (issue 47); the sets hold only the pairs the grammar writes
         let n = self.site_types.len();
-        let mut dock = vec![vec![false; n]; n];
+        let mut dock = vec![std::collections::BTreeSet::new(); n];
         for d in decls {
             let Some(me) = self.site_type_index(&d.name.name) else {
                 continue;
@@ -584,24 +588,25 @@ impl Compiler {
                 continue; // a duplicate, already reported
             }
             if d.docks.is_empty() {
-                dock[me][me] = true;
+                dock[me].insert(me);
             }
             for other in &d.docks {
                 match self.site_type_index(&other.name) {
                     Some(o) => {
-                        dock[me][o] = true;
-                        dock[o][me] = true;
+                        dock[me].insert(o);
+                        dock[o].insert(me);
                     }
                     None => {
-                        let names: Vec<String> =
-                            self.site_types.iter().map(|t| t.name.clone()).collect();
-                        self.unknown("site type", other, names.iter().map(String::as_str), None);
+                        // borrowed, not cloned per unknown name (`unknown` reads no type)
+                        let types = std::mem::take(&mut self.site_types);
+                        self.unknown("site type", other, types.iter().map(|t| &*t.name), None);
+                        self.site_types = types;
                     }
                 }
             }
         }
-        for (i, row) in dock.iter().enumerate() {
-            self.site_types[i].docks_with = (0..n).filter(|&j| row[j]).collect();
+        for (i, set) in dock.into_iter().enumerate() {
+            self.site_types[i].docks_with = set.into_iter().collect();
         }
     }
 

@@ -42,6 +42,8 @@ pub(crate) struct Compiler {
     pub solver: SolverParams,
     pub site_types: Vec<SiteType>,
     pub site_type_spans: Vec<Span>,
+    /// Each site type's index by name: a lookup per site, not a scan of every type.
+    pub site_type_index: HashMap<String, usize>,
     pub pieces: Vec<Piece>,
     pub piece_spans: Vec<PieceSpans>,
     pub piece_index: HashMap<String, usize>,
