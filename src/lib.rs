@@ -26,8 +26,6 @@ mod script;
 mod session;
 mod solver;
 mod summary;
-/// Generated models for `clayc bench`, the benches and the tests (a city of streets, a wall, an
-/// ARAP grid): the shipped `clayc` needs them, so they are not behind `testing`.
 pub mod synthetic;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;

@@ -3,6 +3,8 @@
 //! parts for the benchmark, and the classic ARAP triangulated grid. Each returns a
 //! [`CompiledGrammar`] whose `assembly` is the model. [`grammar_text`] instead writes a large
 //! grammar as `.clay` text, for timing the compiler.
+//!
+//! Not behind the feature `testing`: the shipped `clayc bench` solves the city.
 
 use clay_dsl::compiled::{
     AssemblyData, Binding, Chain, CompiledGrammar, Dock, ElementVertex, FORMAT_VERSION, Instance,
