@@ -50,6 +50,11 @@ fn unordered(a: u64, b: u64) -> (u64, u64) {
     (a.min(b), a.max(b))
 }
 
+/// Most rewrites of one chain that one relaxation proposal makes (each at most
+/// `stretch::MAX_GROWTH` elements): a chain grows or shrinks to its proposed count in one stop
+/// unless the proposal is more than about a thousand elements away.
+const MAX_REWRITES_PER_PROPOSAL: usize = 16;
+
 impl Rules {
     pub fn new() -> Self {
         Self::default()
@@ -180,21 +185,23 @@ impl Rules {
             })
             .collect();
         let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches, &[]);
-        // one rewrite per chain, as a frame's rules make (a stretch inserts at most
-        // `stretch::MAX_GROWTH`): the rest of a large change waits for the next stop
+        // rewrites until each chain has its count, at most `MAX_REWRITES_PER_PROPOSAL` per
+        // chain (a stretch inserts at most `stretch::MAX_GROWTH`): a proposal made far from
+        // the model's size cannot run away; the rest of such a change waits for the next stop
         for &(chain, first, count) in &proposal.counts {
-            let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) else {
-                continue;
-            };
-            let r = if count > n {
-                stretch::stretch(&grammar, asm.data_mut(), chain, first, 2 + count - n)
-            } else if count < n {
-                let elements = 2 - (n - count) as i64;
-                stretch::shrink(&grammar, asm.data_mut(), chain, first, elements, &held)
-            } else {
-                continue;
-            };
-            if let Ok(r) = r {
+            for _ in 0..MAX_REWRITES_PER_PROPOSAL {
+                let Some(n) = asm.data().chains.get(chain).map(|c| c.instances.len()) else {
+                    break;
+                };
+                let r = if count > n {
+                    stretch::stretch(&grammar, asm.data_mut(), chain, first, 2 + count - n)
+                } else if count < n {
+                    let elements = 2 - (n - count) as i64;
+                    stretch::shrink(&grammar, asm.data_mut(), chain, first, elements, &held)
+                } else {
+                    break;
+                };
+                let Ok(r) = r else { break };
                 self.carry(asm, &r);
                 events.push(r.event);
             }
