@@ -283,6 +283,19 @@ fn a_session_whose_grammar_is_missing_or_does_not_fit_is_refused() {
         assert!(err.contains("vertex 3 is at"), "{cmd}: {err}");
     }
 
+    // An instance of a piece the grammar lacks, its parts to be derived again from it: refused,
+    // without a panic.
+    let mut saved = session_file::read(&session).unwrap();
+    saved.assembly.positions[3].x = asm.data().positions[3].x;
+    saved.assembly.instances[0].piece = 99;
+    saved.assembly.parts.clear();
+    session_file::write(&session, &saved).unwrap();
+    let out = clayc(&["run", "--session", shown]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("does not fit its grammar"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+
     // The grammar is gone: an I/O error naming it.
     std::fs::remove_file(dir.join("grammars/wall.clay")).unwrap();
     let out = clayc(&["run", "--session", shown]);
