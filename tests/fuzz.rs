@@ -278,3 +278,103 @@ fn compiled_grammars_mutated_never_panic() {
         "only {used} of {cases} mutants passed the checks"
     );
 }
+
+/// The wall's grammar, compiled once: the grammar every session of the session fuzzer names.
+fn wall_grammar() -> std::sync::Arc<clay_dsl::CompiledGrammar> {
+    static WALL: std::sync::OnceLock<std::sync::Arc<clay_dsl::CompiledGrammar>> =
+        std::sync::OnceLock::new();
+    WALL.get_or_init(|| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammars/wall.clay");
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::sync::Arc::new(clay_dsl::compile(&text, "wall.clay").unwrap().grammar)
+    })
+    .clone()
+}
+
+/// Sessions of the wall: as compiled, pulled with the west end pinned, and pushed.
+fn session_corpus() -> Vec<Vec<u8>> {
+    let grammar = wall_grammar();
+    let mut out = Vec::new();
+    for by in [0.0, 4.0, -2.0] {
+        let mut asm = clay::Assembly::new(grammar.clone());
+        let mut session = clay::Session::new(clay::SolverConfig::from_params(&grammar.solver));
+        let script = clay::Script::parse(&format!(
+            r#"{{"steps": [{{"pin": {{"extreme": "west"}}}}, {{"grab": {{"extreme": "east"}}}},
+                {{"drag": {{"by": [{by}, 0.5], "frames": 10}}}}, {{"hold": {{"frames": 5}}}}]}}"#
+        ))
+        .unwrap();
+        clay::replay(&mut asm, &script, &mut session).unwrap();
+        let pins = (asm.handles().iter())
+            .filter(|h| h.kind() == clay::HandleKind::Pin)
+            .map(|h| clay::session_file::Pin {
+                vertices: h.vertices().to_vec(),
+                at: (0..h.vertices().len()).map(|k| h.target(k)).collect(),
+            })
+            .collect();
+        let saved =
+            clay::session_file::Session::new("wall.clay".into(), asm.data().clone(), pins, None);
+        out.push(serde_json::to_vec_pretty(&saved).unwrap());
+    }
+    out
+}
+
+/// What opening a session does (`clayc --session`, the editor): parse it, check its model
+/// against the grammar, rebuild the assembly, put its pins back, sculpt a few frames and
+/// draw it: a refusal is fine, a panic or a non-finite position is not.
+fn session(input: &[u8]) -> Result<(), String> {
+    let Ok(text) = std::str::from_utf8(input) else {
+        return Ok(());
+    };
+    let Ok(saved) = clay::session_file::parse(text) else {
+        return Ok(());
+    };
+    let grammar = wall_grammar();
+    if saved.assembly.check(&grammar).is_err() {
+        return Ok(());
+    }
+    let mut asm = clay::Assembly::from_data(grammar.clone(), saved.assembly);
+    for pin in saved.pins {
+        if pin.at.iter().any(|p| !p.is_finite()) {
+            return Ok(());
+        }
+        if clay::pin_at(&mut asm, pin.vertices, &pin.at).is_none() {
+            return Ok(());
+        }
+    }
+    if asm.validate().is_err() {
+        return Ok(());
+    }
+    SESSIONS_USED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let mut session = clay::Session::new(clay::SolverConfig::from_params(&grammar.solver));
+    let script = clay::Script::parse(
+        r#"{"steps": [{"grab": {"extreme": "east"}}, {"drag": {"by": [1, 0], "frames": 3}}]}"#,
+    )
+    .map_err(|e| e.to_string())?;
+    let _ = clay::replay(&mut asm, &script, &mut session);
+    if asm.data().positions.iter().any(|p| !p.is_finite()) {
+        return Err("a non-finite position after sculpting a session".into());
+    }
+    let options = clay::RenderOptions {
+        width: 64,
+        height: 48,
+        ..Default::default()
+    };
+    let _ = clay::render_png(&grammar, asm.data(), &options);
+    Ok(())
+}
+
+/// How many session mutants were opened and sculpted.
+static SESSIONS_USED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Issue 47: session files had no fuzzer. Structure-aware mutants of three sessions of the
+/// wall, through everything opening one does.
+#[test]
+fn session_files_mutated_never_panic() {
+    let cases = fuzzing::cases_or(3_000);
+    fuzzing::fuzz_cases("session", cases, session_corpus(), mutate_json, session);
+    let used = SESSIONS_USED.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(
+        used * 10 >= cases,
+        "only {used} of {cases} mutants were opened"
+    );
+}
