@@ -65,6 +65,26 @@ fn child(recovery: &Path, expected: &Path) -> ! {
     }
 }
 
+/// This test binary running only `test`, as the child editor the test kills.
+fn this_test_as_a_child(test: &str) -> Process {
+    let mut p = Process::new(std::env::current_exe().unwrap());
+    p.args([test, "--exact", "--nocapture"]);
+    p
+}
+
+/// Starts the child editor, waits until it says it sculpted, then kills it (no clean exit).
+fn kill_once_sculpted(mut child: Process) {
+    let mut editor = child.stdout(Stdio::piped()).spawn().unwrap();
+    let out = BufReader::new(editor.stdout.take().unwrap());
+    let said = out
+        .lines()
+        .map_while(Result::ok)
+        .any(|l| l.contains("sculpted"));
+    editor.kill().unwrap();
+    editor.wait().unwrap();
+    assert!(said, "the child editor sculpted");
+}
+
 #[test]
 fn a_killed_editor_is_restored_by_the_next() {
     if let Some(dir) = std::env::var_os(CHILD) {
@@ -76,24 +96,9 @@ fn a_killed_editor_is_restored_by_the_next() {
     }
     let dir = scratch("killed");
     let recovery = dir.join("recovery.clay-session");
-    let mut editor = Process::new(std::env::current_exe().unwrap())
-        .args([
-            "a_killed_editor_is_restored_by_the_next",
-            "--exact",
-            "--nocapture",
-        ])
-        .env(CHILD, &dir)
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = BufReader::new(editor.stdout.take().unwrap());
-    let said = out
-        .lines()
-        .map_while(Result::ok)
-        .any(|l| l.contains("sculpted"));
-    editor.kill().unwrap();
-    editor.wait().unwrap();
-    assert!(said, "the child editor sculpted");
+    let mut editor = this_test_as_a_child("a_killed_editor_is_restored_by_the_next");
+    editor.env(CHILD, &dir);
+    kill_once_sculpted(editor);
 
     let expected = session::read(&dir.join("expected.json")).unwrap();
     let left = std::fs::read(&recovery).expect("the killed editor left its work");
@@ -139,27 +144,13 @@ fn a_first_time_user_with_an_empty_home_is_restored() {
         child(&path, &PathBuf::from(home).join("expected.json"));
     }
     let home = scratch("first-time");
-    let mut editor = Process::new(std::env::current_exe().unwrap())
-        .args([
-            "a_first_time_user_with_an_empty_home_is_restored",
-            "--exact",
-            "--nocapture",
-        ])
+    let mut editor = this_test_as_a_child("a_first_time_user_with_an_empty_home_is_restored");
+    editor
         .env(FIRST, &home)
         .env("HOME", &home)
         .env_remove("XDG_STATE_HOME")
-        .env_remove("CLAY_RECOVERY_FILE")
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let out = BufReader::new(editor.stdout.take().unwrap());
-    let said = out
-        .lines()
-        .map_while(Result::ok)
-        .any(|l| l.contains("sculpted"));
-    editor.kill().unwrap();
-    editor.wait().unwrap();
-    assert!(said, "the child editor sculpted");
+        .env_remove("CLAY_RECOVERY_FILE");
+    kill_once_sculpted(editor);
     let folder = home.join(".local/state/clay");
     let recovery = folder.join("recovery.clay-session");
     let expected = session::read(&home.join("expected.json")).unwrap();
