@@ -42,6 +42,19 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(config(24, 25))]
+
+    /// Morph to a rest configuration (paper 4.2, 5.1): led from one rest configuration's held
+    /// poses to another's (other chain counts, other bend states) over any number of frames
+    /// and held, the model is at rest there, since a rest configuration exists; a chain whose
+    /// count the held hubs fix has it within one.
+    #[test]
+    fn sec5_1_morph_to_a_rest_configuration(m in morphs(), frames in strategy::frames()) {
+        holds(claims::morph_to_rest(&m, frames))?;
+    }
+}
+
+proptest! {
     #![proptest_config(config(16, 23))]
 
     /// Relaxation (paper 4, 5.1): released, an assembly (loops included) is at rest within

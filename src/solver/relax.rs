@@ -50,6 +50,8 @@ struct Family {
     qb: Vec<DVec2>,
     ends: StretchEnds,
     two: Vec<DVec2>,
+    /// The least and most scale of an element ([`scale_bounds`]).
+    bounds: [f64; 2],
 }
 
 impl Family {
@@ -90,6 +92,7 @@ impl Family {
             qb,
             ends,
             two: two.to_vec(),
+            bounds: [SHORTEST, f64::INFINITY],
         })
     }
 
@@ -107,13 +110,11 @@ impl Family {
 
 impl Solver {
     /// The relaxation from `warm` (the displayed pose; the handles gathered this frame), and
-    /// what it proposes (empty when it changes nothing), two alternatives. Its chains'
-    /// lengths are rounded in rounds: each round relaxes with the chains decided so far held
-    /// at their counts, then decides the chains whose lengths are nearly whole (within
-    /// [`DECIDED`] of a count) and the one nearest a whole count (with the chains in series
-    /// with it: `rounding.rs`), so that a change the relaxation spreads over chains in series
-    /// or round a loop ends whole in one of them rather than split and lost; and the first
-    /// round's lengths each rounded on their own (a loop that only closes evenly).
+    /// what it proposes (empty when it changes nothing), up to three alternatives. Its
+    /// chains' lengths are rounded in rounds (`Solver::round_counts`), twice: deciding in
+    /// each round, besides the chains nearly whole, the one nearest a whole count, and then
+    /// the one furthest from it; and the first round's lengths each rounded on their own (a
+    /// loop that only closes evenly). The session keeps the one the model rests best with.
     pub(super) fn relax(
         &mut self,
         asm: &Assembly,
@@ -121,37 +122,99 @@ impl Solver {
         deadline: Option<Instant>,
     ) -> Result<Vec<Proposal>, SolverError> {
         let data = asm.data();
-        let families: Vec<Option<Family>> = data.parts.iter().map(Family::of).collect();
-        let held = held_elements(asm);
+        let families: Vec<Option<Family>> = (data.parts.iter())
+            .map(|part| {
+                let mut family = Family::of(part)?;
+                family.bounds = scale_bounds(asm, part, family.ends.element, warm);
+                Some(family)
+            })
+            .collect();
         let hysteresis = self.config.hysteresis;
         let mut f = warm.to_vec();
-        let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
-        let series = runs(asm.grammar(), data);
-        // the first relaxation's lengths each rounded on their own: the other alternative
-        let mut at_once: Option<(Vec<Option<usize>>, Vec<DVec2>)> = None;
-        loop {
-            let fixed = fixed_scales(asm, &decided, &held);
-            self.relax_from(asm, &families, &fixed, &mut f, deadline)?;
-            if f.iter().any(|p| !p.is_finite()) {
+        let forced = self.relaxed_piece_states(asm, &families, &mut f, deadline)?;
+        let mut found: Vec<(Vec<Option<usize>>, Vec<DVec2>)> = Vec::new();
+        for pick in [Pick::Nearest, Pick::Furthest] {
+            let Some((decided, g, first)) =
+                self.round_counts(asm, &families, &forced, &f, pick, deadline)?
+            else {
                 return Ok(Vec::new());
-            }
-            let lengths = relaxed_lengths(asm, &families, &f);
-            if at_once.is_none() {
+            };
+            found.push((decided, g));
+            if pick == Pick::Nearest {
                 let mut each = vec![None; data.chains.len()];
-                for r in &lengths {
+                for r in relaxed_lengths(asm, &families, &first) {
                     each[r.chain] = Some(r.decide(hysteresis));
                 }
-                at_once = Some((each, f.clone()));
+                found.push((each, first));
             }
+        }
+        let mut alternatives: Vec<Proposal> = Vec::new();
+        for (decided, f) in found {
+            let lengths = relaxed_lengths(asm, &families, &f);
+            let counts: Vec<(usize, usize, usize)> = (lengths.iter())
+                .filter_map(|r| decided[r.chain].and_then(|want| r.towards(want)))
+                .collect();
+            let p = Proposal {
+                counts,
+                states: self.relaxed_states(&data.parts, &forced, &f),
+                pose: f,
+            };
+            if !p.is_empty()
+                && !alternatives
+                    .iter()
+                    .any(|q| q.counts == p.counts && q.states == p.states)
+            {
+                alternatives.push(p);
+            }
+        }
+        Ok(alternatives)
+    }
+
+    /// Counts for every chain, decided in rounds from the relaxation at `start`: each round
+    /// relaxes with the chains decided so far held at their counts, then decides the chains
+    /// whose lengths are nearly whole (within [`DECIDED`] of a count) and one more, the
+    /// [`Pick`] (with the chains in series with it: `rounding.rs`), so that a change the
+    /// relaxation spreads over chains in series or round a loop ends whole in one of them
+    /// rather than split and lost. Returns the counts, the last round's pose and the first
+    /// round's; `None` when the relaxation left the finite numbers.
+    fn round_counts(
+        &mut self,
+        asm: &Assembly,
+        families: &[Option<Family>],
+        forced: &[(usize, usize)],
+        start: &[DVec2],
+        pick: Pick,
+        deadline: Option<Instant>,
+    ) -> Result<Option<Rounded>, SolverError> {
+        let data = asm.data();
+        let held = held_elements(asm);
+        let hysteresis = self.config.hysteresis;
+        let series = runs(asm.grammar(), data);
+        let mut f = start.to_vec();
+        let mut first: Option<Vec<DVec2>> = None;
+        let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
+        loop {
+            let fixed = fixed_scales(asm, &decided, &held);
+            self.relax_from(asm, families, &fixed, forced, &mut f, deadline)?;
+            if f.iter().any(|p| !p.is_finite()) {
+                return Ok(None);
+            }
+            first.get_or_insert_with(|| f.clone());
+            let lengths = relaxed_lengths(asm, families, &f);
             let open: Vec<&Relaxed> = lengths
                 .iter()
                 .filter(|r| decided[r.chain].is_none())
                 .collect();
-            let Some(nearest) = open.iter().map(|r| r.doubt()).min_by(f64::total_cmp) else {
+            let doubts = open.iter().map(|r| r.doubt());
+            let Some(chosen) = (match pick {
+                Pick::Nearest => doubts.min_by(f64::total_cmp),
+                Pick::Furthest => doubts.max_by(f64::total_cmp),
+            }) else {
                 break;
             };
             for r in &open {
-                if decided[r.chain].is_some() || r.doubt() > DECIDED.max(nearest) {
+                let doubt = r.doubt();
+                if decided[r.chain].is_some() || (doubt > DECIDED && doubt != chosen) {
                     continue;
                 }
                 // a chain in series with others is decided with them (`rounding.rs`)
@@ -178,40 +241,128 @@ impl Solver {
                 break;
             }
         }
-        let mut alternatives: Vec<Proposal> = Vec::new();
-        for (decided, f) in [Some((decided, f)), at_once].into_iter().flatten() {
-            let lengths = relaxed_lengths(asm, &families, &f);
-            let counts: Vec<(usize, usize, usize)> = (lengths.iter())
-                .filter_map(|r| decided[r.chain].and_then(|want| r.towards(want)))
-                .collect();
-            let p = Proposal {
-                counts,
-                states: self.relaxed_states(&data.parts, &f),
-                pose: f,
+        let first = first.unwrap_or_else(|| f.clone());
+        Ok(Some((decided, f, first)))
+    }
+
+    /// The piece parts' states the relaxation keeps, judged by its energy, and `f` relaxed
+    /// with them (counts free). Least squares spreads a turn over every part it crosses, so
+    /// a piece part whose bent state would take the whole turn reads nearest its straight
+    /// one in the relaxed pose (a bend piece between two chains, its hubs turned 45 degrees
+    /// apart, sees 4 degrees of it). So, in up to [`STATE_ROUNDS`] rounds, the
+    /// [`STATE_TRIES`] alternative states nearest their parts' shapes are each relaxed with,
+    /// and the lowest is kept when below `(1 - hysteresis)` times the relaxation without it
+    /// (paper 4.2: a rest state is taken where it fits better, judged by energy).
+    fn relaxed_piece_states(
+        &mut self,
+        asm: &Assembly,
+        families: &[Option<Family>],
+        f: &mut Vec<DVec2>,
+        deadline: Option<Instant>,
+    ) -> Result<Vec<(usize, usize)>, SolverError> {
+        let parts = &asm.data().parts;
+        let free = vec![None; parts.len()];
+        let mut forced: Vec<(usize, usize)> = Vec::new();
+        let mut energy = self.relax_from(asm, families, &free, &forced, f, deadline)?;
+        let margin = 1.0 - self.config.hysteresis;
+        for _ in 0..STATE_ROUNDS {
+            // (relaxed objective, the states kept, the relaxed pose)
+            let mut best: Option<(f64, States, Vec<DVec2>)> = None;
+            for m in self.state_candidates(parts, &forced, f) {
+                if out_of_time(deadline, Duration::ZERO) {
+                    break;
+                }
+                let mut trial: Vec<(usize, usize)> = (forced.iter().copied())
+                    .filter(|x| m.iter().all(|y| y.0 != x.0))
+                    .collect();
+                trial.extend(&m);
+                let mut g = f.clone();
+                let e = self.relax_from(asm, families, &free, &trial, &mut g, deadline)?;
+                if e < margin * energy && best.as_ref().is_none_or(|b| e < b.0) {
+                    best = Some((e, trial, g));
+                }
+            }
+            let Some((e, trial, g)) = best else {
+                break;
             };
-            if !p.is_empty()
-                && !alternatives
-                    .iter()
-                    .any(|q| q.counts == p.counts && q.states == p.states)
+            forced = trial;
+            energy = e;
+            *f = g;
+        }
+        Ok(forced)
+    }
+
+    /// The moves a round of [`Solver::relaxed_piece_states`] tries, each a list of (piece
+    /// part, state): up to [`STATE_TRIES`] single switches of parts not yet `forced`, to
+    /// another state than the part's in the relaxation at `f`, the nearest (by the squared
+    /// shape distance the local step compares, less the current state's) first; and every
+    /// bent part back in its first state (a bend and its mirror kept on two links of a tree,
+    /// which only close together: one put back alone fits worse).
+    fn state_candidates(
+        &self,
+        parts: &[Part],
+        forced: &[(usize, usize)],
+        f: &[DVec2],
+    ) -> Vec<Vec<(usize, usize)>> {
+        let how = local::Switching {
+            hysteresis: 0.0,
+            stretch: &[],
+            shared: Some(&self.work.vertex_parts),
+        };
+        let now = self.relaxed_states(parts, forced, f);
+        let mut out: Vec<(f64, usize, usize)> = Vec::new();
+        for (pi, part) in parts.iter().enumerate() {
+            if !matches!(part.kind, PartKind::Piece { .. })
+                || part.states.len() < 2
+                || forced.iter().any(|x| x.0 == pi)
             {
-                alternatives.push(p);
+                continue;
+            }
+            let current = now.iter().find(|x| x.0 == pi).map_or(part.active, |x| x.1);
+            let j = local::judge(pi, part, f, how);
+            let Some(&here) = j.distances.get(current) else {
+                continue;
+            };
+            for (state, d) in j.distances.iter().enumerate() {
+                if state != current && d.is_finite() {
+                    out.push((d - here, pi, state));
+                }
             }
         }
-        Ok(alternatives)
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut moves: Vec<Vec<(usize, usize)>> = (out.into_iter().take(STATE_TRIES))
+            .map(|(_, pi, state)| vec![(pi, state)])
+            .collect();
+        let back: Vec<(usize, usize)> = (parts.iter().enumerate())
+            .filter(|(pi, p)| {
+                matches!(p.kind, PartKind::Piece { .. })
+                    && p.states.len() > 1
+                    && (forced.iter().chain(&now))
+                        .find(|x| x.0 == *pi)
+                        .map_or(p.active, |x| x.1)
+                        != 0
+            })
+            .map(|(pi, _)| (pi, 0))
+            .collect();
+        if back.len() > 1 {
+            moves.push(back);
+        }
+        moves
     }
 
     /// One relaxation from `f` (left there), every stretch part's scales fitted but the
-    /// `fixed` ones. Least squares with the local step of [`Solver::relaxed_targets`],
-    /// Anderson-accelerated like pass 2 and, like it, taking only iterates that lower the
-    /// objective.
+    /// `fixed` ones, the `forced` piece parts in the given states. Least squares with the
+    /// local step of [`Solver::relaxed_targets`], Anderson-accelerated like pass 2 and, like
+    /// it, taking only iterates that lower the objective; returns the objective reached.
     fn relax_from(
         &mut self,
         asm: &Assembly,
         families: &[Option<Family>],
         fixed: &[Option<[f64; 2]>],
+        forced: &[(usize, usize)],
         f: &mut Vec<DVec2>,
         deadline: Option<Instant>,
-    ) -> Result<(), SolverError> {
+    ) -> Result<f64, SolverError> {
         let parts = &asm.data().parts;
         let handles = asm.handles();
         let mut next = vec![DVec2::ZERO; f.len()];
@@ -221,7 +372,7 @@ impl Solver {
         let mut anderson = std::mem::take(&mut self.anderson);
         anderson.start(ANDERSON);
         let mut scales: Vec<[f64; 2]> = fixed.iter().map(|x| x.unwrap_or([1.0, 1.0])).collect();
-        let mut objective = self.relaxed_targets(parts, families, fixed, f, &mut scales)
+        let mut objective = self.relaxed_targets(parts, families, fixed, forced, f, &mut scales)
             + handle_term(handles, f, weight);
         let mut kept = self.work.targets.clone();
         let mut last = Duration::ZERO;
@@ -234,7 +385,7 @@ impl Solver {
             self.solve_global(f, &mut next, Pass::LeastSquares, &mut report)?;
             let mixed = anderson.mix(f, &mut next);
             let mut trial = scales.clone();
-            let mut e = self.relaxed_targets(parts, families, fixed, &next, &mut trial)
+            let mut e = self.relaxed_targets(parts, families, fixed, forced, &next, &mut trial)
                 + handle_term(handles, &next, weight);
             // NaN does not descend either
             let descends = |e: f64| e < objective;
@@ -242,7 +393,7 @@ impl Solver {
                 anderson.plain(&mut next);
                 anderson.reset();
                 trial.clone_from(&scales);
-                e = self.relaxed_targets(parts, families, fixed, &next, &mut trial)
+                e = self.relaxed_targets(parts, families, fixed, forced, &next, &mut trial)
                     + handle_term(handles, &next, weight);
             }
             if !descends(e) {
@@ -259,12 +410,12 @@ impl Solver {
             }
         }
         self.anderson = anderson;
-        Ok(())
+        Ok(objective)
     }
 
     /// The relaxed local step at `f`: every part's rest edges (a stretch part's its two
     /// elements scaled to span `scales[part]` elements, fitted here, a piece part's its
-    /// nearest rest state) and the rotation, fitted to its edges, that brings them nearest
+    /// nearest rest state, or its `forced` one) and the rotation, fitted to its edges, that brings them nearest
     /// `f`'s, as edge targets into `work.targets`; returns their elastic energy. Each part's
     /// fit lowers its edges' energy, so with the global step the relaxation descends.
     fn relaxed_targets(
@@ -272,10 +423,11 @@ impl Solver {
         parts: &[Part],
         families: &[Option<Family>],
         fixed: &[Option<[f64; 2]>],
+        forced: &[(usize, usize)],
         f: &[DVec2],
         scales: &mut [[f64; 2]],
     ) -> f64 {
-        let nearest = self.relaxed_states(parts, f);
+        let nearest = self.relaxed_states(parts, forced, f);
         let edges = &self.pattern.edges;
         let targets = &mut self.work.targets;
         targets.clear();
@@ -312,11 +464,13 @@ impl Solver {
                     base: (k..end).map(|j| edge(&family.p0, &edges[j])).collect(),
                     a: (k..end).map(|j| edge(&family.qa, &edges[j])).collect(),
                     b: (k..end).map(|j| edge(&family.qb, &edges[j])).collect(),
+                    bounds: family.bounds,
                 },
                 None => Rest {
                     base: (k..end).map(|j| edge(rest_of(state), &edges[j])).collect(),
                     a: Vec::new(),
                     b: Vec::new(),
+                    bounds: [SHORTEST, f64::INFINITY],
                 },
             };
             let (r, sc) = rest.fit(&posed, scales[pi], fixed[pi].is_some());
@@ -331,9 +485,15 @@ impl Solver {
         elastic
     }
 
-    /// The piece parts with alternative rest states whose nearest state at `f` is not their
-    /// active one (the local step's judgement, without hysteresis).
-    fn relaxed_states(&self, parts: &[Part], f: &[DVec2]) -> Vec<(usize, usize)> {
+    /// The piece parts whose state in the relaxation is not their active one: the `forced`
+    /// ones (part, state), and those with alternative rest states whose nearest state at `f`
+    /// is not (the local step's judgement, without hysteresis).
+    fn relaxed_states(
+        &self,
+        parts: &[Part],
+        forced: &[(usize, usize)],
+        f: &[DVec2],
+    ) -> Vec<(usize, usize)> {
         let how = local::Switching {
             hysteresis: 0.0,
             stretch: &[],
@@ -342,6 +502,9 @@ impl Solver {
         (parts.iter().enumerate())
             .filter(|(_, p)| matches!(p.kind, PartKind::Piece { .. }) && p.states.len() > 1)
             .filter_map(|(pi, part)| {
+                if let Some(&(_, state)) = forced.iter().find(|x| x.0 == pi) {
+                    return (state != part.active).then_some((pi, state));
+                }
                 let j = local::judge(pi, part, f, how);
                 let best = (0..j.distances.len())
                     .min_by(|&a, &b| j.distances[a].total_cmp(&j.distances[b]))?;
@@ -358,6 +521,8 @@ struct Rest {
     base: Vec<DVec2>,
     a: Vec<DVec2>,
     b: Vec<DVec2>,
+    /// The least and most scale of an element.
+    bounds: [f64; 2],
 }
 
 impl Rest {
@@ -370,7 +535,7 @@ impl Rest {
     }
 
     /// The rotation and scales that bring the rest edges nearest `posed` (least squares),
-    /// by alternating the two fits a few times from `s` (scales at least [`SHORTEST`]); with
+    /// by alternating the two fits a few times from `s` (scales within `bounds`); with
     /// `fixed`, the rotation for the scales `s`.
     fn fit(&self, posed: &[DVec2], mut s: [f64; 2], fixed: bool) -> (DVec2, [f64; 2]) {
         let rotation = |s: [f64; 2]| {
@@ -407,7 +572,8 @@ impl Rest {
             if det > 1e-300 * (aa * bb).max(1e-300) && det.is_finite() {
                 let sa = (ra * bb - rb * ab) / det;
                 let sb = (aa * rb - ab * ra) / det;
-                s = [sa.max(SHORTEST), sb.max(SHORTEST)];
+                let [lo, hi] = self.bounds;
+                s = [sa.clamp(lo, hi), sb.clamp(lo, hi)];
             }
             r = rotation(s);
         }
@@ -415,8 +581,79 @@ impl Rest {
     }
 }
 
+/// Piece parts and the states the relaxation holds them in, `(part, state)`.
+type States = Vec<(usize, usize)>;
+
+/// What [`Solver::round_counts`] decides: every chain's count (`None`: left as it is), the
+/// last round's relaxed pose and the first round's.
+type Rounded = (Vec<Option<usize>>, Vec<DVec2>, Vec<DVec2>);
+
+/// Which chain a round of [`Solver::round_counts`] decides besides the nearly whole ones.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Pick {
+    /// The one nearest a whole count.
+    Nearest,
+    /// The one furthest from a whole count: in a family of rest configurations (a loop of
+    /// free hubs), the chain that took up the change, the others relaxed to their counts.
+    Furthest,
+}
+
+/// Rounds of [`Solver::relaxed_piece_states`]: each keeps at most one piece part's state.
+const STATE_ROUNDS: usize = 3;
+
+/// Alternative piece states [`Solver::relaxed_piece_states`] relaxes with in a round.
+const STATE_TRIES: usize = 4;
+
 /// Past differences the relaxation's Anderson acceleration mixes.
 const ANDERSON: usize = 3;
+
+/// The least and most scale of an element of a stretch `part`'s chain in the relaxation:
+/// at least [`SHORTEST`] and `min / count`, at most `max / count`, so that the relaxed
+/// chain stays within its rule's bounds. Without them a loop of free hubs relaxed into a rest
+/// configuration that needs a chain shorter than its `min` (a hexagon pulled out and back:
+/// sides of 3.49, 0.51 and 3.49 elements where the rule allows 2, 2 and 2 only). Not the
+/// least for a chain whose ends in `pose` are closer than its `min` elements in a row: no
+/// rest configuration keeps it above its `min`, and a chain held from shrinking buckles in
+/// the relaxation too, its wavy elements read long (71 thin bricks, `min 71`, pushed to 0.2
+/// of their length were proposed 152). `element`: an element's length at rest.
+fn scale_bounds(asm: &Assembly, part: &Part, element: f64, pose: &[DVec2]) -> [f64; 2] {
+    let PartKind::Stretch { chain, .. } = part.kind else {
+        return [SHORTEST, f64::INFINITY];
+    };
+    let data = asm.data();
+    let (Some(c), grammar) = (data.chains.get(chain), asm.grammar()) else {
+        return [SHORTEST, f64::INFINITY];
+    };
+    let Some(rule) = grammar.stretch_rules.get(c.rule) else {
+        return [SHORTEST, f64::INFINITY];
+    };
+    let count = c.instances.len().max(1) as f64;
+    let site_centre = |instance: Option<&usize>, site: usize| -> Option<DVec2> {
+        let inst = data.instances.get(*instance?)?;
+        let vertices = &grammar.pieces.get(inst.piece)?.sites.get(site)?.vertices;
+        let sum = (vertices.iter())
+            .map(|&k| inst.vertices.get(k).and_then(|&v| pose.get(v)).copied())
+            .sum::<Option<DVec2>>()?;
+        Some(sum / vertices.len().max(1) as f64)
+    };
+    let ends = (
+        site_centre(c.instances.first(), rule.from),
+        site_centre(c.instances.last(), rule.to),
+    );
+    let fits_min = match ends {
+        (Some(a), Some(b)) => a.distance(b) >= rule.min as f64 * element,
+        _ => true,
+    };
+    let lo = if fits_min {
+        (rule.min as f64 / count).clamp(SHORTEST, 1.0)
+    } else {
+        SHORTEST
+    };
+    let hi = rule
+        .max
+        .map_or(f64::INFINITY, |m| (m as f64 / count).max(1.0));
+    [lo, hi]
+}
 
 /// The stable ids of the instances the handles hold.
 fn held_elements(asm: &Assembly) -> Vec<u64> {
