@@ -49,3 +49,25 @@ fn human_output_stops_after_its_limit_and_json_keeps_all() {
     assert_eq!(all.as_array().map(Vec::len), Some(3_000));
     std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
 }
+
+/// A mistake 200,000 columns into a line (issue 47: every diagnostic reprinted its whole
+/// line, 13.5 MB of stderr for fifty on a 270 KB line): shown as a window round the label,
+/// with the original line and column.
+#[test]
+fn a_mistake_on_a_very_long_line_shows_a_window_with_the_true_column() {
+    let dir = std::env::temp_dir().join(format!("clay-cli-long-line-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("long.clay");
+    let pad = " ".repeat(200_000);
+    std::fs::write(
+        &path,
+        format!("piece w {{\n    vertex a (0, 0) {pad}nonsense\n}}\n"),
+    )
+    .unwrap();
+    let out = check(&[], &path);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.len() < 2_000, "{} bytes of stderr", err.len());
+    assert!(err.contains("long.clay:2:200021"), "{err}");
+    assert!(err.contains("… ") && err.contains("nonsense"), "{err}");
+}

@@ -2,11 +2,11 @@
 //! renderings (rustc-style text through codespan-reporting, and JSON for tools).
 
 use codespan_reporting::diagnostic as cs;
-use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term;
 use codespan_reporting::term::termcolor::Buffer;
 use serde::Serialize;
 
+use crate::clip;
 use crate::line_index::LineIndex;
 use crate::source_map::{Located, SourceMap, line_col};
 use crate::syntax::Span;
@@ -263,19 +263,37 @@ pub fn omitted_line(diagnostics: &Diagnostics) -> Option<String> {
 /// shown diagnostic costs the length of its own lines.
 fn render_into(buffer: &mut Buffer, diagnostics: &Diagnostics, source: &str, path: &str) {
     let files = all_files(&diagnostics.sources, source, path);
+    let starts: Vec<Vec<usize>> = files.iter().map(|f| clip::line_starts(f.1)).collect();
+    let long: Vec<bool> = (files.iter().zip(&starts))
+        .map(|(f, s)| clip::has_long_line(s, f.1))
+        .collect();
     let config = term_config();
     for d in diagnostics.iter().take(MAX_HUMAN_DIAGNOSTICS) {
         let (primary, secondary) = d.located(&diagnostics.sources, source, path);
+        let mut shown = d.to_codespan(&primary, &secondary);
+        // long lines shown as a window round the labels (`clip.rs`), the spans moved there
+        let clipped = clip::Shown(
+            (files.iter().zip(&starts).zip(&long).enumerate())
+                .map(|(id, ((&(name, text), starts), &long))| {
+                    if !long {
+                        return clip::ShownFile::whole(name, text, starts);
+                    }
+                    let labels: Vec<std::ops::Range<usize>> = (shown.labels.iter())
+                        .filter(|l| l.file_id == id)
+                        .map(|l| l.range.clone())
+                        .collect();
+                    clip::ShownFile::clipped(name, text, starts, &labels)
+                })
+                .collect(),
+        );
+        for l in &mut shown.labels {
+            if let Some(f) = clipped.0.get(l.file_id) {
+                l.range = f.to_shown(l.range.start)..f.to_shown(l.range.end);
+            }
+        }
         // Emitting into a memory buffer with clamped spans cannot fail; if it ever does, fall
         // back to a plain line so the diagnostic is not lost.
-        if term::emit(
-            buffer,
-            &config,
-            &files,
-            &d.to_codespan(&primary, &secondary),
-        )
-        .is_err()
-        {
+        if term::emit(buffer, &config, &clipped, &shown).is_err() {
             let (line, col) = line_col(primary.text, primary.start);
             buffer_push(
                 buffer,
@@ -294,18 +312,11 @@ fn render_into(buffer: &mut Buffer, diagnostics: &Diagnostics, source: &str, pat
     }
 }
 
-/// The main file (id 0) and the imported files (ids 1..) for codespan.
-fn all_files<'a>(
-    map: &'a SourceMap,
-    source: &'a str,
-    path: &'a str,
-) -> SimpleFiles<&'a str, &'a str> {
-    let mut files = SimpleFiles::new();
-    files.add(path, source);
-    for f in &map.files {
-        files.add(f.path.as_str(), &*f.text);
-    }
-    files
+/// The main file (id 0) and the imported files (ids 1..), `(name, text)`, for codespan.
+fn all_files<'a>(map: &'a SourceMap, source: &'a str, path: &'a str) -> Vec<(&'a str, &'a str)> {
+    std::iter::once((path, source))
+        .chain(map.files.iter().map(|f| (f.path.as_str(), &*f.text)))
+        .collect()
 }
 
 fn buffer_push(buffer: &mut Buffer, text: &str) {

@@ -18,6 +18,7 @@ pub mod compiled;
 pub mod settings;
 pub mod syntax;
 
+mod clip;
 mod compile;
 mod diagnostic;
 mod format;
