@@ -35,8 +35,9 @@ pub use export::gltf::{to_glb, to_gltf};
 pub use export::iso::iso_pixmap;
 pub use export::obj::to_obj;
 pub use export::{
-    ChainPlace, ExportOptions, MAX_NAME_BYTES, Node, Primitive, SHARE_TOLERANCE,
-    SHARE_TOLERANCE_PER_METRE, Scene, SharedMesh, scene, srgb_to_linear,
+    ChainPlace, ExportFileError, ExportFormat, ExportOptions, MAX_NAME_BYTES, MAX_THICKNESS, Node,
+    Primitive, SHARE_TOLERANCE, SHARE_TOLERANCE_PER_METRE, Scene, SharedMesh, encode_export,
+    mtl_path, scene, srgb_to_linear, write_export,
 };
 pub use files::write_atomic;
 pub use plane::{nearest_on_segment, polygon_area};

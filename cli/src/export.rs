@@ -1,9 +1,9 @@
 //! `clayc export`: the assembly (initial, or after a sculpting script) as 3D meshes: glTF 2.0
 //! (`.glb`, `.gltf`) or Wavefront OBJ (`.obj` with its `.mtl` beside it). docs/export.md.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use clay::{ExportOptions, scene};
+use clay::{ExportFormat, ExportOptions, encode_export, mtl_path, scene};
 
 use crate::out::{IO_ERROR, write_output};
 use crate::params::ParamArgs;
@@ -39,30 +39,29 @@ pub struct ExportArgs {
     pub params: ParamArgs,
 }
 
+/// `--thickness`: a number within the bound the library keeps (`ExportOptions::with_thickness`).
 fn parse_thickness(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if v.is_finite() && v > 0.0 && v <= 1000.0 {
-        Ok(v)
-    } else {
-        Err(format!("{v} is not above 0 and at most 1000 metres"))
-    }
+    ExportOptions::with_thickness(v).map(|o| o.thickness)
 }
 
-fn format_of(path: &Path) -> Option<Format> {
-    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-    match ext.as_str() {
-        "glb" => Some(Format::Glb),
-        "gltf" => Some(Format::Gltf),
-        "obj" => Some(Format::Obj),
-        _ => None,
+impl From<Format> for ExportFormat {
+    fn from(f: Format) -> Self {
+        match f {
+            Format::Glb => ExportFormat::Glb,
+            Format::Gltf => ExportFormat::Gltf,
+            Format::Obj => ExportFormat::Obj,
+        }
     }
 }
 
 pub fn export(args: ExportArgs) -> u8 {
     let to_stdout = args.output.as_os_str() == "-";
-    let format = match args.format.or_else(|| format_of(&args.output)) {
+    let format = match (args.format.map(ExportFormat::from))
+        .or_else(|| ExportFormat::of_path(&args.output))
+    {
         Some(f) => f,
-        None if to_stdout => Format::Glb,
+        None if to_stdout => ExportFormat::Glb,
         None => {
             errln!(
                 "error: cannot tell the format of `{}`: name it .glb, .gltf or .obj, or pass --format",
@@ -80,30 +79,21 @@ pub fn export(args: ExportArgs) -> u8 {
         Ok(model) => model,
         Err(code) => return code,
     };
-    let options = ExportOptions {
-        thickness: args.thickness,
-        ..ExportOptions::default()
+    let Ok(options) = ExportOptions::with_thickness(args.thickness) else {
+        // `parse_thickness` took it already
+        errln!("error: --thickness {} is out of range", args.thickness);
+        return IO_ERROR;
     };
     let scene = scene(&grammar, &assembly, &options);
-    let bytes = match format {
-        Format::Glb => clay::to_glb(&scene),
-        Format::Gltf => clay::to_gltf(&scene),
-        Format::Obj => {
-            let mtl_path = args.output.with_extension("mtl");
-            let mtl_name = mtl_path
-                .file_name()
-                .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-            let (obj_text, mtl_text) = clay::to_obj(&scene, &mtl_name);
-            // the .obj first: a failed export leaves the .mtl beside it as it was (issue 47)
-            let code = write_output(&args.output, obj_text.as_bytes());
-            if code != 0 || to_stdout {
-                return code;
+    match encode_export(&scene, format, &args.output) {
+        // the .obj first: a failed export leaves the .mtl beside it as it was (issue 47)
+        Ok((bytes, materials)) => {
+            let code = write_output(&args.output, &bytes);
+            match materials {
+                Some(m) if code == 0 && !to_stdout => write_output(&mtl_path(&args.output), &m),
+                _ => code,
             }
-            return write_output(&mtl_path, mtl_text.as_bytes());
         }
-    };
-    match bytes {
-        Ok(bytes) => write_output(&args.output, &bytes),
         Err(e) => {
             errln!("error: cannot encode the model: {e}");
             IO_ERROR

@@ -13,7 +13,8 @@ use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString};
 use serde_json::{Value, json};
 
 use clay::{
-    Assembly, ExportOptions, HandleKind, Overlays, RenderOptions, Script, Step, configure, scene,
+    Assembly, ExportFileError, ExportFormat, ExportOptions, HandleKind, Overlays, RenderOptions,
+    Script, Step, configure, scene,
 };
 use clay_dsl::compiled::CompiledGrammar;
 
@@ -599,11 +600,7 @@ impl Session {
     ) -> PyResult<()> {
         let path = path_of(path)?;
         let options = export_options(thickness)?;
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let Some(ext) = ext.filter(|e| ["glb", "gltf", "obj"].contains(&e.as_str())) else {
+        let Some(format) = ExportFormat::of_path(&path) else {
             return Err(PyValueError::new_err(format!(
                 "cannot tell the format of `{}`: name it .glb, .gltf or .obj",
                 path.display()
@@ -615,23 +612,13 @@ impl Session {
                     let st = self.lock()?;
                     scene(&self.grammar, st.asm.data(), &options)
                 };
-                let encoded = match ext.as_str() {
-                    "glb" => clay::to_glb(&scene),
-                    "gltf" => clay::to_gltf(&scene),
-                    _ => {
-                        let mtl_path = path.with_extension("mtl");
-                        let mtl_name = mtl_path
-                            .file_name()
-                            .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-                        let (obj_text, mtl_text) = clay::to_obj(&scene, &mtl_name);
-                        clay::write_atomic(&mtl_path, mtl_text.as_bytes())
-                            .map_err(|e| os_error(&e, &mtl_path))?;
-                        Ok(obj_text.into_bytes())
+                // the .obj before its .mtl, as `clayc export` writes them
+                clay::write_export(&scene, &path, format).map_err(|e| match e {
+                    ExportFileError::Encode(e) => {
+                        InternalError::new_err(format!("cannot encode the model: {e}"))
                     }
-                };
-                let bytes = encoded
-                    .map_err(|e| InternalError::new_err(format!("cannot encode the model: {e}")))?;
-                clay::write_atomic(&path, &bytes).map_err(|e| os_error(&e, &path))
+                    ExportFileError::Write(at, e) => os_error(&e, &at),
+                })
             })
         })
     }
@@ -795,18 +782,13 @@ impl Session {
     }
 }
 
-/// `thickness` as `clayc export --thickness` takes it.
+/// `thickness` as `clayc export --thickness` takes it (`ExportOptions::with_thickness`).
 fn export_options(thickness: Option<f64>) -> PyResult<ExportOptions> {
-    let mut options = ExportOptions::default();
-    if let Some(t) = thickness {
-        if !(t.is_finite() && t > 0.0 && t <= 1000.0) {
-            return Err(PyValueError::new_err(format!(
-                "thickness: {t} is not above 0 and at most 1000 metres"
-            )));
-        }
-        options.thickness = t;
+    match thickness {
+        None => Ok(ExportOptions::default()),
+        Some(t) => ExportOptions::with_thickness(t)
+            .map_err(|e| PyValueError::new_err(format!("thickness: {e}"))),
     }
-    Ok(options)
 }
 
 /// A step's frame count (1 when not given).

@@ -450,6 +450,19 @@ def test_export_errors(grammars, tmp_path):
         s.export(tmp_path / "no" / "such" / "dir" / "wall.glb")
     with pytest.raises(ValueError, match="thickness"):
         s.export(tmp_path / "wall.glb", thickness=-1)
+    with pytest.raises(ValueError, match="at most 1000 metres"):
+        s.export(tmp_path / "wall.glb", thickness=1e6)
+
+
+def test_a_failed_obj_export_keeps_the_mtl_beside_it(grammars, tmp_path):
+    # The .obj is written before its .mtl, as `clayc export` writes them: an .obj that cannot
+    # be written (a folder of that name) leaves the user's .mtl as it was.
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    (tmp_path / "wall.obj").mkdir()
+    (tmp_path / "wall.mtl").write_text("# the user's materials\n")
+    with pytest.raises(OSError):
+        s.export(tmp_path / "wall.obj")
+    assert (tmp_path / "wall.mtl").read_text() == "# the user's materials\n"
 
 
 def test_the_scene_is_the_exports_nodes_and_meshes_with_z_up(grammars, tmp_path):

@@ -22,6 +22,7 @@
 //! node, are the renderer's (`pose_assembly`) to within f32 rounding (and the sharing tolerance,
 //! [`SHARE_TOLERANCE`]), so a picture and an export of the same assembly agree.
 
+mod file;
 pub mod gltf;
 pub mod iso;
 mod model;
@@ -39,6 +40,9 @@ use crate::render::tessellate::shown_geometry;
 use crate::render::{Mesh, Solid, TessellationCache, WorldMesh, pose_assembly};
 use solid::{Blend, Prism, Shape};
 
+pub use file::{
+    ExportFileError, ExportFormat, MAX_THICKNESS, encode_export, mtl_path, write_export,
+};
 pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh};
 pub use names::MAX_NAME_BYTES;
 

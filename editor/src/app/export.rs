@@ -87,35 +87,17 @@ impl EditorApp {
     /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from
     /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it).
     pub fn export_3d(&self, path: &Path) -> Result<(), String> {
-        use clay::scene;
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let scene = scene(
+        let Some(format) = clay::ExportFormat::of_path(path) else {
+            return Err(format!(
+                "{}: name the file .glb, .gltf or .obj to say the format",
+                path.display()
+            ));
+        };
+        let scene = clay::scene(
             self.sculpt.grammar(),
             self.sculpt.data(),
             &Default::default(),
         );
-        let write = |p: &Path, bytes: &[u8]| {
-            clay::write_atomic(p, bytes).map_err(|e| format!("{}: {e}", p.display()))
-        };
-        match ext.as_deref() {
-            Some("glb") => write(path, &clay::to_glb(&scene)?),
-            Some("gltf") => write(path, &clay::to_gltf(&scene)?),
-            Some("obj") => {
-                let mtl = path.with_extension("mtl");
-                let name = mtl
-                    .file_name()
-                    .map_or("model.mtl".into(), |n| n.to_string_lossy().into_owned());
-                let (obj_text, mtl_text) = clay::to_obj(&scene, &name);
-                write(&mtl, mtl_text.as_bytes())?;
-                write(path, obj_text.as_bytes())
-            }
-            _ => Err(format!(
-                "{}: name the file .glb, .gltf or .obj to say the format",
-                path.display()
-            )),
-        }
+        clay::write_export(&scene, path, format).map_err(|e| e.to_string())
     }
 }
