@@ -148,9 +148,8 @@ fn prism(meshes: &[Mesh], members: &[usize], fill: Rgba, base: f64, top: f64) ->
     if !clean(&points, &triangles) {
         // A panic inside the triangulation must not take the export down: the welded cap is
         // still a good picture, only not a clean solid.
-        let merged =
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| union(&points, &triangles)));
-        if let Ok(Some((weights, merged))) = merged {
+        let merged = quietly(|| union(&points, &triangles));
+        if let Some(Some((weights, merged))) = merged {
             let blends_now = weights
                 .iter()
                 .map(|w| {
@@ -457,6 +456,28 @@ impl Grid {
     }
 }
 
+/// Runs `f`; a panic inside it becomes `None`, without the panic hook's message and backtrace
+/// (issue 47: a panic caught in the triangulation printed a backtrace above an export that then
+/// succeeded, exit 0). Only panics on this thread while `f` runs are silenced; every other
+/// goes to the hook that was installed before (the editor's crash recovery, say).
+fn quietly<T>(f: impl FnOnce() -> T) -> Option<T> {
+    use std::cell::Cell;
+    thread_local!(static QUIET: Cell<bool> = const { Cell::new(false) });
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let before = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                before(info);
+            }
+        }));
+    });
+    let was = QUIET.with(|q| q.replace(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(was));
+    result.ok()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -609,5 +630,13 @@ mod tests {
         let (base, top) = heights(b.extrude, 1, &o);
         assert!(base > 0.0 && top > o.thickness && base < o.thickness);
         assert_eq!(plan(&[a, b], &o).len(), 2);
+    }
+
+    #[test]
+    fn quietly_makes_a_panic_inside_none_and_keeps_the_value_otherwise() {
+        assert_eq!(quietly(|| 3), Some(3));
+        assert_eq!(quietly(|| -> u8 { panic!("a triangulation fails") }), None);
+        // silenced only while it runs: a panic after it is still a panic
+        assert!(std::panic::catch_unwind(|| panic!("after")).is_err());
     }
 }
