@@ -66,7 +66,7 @@ pub use summary::{FrameMs, Summary, connected_components};
 /// grammar's path, its parameters, the solver's settings, the pins and the log of gestures.
 pub mod session_file {
     pub use crate::session::file::{
-        LogEntry, Pin, SESSION_FORMAT, SESSION_VERSION, Session, SessionError, Settings, parse,
-        read, write,
+        LogEntry, Pin, SESSION_FORMAT, SESSION_VERSION, SavedSession, SessionError, Settings,
+        parse, read, write,
     };
 }

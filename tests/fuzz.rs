@@ -311,8 +311,12 @@ fn session_corpus() -> Vec<Vec<u8>> {
                 at: (0..h.vertices().len()).map(|k| h.target(k)).collect(),
             })
             .collect();
-        let saved =
-            clay::session_file::Session::new("wall.clay".into(), asm.data().clone(), pins, None);
+        let saved = clay::session_file::SavedSession::new(
+            "wall.clay".into(),
+            asm.data().clone(),
+            pins,
+            None,
+        );
         out.push(serde_json::to_vec_pretty(&saved).unwrap());
     }
     out

@@ -10,7 +10,8 @@ use std::sync::Arc;
 
 use clay::{
     Assembly, ExportOptions, HandleKind, Script, Session, SolverConfig, replay, scene,
-    session_file, session_file::Pin, session_file::Session as SessionFile, session_file::Settings,
+    session_file, session_file::Pin, session_file::SavedSession as SessionFile,
+    session_file::Settings,
 };
 use clay_dsl::compiled::CompiledGrammar;
 

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
-use crate::session::{self, Session};
+use crate::session::{self, SavedSession};
 
 /// Between two writes while the model moves without a new undo step.
 pub const WRITE_EVERY: Duration = Duration::from_secs(3);
@@ -108,7 +108,7 @@ impl Recovery {
         &mut self,
         stamp: (u64, u64),
         unsaved: bool,
-        session: impl FnOnce() -> Option<Session>,
+        session: impl FnOnce() -> Option<SavedSession>,
     ) -> Option<String> {
         if self.offer.is_some() {
             return None;

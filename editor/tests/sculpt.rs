@@ -8,7 +8,7 @@ use clay_dsl::compiled::PartKind;
 use clay_editor::EditorApp;
 use clay_editor::compile::{CASTLE_PATH, CASTLE_SOURCE, compile};
 use clay_editor::sculpt::{Command, Sculpt};
-use clay_editor::session::{self, Session, SessionError, Settings};
+use clay_editor::session::{self, SavedSession, SessionError, Settings};
 use glam::DVec2;
 
 fn castle() -> Sculpt {
@@ -256,7 +256,7 @@ fn a_session_round_trips_through_a_file() {
 
 #[test]
 fn malformed_sessions_are_clear_errors() {
-    let good = serde_json::to_value(Session::new(
+    let good = serde_json::to_value(SavedSession::new(
         CASTLE_PATH.into(),
         compile(CASTLE_SOURCE, CASTLE_PATH)
             .unwrap()

@@ -51,7 +51,7 @@ pub struct LogEntry {
 
 /// A saved sculpt.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Session {
+pub struct SavedSession {
     pub format: String,
     pub version: u32,
     /// The grammar file the sculpt was made from, as the editor opened it (`clayc` reads a
@@ -72,7 +72,7 @@ pub struct Session {
     pub params: BTreeMap<String, f64>,
 }
 
-impl Session {
+impl SavedSession {
     pub fn new(
         grammar: String,
         assembly: AssemblyData,
@@ -117,7 +117,7 @@ impl std::error::Error for SessionError {}
 
 /// Parses session text. Checks the format tag and version before the body so that a file of
 /// another kind or version says so rather than naming a missing field.
-pub fn parse(text: &str) -> Result<Session, SessionError> {
+pub fn parse(text: &str) -> Result<SavedSession, SessionError> {
     let value: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| SessionError::Malformed(format!("not a session file: invalid JSON ({e})")))?;
     let format = value.get("format").and_then(|f| f.as_str());
@@ -148,7 +148,7 @@ pub fn parse(text: &str) -> Result<Session, SessionError> {
 }
 
 /// Reads and parses a session file.
-pub fn read(path: &Path) -> Result<Session, SessionError> {
+pub fn read(path: &Path) -> Result<SavedSession, SessionError> {
     let text = clay_dsl::read_input_string(path, clay_dsl::MAX_DATA_BYTES).map_err(|error| {
         SessionError::Io {
             path: path.to_path_buf(),
@@ -159,7 +159,7 @@ pub fn read(path: &Path) -> Result<Session, SessionError> {
 }
 
 /// Writes a session file atomically.
-pub fn write(path: &Path, session: &Session) -> Result<(), SessionError> {
+pub fn write(path: &Path, session: &SavedSession) -> Result<(), SessionError> {
     let text = serde_json::to_string_pretty(session)
         .map_err(|e| SessionError::Malformed(format!("cannot encode the session: {e}")))?;
     crate::files::write_atomic(path, text.as_bytes()).map_err(|error| SessionError::Io {
@@ -183,7 +183,7 @@ mod tests {
             .assembly
     }
 
-    fn session() -> Session {
+    fn session() -> SavedSession {
         let pins = vec![Pin {
             vertices: vec![0, 1],
             at: vec![DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.25)],
@@ -193,7 +193,7 @@ mod tests {
             norm: 1.0,
             merge_distance: 0.5,
         };
-        Session::new("t.clay".into(), assembly(), pins, Some(settings))
+        SavedSession::new("t.clay".into(), assembly(), pins, Some(settings))
     }
 
     fn malformed(text: &str) -> String {

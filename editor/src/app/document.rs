@@ -7,7 +7,7 @@ use crate::compile::{
     self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem, Severity, check_grammar, empty_grammar,
 };
 use crate::sculpt::Sculpt;
-use crate::session::{self, Session};
+use crate::session::{self, SavedSession};
 use crate::watch::FileWatch;
 
 use super::{EditorApp, TITLE};
@@ -246,7 +246,7 @@ impl EditorApp {
     }
 
     /// The sculpt as a session.
-    pub fn session(&self) -> Session {
+    pub fn session(&self) -> SavedSession {
         let grammar = match &self.grammar_path {
             Some(p) => std::path::absolute(p)
                 .unwrap_or_else(|_| p.clone())
@@ -254,7 +254,7 @@ impl EditorApp {
                 .to_string(),
             None => CASTLE_PATH.to_string(),
         };
-        let mut session = Session::new(
+        let mut session = SavedSession::new(
             grammar,
             self.sculpt.data().clone(),
             self.sculpt.pins(),
