@@ -495,7 +495,7 @@ fn top(m: &str) -> String {
 const ALLOWED: &[(&str, &[&str])] = &[
     ("assembly", &["fit"]),
     ("authoring", &["plane"]),
-    ("export", &["fit", "plane", "render"]),
+    ("export", &["files", "fit", "plane", "render"]),
     ("files", &[]),
     ("fit", &[]),
     ("plane", &[]),

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use base64::Engine as _;
 use gltf::json::{self, validation::Checked::Valid, validation::USize64};
 
-use super::{Scene, srgb_to_linear};
+use super::model::{Scene, srgb_to_linear};
 
 /// The binary data and the accessors into it, as they are appended.
 struct Buffers {

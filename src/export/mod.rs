@@ -43,7 +43,7 @@ use solid::{Blend, Prism, Shape};
 pub use file::{
     ExportFileError, ExportFormat, MAX_THICKNESS, encode_export, mtl_path, write_export,
 };
-pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh};
+pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh, srgb_to_linear};
 pub use names::MAX_NAME_BYTES;
 
 /// How far apart (metres, per coordinate) two instances' local geometry may be and still share
@@ -445,15 +445,5 @@ fn extrude(mesh: &WorldMesh, local: &[DVec2], base: f64, top: f64, out: &mut Pri
         let (a0, b0, a1, b1) = (lift(a, base), lift(b, base), lift(a, top), lift(b, top));
         out.triangle([a0, b0, b1], normal);
         out.triangle([a0, b1, a1], normal);
-    }
-}
-
-/// The linear value of an sRGB channel (glTF's colour factors are linear).
-pub fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }

@@ -164,3 +164,13 @@ impl Scene {
         }))
     }
 }
+
+/// The linear value of an sRGB channel (glTF's colour factors are linear).
+pub fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}

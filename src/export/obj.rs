@@ -11,7 +11,7 @@
 
 use std::fmt::Write as _;
 
-use super::{Scene, srgb_to_linear};
+use super::model::{Scene, srgb_to_linear};
 
 /// The OBJ text (referring to the material library `mtl_name`) and the MTL text.
 pub fn to_obj(scene: &Scene, mtl_name: &str) -> (String, String) {
