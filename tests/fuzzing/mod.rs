@@ -97,11 +97,25 @@ pub fn rng(seed: u64) -> TestRng {
 }
 
 /// One mutation of `input`: a few edits, each a byte flip, an insertion of a token or a byte,
-/// a deletion, a duplication, or a splice from another corpus entry.
+/// a deletion, a duplication, or a splice from another corpus entry; rarely (issue 47: every
+/// linear-time claim on long single lines) the whole input folded onto one line, or a token
+/// repeated thousands of times on one.
 pub fn mutate(rng: &mut TestRng, input: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
     let mut s = input.to_vec();
     for _ in 0..rng.random_range(1..=4) {
         let at = rng.random_range(0..=s.len());
+        if rng.random_range(0..64) == 0 {
+            if rng.random() {
+                for b in s.iter_mut().filter(|b| **b == b'\n') {
+                    *b = b' ';
+                }
+            } else {
+                let t = TOKENS[rng.random_range(0..TOKENS.len())];
+                let n = rng.random_range(1000..5000);
+                s.splice(at..at, t.repeat(n).bytes().collect::<Vec<_>>());
+            }
+            continue;
+        }
         match rng.random_range(0..7) {
             0 if !s.is_empty() => {
                 let i = at.min(s.len() - 1);
