@@ -20,6 +20,7 @@ use glam::DVec2;
 
 use super::clock::out_of_time;
 use super::global_step::Pass;
+use super::growth::ChainLength;
 use super::local::{self, StretchEnds};
 use super::pass2::handle_term;
 use super::report::{FrameReport, Proposal, SolverError};
@@ -125,7 +126,7 @@ impl Solver {
         let families: Vec<Option<Family>> = (data.parts.iter())
             .map(|part| {
                 let mut family = Family::of(part)?;
-                family.bounds = scale_bounds(asm, part, family.ends.element, warm);
+                family.bounds = scale_bounds(asm, part, &self.work.chain_lengths);
                 Some(family)
             })
             .collect();
@@ -612,38 +613,24 @@ const ANDERSON: usize = 3;
 /// chain stays within its rule's bounds. Without them a loop of free hubs relaxed into a rest
 /// configuration that needs a chain shorter than its `min` (a hexagon pulled out and back:
 /// sides of 3.49, 0.51 and 3.49 elements where the rule allows 2, 2 and 2 only). Not the
-/// least for a chain whose ends in `pose` are closer than its `min` elements in a row: no
-/// rest configuration keeps it above its `min`, and a chain held from shrinking buckles in
+/// least for a chain whose ends are closer than its `min` elements in a row (its chord in
+/// `lengths`, this frame's [`ChainLength`]s, measured where pass 1
+/// started: the displayed pose, since the relaxation runs only while the handles stay put):
+/// no rest configuration keeps it above its `min`, and a chain held from shrinking buckles in
 /// the relaxation too, its wavy elements read long (71 thin bricks, `min 71`, pushed to 0.2
-/// of their length were proposed 152). `element`: an element's length at rest.
-fn scale_bounds(asm: &Assembly, part: &Part, element: f64, pose: &[DVec2]) -> [f64; 2] {
+/// of their length were proposed 152).
+fn scale_bounds(asm: &Assembly, part: &Part, lengths: &[Option<ChainLength>]) -> [f64; 2] {
     let PartKind::Stretch { chain, .. } = part.kind else {
         return [SHORTEST, f64::INFINITY];
     };
     let data = asm.data();
-    let (Some(c), grammar) = (data.chains.get(chain), asm.grammar()) else {
+    let Some(rule) = (data.chains.get(chain)).and_then(|c| asm.grammar().stretch_rules.get(c.rule))
+    else {
         return [SHORTEST, f64::INFINITY];
     };
-    let Some(rule) = grammar.stretch_rules.get(c.rule) else {
-        return [SHORTEST, f64::INFINITY];
-    };
-    let count = c.instances.len().max(1) as f64;
-    let site_centre = |instance: Option<&usize>, site: usize| -> Option<DVec2> {
-        let inst = data.instances.get(*instance?)?;
-        let vertices = &grammar.pieces.get(inst.piece)?.sites.get(site)?.vertices;
-        let sum = (vertices.iter())
-            .map(|&k| inst.vertices.get(k).and_then(|&v| pose.get(v)).copied())
-            .sum::<Option<DVec2>>()?;
-        Some(sum / vertices.len().max(1) as f64)
-    };
-    let ends = (
-        site_centre(c.instances.first(), rule.from),
-        site_centre(c.instances.last(), rule.to),
-    );
-    let fits_min = match ends {
-        (Some(a), Some(b)) => a.distance(b) >= rule.min as f64 * element,
-        _ => true,
-    };
+    let count = data.chains[chain].instances.len().max(1) as f64;
+    let fits_min =
+        (lengths.get(chain).and_then(Option::as_ref)).is_none_or(|l| l.chord >= rule.min as f64);
     let lo = if fits_min {
         (rule.min as f64 / count).clamp(SHORTEST, 1.0)
     } else {
