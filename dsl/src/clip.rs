@@ -2,12 +2,14 @@
 //! labelled line whole, so one mistake on a 270 KB line printed 270 KB (13.5 MB for fifty).
 //! A line longer than [`MAX_SHOWN_LINE`] bytes is shown as a window around the diagnostic's
 //! first label on it (`…` where it was cut); the line and column numbers stay the original
-//! file's ([`Shown`] answers them from the original text).
+//! file's, answered by its [`LineIndex`] (the one conversion of offsets to positions).
 
 use std::borrow::Cow;
 use std::ops::Range;
 
 use codespan_reporting::files::{Error, Files};
+
+use crate::line_index::LineIndex;
 
 /// The longest line a human diagnostic shows whole, in bytes.
 pub const MAX_SHOWN_LINE: usize = 240;
@@ -15,57 +17,47 @@ pub const MAX_SHOWN_LINE: usize = 240;
 /// The mark where a shown line was cut.
 const CUT: &str = "…";
 
-/// One file as a diagnostic shows it: the original text, or a copy with its long lines
-/// clipped and the map from the copy's bytes back to the original's.
+/// One file as a diagnostic shows it: the original, or a copy with its long lines clipped and
+/// the map from the copy's bytes back to the original's.
 pub(crate) struct ShownFile<'a> {
     name: &'a str,
-    original: &'a str,
-    /// The text shown: `None` when it is the original.
-    clipped: Option<String>,
-    /// Line starts of the text shown.
-    starts: Cow<'a, [usize]>,
-    /// Line starts of the original (the same count of lines).
-    original_starts: &'a [usize],
+    original: &'a LineIndex,
+    /// The text shown and its lines: the original's, or the clipped copy's.
+    shown: Cow<'a, LineIndex>,
     /// Runs of bytes copied, `(shown start, original start, length)`, in order.
     runs: Vec<(usize, usize, usize)>,
 }
 
-/// Line starts of `text`.
-pub(crate) fn line_starts(text: &str) -> Vec<usize> {
-    std::iter::once(0)
-        .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-        .collect()
-}
-
-/// Whether any line of `text` is longer than [`MAX_SHOWN_LINE`].
-pub(crate) fn has_long_line(starts: &[usize], text: &str) -> bool {
-    let mut ends = starts.iter().skip(1).copied().chain([text.len() + 1]);
+/// Whether any line of the text is longer than [`MAX_SHOWN_LINE`] bytes.
+pub(crate) fn has_long_line(index: &LineIndex) -> bool {
+    let starts = index.line_starts();
+    let ends = starts
+        .iter()
+        .skip(1)
+        .copied()
+        .chain([index.text().len() + 1]);
     starts
         .iter()
-        .any(|&s| ends.next().is_some_and(|e| e - s - 1 > MAX_SHOWN_LINE))
+        .zip(ends)
+        .any(|(&s, e)| e - s - 1 > MAX_SHOWN_LINE)
 }
 
 impl<'a> ShownFile<'a> {
-    /// The file as it is (`starts`: its line starts).
-    pub(crate) fn whole(name: &'a str, text: &'a str, starts: &'a [usize]) -> Self {
+    /// The file as it is.
+    pub(crate) fn whole(name: &'a str, original: &'a LineIndex) -> Self {
         Self {
             name,
-            original: text,
-            clipped: None,
-            original_starts: starts,
-            runs: vec![(0, 0, text.len())],
-            starts: Cow::Borrowed(starts),
+            original,
+            shown: Cow::Borrowed(original),
+            runs: vec![(0, 0, original.text().len())],
         }
     }
 
     /// The file with every line longer than [`MAX_SHOWN_LINE`] clipped to a window around
-    /// the first of `labels` (byte ranges into `text`) that starts on it, or to its start.
-    pub(crate) fn clipped(
-        name: &'a str,
-        text: &'a str,
-        original_starts: &'a [usize],
-        labels: &[Range<usize>],
-    ) -> Self {
+    /// the first of `labels` (byte ranges into it) that starts on it, or to its start.
+    pub(crate) fn clipped(name: &'a str, original: &'a LineIndex, labels: &[Range<usize>]) -> Self {
+        let text = original.text();
+        let starts = original.line_starts();
         let mut shown = String::with_capacity(text.len().min(1 << 16));
         let mut runs: Vec<(usize, usize, usize)> = Vec::new();
         let mut copy = |shown: &mut String, from: usize, to: usize| {
@@ -78,13 +70,9 @@ impl<'a> ShownFile<'a> {
             }
             shown.push_str(&text[from..to]);
         };
-        for (k, &start) in original_starts.iter().enumerate() {
-            let next = original_starts.get(k + 1).copied().unwrap_or(text.len());
-            let end = if text[start..next].ends_with('\n') {
-                next - 1
-            } else {
-                next
-            };
+        for (k, &start) in starts.iter().enumerate() {
+            let next = starts.get(k + 1).copied().unwrap_or(text.len());
+            let end = next - usize::from(text[start..next].ends_with('\n'));
             if end - start <= MAX_SHOWN_LINE {
                 copy(&mut shown, start, next);
                 continue;
@@ -105,19 +93,12 @@ impl<'a> ShownFile<'a> {
             }
             copy(&mut shown, end, next);
         }
-        let starts = Cow::Owned(line_starts(&shown));
         Self {
             name,
-            original: text,
-            clipped: Some(shown),
-            starts,
-            original_starts,
+            original,
+            shown: Cow::Owned(LineIndex::new(&shown)),
             runs,
         }
-    }
-
-    fn text(&self) -> &str {
-        self.clipped.as_deref().unwrap_or(self.original)
     }
 
     /// The shown byte of original byte `b` (the nearest shown one where it was cut away).
@@ -125,7 +106,7 @@ impl<'a> ShownFile<'a> {
         let k = self.runs.partition_point(|r| r.1 + r.2 < b);
         match self.runs.get(k) {
             Some(&(s, o, n)) => s + b.saturating_sub(o).min(n),
-            None => self.text().len(),
+            None => self.shown.text().len(),
         }
     }
 
@@ -134,7 +115,7 @@ impl<'a> ShownFile<'a> {
         let k = self.runs.partition_point(|r| r.0 + r.2 < b);
         match self.runs.get(k) {
             Some(&(s, o, n)) => o + b.saturating_sub(s).min(n),
-            None => self.original.len(),
+            None => self.original.text().len(),
         }
     }
 }
@@ -151,55 +132,50 @@ fn floor_boundary(text: &str, mut b: usize) -> usize {
 /// The files a diagnostic shows, by the ids its labels use.
 pub(crate) struct Shown<'a>(pub(crate) Vec<ShownFile<'a>>);
 
+impl<'a> Shown<'a> {
+    fn file(&self, id: usize) -> Result<&ShownFile<'a>, Error> {
+        self.0.get(id).ok_or(Error::FileMissing)
+    }
+}
+
 impl<'a> Files<'a> for Shown<'a> {
     type FileId = usize;
     type Name = &'a str;
     type Source = &'a str;
 
     fn name(&'a self, id: usize) -> Result<&'a str, Error> {
-        Ok(self.0.get(id).ok_or(Error::FileMissing)?.name)
+        Ok(self.file(id)?.name)
     }
 
     fn source(&'a self, id: usize) -> Result<&'a str, Error> {
-        Ok(self.0.get(id).ok_or(Error::FileMissing)?.text())
+        Ok(self.file(id)?.shown.text())
     }
 
     fn line_index(&'a self, id: usize, byte_index: usize) -> Result<usize, Error> {
-        let f = self.0.get(id).ok_or(Error::FileMissing)?;
-        Ok(f.starts
+        let starts = self.file(id)?.shown.line_starts();
+        Ok(starts
             .partition_point(|&s| s <= byte_index)
             .saturating_sub(1))
     }
 
     fn line_range(&'a self, id: usize, line_index: usize) -> Result<Range<usize>, Error> {
-        let f = self.0.get(id).ok_or(Error::FileMissing)?;
-        let start = *f.starts.get(line_index).ok_or(Error::LineTooLarge {
+        let shown = &self.file(id)?.shown;
+        let starts = shown.line_starts();
+        let start = *starts.get(line_index).ok_or(Error::LineTooLarge {
             given: line_index,
-            max: f.starts.len().saturating_sub(1),
+            max: starts.len().saturating_sub(1),
         })?;
-        let end = f
-            .starts
+        let end = starts
             .get(line_index + 1)
             .copied()
-            .unwrap_or(f.text().len());
+            .unwrap_or(shown.text().len());
         Ok(start..end)
     }
 
-    fn column_number(
-        &'a self,
-        id: usize,
-        line_index: usize,
-        byte_index: usize,
-    ) -> Result<usize, Error> {
-        let f = self.0.get(id).ok_or(Error::FileMissing)?;
-        if f.clipped.is_none() {
-            let start = self.line_range(id, line_index)?.start;
-            let b = floor_boundary(f.original, byte_index.max(start));
-            return Ok(f.original[start..b].chars().count() + 1);
-        }
-        let start = f.original_starts.get(line_index).copied().unwrap_or(0);
-        let b = floor_boundary(f.original, f.to_original(byte_index).max(start));
-        Ok(f.original[start..b].chars().count() + 1)
+    /// The original file's column (its [`LineIndex`]), however the line was clipped.
+    fn column_number(&'a self, id: usize, _line: usize, byte_index: usize) -> Result<usize, Error> {
+        let f = self.file(id)?;
+        Ok(f.original.line_col(f.to_original(byte_index)).1)
     }
 }
 
@@ -211,10 +187,11 @@ mod tests {
     fn a_long_line_is_shown_around_its_label_with_the_original_column() {
         let text = format!("a\n{}X{}\nb\n", "y".repeat(5000), "z".repeat(5000));
         let at = text.find('X').unwrap();
-        let starts = line_starts(&text);
+        let index = LineIndex::new(&text);
+        assert!(has_long_line(&index));
         let label = at..at + 1;
-        let file = ShownFile::clipped("f", &text, &starts, std::slice::from_ref(&label));
-        let shown = file.text().to_string();
+        let file = ShownFile::clipped("f", &index, std::slice::from_ref(&label));
+        let shown = file.shown.text().to_string();
         assert!(
             shown.len() < 2 * MAX_SHOWN_LINE + 20,
             "{} bytes shown",
@@ -233,10 +210,10 @@ mod tests {
     #[test]
     fn short_lines_are_shown_as_they_are() {
         let text = "one\ntwo é\nthree";
-        let starts = line_starts(text);
-        assert!(!has_long_line(&starts, text));
-        let file = ShownFile::clipped("f", text, &starts, &[]);
-        assert_eq!(file.text(), text);
+        let index = LineIndex::new(text);
+        assert!(!has_long_line(&index));
+        let file = ShownFile::clipped("f", &index, &[]);
+        assert_eq!(file.shown.text(), text);
         assert_eq!(file.to_shown(8), 8);
     }
 }

@@ -263,26 +263,24 @@ pub fn omitted_line(diagnostics: &Diagnostics) -> Option<String> {
 /// shown diagnostic costs the length of its own lines.
 fn render_into(buffer: &mut Buffer, diagnostics: &Diagnostics, source: &str, path: &str) {
     let files = all_files(&diagnostics.sources, source, path);
-    let starts: Vec<Vec<usize>> = files.iter().map(|f| clip::line_starts(f.1)).collect();
-    let long: Vec<bool> = (files.iter().zip(&starts))
-        .map(|(f, s)| clip::has_long_line(s, f.1))
-        .collect();
+    let indexes: Vec<LineIndex> = files.iter().map(|f| LineIndex::new(f.1)).collect();
+    let long: Vec<bool> = indexes.iter().map(clip::has_long_line).collect();
     let config = term_config();
     for d in diagnostics.iter().take(MAX_HUMAN_DIAGNOSTICS) {
         let (primary, secondary) = d.located(&diagnostics.sources, source, path);
         let mut shown = d.to_codespan(&primary, &secondary);
         // long lines shown as a window round the labels (`clip.rs`), the spans moved there
         let clipped = clip::Shown(
-            (files.iter().zip(&starts).zip(&long).enumerate())
-                .map(|(id, ((&(name, text), starts), &long))| {
+            (files.iter().zip(&indexes).zip(&long).enumerate())
+                .map(|(id, ((&(name, _), index), &long))| {
                     if !long {
-                        return clip::ShownFile::whole(name, text, starts);
+                        return clip::ShownFile::whole(name, index);
                     }
                     let labels: Vec<std::ops::Range<usize>> = (shown.labels.iter())
                         .filter(|l| l.file_id == id)
                         .map(|l| l.range.clone())
                         .collect();
-                    clip::ShownFile::clipped(name, text, starts, &labels)
+                    clip::ShownFile::clipped(name, index, &labels)
                 })
                 .collect(),
         );

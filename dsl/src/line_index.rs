@@ -130,6 +130,11 @@ impl LineIndex {
     pub fn text(&self) -> &str {
         &self.text
     }
+
+    /// Byte offset where each line starts; the first is 0.
+    pub fn line_starts(&self) -> &[usize] {
+        &self.starts
+    }
 }
 
 #[cfg(test)]
