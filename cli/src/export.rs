@@ -79,10 +79,10 @@ pub fn export(args: ExportArgs) -> u8 {
         Ok(model) => model,
         Err(code) => return code,
     };
-    let Ok(options) = ExportOptions::with_thickness(args.thickness) else {
-        // `parse_thickness` took it already
-        errln!("error: --thickness {} is out of range", args.thickness);
-        return IO_ERROR;
+    // `parse_thickness` kept it within the library's bound
+    let options = ExportOptions {
+        thickness: args.thickness,
+        ..ExportOptions::default()
     };
     let scene = scene(&grammar, &assembly, &options);
     match encode_export(&scene, format, &args.output) {
