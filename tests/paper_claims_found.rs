@@ -151,3 +151,25 @@ fn a_far_chain_of_long_elements_changes_nothing() {
     let without = replay_text(&alone, "far_chain_borderline").count("brick");
     assert_eq!((with_far, without), (5, 5));
 }
+
+/// Paper 4.3, states follow the shape whatever the proportions (issue 46): a fence corner post
+/// 0.2 m deep with quarter-turn states, the fence pushed in 0.3 m (a squeeze, no turn) keeps
+/// the post straight, as it keeps a post 1 m deep. Judged on its sites' vertices alone, the
+/// thin post's squeeze read as nearer its bent state (whose sites are closer) and it flipped
+/// between `right` and `base` 151 times in 330 frames; the sites are now judged spread to the
+/// part's size (`solver::local::Boundary`).
+#[test]
+fn a_thin_corner_pushed_gently_stays_straight() {
+    let thin = fixture("thin_corner.clay");
+    // the post's half-depth 0.1 -> 0.5 and the bars' depth 0.2 -> 1 (their sites dock)
+    let deep = thin
+        .replace(", 0.1)", ", 0.5)")
+        .replace(", -0.1)", ", -0.5)")
+        .replace(", 0.2)", ", 1)");
+    assert_ne!(deep, thin);
+    for text in [thin, deep] {
+        let run = replay_text(&text, "thin_corner");
+        assert_eq!(run.fired(RuleKind::Replace), 0, "{}", run.repro());
+        assert_eq!(run.states("post"), ["base"], "{}", run.repro());
+    }
+}

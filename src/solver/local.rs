@@ -110,7 +110,7 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
         };
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
-    let judge = |rest: &[DVec2]| judged(part, positions, boundary.as_deref(), rest);
+    let judge = |rest: &[DVec2]| judged(part, positions, boundary.as_ref(), rest);
     let mut best = (active, judge(&current.positions));
     let judged_here = best.1;
     for (j, state) in part.states.iter().enumerate() {
@@ -136,31 +136,128 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
 }
 
 /// How well rest shape `rest` of `part` fits the pose: on the `boundary` vertices
-/// ([`boundary_of`]) when there are such, else on all of the part's vertices.
+/// ([`boundary_of`]), each docking site spread to the part's size, when there are such, else
+/// on all of the part's vertices.
 fn judged(
     part: &Part,
     positions: &[DVec2],
-    boundary: Option<&[usize]>,
+    boundary: Option<&Boundary>,
     rest: &[DVec2],
 ) -> Alignment {
     match boundary {
-        Some(ks) => {
-            let r: Vec<DVec2> = ks.iter().map(|&k| rest[k]).collect();
-            let vs: Vec<usize> = ks.iter().map(|&k| part.vertices[k]).collect();
-            align(&r, &vs, positions)
-        }
+        Some(b) => b.align(&b.points(|k| rest[k]), |k| positions[part.vertices[k]]),
         None => align(rest, &part.vertices, positions),
     }
 }
 
-/// The local indices of the vertices of a piece part with alternative rest states that it
-/// shares with other parts, when there are at least two and fewer than all (paper 5.1,
-/// replacement: "the shape of the boundary vertices determines which piece to insert"). The
-/// others belong to the part alone and take whichever state it takes, so they decide nothing:
-/// judged with them, a segment whose ends are where its bent state puts them reads as
-/// no nearer that state than its straight one, its middle still where the straight state's
-/// elasticity holds it.
-pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Vec<usize>> {
+/// The vertices of a piece part with alternative rest states that it shares with other
+/// parts ([`boundary_of`]), grouped by the parts they are shared with (one group per docking
+/// site), each group spread about its centre to the part's own size.
+///
+/// Why spread: the states of a part that bends differ in the turn between its sites and in
+/// the distance between them. A site as narrow as a thin piece (a fence corner 0.2 m deep and
+/// 1 m long) turned by a quarter moves its vertices a tenth of a metre, less than a squeeze
+/// moves them, so a gentle push read as a bend and the corner snapped to 90 degrees (the
+/// deep piece stayed straight). Spread to the distance between the sites, a turn weighs as
+/// much as a move whatever the piece's depth: what `sec4_3_states_follow_the_shape` asks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Boundary {
+    /// Local indices of the shared vertices.
+    local: Vec<usize>,
+    /// Per entry of `local`: its group.
+    group: Vec<usize>,
+    /// Per group: the factor its vertices are spread by about their centre (at least 1).
+    spread: Vec<f64>,
+}
+
+impl Boundary {
+    /// Groups `local` (indices into `part.vertices`) by the parts sharing each vertex; each
+    /// group's spread is the first state's distance of the groups' centres from their mean
+    /// over the group's own radius (root mean squares), or 1 when the group is as wide.
+    fn new(part: &Part, local: Vec<usize>, shared: &VertexParts) -> Self {
+        let mut keys: Vec<&[usize]> = Vec::new();
+        let group: Vec<usize> = (local.iter())
+            .map(|&k| {
+                let key = shared.of(part.vertices[k]);
+                keys.iter().position(|&g| g == key).unwrap_or_else(|| {
+                    keys.push(key);
+                    keys.len() - 1
+                })
+            })
+            .collect();
+        let first = &part.states[0].positions;
+        let centres = centres(&group, keys.len(), |i| first[local[i]]);
+        let mean = centres.iter().copied().sum::<DVec2>() / centres.len() as f64;
+        let size = rms(centres.iter().map(|&c| c - mean));
+        let spread = (0..keys.len())
+            .map(|g| {
+                let own = (0..local.len()).filter(|&i| group[i] == g);
+                let radius = rms(own.map(|i| first[local[i]] - centres[g]));
+                if radius > 0.0 && size > radius {
+                    size / radius
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        Self {
+            local,
+            group,
+            spread,
+        }
+    }
+
+    /// Local indices of the shared vertices.
+    pub fn local(&self) -> &[usize] {
+        &self.local
+    }
+
+    /// The boundary's points of `at` (by local vertex index), each group spread about its
+    /// centre by its factor.
+    pub fn points(&self, at: impl Fn(usize) -> DVec2) -> Vec<DVec2> {
+        let raw: Vec<DVec2> = self.local.iter().map(|&k| at(k)).collect();
+        let centres = centres(&self.group, self.spread.len(), |i| raw[i]);
+        (raw.iter().zip(&self.group))
+            .map(|(&p, &g)| centres[g] + (p - centres[g]) * self.spread[g])
+            .collect()
+    }
+
+    /// How well `rest` (a state's [`Boundary::points`]) fits the pose `at` gives.
+    pub fn align(&self, rest: &[DVec2], at: impl Fn(usize) -> DVec2) -> Alignment {
+        let pose = self.points(at);
+        let indices: Vec<usize> = (0..pose.len()).collect();
+        align(rest, &indices, &pose)
+    }
+}
+
+/// The centre of each of `groups` groups of the points `at(i)`, `group[i]` naming point
+/// `i`'s.
+fn centres(group: &[usize], groups: usize, at: impl Fn(usize) -> DVec2) -> Vec<DVec2> {
+    let mut sum = vec![DVec2::ZERO; groups];
+    let mut count = vec![0usize; groups];
+    for (i, &g) in group.iter().enumerate() {
+        sum[g] += at(i);
+        count[g] += 1;
+    }
+    (sum.iter().zip(&count))
+        .map(|(&s, &n)| s / n.max(1) as f64)
+        .collect()
+}
+
+/// The root mean square length of `vectors` (0 for none).
+fn rms(vectors: impl Iterator<Item = DVec2>) -> f64 {
+    let (sum, n) = vectors.fold((0.0, 0usize), |(s, n), v| (s + v.length_squared(), n + 1));
+    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+}
+
+/// The vertices of a piece part with alternative rest states that it shares with other parts,
+/// when there are at least two and fewer than all (paper 5.1, replacement: "the shape of the
+/// boundary vertices determines which piece to insert"), as a [`Boundary`]. The others belong
+/// to the part alone and take whichever state it takes, so they decide nothing: judged with
+/// them, a segment whose ends are where its bent state puts them reads as no nearer that
+/// state than its straight one, its middle still where the straight state's elasticity holds
+/// it.
+pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Boundary> {
     if !matches!(part.kind, clay_dsl::compiled::PartKind::Piece { .. }) || part.states.len() < 2 {
         return None;
     }
@@ -188,7 +285,7 @@ pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Vec<usize>> {
             align(&first, &indices, &other).distance > 1e-9 * scale
         })
     });
-    differ.then_some(ks)
+    differ.then(|| Boundary::new(part, ks, shared))
 }
 
 /// A stretch part's sums over its centred pose for its three states (as [`align`] forms
@@ -463,7 +560,7 @@ pub fn judge(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Jud
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
     let distances = (part.states.iter())
-        .map(|st| judged(part, positions, boundary.as_deref(), &st.positions).distance)
+        .map(|st| judged(part, positions, boundary.as_ref(), &st.positions).distance)
         .collect();
     Judgement {
         distances,

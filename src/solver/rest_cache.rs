@@ -8,8 +8,8 @@ use clay_dsl::compiled::Part;
 use glam::DVec2;
 
 use super::local::{
-    Chosen, PartMeasure, StateSums, StretchEnds, Switching, VertexParts, boundary_of, choose_state,
-    decide_stretch, normalised_or, part_rotation, with_hysteresis,
+    self as local, Chosen, PartMeasure, StateSums, StretchEnds, Switching, VertexParts,
+    boundary_of, choose_state, decide_stretch, normalised_or, part_rotation, with_hysteresis,
 };
 use crate::fit::{distance_of, finish, rotation_of};
 
@@ -100,32 +100,25 @@ pub struct RestCache {
 }
 
 /// The vertices a piece part shares with other parts ([`boundary_of`]), with every state's
-/// positions of them centred, and their squared norms.
-#[derive(Clone, Debug, Default)]
+/// positions of them as the judgement takes them ([`local::Boundary::points`]).
+#[derive(Clone, Debug)]
 struct Boundary {
-    local: Vec<usize>,
-    /// State `j`'s centred positions at `j * local.len()`.
+    judged: local::Boundary,
+    /// State `j`'s points at `j * judged.local().len()`.
     rest: Vec<DVec2>,
-    pp: Vec<f64>,
 }
 
 impl Boundary {
-    fn new(part: &Part, local: Vec<usize>) -> Self {
-        let b = local.len();
-        let mut rest = Vec::with_capacity(b * part.states.len());
-        let mut pp = Vec::with_capacity(part.states.len());
-        for state in &part.states {
-            let r: Vec<DVec2> = local.iter().map(|&k| state.positions[k]).collect();
-            let centre = r.iter().copied().sum::<DVec2>() / b as f64;
-            let mut norm = 0.0;
-            for p in r {
-                let c = p - centre;
-                norm += c.length_squared();
-                rest.push(c);
-            }
-            pp.push(norm);
-        }
-        Self { local, rest, pp }
+    fn new(part: &Part, judged: local::Boundary) -> Self {
+        let rest = (part.states.iter())
+            .flat_map(|state| judged.points(|k| state.positions[k]))
+            .collect();
+        Self { judged, rest }
+    }
+
+    /// How many states the boundary has points of.
+    fn states(&self) -> usize {
+        self.rest.len() / self.judged.local().len().max(1)
     }
 }
 
@@ -198,9 +191,9 @@ impl RestCache {
                 .iter()
                 .all(|st| st.positions.len() >= part.vertices.len());
             match boundary_of(part, vertex_parts).filter(|_| dense) {
-                Some(local) => {
+                Some(judged) => {
                     c.boundary_at.push(compact(c.boundaries.len())?);
-                    c.boundaries.push(Boundary::new(part, local));
+                    c.boundaries.push(Boundary::new(part, judged));
                 }
                 None => c.boundary_at.push(SHORT),
             }
@@ -432,7 +425,7 @@ impl RestCache {
                 .boundary_at
                 .get(pi)
                 .and_then(|&i| self.boundaries.get(i as usize))
-            && b.pp.len() == count
+            && b.states() == count
         {
             return self
                 .decide_on_boundary(b, s, pose, positions, rest, pp, qq, active, hysteresis);
@@ -485,24 +478,12 @@ impl RestCache {
         hysteresis: f64,
     ) -> Chosen {
         let verts = &self.vertices[s.vertex as usize..];
-        let n = b.local.len();
-        let centre = b
-            .local
-            .iter()
-            .map(|&k| positions[verts[k] as usize])
-            .sum::<DVec2>()
-            / n as f64;
-        let q: Vec<DVec2> = (b.local.iter())
-            .map(|&k| positions[verts[k] as usize] - centre)
-            .collect();
-        let qq_b: f64 = q.iter().map(|p| p.length_squared()).sum();
-        let judge = |j: usize| {
-            let (dot, cross) = products(&b.rest[j * n..][..n], &q);
-            finish(dot, cross, b.pp[j], qq_b)
-        };
+        let n = b.judged.local().len();
+        let at = |k: usize| positions[verts[k] as usize];
+        let judge = |j: usize| b.judged.align(&b.rest[j * n..][..n], at);
         let here = judge(active);
         let mut best = (active, here);
-        for j in (0..b.pp.len()).filter(|&j| j != active) {
+        for j in (0..b.states()).filter(|&j| j != active) {
             let a = judge(j);
             if a.distance < best.1.distance {
                 best = (j, a);
