@@ -830,12 +830,15 @@ fn closing_the_input_stops_the_server_with_exit_code_0() {
 
 #[test]
 fn an_analysis_past_its_timeout_is_reported_and_the_server_answers_on() {
-    // A wall of 20,000 bricks takes far longer to analyse than the millisecond this server
-    // allows (the compiler refuses a FIFO import, which would block for good, before reading).
-    let big = wall().replace("chain brick x 8", "chain brick x 20000");
+    // A wall of 90,000 bricks takes far longer to analyse than the 50 ms this server allows
+    // (about 0.3 s to check in a debug build), a plain wall far less (about 1 ms): with a
+    // deadline of 1 ms, the plain wall's analysis was itself late on a loaded machine, and the
+    // hover below failed (the compiler refuses a FIFO import, which would block for good,
+    // before reading).
+    let big = wall().replace("chain brick x 8", "chain brick x 90000");
     assert_ne!(big, wall());
     let uri = "file:///clay-lsp-late/main.clay";
-    let mut c = Client::initialised(Client::spawn_with(&["--analysis-timeout-ms", "1"]));
+    let mut c = Client::initialised(Client::spawn_with(&["--analysis-timeout-ms", "50"]));
     let published = c.open_as(uri, &big);
     assert_eq!(published["version"], 1, "{published}");
     let diags = published["diagnostics"].as_array().unwrap();
