@@ -1094,3 +1094,79 @@ fn the_shipped_binaries_are_built_without_the_test_helpers() {
         assert!(clay_seen, "{manifest}: no `clay` dependency read");
     }
 }
+
+/// The packages `Cargo.lock` says `name` depends on, directly or not, any kind (normal, build,
+/// dev), itself included.
+fn locked_closure(lock: &str, name: &str) -> BTreeSet<String> {
+    let mut deps: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for package in lock.split("[[package]]").skip(1) {
+        let field = |key: &str| {
+            package
+                .lines()
+                .find_map(|l| l.strip_prefix(key))
+                .map(|v| v.trim().trim_matches('"').to_string())
+        };
+        let Some(own) = field("name = ") else {
+            continue;
+        };
+        let listed = package.split("dependencies = [").nth(1).unwrap_or("");
+        let listed = listed.split(']').next().unwrap_or("");
+        let names = listed
+            .split(',')
+            .filter_map(|d| d.trim().trim_matches('"').split(' ').next())
+            .filter(|d| !d.is_empty())
+            .map(str::to_string);
+        deps.entry(own).or_default().extend(names);
+    }
+    let mut seen = BTreeSet::from([name.to_string()]);
+    let mut todo = vec![name.to_string()];
+    while let Some(p) = todo.pop() {
+        for d in deps.get(&p).into_iter().flatten() {
+            if seen.insert(d.clone()) {
+                todo.push(d.clone());
+            }
+        }
+    }
+    seen
+}
+
+/// Architecture Invariant: the dependencies the dev profile builds without optimisation
+/// (`Cargo.toml`, `[profile.dev.package.NAME] opt-level = 0`: the editor's window system, GPU
+/// and GUI) are none the core library or its tests use, whose solver and parser the tests
+/// spend their time in.
+#[test]
+fn unoptimised_dependencies_are_none_of_the_cores() {
+    let manifest = std::fs::read_to_string(root().join("Cargo.toml")).unwrap();
+    let lock = std::fs::read_to_string(root().join("Cargo.lock")).unwrap();
+    let mut unoptimised = Vec::new();
+    let mut current = None;
+    for line in manifest.lines() {
+        if let Some(p) = line.strip_prefix("[profile.dev.package.") {
+            current = Some(p.trim_end_matches(']').trim_matches('"').to_string());
+        } else if line.starts_with('[') {
+            current = None;
+        } else if line.replace(' ', "") == "opt-level=0"
+            && let Some(p) = current.take()
+        {
+            unoptimised.push(p);
+        }
+    }
+    assert!(unoptimised.len() > 10, "{unoptimised:?}");
+    let core = locked_closure(&lock, "clay");
+    assert!(
+        core.contains("faer") && core.contains("proptest"),
+        "{core:?}"
+    );
+    let mut all = locked_closure(&lock, "clay-editor");
+    all.extend(locked_closure(&lock, "clayc"));
+    for p in &unoptimised {
+        assert!(
+            all.contains(p),
+            "`{p}` is not a dependency: remove its profile entry"
+        );
+        assert!(
+            !core.contains(p),
+            "`{p}` is built without optimisation but `clay` depends on it"
+        );
+    }
+}
