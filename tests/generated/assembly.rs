@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 
 use glam::DVec2;
 
-use super::{Element, arc_end, step, strategy::round};
+use super::{Element, arc_end, shift_piece_y, step, strategy::round};
 
 /// What a case is drawn from: choices (each read modulo its range; 0 the simplest) and
 /// sizes in [0, 1).
@@ -254,7 +254,7 @@ impl Graph {
             let _ = writeln!(extra, "    state b{k} bend {a}\n    state m{k} mirror b{k}");
         }
         let text = e.piece(&format!("k{i}"), "joint", &extra);
-        shift_y(&text, -self.width / 2.0)
+        shift_piece_y(&text, -self.width / 2.0, f9)
     }
 
     fn hub_piece(&self, i: usize, h: &Hub) -> String {
@@ -356,29 +356,6 @@ fn f9(x: f64) -> f64 {
 /// Nine decimals, for script angles and points: what the script prints is what ran.
 pub fn round9(x: f64) -> f64 {
     f9(x)
-}
-
-/// A piece's text with every `(x, y)` point's y moved by `dy` (vertices, proxy points), not
-/// `out` directions.
-fn shift_y(piece: &str, dy: f64) -> String {
-    let mut out = String::new();
-    let mut rest = piece;
-    while let Some(open) = rest.find('(') {
-        out.push_str(&rest[..open]);
-        let close = open + rest[open..].find(')').unwrap_or(0);
-        let inside = &rest[open + 1..close];
-        let direction = out.ends_with("out ");
-        match inside.split_once(',') {
-            Some((x, y)) if !direction && x.trim().parse::<f64>().is_ok() => {
-                let y: f64 = y.trim().parse().unwrap_or(0.0);
-                let _ = write!(out, "({}, {})", x.trim(), f9(y + dy));
-            }
-            _ => out.push_str(&rest[open..=close]),
-        }
-        rest = &rest[close + 1..];
-    }
-    out.push_str(rest);
-    out
 }
 
 /// What a link segment does to the path along it, at a value of its configuration.

@@ -700,7 +700,7 @@ impl BendGrammar {
         let piece = shifted.piece("road", "lane", &extra);
         // move every point down by half the height so the axis is y = 0
         let h = s.height / 2.0;
-        let piece = shift_piece_y(&piece, -h);
+        let piece = shift_piece_y(&piece, -h, strategy::round6);
         format!(
             "site type lane\n\n{piece}\nmodel {{\n    street = chain road x {} along west -> east at ({}, {}) rotate {}\n}}\n",
             self.count, self.origin.x, self.origin.y, self.heading
@@ -767,8 +767,9 @@ pub fn arc_end(p: DVec2, heading: f64, l: f64, theta: f64) -> DVec2 {
     p + t * (r * theta.sin()) + t.perp() * (r * (1.0 - theta.cos()))
 }
 
-/// A piece's text with every `(x, y)` point's y moved by `dy` (vertices, proxy points).
-fn shift_piece_y(piece: &str, dy: f64) -> String {
+/// A piece's text with every `(x, y)` point's y moved by `dy` (vertices, proxy points; not
+/// `out` directions), each new y rounded by `round_y`.
+pub fn shift_piece_y(piece: &str, dy: f64, round_y: impl Fn(f64) -> f64) -> String {
     let mut out = String::new();
     let mut rest = piece;
     while let Some(open) = rest.find('(') {
@@ -776,14 +777,13 @@ fn shift_piece_y(piece: &str, dy: f64) -> String {
         let close = open + rest[open..].find(')').unwrap_or(0);
         let inside = &rest[open + 1..close];
         let direction = out.ends_with("out ");
-        match inside.split_once(',') {
-            Some((x, y))
-                if !direction
-                    && y.trim().parse::<f64>().is_ok()
-                    && x.trim().parse::<f64>().is_ok() =>
-            {
-                let y: f64 = y.trim().parse().unwrap_or(0.0);
-                let _ = write!(out, "({}, {})", x.trim(), strategy::round6(y + dy));
+        let point = inside.split_once(',').and_then(|(x, y)| {
+            let y = y.trim().parse::<f64>().ok()?;
+            x.trim().parse::<f64>().is_ok().then_some((x.trim(), y))
+        });
+        match point {
+            Some((x, y)) if !direction => {
+                let _ = write!(out, "({x}, {})", round_y(y + dy));
             }
             _ => out.push_str(&rest[open..=close]),
         }
