@@ -141,6 +141,20 @@ pub fn align(rest: &[DVec2], vertices: &[usize], positions: &[DVec2]) -> Alignme
     finish(s.dot, s.cross, s.pp, s.qq)
 }
 
+/// Aligns the points `rest` to the points `pose`, pairwise (the shorter list's length); as
+/// [`align`], for points that are not the model's vertices.
+pub fn align_points(rest: &[DVec2], pose: &[DVec2]) -> Alignment {
+    let m = rest.len().min(pose.len());
+    if m == 0 {
+        return Alignment {
+            rotation: DVec2::X,
+            distance: 0.0,
+        };
+    }
+    let s = CentredSums::of(m, |k| rest[k], |k| pose[k]);
+    finish(s.dot, s.cross, s.pp, s.qq)
+}
+
 /// The alignment from the sums of dot and cross products of the centred rest (p) and pose (q)
 /// vectors and their squared norms; shared by [`align`] and the solver's rest cache so both give the
 /// same result bit for bit.

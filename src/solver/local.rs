@@ -224,9 +224,7 @@ impl Boundary {
 
     /// How well `rest` (a state's [`Boundary::points`]) fits the pose `at` gives.
     pub fn align(&self, rest: &[DVec2], at: impl Fn(usize) -> DVec2) -> Alignment {
-        let pose = self.points(at);
-        let indices: Vec<usize> = (0..pose.len()).collect();
-        align(rest, &indices, &pose)
+        crate::fit::align_points(rest, &self.points(at))
     }
 }
 
