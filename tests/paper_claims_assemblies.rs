@@ -1,6 +1,7 @@
 //! The paper's claims over generated assemblies (issue 46): random piece graphs of rigid hubs
 //! (towers, corners, tees, windows, posts) joined by stretch chains, bendable pieces and
-//! windows, as trees, rectangles (castles) and regular polygons (`tests/generated/assembly.rs`).
+//! windows, chains of turning elements (arcs), as trees, rectangles (castles), regular polygons
+//! and rings (`tests/generated/assembly.rs`).
 //! Each case is led from one rest configuration to another (other chain counts, other bend
 //! states) along the way one morphs into the other; the oracles need no example: a rest
 //! configuration exists there, counts from lengths, exact rigid motions.
@@ -51,6 +52,29 @@ proptest! {
     #[test]
     fn sec5_1_morph_to_a_rest_configuration(m in morphs(), frames in strategy::frames()) {
         holds(claims::morph_to_rest(&m, frames))?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(16, 26))]
+
+    /// Round trip (paper 5.1): from rest, a hub pulled any way by up to three and a half
+    /// elements over any number of frames and brought back: the links the held hubs fix are
+    /// as long as at the start, at rest; rings of turning elements included (no count but
+    /// the start's closes them).
+    #[test]
+    fn sec5_1_pulled_and_back(
+        m in morphs(),
+        degrees in -180.0f64..180.0,
+        elements in 0.5f64..3.5,
+        frames in strategy::frames(),
+        back in strategy::frames(),
+    ) {
+        let by = DVec2::from_angle(strategy::round(degrees).to_radians())
+            * strategy::round(elements)
+            * m.graph.shortest();
+        let by = DVec2::new(assembly::round9(by.x), assembly::round9(by.y));
+        holds(claims::pulled_and_back(&m, by, frames, back))?;
     }
 }
 

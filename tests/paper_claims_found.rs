@@ -4,7 +4,7 @@
 
 mod generated;
 
-use generated::{Run, step};
+use generated::{Run, check, step};
 use glam::DVec2;
 
 use clay::RuleKind;
@@ -223,4 +223,25 @@ fn a_facade_pushed_in_drops_bricks_across_its_window() {
         .step(&step::hold(300));
     assert_eq!(run.count("brick"), 5, "{}", run.repro());
     assert_at_rest(&run);
+}
+
+/// Paper 4.2, 5.1 (issue 46): a ring of twelve 30-degree wedges (a stretch chain closed on
+/// itself) pulled out 2 m over 30 frames and brought back: twelve again, at rest, since no
+/// other count near it closes the ring (counts from turns, `solver/turns.rs`). It kept 13
+/// (energy 2.2: the relaxation judged counts by length, which a squeezed 13 keeps).
+#[test]
+fn a_ring_of_wedges_pulled_out_and_back_closes_with_twelve() {
+    let run = replay("ring_of_wedges");
+    assert_eq!(run.chain_count("w"), 12, "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}
+
+/// Paper 4.2, 5.1 (issue 46): three 30-degree wedges between two posts, the second post led
+/// round the wedges' circle and turned with it to where six put it: six wedges, at rest. It
+/// ended with four (energy 1.2): the chain's count from its length alone.
+#[test]
+fn an_arc_between_posts_led_round_its_circle_grows_to_the_turn() {
+    let run = replay("arc_between_posts");
+    assert_eq!(run.chain_count("w"), 6, "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
 }

@@ -34,6 +34,7 @@ mod rest_cache;
 mod rounding;
 mod state;
 mod trials;
+mod turns;
 mod units;
 
 pub use config::{SolverConfig, SolverKind};

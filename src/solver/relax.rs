@@ -26,6 +26,7 @@ use super::pass2::handle_term;
 use super::report::{FrameReport, Proposal, SolverError};
 use super::rounding::{Relaxed, decide_run, runs};
 use super::state::Solver;
+use super::turns::counts_from_turns;
 use crate::assembly::Assembly;
 use crate::fit::align;
 
@@ -167,6 +168,15 @@ impl Solver {
             {
                 alternatives.push(p);
             }
+        }
+        // a chain of turning elements: the count its ends' turn asks for (`turns.rs`)
+        let lengths = relaxed_lengths(asm, &families, &f);
+        for counts in counts_from_turns(asm, &lengths, &f, hysteresis) {
+            alternatives.push(Proposal {
+                counts,
+                states: self.relaxed_states(&data.parts, &forced, &f),
+                pose: f.clone(),
+            });
         }
         Ok(alternatives)
     }

@@ -97,6 +97,64 @@ impl Bendable {
     }
 }
 
+/// A chain element that turns by `turn` degrees from its west site to its east site (a
+/// wedge of a round tower, a curved rail): a ladder of `bays` bays bent along an arc
+/// `length` long on its centre line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Arc {
+    pub length: f64,
+    pub turn: f64,
+    pub bays: usize,
+}
+
+impl Arc {
+    /// The piece's statements, named `name`, `width` deep, centred on its arc.
+    fn piece(&self, name: &str, width: f64) -> String {
+        let theta = self.turn.to_radians();
+        let p = |q: DVec2| format!("({}, {})", f9(q.x), f9(q.y));
+        let b = self.bays;
+        let (mut bottom, mut top) = (Vec::new(), Vec::new());
+        for i in 0..=b {
+            let t = i as f64 / b as f64;
+            let c = arc_end(DVec2::ZERO, 0.0, self.length * t, theta * t);
+            let n = DVec2::from_angle(theta * t).perp() * width / 2.0;
+            bottom.push(c - n);
+            top.push(c + n);
+        }
+        let mut s = format!("piece {name} {{\n");
+        for i in 0..=b {
+            let _ = writeln!(s, "    vertex b{i} {}", p(bottom[i]));
+            let _ = writeln!(s, "    vertex t{i} {}", p(top[i]));
+        }
+        let ring: Vec<String> = (0..=b)
+            .map(|i| format!("b{i}"))
+            .chain((0..=b).rev().map(|i| format!("t{i}")))
+            .collect();
+        let mut edges = vec![format!("{}-b0", ring.join("-"))];
+        for i in 0..b {
+            edges.push(format!("b{i}-t{}", i + 1));
+            edges.push(format!("b{}-t{i}", i + 1));
+        }
+        for i in 1..b {
+            edges.push(format!("b{i}-t{i}"));
+        }
+        let _ = writeln!(s, "    edges {}", edges.join(", "));
+        let _ = writeln!(s, "    site west: joint [t0, b0] out (-1, 0)");
+        let (x, y) = (f9(theta.cos()), f9(theta.sin()));
+        let _ = writeln!(s, "    site east: joint [b{b}, t{b}] out ({x}, {y})");
+        let outline: Vec<String> = (bottom.iter().chain(top.iter().rev()))
+            .map(|&q| p(q))
+            .collect();
+        let _ = writeln!(
+            s,
+            "    polygon skinned fill #9a7b4f {{ {} }}",
+            outline.join(" ")
+        );
+        s.push_str("}\n\n");
+        s
+    }
+}
+
 /// One stretch of a link, in order from its `from` hub.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Segment {
@@ -106,6 +164,8 @@ pub enum Segment {
     Bend { piece: usize },
     /// A two-site hub straight through (a window in a wall).
     Window { hub: usize },
+    /// A stretch chain of turning elements (one of [`Graph::arcs`]).
+    Arc { element: usize },
 }
 
 /// A link from site `from.1` of hub node `from.0` to site `to.1` of node `to.0`.
@@ -140,6 +200,8 @@ pub struct Graph {
     pub width: f64,
     pub elements: Vec<Element>,
     pub bendables: Vec<Bendable>,
+    /// Turning chain elements.
+    pub arcs: Vec<Arc>,
     /// Hub pieces; `nodes[i]` is an instance of `hubs[nodes[i]]`. Windows are hubs too.
     pub hubs: Vec<Hub>,
     pub nodes: Vec<usize>,
@@ -207,6 +269,12 @@ impl Graph {
                 let _ = writeln!(s, "stretch e{i} from west to east {{ min 2 }}\n");
             }
         }
+        for (i, a) in self.arcs.iter().enumerate() {
+            if used(&|s| *s == Segment::Arc { element: i }) {
+                s.push_str(&a.piece(&format!("a{i}"), self.width));
+                let _ = writeln!(s, "stretch a{i} from west to east {{ min 2 }}\n");
+            }
+        }
         for (i, b) in self.bendables.iter().enumerate() {
             if used(&|s| *s == Segment::Bend { piece: i }) {
                 s.push_str(&self.bendable_piece(i, b));
@@ -237,7 +305,7 @@ impl Graph {
     fn counts_of(&self, l: usize) -> Vec<usize> {
         let segments = &self.links[l].segments;
         (self.start.values[l].iter().zip(segments))
-            .filter(|(_, s)| matches!(s, Segment::Chain { .. }))
+            .filter(|(_, s)| matches!(s, Segment::Chain { .. } | Segment::Arc { .. }))
             .map(|(&v, _)| v.round() as usize)
             .collect()
     }
@@ -311,6 +379,12 @@ impl Graph {
                 Segment::Window { hub } => {
                     let _ = writeln!(s, "    {name} = h{hub}");
                     (format!("{name}.s0"), format!("{name}.s1"))
+                }
+                Segment::Arc { element } => {
+                    let count = counts[chain_index];
+                    chain_index += 1;
+                    let _ = writeln!(s, "    {name} = chain a{element} x {count}");
+                    (format!("{name}[0].west"), format!("{name}[last].east"))
                 }
             };
             let _ = writeln!(s, "    dock {last} to {first}");
@@ -413,6 +487,12 @@ impl Graph {
                 Segment::Window { hub } => {
                     p += DVec2::from_angle(h) * 2.0 * self.hubs[*hub].radius;
                 }
+                Segment::Arc { element } => {
+                    let a = &self.arcs[*element];
+                    let theta = v * a.turn.to_radians();
+                    p = arc_end(p, h, v * a.length, theta);
+                    h += theta;
+                }
             }
         }
         (p, h)
@@ -423,7 +503,8 @@ impl Graph {
         pose.apply(self.hubs[self.nodes[n]].centroid(self.width))
     }
 
-    /// The instance-name stems of the chains, per link and segment (`None`: not a chain).
+    /// The instance-name stems of the straight chains, per link and segment (the turning
+    /// ones are held at their counts by [`claims`]' `turns_as_in`).
     pub fn chain_names(&self) -> Vec<(usize, usize, String)> {
         let mut names = Vec::new();
         for (l, link) in self.links.iter().enumerate() {
@@ -479,6 +560,8 @@ impl Graph {
                         }
                     }
                     Segment::Bend { .. } => h += v.to_radians(),
+                    // a turning chain held at its count (`turns_as_in`): its way is fixed
+                    Segment::Arc { element } => h += v * self.arcs[*element].turn.to_radians(),
                     Segment::Window { .. } => {}
                 }
             }
@@ -514,7 +597,8 @@ impl Graph {
     pub fn shortest(&self) -> f64 {
         let e = self.elements.iter().map(|e| e.length);
         let b = self.bendables.iter().map(|b| b.length);
-        e.chain(b).fold(f64::INFINITY, f64::min)
+        let a = self.arcs.iter().map(|a| a.length);
+        e.chain(b).chain(a).fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -658,6 +742,20 @@ const TREE_ANGLES: [f64; 13] = [
     0.0, 90.0, -90.0, 45.0, -45.0, 30.0, -30.0, 60.0, -60.0, 120.0, -120.0, 135.0, -135.0,
 ];
 
+/// Turns a turning chain element may have, in degrees (either way; a stretch rule's sites
+/// face within 60 degrees of opposite ways, E040).
+const ARC_TURNS: [f64; 10] = [30.0, 15.0, 45.0, 20.0, 50.0, 10.0, 36.0, 5.0, 24.0, 12.0];
+
+/// A turning element `width` deep whose centre line is `length` long (at least its depth
+/// times its turn in radians, so its inner edge is never folded).
+fn arc(width: f64, length: f64, turn: f64, bays: usize) -> Arc {
+    Arc {
+        length: round(length.max(1.1 * width * turn.to_radians().abs())),
+        turn,
+        bays,
+    }
+}
+
 /// Bend angles a bendable piece's states may have, in degrees.
 const BEND_ANGLES: [f64; 9] = [90.0, 45.0, 15.0, 30.0, 60.0, 10.0, 20.0, 75.0, 50.0];
 
@@ -722,12 +820,15 @@ pub fn build(recipe: &Recipe) -> Morph {
         bays: 1 + c.pick(3),
         angles,
     };
+    let turn = ARC_TURNS[c.pick(ARC_TURNS.len())] * if c.pick(2) == 1 { -1.0 } else { 1.0 };
+    let arcs = vec![arc(width, width * c.between(0.5, 4.0), turn, 1 + c.pick(3))];
     let origin = DVec2::new(c.between(-20.0, 20.0), c.between(-20.0, 20.0));
     let heading = round(c.between(-180.0, 180.0));
     let mut g = Graph {
         width,
         elements,
         bendables: vec![bendable],
+        arcs,
         hubs: Vec::new(),
         nodes: Vec::new(),
         links: Vec::new(),
@@ -737,10 +838,11 @@ pub fn build(recipe: &Recipe) -> Morph {
         shape: "tree",
         start: Config { values: Vec::new() },
     };
-    let (end, movers) = match c.pick(3) {
+    let (end, movers) = match c.pick(4) {
         0 => tree(&mut g, &mut c),
         1 => rectangle(&mut g, &mut c),
-        _ => polygon(&mut g, &mut c),
+        2 => polygon(&mut g, &mut c),
+        _ => ring(&mut g, &mut c),
     };
     Morph {
         graph: g,
@@ -750,13 +852,20 @@ pub fn build(recipe: &Recipe) -> Morph {
 }
 
 /// A link's segments and its start values: a chain, a chain with a bendable piece or a
-/// window in it, two chains of different elements, or a bendable piece alone (a fence's
-/// corner post between two hubs). `bends` allows the bendable piece.
+/// window in it, two chains of different elements, a bendable piece alone (a fence's
+/// corner post between two hubs), a chain of turning elements alone or after a straight
+/// one. `bends` allows the bendable piece and the turning elements.
 fn link_segments(g: &mut Graph, c: &mut Cursor, bends: bool) -> (Vec<Segment>, Vec<f64>) {
     let count = |c: &mut Cursor| (2 + c.pick(6)) as f64;
     let chain = |element| Segment::Chain { element };
-    match c.pick(5) {
+    let arc = Segment::Arc { element: 0 };
+    match c.pick(7) {
         4 if bends => (vec![Segment::Bend { piece: 0 }], vec![0.0]),
+        5 if bends => (vec![arc], vec![count(c)]),
+        6 if bends => {
+            let (a, b) = (count(c), count(c));
+            (vec![chain(0), arc], vec![a, b])
+        }
         1 if bends => {
             let (a, b) = (count(c), count(c));
             (
@@ -855,7 +964,7 @@ fn tree(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
             let l = node - 1;
             for (k, seg) in g.links[l].segments.iter().enumerate() {
                 end.values[l][k] = match seg {
-                    Segment::Chain { .. } => (2 + c.pick(9)) as f64,
+                    Segment::Chain { .. } | Segment::Arc { .. } => (2 + c.pick(9)) as f64,
                     Segment::Bend { piece } => {
                         let b = &g.bendables[*piece];
                         b.turn(c.pick(b.states()))
@@ -959,6 +1068,48 @@ fn polygon(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
     )
 }
 
+/// A closed ring of 2 or 3 straight gate hubs joined by chains of turning elements, the
+/// turns adding up to a whole turn; or a stadium: two gates joined by a half turn of them
+/// and a straight chain either side, pulled longer or shorter by the gate across.
+fn ring(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
+    g.shape = "ring";
+    let stadium = c.pick(2) == 1;
+    let k = if stadium { 2 } else { 2 + c.pick(2) };
+    // at least 7 elements round: each turns less than 60 degrees (E040)
+    let n = (2 + c.pick(4)).max(7usize.div_ceil(k));
+    let turn = 360.0 / (k * n) as f64;
+    let old = &g.arcs[0];
+    g.arcs[0] = arc(g.width, old.length, turn, old.bays);
+    let r = g.width * c.between(0.6, 3.0);
+    g.hubs.push(hub(vec![180.0, 0.0], g.width, r));
+    g.nodes = vec![0; k];
+    let arc = Segment::Arc { element: 0 };
+    let m = (2 + c.pick(5)) as f64;
+    let (segments, values) = if stadium {
+        (vec![arc, Segment::Chain { element: 0 }], vec![n as f64, m])
+    } else {
+        (vec![arc], vec![n as f64])
+    };
+    for i in 0..k {
+        g.links.push(Link {
+            from: (i, 1),
+            to: ((i + 1) % k, 0),
+            segments: segments.clone(),
+        });
+    }
+    g.start = Config {
+        values: vec![values.clone(); k],
+    };
+    let mut end = g.start.clone();
+    if stadium {
+        let m2 = (2 + c.pick(2 * m as usize)) as f64;
+        for v in &mut end.values {
+            v[1] = m2;
+        }
+    }
+    (end, vec![k / 2])
+}
+
 /// The paper's claims on generated assemblies (`tests/paper_claims_assemblies.rs`).
 pub mod claims {
     use super::super::{Run, check, step};
@@ -984,32 +1135,32 @@ pub mod claims {
         run
     }
 
-    /// The chains held straight between held hubs with a count off the only one that fits
-    /// by more than one.
     /// Whether every bendable piece of `run` is in the state configuration `config` gives
-    /// it (by its turn): the held hubs fix the counts of a configuration only with its
-    /// states, and another assignment of bends may close too (a bend and its mirror on two
-    /// links, each chain another length).
-    fn bends_as_in(m: &Morph, run: &Run, config: &Config) -> bool {
+    /// it (by its turn), and every chain of turning elements has its count: the held hubs
+    /// fix the counts of a configuration only with its turns, and another assignment may
+    /// close too (a bend and its mirror on two links of a tree, each chain another length).
+    fn turns_as_in(m: &Morph, run: &Run, config: &Config) -> bool {
         let g = &m.graph;
         let data = run.asm.data();
         (g.links.iter().enumerate()).all(|(l, link)| {
             (link.segments.iter().enumerate()).all(|(k, segment)| {
-                let Segment::Bend { piece } = *segment else {
-                    return true;
-                };
                 let name = format!("l{l}x{k}");
-                (data.instances.iter())
-                    .find(|i| i.name == name)
-                    .is_some_and(|i| {
-                        (g.bendables[piece].turn(i.state) - config.values[l][k]).abs() < 1e-6
-                    })
+                let want = config.values[l][k];
+                match *segment {
+                    Segment::Bend { piece } => (data.instances.iter())
+                        .find(|i| i.name == name)
+                        .is_some_and(|i| (g.bendables[piece].turn(i.state) - want).abs() < 1e-6),
+                    Segment::Arc { .. } => run.chain_count(&name) as f64 == want.round(),
+                    _ => true,
+                }
             })
         })
     }
 
+    /// The chains held straight between held hubs with a count off the only one that fits
+    /// by more than one.
     fn determined_off(m: &Morph, run: &Run) -> Vec<String> {
-        if !bends_as_in(m, run, &m.end) {
+        if !turns_as_in(m, run, &m.end) {
             return Vec::new();
         }
         (m.determined().into_iter())
@@ -1101,6 +1252,14 @@ pub mod claims {
                 lengths[l] += run.chain_count(&stem) as f64 * g.elements[element].length;
             }
         }
+        for (l, link) in g.links.iter().enumerate() {
+            for (k, segment) in link.segments.iter().enumerate() {
+                if let Segment::Arc { element } = *segment {
+                    let count = run.chain_count(&format!("l{l}x{k}"));
+                    lengths[l] += count as f64 * g.arcs[element].length;
+                }
+            }
+        }
         lengths
     }
 
@@ -1112,17 +1271,23 @@ pub mod claims {
     /// fix the links' lengths only with the states fixed; paper 4.3's hysteresis keeps them).
     pub fn round_trip(m: &Morph, frames: u64, back: u64) -> Result<(), String> {
         let mut run = morphed(m, frames);
-        let fresh = Run::new(&m.graph.text());
-        let before = link_lengths(m, &fresh);
         let mut flipped = m.clone();
         flipped.movers.reverse();
         run.steps(&flipped.regrab(&m.end));
         run.steps(&flipped.lead(&m.end, &m.graph.start, back));
         run.steps(&m.regrab(&m.graph.start));
         run.step(&step::hold(settle(m)));
-        let after = link_lengths(m, &run);
+        back_at_start(m, &run)
+    }
+
+    /// The end of a round trip: at rest, and, when every bendable piece and turning chain is
+    /// back as at the start, every link whose length the held hubs fix as long as at the start.
+    fn back_at_start(m: &Morph, run: &Run) -> Result<(), String> {
+        let fresh = Run::new(&m.graph.text());
+        let before = link_lengths(m, &fresh);
+        let after = link_lengths(m, run);
         let shortest = m.graph.shortest();
-        let same_states = bends_as_in(m, &run, &m.graph.start);
+        let same_states = turns_as_in(m, run, &m.graph.start);
         let determined = m.determined_links(&m.graph.start);
         let off: Vec<usize> = (0..before.len())
             .filter(|_| same_states)
@@ -1134,10 +1299,24 @@ pub mod claims {
                     "links {off:?} are {after:?} long, were {before:?}; {}",
                     m.describe()
                 )],
-                &run,
+                run,
             );
         }
-        check::at_rest(&run, 1e-6).map_err(|e| format!("{e}\n{}", m.describe()))
+        check::at_rest(run, 1e-6).map_err(|e| format!("{e}\n{}", m.describe()))
+    }
+
+    /// Round trip by a pull (paper 5.1): from the start, the first mover dragged by `by`
+    /// over `frames` frames, held 30, and dragged back to where it was over `back` frames,
+    /// then held: as [`round_trip`]'s end (rings included: a ring of turning elements pulled
+    /// out and back has its counts again, at rest).
+    pub fn pulled_and_back(m: &Morph, by: DVec2, frames: u64, back: u64) -> Result<(), String> {
+        let mut run = Run::new(&m.graph.text());
+        run.steps(&m.hold_steps());
+        run.step(&step::drag(by, frames.max(1)))
+            .step(&step::hold(30))
+            .step(&step::drag(-by, back.max(1)))
+            .step(&step::hold(settle(m)));
+        back_at_start(m, &run)
     }
 
     /// Relaxation: led to the end, held 10 frames, then let go of (the grab released, every

@@ -1,0 +1,389 @@
+//! Counts from turns (`relax.rs`, `docs/solver.md`): a chain whose elements each turn by an
+//! angle between their sites (a wedge, a curved rail) rests only with the counts whose turn
+//! matches the turn between the frames its ends are held in: twelve 30-degree wedges close a
+//! ring, and no other count near twelve does, whatever the ring's length. The relaxation's
+//! lengths cannot see this (a ring of thirteen squeezed into twelve's circle keeps its
+//! length); the turn of the chain's end parts can.
+
+use clay_dsl::compiled::{
+    CompiledGrammar, InstanceSite, Part, PartKind, STRETCH_TWO, StretchPart, StretchRule,
+};
+use std::cmp::Ordering;
+
+use glam::DVec2;
+
+use super::rounding::{Relaxed, runs};
+use crate::assembly::Assembly;
+use crate::fit::{RigidMotion, align, rigid_motion};
+
+/// An element that turns by less than this (radians) between its sites is straight: its
+/// chain's turn says nothing of its count.
+const STRAIGHT: f64 = 1e-3;
+
+/// The centre of points.
+fn centre(ps: &[DVec2]) -> DVec2 {
+    ps.iter().sum::<DVec2>() / ps.len().max(1) as f64
+}
+
+/// The angle `a` brought into (-pi, pi].
+fn wrap(a: f64) -> f64 {
+    let t = std::f64::consts::TAU;
+    let w = a - t * (a / t).round();
+    if w <= -std::f64::consts::PI { w + t } else { w }
+}
+
+/// The rigid motion from one element of a two-element part to the next in its `two` rest
+/// state: the one taking element 0's vertices onto element 1's, vertex by piece vertex.
+/// `None` with fewer than two such vertices.
+fn element_step(part: &StretchPart) -> Option<RigidMotion> {
+    let two = &part.states.get(STRETCH_TWO)?.positions;
+    let (mut from, mut to) = (Vec::new(), Vec::new());
+    for (k, v) in part.vertices.iter().enumerate() {
+        if v.element != 0 {
+            continue;
+        }
+        let twin = part
+            .vertices
+            .iter()
+            .position(|w| w.element == 1 && w.vertex == v.vertex);
+        if let (Some(j), Some(&p)) = (twin, two.get(k)) {
+            from.push(p);
+            to.push(*two.get(j)?);
+        }
+    }
+    if from.len() < 2 {
+        return None;
+    }
+    rigid_motion(&from, &to)
+}
+
+/// The positions, in the part's vertex order, of element 0's `from` site and element 1's
+/// `to` site of a two-element part (the chain's ends when the part is its first or last).
+struct EndSites {
+    from: Vec<usize>,
+    to: Vec<usize>,
+}
+
+impl EndSites {
+    fn of(grammar: &CompiledGrammar, rule: &StretchRule) -> Option<Self> {
+        let piece = grammar.pieces.get(rule.piece)?;
+        let find = |element: u8, v: usize| {
+            (rule.part.vertices.iter()).position(|w| w.element == element && w.vertex == v)
+        };
+        let site = |s: usize, element: u8| -> Option<Vec<usize>> {
+            let vs = &piece.sites.get(s)?.vertices;
+            let ks: Option<Vec<usize>> = vs.iter().map(|&v| find(element, v)).collect();
+            ks.filter(|ks| ks.len() >= 2)
+        };
+        Some(Self {
+            from: site(rule.from, 0)?,
+            to: site(rule.to, 1)?,
+        })
+    }
+
+    /// The direction (radians) of a site's vertices, first to last, at `at(k)`.
+    fn angle(ks: &[usize], at: impl Fn(usize) -> Option<DVec2>) -> Option<f64> {
+        let d = at(*ks.last()?)? - at(*ks.first()?)?;
+        (d.length_squared() > 0.0).then(|| d.y.atan2(d.x))
+    }
+}
+
+/// A chain's turn against its rest turn: the element's turn, its count, how far (radians)
+/// the turn from its first site to its last in a pose is from the turn its count has at
+/// rest, and the part a change of count goes to (the one furthest from its rest shape).
+struct ChainTurn {
+    theta: f64,
+    step: RigidMotion,
+    /// In the `two` state: element 0's `from` site's vertices, element 1's `to` site's.
+    rest_from: Vec<DVec2>,
+    rest_to: Vec<DVec2>,
+    /// In the pose: the chain's first site's vertices, its last site's.
+    from: Vec<DVec2>,
+    to: Vec<DVec2>,
+    /// An element's length at rest (its step's).
+    element: f64,
+    count: usize,
+    off: f64,
+    first: usize,
+    min: usize,
+    max: Option<usize>,
+}
+
+impl ChainTurn {
+    fn of(asm: &Assembly, c: usize, pose: &[DVec2]) -> Option<Self> {
+        let (data, grammar) = (asm.data(), asm.grammar());
+        let rule = grammar.stretch_rules.get(data.chains.get(c)?.rule)?;
+        let step = element_step(&rule.part)?;
+        let theta = step.rotation.y.atan2(step.rotation.x);
+        let n = data.chains[c].instances.len();
+        let parts: Vec<(usize, &Part)> = (data.parts.iter())
+            .filter_map(|p| match p.kind {
+                PartKind::Stretch { chain, first } if chain == c => Some((first, p)),
+                _ => None,
+            })
+            .collect();
+        let ends = EndSites::of(grammar, rule)?;
+        let part = |first: usize| parts.iter().find(|p| p.0 == first).map(|p| p.1);
+        let (head, tail) = (part(0)?, part(n.checked_sub(2)?)?);
+        let two = |k: usize| rule.part.states.get(STRETCH_TWO)?.positions.get(k).copied();
+        let at = |p: &Part, k: usize| pose.get(*p.vertices.get(k)?).copied();
+        // the turn from the chain's first site to its last: two elements' at rest, and one
+        // element's more for each further element
+        let rest = EndSites::angle(&ends.to, two)? - EndSites::angle(&ends.from, two)?;
+        let turn = EndSites::angle(&ends.to, |k| at(tail, k))?
+            - EndSites::angle(&ends.from, |k| at(head, k))?;
+        let rest_from: Vec<DVec2> = ends.from.iter().filter_map(|&k| two(k)).collect();
+        let rest_to: Vec<DVec2> = ends.to.iter().filter_map(|&k| two(k)).collect();
+        let from: Vec<DVec2> = ends.from.iter().filter_map(|&k| at(head, k)).collect();
+        let to: Vec<DVec2> = ends.to.iter().filter_map(|&k| at(tail, k)).collect();
+        let strain = |p: &Part| {
+            (p.states.get(STRETCH_TWO))
+                .map_or(0.0, |s| align(&s.positions, &p.vertices, pose).distance)
+        };
+        let first = (parts.iter())
+            .max_by(|x, y| strain(x.1).total_cmp(&strain(y.1)))
+            .map_or(0, |p| p.0);
+        Some(Self {
+            theta,
+            step,
+            rest_from,
+            rest_to,
+            element: step.apply(step.from_centre).distance(step.from_centre),
+            from,
+            to,
+            count: n,
+            off: wrap(turn - rest - (n as f64 - 2.0) * theta),
+            first,
+            min: rule.min.max(2),
+            max: rule.max,
+        })
+    }
+
+    fn turns(&self) -> bool {
+        self.theta.abs() >= STRAIGHT
+    }
+
+    /// The rest positions of the `to` site of element `m - 1` (element 1's carried on).
+    fn rest_last(&self, m: usize) -> Vec<DVec2> {
+        let mut last = self.rest_to.clone();
+        for _ in 2..m {
+            last.iter_mut().for_each(|p| *p = self.step.apply(*p));
+        }
+        last
+    }
+
+    /// How far the chain's first site's centre moves when it has `m` elements at rest and
+    /// its last site stays where the pose has it.
+    fn first_moves(&self, m: usize) -> Option<DVec2> {
+        let onto = rigid_motion(&self.rest_last(m), &self.to)?;
+        Some(onto.apply(centre(&self.rest_from)) - centre(&self.from))
+    }
+
+    /// How far its last site's centre moves when it has `m` elements at rest and its first
+    /// site stays where the pose has it.
+    fn last_moves(&self, m: usize) -> Option<DVec2> {
+        let onto = rigid_motion(&self.rest_from, &self.from)?;
+        Some(onto.apply(centre(&self.rest_last(m))) - centre(&self.to))
+    }
+
+    /// How far apart its first and last sites' centres are at rest with `m` elements.
+    fn chord(&self, m: usize) -> Option<f64> {
+        let d = centre(&self.rest_last(m)).distance(centre(&self.rest_from));
+        d.is_finite().then_some(d)
+    }
+
+    /// How far apart its first and last sites' centres are in the pose.
+    fn span(&self) -> f64 {
+        centre(&self.to).distance(centre(&self.from))
+    }
+
+    /// Its direction in the pose, first site to last.
+    fn direction(&self) -> DVec2 {
+        (centre(&self.to) - centre(&self.from)).normalize_or_zero()
+    }
+}
+
+/// Proposals of counts (each a list of `(chain, first, count)` as a [`Proposal`]'s) for
+/// every chain of turning elements whose count does not match the turn it is held to in
+/// `pose` (the relaxed pose): the count whose turn matches best, when better than the
+/// chain's own by the `hysteresis` margin (paper 4.3, in elements' turns), within the rule's
+/// bounds, among counts a whole turn apart the one whose ends are as far apart at rest as
+/// in the pose; alone, and with a straight chain docked to either end taking up what its
+/// ends move by (its count from its relaxed length in `lengths`). A chain's turn from its first site to
+/// its last grows by one element's turn with each element, modulo a whole turn. The turn it
+/// is held to: its own, or, where it is the one turning chain of chains in series
+/// (`rounding::runs`: a straight wall and an arc docked end to end), theirs all together,
+/// since only the run's ends are held by rigid pieces and a straight chain rests straight.
+///
+/// [`Proposal`]: super::report::Proposal
+pub(super) fn counts_from_turns(
+    asm: &Assembly,
+    lengths: &[Relaxed],
+    pose: &[DVec2],
+    hysteresis: f64,
+) -> Vec<Vec<(usize, usize, usize)>> {
+    let data = asm.data();
+    let turns: Vec<Option<ChainTurn>> = (0..data.chains.len())
+        .map(|c| ChainTurn::of(asm, c, pose))
+        .collect();
+    let series = runs(asm.grammar(), data);
+    let mut out = Vec::new();
+    for (c, t) in turns.iter().enumerate() {
+        let Some(t) = t.as_ref().filter(|t| t.turns()) else {
+            continue;
+        };
+        let run = series.iter().find(|g| g.contains(&c));
+        let alone = run.is_none_or(|g| {
+            g.iter()
+                .filter(|&&d| turns[d].as_ref().is_none_or(ChainTurn::turns))
+                .count()
+                == 1
+        });
+        let off = match run {
+            Some(g) if alone => wrap(
+                g.iter()
+                    .filter_map(|&d| turns[d].as_ref())
+                    .map(|d| d.off)
+                    .sum(),
+            ),
+            _ => t.off,
+        };
+        let n = t.count;
+        // how far `m` elements' turn is from the one held, in element turns
+        // (to a millionth: counts a whole turn apart miss alike, not by rounding)
+        let miss = |m: usize| {
+            let x = wrap(off - (m as f64 - n as f64) * t.theta).abs() / t.theta.abs();
+            (x * 1e6).round() / 1e6
+        };
+        // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
+        // as in the pose among them, then the nearest the chain's count
+        let key = |m: usize| {
+            let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
+            (
+                (miss(m) * 1e6).round(),
+                (chord * 1e6).round(),
+                m.abs_diff(n),
+            )
+        };
+        // up to a whole turn more than it has (and twice its count)
+        let turn = (std::f64::consts::TAU / t.theta.abs()).ceil() as usize;
+        let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
+        let best = (t.min..=hi)
+            .filter(|&m| m != n)
+            .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
+        let Some(m) = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5)
+        else {
+            continue;
+        };
+        let change = (c, t.first, m);
+        out.push(vec![change]);
+        // a straight chain docked to either end takes up what the turning one's new count
+        // moves that end by, its other end staying (a wall between a tower and an arc)
+        for (before, moved) in [(true, t.first_moves(m)), (false, t.last_moves(m))] {
+            let Some((d, moved)) = neighbour(asm, c, before).zip(moved) else {
+                continue;
+            };
+            let Some(s) = turns[d].as_ref().filter(|s| !s.turns() && s.element > 0.0) else {
+                continue;
+            };
+            let along = moved.dot(s.direction()) / s.element;
+            let length = (lengths.iter())
+                .find(|r| r.chain == d)
+                .map_or(s.count as f64, |r| r.length);
+            let want = length + if before { along } else { -along };
+            let want = (want.round().max(s.min as f64) as usize).min(s.max.unwrap_or(usize::MAX));
+            if want != s.count {
+                out.push(vec![change, (d, s.first, want)]);
+            }
+        }
+    }
+    // chains in series with several turning ones (a ring of arcs between gates): what the
+    // run's turn asks for, spread over them evenly
+    for run in &series {
+        let turning: Vec<&ChainTurn> = (run.iter())
+            .filter_map(|&d| turns[d].as_ref())
+            .filter(|t| t.turns())
+            .collect();
+        let Some(t0) = turning.first() else {
+            continue;
+        };
+        let known = run.iter().all(|&d| turns[d].is_some());
+        let alike = turning.iter().all(|t| (t.theta - t0.theta).abs() < 1e-9);
+        if turning.len() < 2 || !known || !alike {
+            continue;
+        }
+        let off = wrap(
+            run.iter()
+                .filter_map(|&d| turns[d].as_ref())
+                .map(|d| d.off)
+                .sum(),
+        );
+        let whole = (off / t0.theta).round();
+        let miss = |j: f64| wrap(off - j * t0.theta).abs() / t0.theta.abs();
+        if whole == 0.0 || miss(whole) >= (1.0 - hysteresis) * miss(0.0) {
+            continue;
+        }
+        let (k, j) = (turning.len() as i64, whole as i64);
+        let counts: Option<Vec<(usize, usize, usize)>> = (run.iter())
+            .filter(|&&d| turns[d].as_ref().is_some_and(ChainTurn::turns))
+            .enumerate()
+            .map(|(i, &d)| {
+                let t = turns[d].as_ref()?;
+                let share = j.div_euclid(k) + i64::from((i as i64) < j.rem_euclid(k));
+                let m = usize::try_from(t.count as i64 + share).ok()?;
+                (m >= t.min && t.max.is_none_or(|x| m <= x)).then_some((d, t.first, m))
+            })
+            .collect();
+        let changed =
+            |&(d, _, m): &(usize, usize, usize)| turns[d].as_ref().map(|t| t.count) != Some(m);
+        if let Some(counts) = counts.map(|c| c.into_iter().filter(changed).collect::<Vec<_>>())
+            && !counts.is_empty()
+        {
+            out.push(counts);
+        }
+    }
+    out
+}
+
+/// The chain docked to chain `c`'s first site (`before`) or to its last: the one whose last
+/// (first) element's site is docked there.
+fn neighbour(asm: &Assembly, c: usize, before: bool) -> Option<usize> {
+    let (data, grammar) = (asm.data(), asm.grammar());
+    let chain = data.chains.get(c)?;
+    let rule = grammar.stretch_rules.get(chain.rule)?;
+    let end = if before {
+        InstanceSite {
+            instance: *chain.instances.first()?,
+            site: rule.from,
+        }
+    } else {
+        InstanceSite {
+            instance: *chain.instances.last()?,
+            site: rule.to,
+        }
+    };
+    let other = (data.docks.iter())
+        .find_map(|d| (d.a == end).then_some(d.b).or((d.b == end).then_some(d.a)))?;
+    (data.chains.iter().enumerate()).find_map(|(d, x)| {
+        let at = if before {
+            x.instances.last()
+        } else {
+            x.instances.first()
+        };
+        (d != c && at == Some(&other.instance)).then_some(d)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn wrap_keeps_the_half_open_turn() {
+        assert!((wrap(3.0 * PI) - PI).abs() < 1e-12);
+        assert!((wrap(-PI) - PI).abs() < 1e-12);
+        assert!((wrap(0.25) - 0.25).abs() < 1e-12);
+        assert!((wrap(2.0 * PI - 0.25) + 0.25).abs() < 1e-12);
+    }
+}
