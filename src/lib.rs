@@ -17,6 +17,7 @@
 mod assembly;
 pub mod authoring;
 mod export;
+mod figure;
 mod files;
 mod fit;
 mod plane;

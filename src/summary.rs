@@ -10,6 +10,7 @@ use serde::{Serialize, Serializer};
 use clay_dsl::compiled::AssemblyData;
 
 use crate::assembly::Assembly;
+use crate::figure::figure;
 use crate::rules::RuleKind;
 use crate::solver::follow::Components;
 use crate::solver::{FrameReport, SolverConfig, bbox, elastic_energy, max_edge_strain};
@@ -225,15 +226,5 @@ impl Summary {
             f(self.frame_ms.median, 2),
             f(self.frame_ms.max, 2),
         )
-    }
-}
-
-/// A figure for people: `decimals` places below a million, three significant decimals in
-/// scientific notation above (never a 300-digit number), `inf` / `NaN` as such.
-pub fn figure(x: f64, decimals: usize) -> String {
-    if x.is_finite() && x.abs() >= 1e6 {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.decimals$}")
     }
 }

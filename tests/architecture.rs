@@ -496,19 +496,22 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("assembly", &["fit"]),
     ("authoring", &["plane"]),
     ("export", &["files", "fit", "plane", "render"]),
+    ("figure", &[]),
     ("files", &[]),
     ("fit", &[]),
     ("plane", &[]),
     ("render", &["fit", "plane", "solver"]),
-    ("rules", &["assembly", "fit", "plane", "solver"]),
+    ("rules", &["assembly", "figure", "fit", "plane", "solver"]),
     ("script", &["assembly"]),
     (
         "session",
-        &["assembly", "files", "rules", "script", "solver", "summary"],
+        &[
+            "assembly", "figure", "files", "rules", "script", "solver", "summary",
+        ],
     ),
     // `synthetic`: only the tests of `solver/chunks.rs`, which build a city.
     ("solver", &["assembly", "fit", "synthetic"]),
-    ("summary", &["assembly", "rules", "solver"]),
+    ("summary", &["assembly", "figure", "rules", "solver"]),
     ("testing", &["rules"]),
     (
         "testing::gallery",

@@ -113,11 +113,13 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             part: pi,
             from: 0,
             to: 1,
+            energy: None,
         },
         StateSwitch {
             part: pi,
             from: 1,
             to: 2,
+            energy: None,
         },
     ];
     let events = replace::replacement_events(&g, &mut d, &switches, &[]);
@@ -137,11 +139,13 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             part: pi,
             from: 2,
             to: 0,
+            energy: None,
         },
         StateSwitch {
             part: pi,
             from: 0,
             to: 2,
+            energy: None,
         },
     ];
     assert!(replace::replacement_events(&g, &mut d, &back, &[]).is_empty());

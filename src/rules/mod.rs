@@ -181,7 +181,12 @@ impl Rules {
             .filter_map(|&(part, to)| {
                 let p = parts.get_mut(part)?;
                 let from = std::mem::replace(&mut p.active, to);
-                Some(StateSwitch { part, from, to })
+                Some(StateSwitch {
+                    part,
+                    from,
+                    to,
+                    energy: None,
+                })
             })
             .collect();
         let mut events = replace::replacement_events(&grammar, asm.data_mut(), &switches, &[]);

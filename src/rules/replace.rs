@@ -9,6 +9,7 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 
 use super::rewrite::{RuleEvent, RuleKind};
+use crate::figure::rests_better;
 use crate::solver::StateSwitch;
 use crate::solver::local::{Switching, VertexParts, judge};
 
@@ -25,8 +26,11 @@ pub fn replacement_events(
 ) -> Vec<RuleEvent> {
     // First `from` per part: the state it had when the frame began.
     let mut began: BTreeMap<usize, usize> = BTreeMap::new();
+    // The energies of the last try that switched the part (a switch judged by energy).
+    let mut tried: BTreeMap<usize, Option<[f64; 2]>> = BTreeMap::new();
     for s in switches {
         began.entry(s.part).or_insert(s.from);
+        tried.insert(s.part, s.energy);
     }
     let mut events = Vec::new();
     let pose = if decided.len() == data.positions.len() {
@@ -56,7 +60,8 @@ pub fn replacement_events(
         let inst = &data.instances[instance];
         // How much nearer the new state is than the old one, as the solver's local step
         // judged them in the pose that decided (the hysteresis makes this at least its
-        // share; a state changed for energy, by a trial, may be less), so the log says why.
+        // share); a state a try changed for energy says its energies instead: the log says
+        // why in the figures that decided it.
         let how = Switching {
             hysteresis: 0.0,
             stretch: &[],
@@ -65,10 +70,11 @@ pub fn replacement_events(
         let judged = judge(pi, part, pose, how);
         let misfit = |s: usize| judged.distances.get(s).copied().unwrap_or(f64::NAN);
         let better = 1.0 - misfit(to) / misfit(from);
-        let why = if better.is_finite() {
-            format!(", {:.0}% closer to its shape", 100.0 * better)
-        } else {
-            String::new()
+        let why = match tried.get(&pi).copied().flatten() {
+            // a try's switch: the figures that decided it
+            Some([before, after]) => format!(": {}", rests_better(before, after)),
+            None if better.is_finite() => format!(", {:.0}% closer to its shape", 100.0 * better),
+            None => String::new(),
         };
         events.push(RuleEvent {
             kind: RuleKind::Replace,

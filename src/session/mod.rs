@@ -22,6 +22,7 @@ pub use gesture::{Grab, pin, pin_at, pin_of, toggle_pin, unpin};
 pub use settings::{SETTING_NAMES, apply_setting, configure};
 
 use crate::assembly::{Assembly, HandleId};
+use crate::figure::rests_better;
 use crate::rules::cut::CUT_REACH;
 use crate::rules::{RuleEvent, RuleKind, Rules, replace};
 use crate::script::{Motion, Script, Selector, Step};
@@ -281,12 +282,7 @@ impl Session {
             return Vec::new();
         }
         for e in &mut events {
-            e.detail = format!(
-                "{}: the model rests better so (energy {} -> {})",
-                e.detail,
-                crate::summary::figure(energy, 3),
-                crate::summary::figure(after, 3)
-            );
+            e.detail = format!("{}: {}", e.detail, rests_better(energy, after));
         }
         *asm = trial;
         rules.record(asm, events)

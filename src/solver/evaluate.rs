@@ -73,6 +73,7 @@ impl Solver {
                         part: i,
                         from: part.active,
                         to: state,
+                        energy: None,
                     });
                     part.active = state;
                 }
@@ -86,7 +87,12 @@ impl Solver {
         self.work.vertex_parts = shared;
         let w = &mut self.work;
         std::mem::swap(&mut w.pass1_claims, &mut w.claims);
-        if growth::one_per_chain(parts, switches, from, &w.residuals, &w.pass1_claims) {
+        // a state a try chose by energy holds until the handles move: judged by shape, pass 1
+        // could switch it back, and the next try again (a 2-cycle while held still)
+        let kept = &w.kept_by_trial;
+        let undone = !kept.is_empty() && undo_kept(parts, switches, from, kept);
+        let w = &mut self.work;
+        if growth::one_per_chain(parts, switches, from, &w.residuals, &w.pass1_claims) || undone {
             // the reverted parts' rotations and targets are their kept states'
             self.evaluate_fixed(parts, f);
         }
@@ -167,6 +173,7 @@ impl Solver {
                     part: i,
                     from: part.active,
                     to: chosen.state,
+                    energy: None,
                 });
                 part.active = chosen.state;
             }
@@ -227,4 +234,26 @@ impl Solver {
             }
         }
     }
+}
+
+/// Undoes the switches `switches[from..]` of parts in `kept` (their states back to where the
+/// switch found them; the switches leave the list). Returns whether any was undone.
+fn undo_kept(
+    parts: &mut [Part],
+    switches: &mut Vec<StateSwitch>,
+    from: usize,
+    kept: &[usize],
+) -> bool {
+    let mut step = switches.split_off(from);
+    let before = step.len();
+    step.retain(|s| {
+        let undo = kept.contains(&s.part);
+        if undo {
+            parts[s.part].active = s.from;
+        }
+        !undo
+    });
+    let undone = step.len() < before;
+    switches.append(&mut step);
+    undone
 }

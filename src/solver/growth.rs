@@ -83,6 +83,7 @@ pub fn one_per_chain(
                 part: s.part,
                 from: s.to,
                 to: s.from,
+                energy: None,
             });
         }
     }
@@ -169,6 +170,7 @@ mod tests {
                     part,
                     from: STRETCH_TWO,
                     to,
+                    energy: None,
                 }
             })
             .collect()
@@ -225,6 +227,7 @@ mod tests {
             part,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
+            energy: None,
         };
         // part 0 switched in an earlier iteration of the frame and now claims 3; part 1
         // claims 5 in this step: part 0 switches back
@@ -259,6 +262,7 @@ mod tests {
             part,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
+            energy: None,
         };
         let mut switches = vec![switch(0), switch(1)];
         assert!(one_per_chain(
@@ -281,6 +285,7 @@ mod tests {
             part: 2,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
+            energy: None,
         }];
         assert!(!one_per_chain(
             &mut parts,
@@ -302,11 +307,13 @@ mod tests {
                 part: 0,
                 from: STRETCH_TWO,
                 to: STRETCH_ONE,
+                energy: None,
             },
             StateSwitch {
                 part: 1,
                 from: STRETCH_TWO,
                 to: STRETCH_THREE,
+                energy: None,
             },
         ];
         assert!(!one_per_chain(

@@ -4,11 +4,15 @@
 use glam::DVec2;
 
 /// A part's active rest state changed during a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StateSwitch {
     pub part: usize,
     pub from: usize,
     pub to: usize,
+    /// Switched by a try of other states, judged by energy (`docs/solver.md`, "A held model
+    /// that stops strained tries other states"): the model's energy without the switch and
+    /// with it, settled alike. `None`: the local step's choice, by shape.
+    pub energy: Option<[f64; 2]>,
 }
 
 /// What one frame did.

@@ -134,6 +134,7 @@ impl Solver {
         self.work.l2_diagonal.clear();
         self.generation = Some(asm.generation());
         self.work.tried = false;
+        self.work.kept_by_trial.clear();
         Ok(())
     }
 }
@@ -201,6 +202,9 @@ pub(super) struct Work {
     /// Other rest states were tried since the handles, the states or the structure last
     /// changed, and none helped ([`Solver::try_states`]).
     pub(super) tried: bool,
+    /// The parts whose states a try switched (by energy) since the handles or the structure
+    /// last changed: pass 1 (by shape) does not switch them back meanwhile.
+    pub(super) kept_by_trial: Vec<usize>,
 }
 
 /// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),

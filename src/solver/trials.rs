@@ -56,7 +56,11 @@ impl Solver {
     /// the structure last changed.
     pub(super) fn settling(&mut self, report: &FrameReport, free: bool) -> bool {
         let w = &mut self.work;
-        let still = w.last_targets == w.handle_sum && report.switches.is_empty();
+        let held_still = w.last_targets == w.handle_sum;
+        if !held_still {
+            w.kept_by_trial.clear();
+        }
+        let still = held_still && report.switches.is_empty();
         if !still {
             w.tried = false;
         }
@@ -134,6 +138,7 @@ impl Solver {
                 unfolded = Some(laid);
             }
         }
+        let energy = best.as_ref().map(|b| [baseline, b.0]);
         let chosen = best.map_or(actives.clone(), |b| b.1);
         // a kept assignment that switches nothing (the rest layout of the same states) is the
         // one try too: were it due again, a model whose pass 2 returns from that layout to
@@ -147,7 +152,13 @@ impl Solver {
         {
             p.active = to;
             if from != to {
-                report.switches.push(StateSwitch { part: pi, from, to });
+                report.switches.push(StateSwitch {
+                    part: pi,
+                    from,
+                    to,
+                    energy,
+                });
+                self.work.kept_by_trial.push(pi);
             }
         }
         self.work.start.valid = None;
