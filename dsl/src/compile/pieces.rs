@@ -1,6 +1,8 @@
 //! Compiling a `piece` declaration: its vertices, edges, docking sites, proxy geometry and
 //! alternative rest states (paper 4.1), with the checks on each.
 
+use std::collections::HashMap;
+
 use crate::compiled::*;
 use crate::diagnostic::Diagnostic;
 use crate::suggest::closest;
@@ -36,14 +38,18 @@ impl Compiler {
             ..Default::default()
         };
         let mut base = Vec::new();
+        // each vertex's index by name: a lookup per vertex, not a scan (a piece may have
+        // 100,000 of them)
+        let mut named: HashMap<String, usize> = HashMap::new();
         // Vertices first: statements may come in any order and refer to later vertices.
         for s in &decl.stmts {
             if let PieceStmt::Vertex(v) = s {
-                if let Some(i) = piece.vertices.iter().position(|n| *n == v.name.name) {
+                if let Some(&i) = named.get(&v.name.name) {
                     self.duplicate("vertex", &v.name, spans.vertices[i]);
                     spans.partial = true;
                     continue;
                 }
+                named.insert(v.name.name.clone(), piece.vertices.len());
                 piece.vertices.push(v.name.name.clone());
                 spans.vertices.push(v.name.span);
                 base.push(self.point(&v.pos));
@@ -60,17 +66,17 @@ impl Compiler {
                 .with_hint("add vertices with `vertex NAME (x, y)`"),
             );
         }
-        let mut edge_spans: Vec<Span> = Vec::new();
+        let mut list = EdgeList::default();
         let mut axis: Option<&syntax::AxisDecl> = None;
         let mut geometry = Vec::new();
         for s in &decl.stmts {
             match s {
                 PieceStmt::Edges(e) => {
-                    let mut edges = std::mem::take(&mut piece.edges);
-                    if !self.edges(&piece, e, &mut edges, &mut edge_spans) {
+                    list.edges = std::mem::take(&mut piece.edges);
+                    if !self.edges(&piece, &named, e, &mut list) {
                         spans.partial = true;
                     }
-                    piece.edges = edges;
+                    piece.edges = std::mem::take(&mut list.edges);
                 }
                 PieceStmt::Site(site) => {
                     if let Some(i) = piece.sites.iter().position(|x| x.name == site.name.name) {
@@ -78,7 +84,7 @@ impl Compiler {
                         spans.partial = true;
                         continue;
                     }
-                    match self.site(&piece, site) {
+                    match self.site(&piece, &named, site) {
                         Some(compiled) => {
                             piece.sites.push(compiled);
                             spans.sites.push(site.name.span);
@@ -111,7 +117,7 @@ impl Compiler {
             &base,
             &spans.vertices,
             decl.name.span,
-            &edge_spans,
+            &list.spans,
         );
         piece.states.push(RestState {
             name: "base".into(),
@@ -119,7 +125,7 @@ impl Compiler {
             geometry: geometry.clone(),
             geometry_frame: 0,
         });
-        spans.edges = edge_spans;
+        spans.edges = list.spans;
         let derive_axis = derive::AxisState::resolve(&piece, axis, &base);
         let mut made = vec![derive::Made::Listed];
         let mut state_spans: Vec<Span> = Vec::new();
@@ -166,7 +172,7 @@ impl Compiler {
                     }
                     None => {
                         let before = self.diags.error_count();
-                        let state = self.state(&piece, &spans, st, index, &geometry);
+                        let state = self.state(&piece, &named, &spans, st, index, &geometry);
                         made.push(if self.diags.error_count() == before {
                             derive::Made::Listed
                         } else {
@@ -258,8 +264,15 @@ impl Compiler {
         ok
     }
 
-    pub(super) fn vertex_index(&mut self, piece: &Piece, ident: &Ident) -> Option<usize> {
-        match piece.vertices.iter().position(|v| *v == ident.name) {
+    pub(super) fn vertex_index(
+        &mut self,
+        piece: &Piece,
+        named: &HashMap<String, usize>,
+        ident: &Ident,
+    ) -> Option<usize> {
+        let known = (named.get(&ident.name).copied())
+            .filter(|&i| piece.vertices.get(i) == Some(&ident.name));
+        match known.or_else(|| piece.vertices.iter().position(|v| *v == ident.name)) {
             Some(i) => Some(i),
             None => {
                 let names: Vec<&str> = piece.vertices.iter().map(String::as_str).collect();
@@ -280,14 +293,15 @@ impl Compiler {
     pub(super) fn edges(
         &mut self,
         piece: &Piece,
+        named: &HashMap<String, usize>,
         e: &syntax::EdgesDecl,
-        edges: &mut Vec<[usize; 2]>,
-        spans: &mut Vec<Span>,
+        list: &mut EdgeList,
     ) -> bool {
         let mut whole = true;
         for path in &e.paths {
-            let ids: Vec<Option<usize>> =
-                path.iter().map(|v| self.vertex_index(piece, v)).collect();
+            let ids: Vec<Option<usize>> = (path.iter())
+                .map(|v| self.vertex_index(piece, named, v))
+                .collect();
             whole &= ids.iter().all(Option::is_some);
             for k in 0..path.len().saturating_sub(1) {
                 let (Some(a), Some(b)) = (ids[k], ids[k + 1]) else {
@@ -307,10 +321,7 @@ impl Compiler {
                     whole = false;
                     continue;
                 }
-                if let Some(i) = edges
-                    .iter()
-                    .position(|&[x, y]| (x, y) == (a, b) || (x, y) == (b, a))
-                {
+                if let Some(i) = list.find(a, b) {
                     self.diags.push(
                         Diagnostic::warning(
                             codes::REPEATED_EDGE,
@@ -322,19 +333,23 @@ impl Compiler {
                             span,
                             "repeated here",
                         )
-                        .with_secondary(spans[i], "first listed here")
+                        .with_secondary(list.spans[i], "first listed here")
                         .with_hint("edges are undirected: `a-b` and `b-a` are the same edge"),
                     );
                     continue;
                 }
-                edges.push([a, b]);
-                spans.push(span);
+                list.push([a, b], span);
             }
         }
         whole
     }
 
-    pub(super) fn site(&mut self, piece: &Piece, s: &syntax::SiteDecl) -> Option<Site> {
+    pub(super) fn site(
+        &mut self,
+        piece: &Piece,
+        named: &HashMap<String, usize>,
+        s: &syntax::SiteDecl,
+    ) -> Option<Site> {
         let site_type = match self.site_type_index(&s.site_type.name) {
             Some(t) => Some(t),
             None => {
@@ -351,7 +366,7 @@ impl Compiler {
         let mut vertices = Vec::new();
         let mut ok = true;
         for (k, v) in s.vertices.iter().enumerate() {
-            match self.vertex_index(piece, v) {
+            match self.vertex_index(piece, named, v) {
                 Some(i) => {
                     if let Some(j) = s.vertices[..k].iter().position(|w| w.name == v.name) {
                         self.duplicate("site vertex", v, s.vertices[j].span);
@@ -575,6 +590,7 @@ impl Compiler {
     pub(super) fn state(
         &mut self,
         piece: &Piece,
+        named: &HashMap<String, usize>,
         spans: &PieceSpans,
         st: &syntax::StateDecl,
         index: usize,
@@ -584,7 +600,7 @@ impl Compiler {
         let mut pos: Vec<Option<DVec2>> = vec![None; n];
         let mut vspans: Vec<Span> = vec![st.name.span; n];
         for p in &st.positions {
-            match piece.vertices.iter().position(|v| *v == p.name.name) {
+            match named.get(&p.name.name).copied().filter(|&i| i < n) {
                 Some(i) => {
                     if pos[i].is_some() {
                         self.duplicate("vertex position", &p.name, vspans[i]);
@@ -643,13 +659,13 @@ impl Compiler {
         }
         // Restated edges must equal the piece's: the part's edge set is shared by all states.
         for e in &st.edges {
-            let mut list = Vec::new();
-            let mut espans = Vec::new();
+            let mut list = EdgeList::default();
             // An edge dropped here or in the piece was reported where it was written: the two
             // lists then differ by that mistake, not by a second one.
-            if !self.edges(piece, e, &mut list, &mut espans) || spans.partial {
+            if !self.edges(piece, named, e, &mut list) || spans.partial {
                 continue;
             }
+            let list = list.edges;
             let key = |[a, b]: [usize; 2]| [a.min(b), a.max(b)];
             let mine: Vec<[usize; 2]> = piece.edges.iter().map(|&e| key(e)).collect();
             let theirs: Vec<[usize; 2]> = list.iter().map(|&e| key(e)).collect();
@@ -706,5 +722,33 @@ impl Compiler {
             geometry,
             geometry_frame,
         }
+    }
+}
+
+/// A piece's edges as an `edges` statement adds them, with where each was written and an
+/// index by its (unordered) ends: a repeat is found by a lookup, not a scan of every edge.
+#[derive(Default)]
+pub(super) struct EdgeList {
+    pub edges: Vec<[usize; 2]>,
+    pub spans: Vec<Span>,
+    index: HashMap<[usize; 2], usize>,
+}
+
+impl EdgeList {
+    /// The position of edge `a-b` (either way) when listed.
+    fn find(&mut self, a: usize, b: usize) -> Option<usize> {
+        // `edges` may have been refilled from the piece: index what the index lacks
+        for (k, &[x, y]) in self.edges.iter().enumerate().skip(self.index.len()) {
+            self.index.entry([x.min(y), x.max(y)]).or_insert(k);
+        }
+        self.index.get(&[a.min(b), a.max(b)]).copied()
+    }
+
+    fn push(&mut self, edge: [usize; 2], span: Span) {
+        self.index
+            .entry([edge[0].min(edge[1]), edge[0].max(edge[1])])
+            .or_insert(self.edges.len());
+        self.edges.push(edge);
+        self.spans.push(span);
     }
 }
