@@ -284,3 +284,21 @@ fn a_state_a_try_chose_holds_while_the_handles_stay() {
     }
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 5.1, counts from lengths (issue 46): a pinned hub whose two sites face opposite
+/// ways, a free chain of 0.358 m elements on one side, and on the other 3 of them and 7 of
+/// 0.982 m in series to a grabbed hub, led to where 6 and 8 fit (10.004 m; 3 and 9 leave
+/// 9.912 m). The relaxation took the pinned hub for a window in one run with the free
+/// chain and moved elements into it (8, 3, 8: energy 0.615, not kept), so the model stayed
+/// at 3 and 9 (strain 0.032). A held piece now ends a run: 5, 6, 8, at rest.
+#[test]
+fn a_held_hub_ends_a_run_of_chains() {
+    let run = replay("held_through_hub");
+    let counts = [
+        run.chain_count("l1x0"),
+        run.chain_count("l0x0"),
+        run.chain_count("l0x1"),
+    ];
+    assert_eq!(counts, [5, 6, 8], "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}

@@ -200,7 +200,7 @@ impl Solver {
         let data = asm.data();
         let held = held_elements(asm);
         let hysteresis = self.config.hysteresis;
-        let series = runs(asm.grammar(), data);
+        let series = runs(asm.grammar(), data, &held);
         let mut f = start.to_vec();
         let mut first: Option<Vec<DVec2>> = None;
         let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
@@ -653,7 +653,7 @@ fn scale_bounds(asm: &Assembly, part: &Part, lengths: &[Option<ChainLength>]) ->
 }
 
 /// The stable ids of the instances the handles hold.
-fn held_elements(asm: &Assembly) -> Vec<u64> {
+pub(super) fn held_elements(asm: &Assembly) -> Vec<u64> {
     (asm.handles().iter())
         .filter_map(|h| h.held.as_ref().map(|x| x.id))
         .collect()

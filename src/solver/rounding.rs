@@ -58,8 +58,13 @@ impl Relaxed {
 
 /// The chains in series (more than one): chains docked end to end, directly or through a
 /// piece with two docked sites facing opposite ways and no other rest state (a window in a
-/// wall).
-pub(super) fn runs(grammar: &CompiledGrammar, data: &AssemblyData) -> Vec<Vec<usize>> {
+/// wall) that no handle holds (the instances of stable ids `held`): a held piece fixes where
+/// the chains either side of it end, each side's length on its own.
+pub(super) fn runs(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    held: &[u64],
+) -> Vec<Vec<usize>> {
     let n = data.chains.len();
     let mut chain_of = vec![None; data.instances.len()];
     for (c, chain) in data.chains.iter().enumerate() {
@@ -109,6 +114,9 @@ pub(super) fn runs(grammar: &CompiledGrammar, data: &AssemblyData) -> Vec<Vec<us
             let other = match chain_of.get(next.instance).copied().flatten() {
                 Some(c2) => Some(c2),
                 None => through(grammar, data, &partner, &docks_of, next)
+                    .filter(|_| {
+                        (data.instances.get(next.instance)).is_none_or(|i| !held.contains(&i.id))
+                    })
                     .and_then(|s| chain_of.get(s.instance).copied().flatten()),
             };
             if let Some(c2) = other.filter(|&c2| c2 != c) {

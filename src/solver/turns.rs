@@ -12,6 +12,7 @@ use std::cmp::Ordering;
 
 use glam::DVec2;
 
+use super::relax::held_elements;
 use super::rounding::{Relaxed, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
@@ -226,7 +227,7 @@ pub(super) fn counts_from_turns(
     let turns: Vec<Option<ChainTurn>> = (0..data.chains.len())
         .map(|c| ChainTurn::of(asm, c, pose))
         .collect();
-    let series = runs(asm.grammar(), data);
+    let series = runs(asm.grammar(), data, &held_elements(asm));
     let mut out = Vec::new();
     for (c, t) in turns.iter().enumerate() {
         let Some(t) = t.as_ref().filter(|t| t.turns()) else {
