@@ -24,7 +24,7 @@ use super::growth::ChainLength;
 use super::local::{self, StretchEnds};
 use super::pass2::handle_term;
 use super::report::{FrameReport, Proposal, SolverError};
-use super::rounding::{Relaxed, decide_run, runs};
+use super::rounding::{Relaxed, decide_run, held_elements, runs};
 use super::state::Solver;
 use super::turns::counts_from_turns;
 use crate::assembly::Assembly;
@@ -650,13 +650,6 @@ fn scale_bounds(asm: &Assembly, part: &Part, lengths: &[Option<ChainLength>]) ->
         .max
         .map_or(f64::INFINITY, |m| (m as f64 / count).max(1.0));
     [lo, hi]
-}
-
-/// The stable ids of the instances the handles hold.
-pub(super) fn held_elements(asm: &Assembly) -> Vec<u64> {
-    (asm.handles().iter())
-        .filter_map(|h| h.held.as_ref().map(|x| x.id))
-        .collect()
 }
 
 /// Per part, the scales of its two elements when its chain is decided (`decided[chain]`:

@@ -6,6 +6,8 @@
 
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, InstanceSite};
 
+use crate::assembly::Assembly;
+
 /// A chain's relaxed length (its elements' lengths summed, in elements) against its count.
 pub(super) struct Relaxed {
     pub(super) chain: usize,
@@ -291,3 +293,10 @@ const CLOSE: f64 = 0.1;
 
 /// The most combinations of counts [`decide_run`] searches across a run's whole length.
 const WIDEST: usize = 100_000;
+
+/// The stable ids of the instances the handles hold.
+pub(super) fn held_elements(asm: &Assembly) -> Vec<u64> {
+    (asm.handles().iter())
+        .filter_map(|h| h.held.as_ref().map(|x| x.id))
+        .collect()
+}

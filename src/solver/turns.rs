@@ -12,8 +12,7 @@ use std::cmp::Ordering;
 
 use glam::DVec2;
 
-use super::relax::held_elements;
-use super::rounding::{Relaxed, runs};
+use super::rounding::{Relaxed, held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
 
