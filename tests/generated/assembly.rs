@@ -1031,6 +1031,21 @@ fn rectangle(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
     (end, vec![mover])
 }
 
+/// Closes `k` nodes into a loop, node `i`'s site 1 to node `i + 1`'s site 0, every link of
+/// `segments` starting at `values`.
+fn loop_of(g: &mut Graph, k: usize, segments: &[Segment], values: &[f64]) {
+    for i in 0..k {
+        g.links.push(Link {
+            from: (i, 1),
+            to: ((i + 1) % k, 0),
+            segments: segments.to_vec(),
+        });
+    }
+    g.start = Config {
+        values: vec![values.to_vec(); k],
+    };
+}
+
 /// A regular polygon of 3 to 6 corner hubs, all sides alike; the mover is the corner across.
 fn polygon(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
     g.shape = "polygon";
@@ -1040,16 +1055,7 @@ fn polygon(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
     g.hubs.push(hub(vec![180.0, turn], g.width, r));
     g.nodes = vec![0; k];
     let (side, a) = link_segments(g, c, false);
-    for i in 0..k {
-        g.links.push(Link {
-            from: (i, 1),
-            to: ((i + 1) % k, 0),
-            segments: side.clone(),
-        });
-    }
-    g.start = Config {
-        values: vec![a.clone(); k],
-    };
+    loop_of(g, k, &side, &a);
     let a2: Vec<f64> = a
         .iter()
         .map(|&x| {
@@ -1090,16 +1096,7 @@ fn ring(g: &mut Graph, c: &mut Cursor) -> (Config, Vec<usize>) {
     } else {
         (vec![arc], vec![n as f64])
     };
-    for i in 0..k {
-        g.links.push(Link {
-            from: (i, 1),
-            to: ((i + 1) % k, 0),
-            segments: segments.clone(),
-        });
-    }
-    g.start = Config {
-        values: vec![values.clone(); k],
-    };
+    loop_of(g, k, &segments, &values);
     let mut end = g.start.clone();
     if stadium {
         let m2 = (2 + c.pick(2 * m as usize)) as f64;
