@@ -110,18 +110,13 @@ struct ChainTurn {
 }
 
 impl ChainTurn {
-    fn of(asm: &Assembly, c: usize, pose: &[DVec2]) -> Option<Self> {
+    /// Chain `c`'s, from its `parts` (`(first, part)`) in `pose`.
+    fn of(asm: &Assembly, c: usize, parts: &[(usize, &Part)], pose: &[DVec2]) -> Option<Self> {
         let (data, grammar) = (asm.data(), asm.grammar());
         let rule = grammar.stretch_rules.get(data.chains.get(c)?.rule)?;
         let step = element_step(&rule.part)?;
         let theta = step.rotation.y.atan2(step.rotation.x);
         let n = data.chains[c].instances.len();
-        let parts: Vec<(usize, &Part)> = (data.parts.iter())
-            .filter_map(|p| match p.kind {
-                PartKind::Stretch { chain, first } if chain == c => Some((first, p)),
-                _ => None,
-            })
-            .collect();
         let ends = EndSites::of(grammar, rule)?;
         let part = |first: usize| parts.iter().find(|p| p.0 == first).map(|p| p.1);
         let (head, tail) = (part(0)?, part(n.checked_sub(2)?)?);
@@ -223,8 +218,16 @@ pub(super) fn counts_from_turns(
     hysteresis: f64,
 ) -> Vec<Vec<(usize, usize, usize)>> {
     let data = asm.data();
+    let mut parts: Vec<Vec<(usize, &Part)>> = vec![Vec::new(); data.chains.len()];
+    for p in &data.parts {
+        if let PartKind::Stretch { chain, first } = p.kind
+            && let Some(of) = parts.get_mut(chain)
+        {
+            of.push((first, p));
+        }
+    }
     let turns: Vec<Option<ChainTurn>> = (0..data.chains.len())
-        .map(|c| ChainTurn::of(asm, c, pose))
+        .map(|c| ChainTurn::of(asm, c, &parts[c], pose))
         .collect();
     let series = runs(asm.grammar(), data, &held_elements(asm));
     let mut out = Vec::new();
