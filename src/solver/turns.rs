@@ -203,7 +203,7 @@ impl ChainTurn {
 /// `pose` (the relaxed pose): the count whose turn matches best, when better than the
 /// chain's own by the `hysteresis` margin (paper 4.3, in elements' turns), within the rule's
 /// bounds, among counts a whole turn apart the one whose ends are as far apart at rest as
-/// in the pose; alone, and with a straight chain docked to either end taking up what its
+/// in the pose, then the fewest (no extra loop); alone, and with a straight chain docked to either end taking up what its
 /// ends move by (its count from its relaxed length in `lengths`). A chain's turn from its first site to
 /// its last grows by one element's turn with each element, modulo a whole turn. The turn it
 /// is held to: its own, or, where it is the one turning chain of chains in series
@@ -259,14 +259,12 @@ pub(super) fn counts_from_turns(
             (x * 1e6).round() / 1e6
         };
         // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
-        // as in the pose among them, then the nearest the chain's count
+        // as in the pose among them, then the fewest elements (a whole loop more closes as
+        // well, and no one wants it: a stadium's arcs grown by pass 1 during a slow pull
+        // went on to 12 where 4 rest, 8 of them a loop)
         let key = |m: usize| {
             let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
-            (
-                (miss(m) * 1e6).round(),
-                (chord * 1e6).round(),
-                m.abs_diff(n),
-            )
+            ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
         };
         // up to a whole turn more than it has (and twice its count)
         let turn = (std::f64::consts::TAU / t.theta.abs()).ceil() as usize;
