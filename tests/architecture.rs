@@ -1068,8 +1068,8 @@ fn no_module_imports_a_whole_crate_root() {
 }
 
 /// Architecture Invariant: the shipped binaries (`clayc`, the editor, the Python module) are
-/// built without the test helpers: no `[dependencies]` entry of theirs enables `clay`'s
-/// feature `testing` (issue 47: `clayc` did, for the synthetic city its bench solves, which
+/// built without the test helpers: no `[dependencies]` entry of theirs (inline, or a
+/// `[dependencies.clay]` table) enables `clay`'s feature `testing` (issue 47: `clayc` did, for the synthetic city its bench solves, which
 /// now lives in `clay::synthetic`).
 #[test]
 fn the_shipped_binaries_are_built_without_the_test_helpers() {
@@ -1083,10 +1083,13 @@ fn the_shipped_binaries_are_built_without_the_test_helpers() {
                 section = line;
                 continue;
             }
-            if section == "[dependencies]"
+            // `clay = { ... }` under `[dependencies]`, or any line of a `[dependencies.clay]`
+            // table (its `features = [...]`)
+            let inline = section == "[dependencies]"
                 && line.starts_with("clay")
-                && !line.starts_with("clay-dsl")
-            {
+                && !line.starts_with("clay-dsl");
+            let table = section == "[dependencies.clay]";
+            if inline || table {
                 clay_seen = true;
                 assert!(
                     !line.contains("testing"),
