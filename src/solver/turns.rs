@@ -3,13 +3,13 @@
 //! matches the turn between the frames its ends are held in: twelve 30-degree wedges close a
 //! ring, and no other count near twelve does, whatever the ring's length. The relaxation's
 //! lengths cannot see this (a ring of thirteen squeezed into twelve's circle keeps its
-//! length); the turn of the chain's end parts can.
+//! length); the turn between the chain's end sites can.
+
+use std::cmp::Ordering;
 
 use clay_dsl::compiled::{
     CompiledGrammar, InstanceSite, Part, PartKind, STRETCH_TWO, StretchPart, StretchRule,
 };
-use std::cmp::Ordering;
-
 use glam::DVec2;
 
 use super::rounding::{Relaxed, held_elements, runs};
@@ -27,9 +27,13 @@ fn centre(ps: &[DVec2]) -> DVec2 {
 
 /// The angle `a` brought into (-pi, pi].
 fn wrap(a: f64) -> f64 {
-    let t = std::f64::consts::TAU;
-    let w = a - t * (a / t).round();
-    if w <= -std::f64::consts::PI { w + t } else { w }
+    DVec2::from_angle(a).to_angle()
+}
+
+/// The direction (radians) of a site's vertices `v`, first to last.
+fn site_angle(v: &[DVec2]) -> Option<f64> {
+    let d = *v.last()? - *v.first()?;
+    (d.length_squared() > 0.0).then(|| d.to_angle())
 }
 
 /// The rigid motion from one element of a two-element part to the next in its `two` rest
@@ -80,12 +84,6 @@ impl EndSites {
             to: site(rule.to, 1)?,
         })
     }
-
-    /// The direction (radians) of a site's vertices, first to last, at `at(k)`.
-    fn angle(ks: &[usize], at: impl Fn(usize) -> Option<DVec2>) -> Option<f64> {
-        let d = at(*ks.last()?)? - at(*ks.first()?)?;
-        (d.length_squared() > 0.0).then(|| d.y.atan2(d.x))
-    }
 }
 
 /// A chain's turn against its rest turn: the element's turn, its count, how far (radians)
@@ -115,22 +113,26 @@ impl ChainTurn {
         let (data, grammar) = (asm.data(), asm.grammar());
         let rule = grammar.stretch_rules.get(data.chains.get(c)?.rule)?;
         let step = element_step(&rule.part)?;
-        let theta = step.rotation.y.atan2(step.rotation.x);
+        let theta = step.rotation.to_angle();
         let n = data.chains[c].instances.len();
         let ends = EndSites::of(grammar, rule)?;
         let part = |first: usize| parts.iter().find(|p| p.0 == first).map(|p| p.1);
         let (head, tail) = (part(0)?, part(n.checked_sub(2)?)?);
-        let two = |k: usize| rule.part.states.get(STRETCH_TWO)?.positions.get(k).copied();
-        let at = |p: &Part, k: usize| pose.get(*p.vertices.get(k)?).copied();
+        let two = &rule.part.states.get(STRETCH_TWO)?.positions;
+        let rest_of = |ks: &[usize]| -> Option<Vec<DVec2>> {
+            ks.iter().map(|&k| two.get(k).copied()).collect()
+        };
+        let posed = |p: &Part, ks: &[usize]| -> Option<Vec<DVec2>> {
+            ks.iter()
+                .map(|&k| pose.get(*p.vertices.get(k)?).copied())
+                .collect()
+        };
+        let (rest_from, rest_to) = (rest_of(&ends.from)?, rest_of(&ends.to)?);
+        let (from, to) = (posed(head, &ends.from)?, posed(tail, &ends.to)?);
         // the turn from the chain's first site to its last: two elements' at rest, and one
         // element's more for each further element
-        let rest = EndSites::angle(&ends.to, two)? - EndSites::angle(&ends.from, two)?;
-        let turn = EndSites::angle(&ends.to, |k| at(tail, k))?
-            - EndSites::angle(&ends.from, |k| at(head, k))?;
-        let rest_from: Vec<DVec2> = ends.from.iter().filter_map(|&k| two(k)).collect();
-        let rest_to: Vec<DVec2> = ends.to.iter().filter_map(|&k| two(k)).collect();
-        let from: Vec<DVec2> = ends.from.iter().filter_map(|&k| at(head, k)).collect();
-        let to: Vec<DVec2> = ends.to.iter().filter_map(|&k| at(tail, k)).collect();
+        let rest = site_angle(&rest_to)? - site_angle(&rest_from)?;
+        let turn = site_angle(&to)? - site_angle(&from)?;
         let strain = |p: &Part| {
             (p.states.get(STRETCH_TWO))
                 .map_or(0.0, |s| align(&s.positions, &p.vertices, pose).distance)
@@ -203,9 +205,10 @@ impl ChainTurn {
 /// `pose` (the relaxed pose): the count whose turn matches best, when better than the
 /// chain's own by the `hysteresis` margin (paper 4.3, in elements' turns), within the rule's
 /// bounds, among counts a whole turn apart the one whose ends are as far apart at rest as
-/// in the pose, then the fewest (no extra loop); alone, and with a straight chain docked to either end taking up what its
-/// ends move by (its count from its relaxed length in `lengths`). A chain's turn from its first site to
-/// its last grows by one element's turn with each element, modulo a whole turn. The turn it
+/// in the pose, then the fewest (no extra loop); alone, and with a straight chain docked to
+/// either end taking up what its ends move by (its count from its relaxed length in
+/// `lengths`). A chain's turn from its first site to its last grows by one element's turn
+/// with each element, modulo a whole turn. The turn it
 /// is held to: its own, or, where it is the one turning chain of chains in series
 /// (`rounding::runs`: a straight wall and an arc docked end to end), theirs all together,
 /// since only the run's ends are held by rigid pieces and a straight chain rests straight.
@@ -381,10 +384,12 @@ mod tests {
     use std::f64::consts::PI;
 
     #[test]
-    fn wrap_keeps_the_half_open_turn() {
-        assert!((wrap(3.0 * PI) - PI).abs() < 1e-12);
-        assert!((wrap(-PI) - PI).abs() < 1e-12);
+    fn wrap_is_the_turn_to_the_nearest_whole_turn() {
+        // callers read |wrap|: how far an angle is from a whole turn, either way
+        assert!((wrap(3.0 * PI).abs() - PI).abs() < 1e-12);
+        assert!((wrap(-PI).abs() - PI).abs() < 1e-12);
         assert!((wrap(0.25) - 0.25).abs() < 1e-12);
         assert!((wrap(2.0 * PI - 0.25) + 0.25).abs() < 1e-12);
+        assert!((wrap(-7.0 * PI + 0.5) - (PI + 0.5 - 2.0 * PI)).abs() < 1e-12);
     }
 }
