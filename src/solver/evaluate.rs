@@ -88,9 +88,13 @@ impl Solver {
         let w = &mut self.work;
         std::mem::swap(&mut w.pass1_claims, &mut w.claims);
         // a state a try chose by energy holds until the handles move: judged by shape, pass 1
-        // could switch it back, and the next try again (a 2-cycle while held still)
+        // could switch it back, and the next try again (a 2-cycle while held still). The
+        // handles moved this frame when their targets differ from the last frame's (the list
+        // itself is cleared after the frame, `Solver::settling`)
         let kept = &w.kept_by_trial;
-        let undone = !kept.is_empty() && undo_kept(parts, switches, from, kept);
+        let undone = !kept.is_empty()
+            && w.last_targets == w.handle_sum
+            && undo_kept(parts, switches, from, kept);
         let w = &mut self.work;
         if growth::one_per_chain(parts, switches, from, &w.residuals, &w.pass1_claims) || undone {
             // the reverted parts' rotations and targets are their kept states'
