@@ -8,7 +8,8 @@
 use std::cmp::Ordering;
 
 use clay_dsl::compiled::{
-    CompiledGrammar, InstanceSite, Part, PartKind, STRETCH_TWO, StretchPart, StretchRule,
+    AssemblyData, CompiledGrammar, InstanceSite, Part, PartKind, STRETCH_TWO, StretchPart,
+    StretchRule,
 };
 use glam::DVec2;
 
@@ -232,7 +233,9 @@ pub(super) fn counts_from_turns(
     let turns: Vec<Option<ChainTurn>> = (0..data.chains.len())
         .map(|c| ChainTurn::of(asm, c, &parts[c], pose))
         .collect();
-    let series = runs(asm.grammar(), data, &held_elements(asm));
+    let held = held_elements(asm);
+    let series = runs(asm.grammar(), data, &held);
+    let paths = held_paths(data, &held);
     let mut out = Vec::new();
     for (c, t) in turns.iter().enumerate() {
         let Some(t) = t.as_ref().filter(|t| t.turns()) else {
@@ -245,59 +248,43 @@ pub(super) fn counts_from_turns(
                 .count()
                 == 1
         });
-        let off = match run {
-            Some(g) if alone => wrap(
+        // the turns it may be held to: its own; its run's when it is the run's one turning
+        // chain; each path's between held pieces through it (the whole path's misfit on it)
+        let mut offs = vec![t.off];
+        if let Some(g) = run.filter(|_| alone) {
+            offs.push(wrap(
                 g.iter()
                     .filter_map(|&d| turns[d].as_ref())
                     .map(|d| d.off)
                     .sum(),
-            ),
-            _ => t.off,
-        };
-        let n = t.count;
-        // how far `m` elements' turn is from the one held, in element turns
-        // (to a millionth: counts a whole turn apart miss alike, not by rounding)
-        let miss = |m: usize| {
-            let x = wrap(off - (m as f64 - n as f64) * t.theta).abs() / t.theta.abs();
-            (x * 1e6).round() / 1e6
-        };
-        // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
-        // as in the pose among them, then the fewest elements (a whole loop more closes as
-        // well, and no one wants it: a stadium's arcs grown by pass 1 during a slow pull
-        // went on to 12 where 4 rest, 8 of them a loop)
-        let key = |m: usize| {
-            let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
-            ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
-        };
-        // up to a whole turn more than it has (and twice its count)
-        let turn = (std::f64::consts::TAU / t.theta.abs()).ceil() as usize;
-        let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
-        let best = (t.min..=hi)
-            .filter(|&m| m != n)
-            .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
-        let Some(m) = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5)
-        else {
-            continue;
-        };
-        let change = (c, t.first, m);
-        out.push(vec![change]);
-        // a straight chain docked to either end takes up what the turning one's new count
-        // moves that end by, its other end staying (a wall between a tower and an arc)
-        for (before, moved) in [(true, t.first_moves(m)), (false, t.last_moves(m))] {
-            let Some((d, moved)) = neighbour(asm, c, before).zip(moved) else {
+            ));
+        }
+        for path in &paths {
+            let Some(sign) = path.iter().find_map(|s| match *s {
+                Step::Chain(d, sign) if d == c => Some(sign),
+                _ => None,
+            }) else {
                 continue;
             };
-            let Some(s) = turns[d].as_ref().filter(|s| !s.turns() && s.element > 0.0) else {
-                continue;
-            };
-            let along = moved.dot(s.direction()) / s.element;
-            let length = (lengths.iter())
-                .find(|r| r.chain == d)
-                .map_or(s.count as f64, |r| r.length);
-            let want = length + if before { along } else { -along };
-            let want = (want.round().max(s.min as f64) as usize).min(s.max.unwrap_or(usize::MAX));
-            if want != s.count {
-                out.push(vec![change, (d, s.first, want)]);
+            let along: Option<f64> = (path.iter())
+                .map(|s| match *s {
+                    Step::Chain(d, sign) => turns[d].as_ref().map(|d| sign * d.off),
+                    Step::Piece {
+                        instance,
+                        enter,
+                        leave,
+                    } => piece_off(asm.grammar(), data, pose, (instance, enter, leave)),
+                })
+                .sum();
+            if let Some(along) = along {
+                offs.push(wrap(sign * along));
+            }
+        }
+        for off in offs {
+            for change in from_turn(asm, c, t, off, &turns, lengths, hysteresis) {
+                if !out.contains(&change) {
+                    out.push(change);
+                }
             }
         }
     }
@@ -347,6 +334,189 @@ pub(super) fn counts_from_turns(
         }
     }
     out
+}
+
+/// The proposals for turning chain `c` (`t`) held to a turn `off` (radians) from its rest
+/// turn: the count whose turn matches best, when better than its own by the `hysteresis`
+/// margin, alone and with a straight chain docked to either end taking up what its ends move
+/// by (`lengths`: the relaxed lengths of the straight ones).
+fn from_turn(
+    asm: &Assembly,
+    c: usize,
+    t: &ChainTurn,
+    off: f64,
+    turns: &[Option<ChainTurn>],
+    lengths: &[Relaxed],
+    hysteresis: f64,
+) -> Vec<Vec<(usize, usize, usize)>> {
+    let n = t.count;
+    // how far `m` elements' turn is from the one held, in element turns
+    // (to a millionth: counts a whole turn apart miss alike, not by rounding)
+    let miss = |m: usize| {
+        let x = wrap(off - (m as f64 - n as f64) * t.theta).abs() / t.theta.abs();
+        (x * 1e6).round() / 1e6
+    };
+    // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
+    // as in the pose among them, then the fewest elements (a whole loop more closes as
+    // well, and no one wants it: a stadium's arcs grown by pass 1 during a slow pull
+    // went on to 12 where 4 rest, 8 of them a loop)
+    let key = |m: usize| {
+        let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
+        ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
+    };
+    // up to a whole turn more than it has (and twice its count)
+    let turn = (std::f64::consts::TAU / t.theta.abs()).ceil() as usize;
+    let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
+    let best = (t.min..=hi)
+        .filter(|&m| m != n)
+        .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
+    let Some(m) = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5) else {
+        return Vec::new();
+    };
+    let change = (c, t.first, m);
+    let mut out = vec![vec![change]];
+    // a straight chain docked to either end takes up what the turning one's new count
+    // moves that end by, its other end staying (a wall between a tower and an arc)
+    for (before, moved) in [(true, t.first_moves(m)), (false, t.last_moves(m))] {
+        let Some((d, moved)) = neighbour(asm, c, before).zip(moved) else {
+            continue;
+        };
+        let Some(s) = turns[d].as_ref().filter(|s| !s.turns() && s.element > 0.0) else {
+            continue;
+        };
+        let along = moved.dot(s.direction()) / s.element;
+        let length = (lengths.iter())
+            .find(|r| r.chain == d)
+            .map_or(s.count as f64, |r| r.length);
+        let want = length + if before { along } else { -along };
+        let want = (want.round().max(s.min as f64) as usize).min(s.max.unwrap_or(usize::MAX));
+        if want != s.count {
+            out.push(vec![change, (d, s.first, want)]);
+        }
+    }
+    out
+}
+
+/// A step of a path between held pieces ([`held_paths`]).
+#[derive(Debug)]
+enum Step {
+    /// A chain, with `1.0` where the path runs from its first element to its last and
+    /// `-1.0` the other way.
+    Chain(usize, f64),
+    /// A free piece, entered at one site and left at another.
+    Piece {
+        instance: usize,
+        enter: usize,
+        leave: usize,
+    },
+}
+
+/// The steps of the path between each two pieces the handles hold (of stable ids `held`,
+/// chain elements aside), through the docks. The turns along a path add up to the turn
+/// between its ends' holds, whatever free pieces lie between (a tree's hubs): what its
+/// turning chains' counts must match together. The fewest instances' path where several
+/// join the same two.
+fn held_paths(data: &AssemblyData, held: &[u64]) -> Vec<Vec<Step>> {
+    let mut chain_of = vec![None; data.instances.len()];
+    for (c, chain) in data.chains.iter().enumerate() {
+        for &i in &chain.instances {
+            if let Some(slot) = chain_of.get_mut(i) {
+                *slot = Some(c);
+            }
+        }
+    }
+    // each instance's docked neighbours: (neighbour, own site, neighbour's site)
+    let mut next = vec![Vec::new(); data.instances.len()];
+    for d in &data.docks {
+        if d.a.instance < next.len() && d.b.instance < next.len() {
+            next[d.a.instance].push((d.b.instance, d.a.site, d.b.site));
+            next[d.b.instance].push((d.a.instance, d.b.site, d.a.site));
+        }
+    }
+    let ends: Vec<usize> = (data.instances.iter().enumerate())
+        .filter(|(i, x)| held.contains(&x.id) && chain_of[*i].is_none())
+        .map(|(i, _)| i)
+        .collect();
+    let mut paths = Vec::new();
+    for (k, &from) in ends.iter().enumerate() {
+        // breadth first from `from`: each instance's predecessor and the site it was
+        // entered at
+        let mut before = vec![None; data.instances.len()];
+        before[from] = Some((from, usize::MAX));
+        let mut queue = std::collections::VecDeque::from([from]);
+        while let Some(i) = queue.pop_front() {
+            for &(j, _, site) in &next[i] {
+                if before[j].is_none() {
+                    before[j] = Some((i, site));
+                    queue.push_back(j);
+                }
+            }
+        }
+        for &to in &ends[k + 1..] {
+            let mut walk = vec![(to, usize::MAX)];
+            while let Some(last) = walk.last_mut().filter(|w| w.0 != from) {
+                let Some((j, site)) = before[last.0] else {
+                    break;
+                };
+                last.1 = site;
+                walk.push((j, usize::MAX));
+            }
+            if walk.last().map(|w| w.0) != Some(from) {
+                continue;
+            }
+            walk.reverse();
+            // walk[x] = (instance, the site it was entered at); it leaves at the site
+            // the next one was entered from
+            let mut path: Vec<Step> = Vec::new();
+            for (x, &(i, enter)) in walk.iter().enumerate().take(walk.len() - 1).skip(1) {
+                match chain_of[i] {
+                    Some(c) if matches!(path.last(), Some(Step::Chain(d, _)) if *d == c) => {}
+                    Some(c) => {
+                        let first = data.chains[c].instances.first() == Some(&i);
+                        path.push(Step::Chain(c, if first { 1.0 } else { -1.0 }));
+                    }
+                    None => {
+                        let after = walk[x + 1];
+                        let leave = (next[i].iter())
+                            .find(|n| n.0 == after.0 && n.2 == after.1)
+                            .map(|n| n.1);
+                        if let Some(leave) = leave {
+                            path.push(Step::Piece {
+                                instance: i,
+                                enter,
+                                leave,
+                            });
+                        }
+                    }
+                }
+            }
+            if path.iter().any(|s| matches!(s, Step::Chain(..))) {
+                paths.push(path);
+            }
+        }
+    }
+    paths
+}
+
+/// How far (radians) free piece `instance`'s turn from site `enter` to site `leave` is from
+/// its rest state's in `pose`.
+fn piece_off(
+    grammar: &CompiledGrammar,
+    data: &AssemblyData,
+    pose: &[DVec2],
+    (instance, enter, leave): (usize, usize, usize),
+) -> Option<f64> {
+    let x = data.instances.get(instance)?;
+    let piece = grammar.pieces.get(x.piece)?;
+    let rest = &piece.states.get(x.state)?.positions;
+    let angles = |site: usize| -> Option<(f64, f64)> {
+        let vs = &piece.sites.get(site)?.vertices;
+        let at = |v: usize| Some((*rest.get(v)?, *pose.get(*x.vertices.get(v)?)?));
+        let (a, b) = (at(*vs.first()?)?, at(*vs.last()?)?);
+        Some((site_angle(&[a.0, b.0])?, site_angle(&[a.1, b.1])?))
+    };
+    let (e, l) = (angles(enter)?, angles(leave)?);
+    Some(wrap((l.1 - e.1) - (l.0 - e.0)))
 }
 
 /// The chain docked to chain `c`'s first site (`before`) or to its last: the one whose last
