@@ -316,3 +316,17 @@ fn an_arc_through_a_free_hub_takes_the_turn_between_the_holds() {
     assert_eq!(run.chain_count("l2x0"), 5, "{}", run.repro());
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 4.2, 5.1 (issue 46): a count a turn asks for is judged with the lengths it then asks
+/// for. A slow pull grew an arc of 15-degree elements from 2 to 9 (a loop and more) while its
+/// walls stayed 6 and 2 where 7 and 5 rest: energy 0.74, strain 0.34. The arc's turn asks for
+/// 2 again, but 2 alone settles at energy 35 (its walls far too short); with the walls
+/// re-counted after it, the model rests.
+#[test]
+fn an_arc_grown_a_loop_too_many_goes_back_with_its_walls() {
+    let run = replay("arc_a_loop_too_many");
+    assert_eq!(run.chain_count("l0x0"), 2, "{}", run.repro());
+    let walls = [run.chain_count("l1x0"), run.chain_count("l1x1")];
+    assert_eq!(walls, [7, 5], "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}

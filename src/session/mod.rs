@@ -256,23 +256,29 @@ impl Session {
         };
         let energy = report.energy.min(energy);
         let mut best: Option<(f64, Assembly, Vec<RuleEvent>)> = None;
+        let mut keep = |found: (f64, Assembly, Vec<RuleEvent>)| {
+            if best.as_ref().is_none_or(|b| found.0 < b.0) {
+                best = Some(found);
+            }
+        };
         for proposal in proposals {
-            if proposal.pose.len() != asm.data().positions.len() {
-                continue;
-            }
-            let mut trial = asm.clone();
-            trial.positions_mut().copy_from_slice(&proposal.pose);
-            let events = rules.restructure(&mut trial, proposal);
-            if events.is_empty() {
-                continue;
-            }
-            let Some(budget) = remaining() else { break };
-            let Ok(report) = Solver::new(settle).frame_budgeted(&mut trial, budget) else {
+            let Some((after, trial, events, mut solver)) =
+                restructured(rules, asm, proposal, settle, remaining())
+            else {
                 continue;
             };
-            if best.as_ref().is_none_or(|b| report.energy < b.0) {
-                best = Some((report.energy, trial, events));
+            if proposal.then_lengths {
+                // the counts a turn asks for, with the lengths they then ask for
+                let deadline = remaining().and_then(|b| Instant::now().checked_add(b));
+                for then in solver.relaxed_after(&trial, deadline) {
+                    if let Some((after, trial, more, _)) =
+                        restructured(rules, &trial, &then, settle, remaining())
+                    {
+                        keep((after, trial, [events.clone(), more].concat()));
+                    }
+                }
             }
+            keep((after, trial, events));
         }
         let Some((after, trial, mut events)) = best else {
             return Vec::new();
@@ -394,6 +400,31 @@ impl Session {
             &self.solver.config,
         )
     }
+}
+
+/// A copy of `asm` restructured by the rules as `proposal` says (laid out from its pose)
+/// and settled by a solver of config `settle` within `budget`: its energy, the copy, the
+/// rules' events and the solver (which has run a frame on the copy). `None` when the rules
+/// change nothing, the time is out or the settling fails.
+fn restructured(
+    rules: &mut Rules,
+    asm: &Assembly,
+    proposal: &crate::solver::Proposal,
+    settle: SolverConfig,
+    budget: Option<Duration>,
+) -> Option<(f64, Assembly, Vec<RuleEvent>, Solver)> {
+    if proposal.pose.len() != asm.data().positions.len() {
+        return None;
+    }
+    let mut trial = asm.clone();
+    trial.positions_mut().copy_from_slice(&proposal.pose);
+    let events = rules.restructure(&mut trial, proposal);
+    if events.is_empty() {
+        return None;
+    }
+    let mut solver = Solver::new(settle);
+    let report = solver.frame_budgeted(&mut trial, budget?).ok()?;
+    Some((report.energy, trial, events, solver))
 }
 
 /// Least-squares iterations that settle a restructured model before it is judged

@@ -99,6 +99,20 @@ impl Solver {
         }
     }
 
+    /// What the relaxation proposes for `asm` as it is (after a frame of this solver on it),
+    /// its turns' proposals aside: the lengths a restructured copy then asks for
+    /// ([`Proposal::then_lengths`]). Empty when the relaxation fails.
+    pub(crate) fn relaxed_after(
+        &mut self,
+        asm: &Assembly,
+        deadline: Option<Instant>,
+    ) -> Vec<Proposal> {
+        let warm = asm.data().positions.clone();
+        let mut found = self.relax(asm, &warm, deadline).unwrap_or_default();
+        found.retain(|p| !p.then_lengths);
+        found
+    }
+
     /// Number of stored entries of the normal matrix's lower triangle (after the first frame).
     pub fn matrix_nonzeros(&self) -> usize {
         self.pattern.nnz()

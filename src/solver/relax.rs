@@ -160,6 +160,7 @@ impl Solver {
                 counts,
                 states: self.relaxed_states(&data.parts, &forced, &f),
                 pose: f,
+                then_lengths: false,
             };
             if !p.is_empty()
                 && !alternatives
@@ -176,6 +177,7 @@ impl Solver {
                 counts,
                 states: self.relaxed_states(&data.parts, &forced, &f),
                 pose: f.clone(),
+                then_lengths: true,
             });
         }
         Ok(alternatives)

@@ -89,6 +89,12 @@ pub struct Proposal {
     pub counts: Vec<(usize, usize, usize)>,
     /// `(part, state)`.
     pub states: Vec<(usize, usize)>,
+    /// Whether it is judged with the lengths it then asks for ([`Solver::relaxed_after`]):
+    /// a count a chain's turn asks for (`turns.rs`) moves the pieces at its ends, and the
+    /// straight chains between them rest only at other counts too.
+    ///
+    /// [`Solver::relaxed_after`]: super::Solver::relaxed_after
+    pub then_lengths: bool,
 }
 
 impl Proposal {
