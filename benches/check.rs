@@ -26,8 +26,12 @@ fn compile(c: &mut Criterion) {
         group.throughput(Throughput::Bytes(text.len() as u64));
         group.bench_function(format!("pieces/{pieces}"), |b| {
             b.iter(|| {
-                let compiled = clay_dsl::compile(black_box(&text), "synthetic.clay")
-                    .expect("the synthetic grammar compiles");
+                let compiled = clay_dsl::compile(
+                    black_box(&text),
+                    "synthetic.clay",
+                    &clay_dsl::CompileOptions::default(),
+                )
+                .expect("the synthetic grammar compiles");
                 assert!(compiled.warnings.is_empty());
                 compiled.grammar.pieces.len()
             })
@@ -68,8 +72,12 @@ fn large_piece(c: &mut Criterion) {
         group.throughput(Throughput::Elements(vertices as u64));
         group.bench_function(format!("vertices/{vertices}"), |b| {
             b.iter(|| {
-                let compiled =
-                    clay_dsl::compile(black_box(&text), "big.clay").expect("the ladder compiles");
+                let compiled = clay_dsl::compile(
+                    black_box(&text),
+                    "big.clay",
+                    &clay_dsl::CompileOptions::default(),
+                )
+                .expect("the ladder compiles");
                 compiled.grammar.pieces[0].vertices.len()
             })
         });

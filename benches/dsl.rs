@@ -73,7 +73,12 @@ fn dsl(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(5));
     let fails = |src: String, code: &'static str| {
         move || {
-            let d = clay_dsl::compile(black_box(&src), "bench.clay").unwrap_err();
+            let d = clay_dsl::compile(
+                black_box(&src),
+                "bench.clay",
+                &clay_dsl::CompileOptions::default(),
+            )
+            .unwrap_err();
             assert_eq!(d.error_count(), 1);
             assert!(d.items.iter().any(|d| d.code == code));
         }
@@ -87,7 +92,12 @@ fn dsl(c: &mut Criterion) {
         let mirrored = mirrored_piece(rail);
         group.bench_function(format!("mirror_listed_piece/{}", 2 * rail), |b| {
             b.iter(|| {
-                let g = clay_dsl::compile(black_box(&mirrored), "bench.clay").unwrap();
+                let g = clay_dsl::compile(
+                    black_box(&mirrored),
+                    "bench.clay",
+                    &clay_dsl::CompileOptions::default(),
+                )
+                .unwrap();
                 g.grammar.pieces[0].states.len()
             })
         });
@@ -96,7 +106,12 @@ fn dsl(c: &mut Criterion) {
     let big = chain(limit);
     group.bench_function(format!("instance_limit/{limit}"), |b| {
         b.iter(|| {
-            let g = clay_dsl::compile(black_box(&big), "bench.clay").unwrap();
+            let g = clay_dsl::compile(
+                black_box(&big),
+                "bench.clay",
+                &clay_dsl::CompileOptions::default(),
+            )
+            .unwrap();
             assert_eq!(g.grammar.assembly.instances.len(), limit);
         })
     });

@@ -33,9 +33,13 @@ fn ring_grammar(n: usize, inner: f64) -> String {
 }
 
 fn compiled(inner: f64) -> CompiledGrammar {
-    clay_dsl::compile(&ring_grammar(POINTS, inner), "ring.clay")
-        .expect("the generated ring grammar compiles")
-        .grammar
+    clay_dsl::compile(
+        &ring_grammar(POINTS, inner),
+        "ring.clay",
+        &clay_dsl::CompileOptions::default(),
+    )
+    .expect("the generated ring grammar compiles")
+    .grammar
 }
 
 fn large_polygon(c: &mut Criterion) {

@@ -21,7 +21,7 @@ fn compile(source: &str, path: &Path) -> Result<CompiledGrammar, String> {
         .unwrap_or(path)
         .display()
         .to_string();
-    clay_dsl::compile(source, &name)
+    clay_dsl::compile(source, &name, &clay_dsl::CompileOptions::default())
         .map(|c| c.grammar)
         .map_err(|d| clay_dsl::render(&d, source, &name, false))
 }

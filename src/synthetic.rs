@@ -707,7 +707,11 @@ mod tests {
     #[test]
     fn the_timing_grammar_compiles_clean_with_every_piece_and_rule() {
         let text = grammar_text(8);
-        let c = match clay_dsl::compile(&text, "synthetic.clay") {
+        let c = match clay_dsl::compile(
+            &text,
+            "synthetic.clay",
+            &clay_dsl::CompileOptions::default(),
+        ) {
             Ok(c) => c,
             Err(d) => panic!("{}", clay_dsl::render(&d, &text, "synthetic.clay", false)),
         };

@@ -881,7 +881,12 @@ fn a_solver_frame_changes_no_part_instance_or_connection() {
         let Ok(text) = std::fs::read_to_string(&path) else {
             continue;
         };
-        let compiled = clay_dsl::compile(&text, &path.to_string_lossy()).unwrap();
+        let compiled = clay_dsl::compile(
+            &text,
+            &path.to_string_lossy(),
+            &clay_dsl::CompileOptions::default(),
+        )
+        .unwrap();
         models.push((name, compiled.grammar));
     }
     assert!(models.len() >= 3, "the example grammars are read");

@@ -17,7 +17,7 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 fn compiles_clean(text: &str) -> clay_dsl::CompiledGrammar {
-    match clay_dsl::compile(text, "authored.clay") {
+    match clay_dsl::compile(text, "authored.clay", &clay_dsl::CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!(
             "authored grammar does not compile:\n{}\n{text}",

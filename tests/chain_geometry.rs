@@ -14,7 +14,9 @@ fn wall(binding: &str) -> CompiledGrammar {
         .replace("polyline skinned", &format!("polyline {binding}"));
     assert!(text.contains(&format!("polygon {binding} fill")));
     assert!(text.contains(&format!("polyline {binding} width")));
-    clay_dsl::compile(&text, "wall.clay").unwrap().grammar
+    clay_dsl::compile(&text, "wall.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 /// The area of the brick face (the first proxy) of the last brick, its extent along x and the

@@ -10,7 +10,7 @@
 //! must also have exactly as many points as the hand-computed one: both cut a quarter turn into
 //! 16 straight pieces.
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 use serde_json::Value;
 
 /// Coordinates of derived states compared this loosely (see the module comment).
@@ -21,7 +21,7 @@ const EXACT: f64 = 1e-9;
 fn compiled(path: &str) -> Value {
     let dir = env!("CARGO_MANIFEST_DIR");
     let src = std::fs::read_to_string(format!("{dir}/{path}")).unwrap();
-    let mut g = compile(&src, "grammar.clay")
+    let mut g = compile(&src, "grammar.clay", &CompileOptions::default())
         .unwrap_or_else(|d| panic!("{path} does not compile: {d:?}"))
         .grammar;
     g.source = String::new();

@@ -23,9 +23,13 @@ fn docs_pictures_match_what_the_code_draws() {
         let name = path.file_stem().unwrap().to_str().unwrap().to_string();
         let source = std::fs::read_to_string(&path).unwrap();
         // the sheet's title names the grammar as the docs do
-        let grammar = clay_dsl::compile(&source, &format!("grammars/{name}.clay"))
-            .unwrap()
-            .grammar;
+        let grammar = clay_dsl::compile(
+            &source,
+            &format!("grammars/{name}.clay"),
+            &clay_dsl::CompileOptions::default(),
+        )
+        .unwrap()
+        .grammar;
         let script_path = path.with_extension("script.json");
         let script = script_path
             .exists()

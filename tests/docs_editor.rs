@@ -55,7 +55,9 @@ fn the_rule_logs_stretch_line_has_the_shape_docs_editor_md_quotes() {
     );
     let dir = env!("CARGO_MANIFEST_DIR");
     let src = std::fs::read_to_string(format!("{dir}/grammars/wall.clay")).unwrap();
-    let g = clay_dsl::compile(&src, "wall").unwrap().grammar;
+    let g = clay_dsl::compile(&src, "wall", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     let json = std::fs::read_to_string(format!("{dir}/grammars/wall.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));

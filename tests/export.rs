@@ -17,7 +17,9 @@ const EXAMPLES: [&str; 6] = ["wall", "castle", "streets", "centipede", "junction
 fn grammar(name: &str) -> CompiledGrammar {
     let path = format!("{}/grammars/{name}.clay", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).unwrap();
-    clay_dsl::compile(&source, &path).unwrap().grammar
+    clay_dsl::compile(&source, &path, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 /// The assembly after the example's script, when it has one.
@@ -229,7 +231,9 @@ fn extruded_proxies_keep_their_heights_when_the_floor_plan_deforms() {
     let source = "site type s\npiece tower {\n    vertex a (0, 0)\n    vertex b (2, 0)\n    vertex c (1, 2)\n    \
                   edges a-b-c-a\n    polygon fill #777777 extrude 6 above 2 {\n        (0, 0) (2, 0) (1, 2)\n    }\n    \
                   polygon fill #aa3333 {\n        (0.5, 0.5) (1.5, 0.5) (1, 1.5)\n    }\n}\nmodel {\n    t = tower\n}\n";
-    let g = clay_dsl::compile(source, "t.clay").unwrap().grammar;
+    let g = clay_dsl::compile(source, "t.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     let mut a = g.assembly.clone();
     // Shear the floor plan, as a drag would.
     for p in &mut a.positions {

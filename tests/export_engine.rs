@@ -28,7 +28,9 @@ const EXAMPLES: [&str; 7] = [
 fn grammar(name: &str) -> CompiledGrammar {
     let path = format!("{}/grammars/{name}.clay", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).unwrap();
-    clay_dsl::compile(&source, &path).unwrap().grammar
+    clay_dsl::compile(&source, &path, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 /// The initial assembly, and the one after the example's script when it has one.
@@ -448,7 +450,9 @@ fn uvs_are_planar_in_metres() {
     let source = "piece slab {\n    vertex a (0, 0)\n    vertex b (2, 0)\n    vertex c (2, 1)\n    \
                   vertex d (0, 1)\n    edges a-b-c-d-a, a-c\n    polygon fill #777777 extrude 3 {\n        \
                   (0, 0) (2, 0) (2, 1) (0, 1)\n    }\n}\nmodel {\n    s = slab\n}\n";
-    let g = clay_dsl::compile(source, "slab.clay").unwrap().grammar;
+    let g = clay_dsl::compile(source, "slab.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     let s = scene(&g, &g.assembly, &ExportOptions::default());
     assert_eq!(s.name, "slab");
     let p = &s.nodes[0].primitives[0];

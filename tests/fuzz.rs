@@ -54,7 +54,7 @@ fn grammar(input: &[u8]) -> Result<(), String> {
         Err(_) => return Ok(()),
     };
     let path = "fuzz.clay";
-    let compiled = clay_dsl::compile(text, path);
+    let compiled = clay_dsl::compile(text, path, &clay_dsl::CompileOptions::default());
     match &compiled {
         Ok(c) => located(&c.warnings, text, path)?,
         Err(d) => located(d, text, path)?,
@@ -67,7 +67,7 @@ fn grammar(input: &[u8]) -> Result<(), String> {
             Err(_) => return Err("fmt's output does not parse".into()),
         }
         let before = compiled.as_ref().map(|c| &c.grammar).ok();
-        let after = clay_dsl::compile(&formatted, path);
+        let after = clay_dsl::compile(&formatted, path, &clay_dsl::CompileOptions::default());
         match (before, after.as_ref().map(|c| &c.grammar).ok()) {
             (Some(a), Some(b)) if a != b => {
                 return Err("fmt changed the compiled grammar".into());
@@ -126,9 +126,12 @@ fn compiled_corpus() -> Vec<Vec<u8>> {
         .iter()
         .filter_map(|f| {
             let text = std::fs::read_to_string(f).ok()?;
-            let compiled =
-                clay_dsl::compile_with(&text, &f.display().to_string(), &clay_dsl::FsLoader)
-                    .ok()?;
+            let compiled = clay_dsl::compile(
+                &text,
+                &f.display().to_string(),
+                &clay_dsl::CompileOptions::with_loader(&clay_dsl::FsLoader),
+            )
+            .ok()?;
             serde_json::to_vec_pretty(&compiled.grammar).ok()
         })
         .collect()
@@ -286,7 +289,11 @@ fn wall_grammar() -> std::sync::Arc<clay_dsl::CompiledGrammar> {
     WALL.get_or_init(|| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammars/wall.clay");
         let text = std::fs::read_to_string(&path).unwrap();
-        std::sync::Arc::new(clay_dsl::compile(&text, "wall.clay").unwrap().grammar)
+        std::sync::Arc::new(
+            clay_dsl::compile(&text, "wall.clay", &clay_dsl::CompileOptions::default())
+                .unwrap()
+                .grammar,
+        )
     })
     .clone()
 }

@@ -872,7 +872,7 @@ fn asset_case(input: &[u8]) -> Result<(), String> {
     let text =
         GRAMMARS[(hasher.finish() % GRAMMARS.len() as u64) as usize].replace("ASSET", &asset);
     let path = dir.join("g.clay").to_string_lossy().into_owned();
-    let outcome = match clay_dsl::compile(&text, &path) {
+    let outcome = match clay_dsl::compile(&text, &path, &clay_dsl::CompileOptions::default()) {
         Ok(c) => located(&c.warnings, &text, &path).and_then(|()| accepted(&c.grammar)),
         Err(d) => refused(&d, &text, &path),
     };

@@ -313,7 +313,7 @@ fn mutate(rng: &mut TestRng, input: &[u8], corpus: &[Vec<u8>]) -> Vec<u8> {
 
 /// A compiled grammar with no error, or the codes and the first error.
 fn checks(text: &str) -> Result<(), String> {
-    match clay_dsl::compile(text, "authored.clay") {
+    match clay_dsl::compile(text, "authored.clay", &clay_dsl::CompileOptions::default()) {
         Ok(_) => Ok(()),
         Err(d) => {
             let rendered = clay_dsl::render(&d, text, "authored.clay", false);

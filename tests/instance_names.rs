@@ -13,7 +13,9 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 fn replay(name: &str, mut after: impl FnMut(usize, &CompiledGrammar, &AssemblyData)) {
     let dir = env!("CARGO_MANIFEST_DIR");
     let src = std::fs::read_to_string(format!("{dir}/grammars/{name}.clay")).unwrap();
-    let g = clay_dsl::compile(&src, name).unwrap().grammar;
+    let g = clay_dsl::compile(&src, name, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     let json = std::fs::read_to_string(format!("{dir}/grammars/{name}.script.json")).unwrap();
     let script = Script::parse(&json).unwrap();
     let mut asm = Assembly::new(Arc::new(g.clone()));

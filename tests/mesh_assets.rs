@@ -19,9 +19,13 @@ fn root() -> &'static Path {
 fn keep() -> CompiledGrammar {
     let path = root().join("grammars/keep.clay");
     let source = std::fs::read_to_string(&path).unwrap();
-    clay_dsl::compile(&source, &path.to_string_lossy())
-        .unwrap()
-        .grammar
+    clay_dsl::compile(
+        &source,
+        &path.to_string_lossy(),
+        &clay_dsl::CompileOptions::default(),
+    )
+    .unwrap()
+    .grammar
 }
 
 fn after_script(g: &CompiledGrammar) -> AssemblyData {
@@ -203,9 +207,13 @@ const WALL: &str = "site type s\npiece wall {\n    vertex sw (0, -0.4)\n    vert
 fn a_skinned_mesh_follows_the_skin_of_its_polygon_and_keeps_its_heights() {
     let dir = scratch("skin", &[("wall.clay", WALL), ("box.obj", BOX)]);
     let path = dir.join("wall.clay");
-    let g = clay_dsl::compile(WALL, &path.to_string_lossy())
-        .unwrap()
-        .grammar;
+    let g = clay_dsl::compile(
+        WALL,
+        &path.to_string_lossy(),
+        &clay_dsl::CompileOptions::default(),
+    )
+    .unwrap()
+    .grammar;
     let mut a = g.assembly.clone();
     // Stretch and bend the wall as a drag would: the east site moves out and up.
     for p in &mut a.positions {
@@ -289,7 +297,11 @@ fn an_asset_at_the_coordinate_limit_exports_only_finite_numbers() {
             &[("wall.clay", &source), ("far.gltf", &gltf(scale))],
         );
         let path = dir.join("wall.clay");
-        let compiled = clay_dsl::compile(&source, &path.to_string_lossy());
+        let compiled = clay_dsl::compile(
+            &source,
+            &path.to_string_lossy(),
+            &clay_dsl::CompileOptions::default(),
+        );
         assert_eq!(
             compiled.is_ok(),
             loads,

@@ -23,7 +23,9 @@ struct Session {
 fn grammar(name: &str) -> CompiledGrammar {
     let dir = env!("CARGO_MANIFEST_DIR");
     let src = std::fs::read_to_string(format!("{dir}/grammars/{name}.clay")).unwrap();
-    clay_dsl::compile(&src, name).unwrap().grammar
+    clay_dsl::compile(&src, name, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 impl Session {

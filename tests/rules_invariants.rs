@@ -11,7 +11,9 @@ use proptest::prelude::*;
 fn grammar(name: &str) -> CompiledGrammar {
     let path = format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"));
     let src = std::fs::read_to_string(&path).unwrap();
-    clay_dsl::compile(&src, &path).unwrap().grammar
+    clay_dsl::compile(&src, &path, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 fn initial(g: &CompiledGrammar) -> AssemblyData {

@@ -9,7 +9,7 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar, InstanceSite, PartKind};
 use glam::DVec2;
 
 fn compile(src: &str) -> CompiledGrammar {
-    match clay_dsl::compile(src, "test.clay") {
+    match clay_dsl::compile(src, "test.clay", &clay_dsl::CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!("test grammar does not compile: {d:?}"),
     }

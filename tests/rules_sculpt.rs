@@ -12,7 +12,7 @@ use clay_dsl::compiled::CompiledGrammar;
 fn grammar(name: &str) -> CompiledGrammar {
     let path = format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"));
     let src = std::fs::read_to_string(&path).unwrap();
-    match clay_dsl::compile(&src, &path) {
+    match clay_dsl::compile(&src, &path, &clay_dsl::CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!("{name} does not compile: {d:?}"),
     }
@@ -102,7 +102,9 @@ fn long_wall(n: usize) -> CompiledGrammar {
     let src = std::fs::read_to_string(&path).unwrap();
     assert!(src.contains("chain brick x 8"));
     let src = src.replace("chain brick x 8", &format!("chain brick x {n}"));
-    clay_dsl::compile(&src, &path).unwrap().grammar
+    clay_dsl::compile(&src, &path, &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar
 }
 
 /// Drags the east brick of a wall of `n` bricks out by `fraction` of its length over `frames`

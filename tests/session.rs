@@ -10,9 +10,13 @@ use clay::{Assembly, RuleKind, Script, Session, SolverConfig, replay};
 fn grammar(name: &str) -> clay_dsl::compiled::CompiledGrammar {
     let dir = env!("CARGO_MANIFEST_DIR");
     let src = std::fs::read_to_string(format!("{dir}/grammars/{name}.clay")).unwrap();
-    clay_dsl::compile(&src, &format!("grammars/{name}.clay"))
-        .unwrap()
-        .grammar
+    clay_dsl::compile(
+        &src,
+        &format!("grammars/{name}.clay"),
+        &clay_dsl::CompileOptions::default(),
+    )
+    .unwrap()
+    .grammar
 }
 
 fn script(name: &str) -> Script {

@@ -35,7 +35,8 @@ fn a_grammar_and_set_accept_the_same_values() {
                 &format!("solver {{\n    {} = {x:e}\n}}", s.name),
             );
             assert_ne!(text, WALL);
-            let compiled = clay_dsl::compile(&text, "wall.clay").is_ok();
+            let compiled =
+                clay_dsl::compile(&text, "wall.clay", &clay_dsl::CompileOptions::default()).is_ok();
             let mut config = SolverConfig::default();
             let mut merge = 0.5;
             let set = apply_setting(&mut config, &mut merge, s.name, &format!("{x:e}")).is_ok();
@@ -90,7 +91,11 @@ fn at_bounds(range: Range, count_top: u32) -> Vec<String> {
 
 #[test]
 fn a_session_runs_at_every_settings_bounds() {
-    let grammar = Arc::new(clay_dsl::compile(WALL, "wall.clay").unwrap().grammar);
+    let grammar = Arc::new(
+        clay_dsl::compile(WALL, "wall.clay", &clay_dsl::CompileOptions::default())
+            .unwrap()
+            .grammar,
+    );
     let script = Script::parse(include_str!("../grammars/wall.script.json")).unwrap();
     for s in SETTINGS {
         let values = at_bounds(s.range, 50);
@@ -138,7 +143,9 @@ fn the_examples_run_at_every_settings_bounds() {
         let source = std::fs::read_to_string(root.join(format!("{example}.clay"))).unwrap();
         let text = std::fs::read_to_string(root.join(format!("{example}.script.json"))).unwrap();
         let script = first_frames(&Script::parse(&text).unwrap());
-        let compiled = clay_dsl::compile(&source, example).unwrap().grammar;
+        let compiled = clay_dsl::compile(&source, example, &clay_dsl::CompileOptions::default())
+            .unwrap()
+            .grammar;
         for setting in &SETTINGS {
             for value in at_bounds(setting.range, u32::MAX) {
                 let mut grammar = compiled.clone();

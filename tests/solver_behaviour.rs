@@ -13,7 +13,7 @@ use glam::DVec2;
 fn grammar(name: &str) -> clay_dsl::CompiledGrammar {
     let path = format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).unwrap();
-    match clay_dsl::compile(&source, &path) {
+    match clay_dsl::compile(&source, &path, &clay_dsl::CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!("{}", clay_dsl::render(&d, &source, &path, false)),
     }

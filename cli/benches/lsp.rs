@@ -72,7 +72,14 @@ fn bench(c: &mut Criterion) {
     });
     // The floor: what `clayc check` does with the same text (parse and compile).
     g.bench_function("compile_only", |b| {
-        b.iter(|| clay_dsl::compile(&valid, "wall3000.clay").is_ok())
+        b.iter(|| {
+            clay_dsl::compile(
+                &valid,
+                "wall3000.clay",
+                &clay_dsl::CompileOptions::default(),
+            )
+            .is_ok()
+        })
     });
     g.finish();
 

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::out;
 use crate::params::ParamArgs;
 use clay_dsl::codes::UNREADABLE;
-use clay_dsl::{Diagnostics, Severity, compile_bytes_with_options};
+use clay_dsl::{Diagnostics, Severity, compile, decode_utf8};
 use clay_dsl::{JsonDiagnostic, JsonLabel, JsonPos};
 
 /// How diagnostics are printed.
@@ -154,7 +154,7 @@ pub fn check(args: CheckArgs) -> u8 {
             }
         };
         let path = file.display().to_string();
-        let diags = match compile_bytes_with_options(&bytes, &path, &options) {
+        let diags = match decode_utf8(&bytes).and_then(|s| compile(s, &path, &options)) {
             Ok(c) => c.warnings,
             Err(d) => d,
         };
@@ -239,7 +239,8 @@ pub fn build(args: BuildArgs) -> u8 {
         }
     };
     let path = args.file.display().to_string();
-    let compiled = match compile_bytes_with_options(&bytes, &path, &args.params.options()) {
+    let compiled = match decode_utf8(&bytes).and_then(|s| compile(s, &path, &args.params.options()))
+    {
         Ok(c) => c,
         Err(diags) => {
             print_human(&diags, &bytes, &path);

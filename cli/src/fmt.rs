@@ -45,13 +45,7 @@ pub fn fmt(args: FmtArgs) -> u8 {
             }
         };
         let source = String::from_utf8_lossy(&bytes);
-        let formatted = match std::str::from_utf8(&bytes) {
-            Ok(text) => clay_dsl::format(text),
-            // compile_bytes words the not-UTF-8 diagnostic; reuse it.
-            Err(_) => Err(clay_dsl::compile_bytes(&bytes, &path)
-                .err()
-                .unwrap_or_default()),
-        };
+        let formatted = clay_dsl::decode_utf8(&bytes).and_then(clay_dsl::format);
         let formatted = match formatted {
             Ok(f) => f,
             Err(diags) => {

@@ -65,7 +65,7 @@ pub fn compile(source: &str, path: &Path, params: &ParamArgs) -> Result<Compiled
     // Colour only on a terminal that has not opted out.
     let color = std::io::IsTerminal::is_terminal(&std::io::stderr())
         && std::env::var_os("NO_COLOR").is_none();
-    match clay_dsl::compile_with_options(source, &name, &params.options()) {
+    match clay_dsl::compile(source, &name, &params.options()) {
         Ok(compiled) => {
             err!(
                 "{}",

@@ -51,7 +51,9 @@ fn initial(
         }
     };
     let text = String::from_utf8_lossy(&source);
-    let compiled = match clay_dsl::compile_bytes_with_options(&source, &path, &params.options()) {
+    let compiled = match clay_dsl::decode_utf8(&source)
+        .and_then(|s| clay_dsl::compile(s, &path, &params.options()))
+    {
         Ok(c) => c,
         Err(diagnostics) => {
             err!("{}", clay_dsl::render(&diagnostics, &text, &path, false));

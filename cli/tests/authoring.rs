@@ -31,7 +31,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn compiles_clean(text: &str) -> clay_dsl::CompiledGrammar {
-    match clay_dsl::compile(text, "authored.clay") {
+    match clay_dsl::compile(text, "authored.clay", &clay_dsl::CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!(
             "authored grammar does not compile:\n{}\n{text}",
@@ -166,7 +166,12 @@ fn fmt_prints_checks_and_writes_with_the_documented_exit_codes() {
         assert_eq!(o.status.code(), Some(0), "{}", p.display());
         assert!(
             // At the file's own path: its `mesh` assets are found beside it.
-            clay_dsl::compile(&String::from_utf8(o.stdout).unwrap(), p.to_str().unwrap()).is_ok(),
+            clay_dsl::compile(
+                &String::from_utf8(o.stdout).unwrap(),
+                p.to_str().unwrap(),
+                &clay_dsl::CompileOptions::default()
+            )
+            .is_ok(),
             "{}",
             p.display()
         );

@@ -110,7 +110,8 @@ fn quoted<'a>(doc: &'a str, before: &str, after: &str) -> &'a str {
 #[test]
 fn the_positions_docs_editors_md_quotes_are_the_diagnostics_and_declarations() {
     let typo = wall_with_typo();
-    let diags = clay_dsl::compile(&typo, "wall.clay").unwrap_err();
+    let diags =
+        clay_dsl::compile(&typo, "wall.clay", &clay_dsl::CompileOptions::default()).unwrap_err();
     assert_eq!(diags.len(), 1, "one error for one typo");
     let d = diags.iter().next().unwrap();
     assert_eq!(d.code, "E011");

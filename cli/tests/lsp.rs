@@ -524,7 +524,8 @@ fn rename_of_brick_compiles_clean_and_a_bad_name_is_refused() {
     let edits = edit["changes"][URI].as_array().unwrap();
     assert_eq!(edits.len(), 3);
     let renamed = apply(&text, edits);
-    let compiled = clay_dsl::compile(&renamed, "wall.clay").expect("the renamed grammar compiles");
+    let compiled = clay_dsl::compile(&renamed, "wall.clay", &clay_dsl::CompileOptions::default())
+        .expect("the renamed grammar compiles");
     assert!(compiled.warnings.is_empty(), "{:?}", compiled.warnings);
     assert_eq!(compiled.grammar.pieces[0].name, "block");
     for use_ in ["piece block {", "stretch block from", "chain block x"] {

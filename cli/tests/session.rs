@@ -12,9 +12,13 @@ const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
 fn grammar(name: &str) -> clay_dsl::compiled::CompiledGrammar {
     let src = std::fs::read_to_string(format!("{ROOT}/grammars/{name}.clay")).unwrap();
-    clay_dsl::compile(&src, &format!("grammars/{name}.clay"))
-        .unwrap()
-        .grammar
+    clay_dsl::compile(
+        &src,
+        &format!("grammars/{name}.clay"),
+        &clay_dsl::CompileOptions::default(),
+    )
+    .unwrap()
+    .grammar
 }
 
 fn script(name: &str) -> Script {

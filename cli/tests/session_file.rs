@@ -41,7 +41,9 @@ fn scratch(name: &str) -> PathBuf {
 
 fn wall() -> (String, CompiledGrammar) {
     let source = std::fs::read_to_string(Path::new(ROOT).join("grammars/wall.clay")).unwrap();
-    let grammar = clay_dsl::compile(&source, "wall.clay").unwrap().grammar;
+    let grammar = clay_dsl::compile(&source, "wall.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     (source, grammar)
 }
 
@@ -325,7 +327,7 @@ fn a_session_compiles_its_grammar_with_the_parameters_it_was_saved_with() {
     let dir = scratch("params");
     std::fs::write(dir.join("posts.clay"), POSTS).unwrap();
     let options = clay_dsl::CompileOptions::default().param("height", 2.5);
-    let grammar = clay_dsl::compile_with_options(POSTS, "posts.clay", &options)
+    let grammar = clay_dsl::compile(POSTS, "posts.clay", &options)
         .unwrap()
         .grammar;
     let mut saved = SessionFile::new("posts.clay".into(), grammar.assembly.clone(), vec![], None);

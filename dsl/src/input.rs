@@ -2,10 +2,18 @@
 //! session, a compiled grammar, a drawing, a mesh asset) goes through [`read_input`], which
 //! refuses, before opening it, what is not a regular file (a named pipe waits for a writer,
 //! forever if none comes; `/dev/zero` never ends) and stops reading past a limit of the
-//! file's kind, so that no input can block the program or eat its memory.
+//! file's kind, so that no input can block the program or eat its memory. A grammar's bytes
+//! become text through [`decode_utf8`], which words what is not UTF-8 as a diagnostic.
 
 use std::io::{self, Read};
 use std::path::Path;
+
+use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::syntax::Span;
+
+/// The code of a file that is not valid UTF-8 (here, not in `compile/codes.rs`, which
+/// re-exports it, because the compiler reads its input through this module).
+pub const NOT_UTF8: &str = "E003";
 
 /// Most bytes of a file the user writes by hand or in a drawing program: a grammar (its
 /// imports together, E062), a script, a drawing (32 MiB; the largest example is 8 KiB).
@@ -52,6 +60,23 @@ pub fn utf8(bytes: Vec<u8>) -> io::Result<String> {
                 e.utf8_error().valid_up_to()
             ),
         )
+    })
+}
+
+/// The bytes of a grammar as its text, for [`compile`](crate::compile): what is not UTF-8 is
+/// E003 at the first bad byte. Render that diagnostic against
+/// `String::from_utf8_lossy(bytes)`: offsets before that byte agree.
+pub fn decode_utf8(bytes: &[u8]) -> Result<&str, Diagnostics> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        Diagnostic::error(
+            NOT_UTF8,
+            "file is not valid UTF-8 text",
+            Span::new(at, at + 1),
+            "invalid byte here",
+        )
+        .with_hint("save the file as UTF-8")
+        .into()
     })
 }
 

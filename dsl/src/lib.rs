@@ -33,8 +33,7 @@ pub use compile::{
     CompileOptions, Compiled, DOCK_TOLERANCE, FsLoader, Loader, MAX_COORDINATE, MAX_EXTENDS_DEPTH,
     MAX_IMPORT_BYTES, MAX_IMPORTS, MAX_INHERITED, MAX_INSTANCES, MAX_MESH_BYTES,
     MAX_MESH_TOTAL_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_MODEL_INSTANCES, codes,
-    compile, compile_bytes, compile_bytes_with, compile_bytes_with_options, compile_with,
-    compile_with_options, resolve_import,
+    compile, resolve_import,
 };
 pub use compiled::{AssemblyData, CompiledGrammar, MAX_MODEL_COORDINATE};
 pub use diagnostic::{
@@ -43,8 +42,8 @@ pub use diagnostic::{
 };
 pub use format::{comment_spans, format, format_number, print_file};
 pub use input::{
-    MAX_DATA_BYTES, MAX_SOURCE_BYTES, read_bounded, read_input, read_input_string, regular_file,
-    utf8,
+    MAX_DATA_BYTES, MAX_SOURCE_BYTES, decode_utf8, read_bounded, read_input, read_input_string,
+    regular_file, utf8,
 };
 pub use line_index::{LineIndex, LinePos};
 pub use parse::parse;

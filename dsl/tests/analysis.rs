@@ -180,7 +180,8 @@ fn rename_changes_every_use_and_the_result_checks_clean() {
     for s in spans {
         renamed.replace_range(s.start..s.end, "block");
     }
-    let c = clay_dsl::compile(&renamed, "wall.clay").expect("the renamed grammar compiles");
+    let c = clay_dsl::compile(&renamed, "wall.clay", &clay_dsl::CompileOptions::default())
+        .expect("the renamed grammar compiles");
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
     assert_eq!(c.grammar.pieces[0].name, "block");
     // Refused: a keyword, a clash, not a name.

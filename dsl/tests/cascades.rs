@@ -1,7 +1,7 @@
 //! One true error per mistake (issue 18): a mistake in one declaration is not followed by
 //! errors about names that exist, or about what depends on the failed declaration.
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 
 fn wall() -> String {
     std::fs::read_to_string(concat!(
@@ -13,7 +13,7 @@ fn wall() -> String {
 
 /// The codes and messages of a grammar that must not compile.
 fn errors(source: &str) -> Vec<(String, String)> {
-    compile(source, "wall.clay")
+    compile(source, "wall.clay", &CompileOptions::default())
         .unwrap_err()
         .iter()
         .map(|d| (d.code.to_string(), d.message.clone()))
@@ -74,7 +74,7 @@ fn a_shadowed_merge_rule_is_warned_but_not_one_with_another_reach() {
     ))
     .unwrap();
     let codes = |src: &str| -> Vec<&'static str> {
-        compile(src, "m.clay")
+        compile(src, "m.clay", &CompileOptions::default())
             .unwrap()
             .warnings
             .iter()

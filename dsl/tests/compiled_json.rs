@@ -13,7 +13,8 @@ fn examples() -> Vec<(String, CompiledGrammar)> {
         if path.extension().is_some_and(|e| e == "clay") {
             let text = std::fs::read_to_string(&path).unwrap();
             let name = path.display().to_string();
-            let compiled = clay_dsl::compile(&text, &name).unwrap();
+            let compiled =
+                clay_dsl::compile(&text, &name, &clay_dsl::CompileOptions::default()).unwrap();
             out.push((name, compiled.grammar));
         }
     }

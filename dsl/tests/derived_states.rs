@@ -2,7 +2,7 @@
 //! to, and the one error each mistake gives.
 
 use clay_dsl::compiled::{CompiledGrammar, Piece, ProxyShape, RestState};
-use clay_dsl::{Diagnostics, compile, render};
+use clay_dsl::{CompileOptions, Diagnostics, compile, render};
 use glam::DVec2;
 
 /// A 1 m wide, 2 m long ladder along x with its axis; `STATES` is replaced by the test's states.
@@ -38,14 +38,14 @@ fn road(states: &str) -> String {
 }
 
 fn ok(src: &str) -> CompiledGrammar {
-    match compile(src, "t.clay") {
+    match compile(src, "t.clay", &CompileOptions::default()) {
         Ok(c) => c.grammar,
         Err(d) => panic!("{}", render(&d, src, "t.clay", false)),
     }
 }
 
 fn errors(src: &str) -> Diagnostics {
-    compile(src, "t.clay").expect_err("expected errors")
+    compile(src, "t.clay", &CompileOptions::default()).expect_err("expected errors")
 }
 
 /// The codes of the errors, in order, and the rendered text for messages.
@@ -307,7 +307,7 @@ fn a_mirror_that_folds_is_reported() {
 fn tiny_and_odd_angles_stay_finite() {
     for a in ["1e-300", "-0", "0.0000001", "359.9999", "-360"] {
         let src = road(&format!("state s bend {a}"));
-        if let Ok(c) = compile(&src, "t.clay") {
+        if let Ok(c) = compile(&src, "t.clay", &CompileOptions::default()) {
             let p = &c.grammar.pieces[0];
             assert!(p.states[1].positions.iter().all(|q| q.is_finite()), "{a}");
         }

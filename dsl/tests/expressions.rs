@@ -1,7 +1,7 @@
 //! Expressions and `let` constants (issue 18): values, precedence, degrees, one true error per
 //! mistake pointing inside the expression, poisoned constants, and the formatter.
 
-use clay_dsl::{Diagnostic, compile, format};
+use clay_dsl::{CompileOptions, Diagnostic, compile, format};
 
 /// A one-piece grammar with `lets` above it and the piece's single vertex at `point`.
 fn grammar(lets: &str, point: &str) -> String {
@@ -12,12 +12,13 @@ fn grammar(lets: &str, point: &str) -> String {
 
 /// The position of vertex `a` when the grammar compiles.
 fn vertex_a(lets: &str, point: &str) -> (f64, f64) {
-    let c = compile(&grammar(lets, point), "t.clay").unwrap_or_else(|d| {
-        panic!(
-            "{point}: {:?}",
-            d.iter().map(|d| &d.message).collect::<Vec<_>>()
-        )
-    });
+    let c =
+        compile(&grammar(lets, point), "t.clay", &CompileOptions::default()).unwrap_or_else(|d| {
+            panic!(
+                "{point}: {:?}",
+                d.iter().map(|d| &d.message).collect::<Vec<_>>()
+            )
+        });
     let p = c.grammar.pieces[0].states[0].positions[0];
     (p.x, p.y)
 }
@@ -25,7 +26,9 @@ fn vertex_a(lets: &str, point: &str) -> (f64, f64) {
 /// The diagnostics of a grammar that must not compile.
 fn errors(lets: &str, point: &str) -> Vec<Diagnostic> {
     let source = grammar(lets, point);
-    compile(&source, "t.clay").unwrap_err().items
+    compile(&source, "t.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items
 }
 
 fn text_at(source: &str, d: &Diagnostic) -> String {
@@ -74,7 +77,7 @@ fn constants_use_earlier_constants_and_reach_points_and_solver_values() {
     let src = "let k = 0.1\nsolver {\n    hysteresis = k * 2\n}\nsite type s\n\
                piece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    edges a-b\n}\n\
                model {\n    x = p rotate k * 900\n}\n";
-    let c = compile(src, "t.clay").unwrap();
+    let c = compile(src, "t.clay", &CompileOptions::default()).unwrap();
     assert!((c.grammar.solver.hysteresis - 0.2).abs() < 1e-15);
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
 }
@@ -122,7 +125,9 @@ fn an_unknown_function_suggests_the_closest() {
 fn a_constant_used_before_its_let_points_at_both() {
     let source = "site type s\npiece p {\n    vertex a (w, 0)\n    vertex b (5, 5)\n    edges a-b\n}\n\
                   let w = 1\nmodel {\n    x = p\n}\n";
-    let e = compile(source, "t.clay").unwrap_err().items;
+    let e = compile(source, "t.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items;
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].code, "E052");
     assert_eq!(text_at(source, &e[0]), "w");
@@ -178,7 +183,9 @@ fn a_failed_constant_is_reported_once_and_its_uses_stay_silent() {
     let source = "let bad = 1 / 0\nlet worse = bad * 2\nsite type s\npiece p {\n    \
                   vertex a (bad, worse)\n    vertex b (bad, 5)\n    edges a-b\n}\n\
                   model {\n    x = p rotate bad\n}\n";
-    let e = compile(source, "t.clay").unwrap_err().items;
+    let e = compile(source, "t.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items;
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].code, "E050");
 }
@@ -197,7 +204,12 @@ fn constants_cannot_be_declared_twice_or_shadow_built_ins() {
 
 #[test]
 fn an_unused_constant_is_a_warning() {
-    let c = compile(&grammar("let spare = 3", "(0, 0)"), "t.clay").unwrap();
+    let c = compile(
+        &grammar("let spare = 3", "(0, 0)"),
+        "t.clay",
+        &CompileOptions::default(),
+    )
+    .unwrap();
     let w: Vec<_> = c
         .warnings
         .iter()
@@ -218,9 +230,11 @@ fn whole_numbers_and_ranges_are_checked_after_folding() {
              model {{\n    c = chain p x {count} along w -> e\n}}\n"
         )
     };
-    let c = compile(&src("n * 2"), "t.clay").unwrap();
+    let c = compile(&src("n * 2"), "t.clay", &CompileOptions::default()).unwrap();
     assert_eq!(c.grammar.assembly.instances.len(), 6);
-    let e = compile(&src("n / 2"), "t.clay").unwrap_err().items;
+    let e = compile(&src("n / 2"), "t.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items;
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].code, "E013");
 }
@@ -254,15 +268,21 @@ fn the_formatter_keeps_expressions_in_canonical_spacing() {
     );
     assert!(out.contains("vertex a (w / 2, -h)"), "{out}");
     assert_eq!(format(&out).unwrap(), out, "idempotent");
-    let before = compile(source, "t.clay").unwrap().grammar;
-    let after = compile(&out, "t.clay").unwrap().grammar;
+    let before = compile(source, "t.clay", &CompileOptions::default())
+        .unwrap()
+        .grammar;
+    let after = compile(&out, "t.clay", &CompileOptions::default())
+        .unwrap()
+        .grammar;
     assert_eq!(before, after, "meaning-preserving");
 }
 
 #[test]
 fn an_operator_without_an_operand_is_a_syntax_error_with_position() {
     let source = grammar("", "(1 +, 0)");
-    let e = compile(&source, "t.clay").unwrap_err().items;
+    let e = compile(&source, "t.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items;
     assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].code, "E001");
     assert_eq!(&source[e[0].primary.span.start..e[0].primary.span.end], ",");
@@ -277,7 +297,7 @@ fn the_language_doc_example_of_expressions_compiles_to_the_numbers_it_shows() {
         .expect("the section")..];
     let start = section.find("```clay\n").expect("an example") + "```clay\n".len();
     let end = start + section[start..].find("```").unwrap();
-    let c = compile(&section[start..end], "doc.clay").unwrap();
+    let c = compile(&section[start..end], "doc.clay", &CompileOptions::default()).unwrap();
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
     let p = &c.grammar.pieces[0];
     let bay = 2.0 * 0.4 + 0.1;
@@ -310,7 +330,9 @@ fn a_literal_too_large_is_marked_at_its_digits_in_either_form_of_point() {
         "(-1e999, 0 /* x */)",
     ] {
         let source = grammar("", point);
-        let d = compile(&source, "t.clay").unwrap_err().items;
+        let d = compile(&source, "t.clay", &CompileOptions::default())
+            .unwrap_err()
+            .items;
         assert_eq!(d.len(), 1, "{point}: {d:?}");
         assert_eq!(d[0].code, "E012", "{point}");
         let want = if point.contains("-1e999") {

@@ -1,7 +1,7 @@
 //! `extrude HEIGHT [above BASE]` on proxy geometry (issue 20): compiled heights, range checks,
 //! and the formatter keeping it.
 
-use clay_dsl::{compile, format};
+use clay_dsl::{CompileOptions, compile, format};
 
 fn tower(extrude: &str) -> String {
     format!(
@@ -13,15 +13,20 @@ fn tower(extrude: &str) -> String {
 
 #[test]
 fn heights_compile_to_the_proxy() {
-    let c = compile(&tower(" extrude h above h / 3"), "t.clay").unwrap();
+    let c = compile(
+        &tower(" extrude h above h / 3"),
+        "t.clay",
+        &CompileOptions::default(),
+    )
+    .unwrap();
     let e = c.grammar.pieces[0].states[0].geometry[0]
         .extrude
         .expect("extruded");
     assert_eq!((e.height, e.base), (6.0, 2.0));
-    let c = compile(&tower(" extrude 1.5"), "t.clay").unwrap();
+    let c = compile(&tower(" extrude 1.5"), "t.clay", &CompileOptions::default()).unwrap();
     let e = c.grammar.pieces[0].states[0].geometry[0].extrude.unwrap();
     assert_eq!((e.height, e.base), (1.5, 0.0));
-    let flat = compile(&tower(""), "t.clay").unwrap();
+    let flat = compile(&tower(""), "t.clay", &CompileOptions::default()).unwrap();
     assert_eq!(flat.grammar.pieces[0].states[0].geometry[0].extrude, None);
     // Flat geometry's compiled JSON has no `extrude` key (old readers and files agree).
     let json = serde_json::to_string(&flat.grammar).unwrap();
@@ -36,7 +41,7 @@ fn heights_out_of_range_are_one_error() {
         " extrude 1e5",
         " extrude 1 above 1e6",
     ] {
-        let d = compile(&tower(bad), "t.clay").unwrap_err();
+        let d = compile(&tower(bad), "t.clay", &CompileOptions::default()).unwrap_err();
         assert_eq!(d.len(), 1, "{bad}: {:?}", d.items);
         assert_eq!(d.items[0].code, "E013", "{bad}");
     }
@@ -52,7 +57,11 @@ fn the_formatter_keeps_extrude() {
     );
     assert_eq!(format(&out).unwrap(), out);
     assert_eq!(
-        compile(&source, "t.clay").unwrap().grammar,
-        compile(&out, "t.clay").unwrap().grammar
+        compile(&source, "t.clay", &CompileOptions::default())
+            .unwrap()
+            .grammar,
+        compile(&out, "t.clay", &CompileOptions::default())
+            .unwrap()
+            .grammar
     );
 }

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clay_dsl::{CompileOptions, Loader, compile_bytes_with_options, line_col, render};
+use clay_dsl::{CompileOptions, Loader, compile, decode_utf8, line_col, render};
 
 /// Reads imports of the fixtures (shown as `tests/fixtures/invalid/...`) from the workspace
 /// root, whatever the test's working directory.
@@ -112,7 +112,7 @@ fn check_fixtures(folder: &str, params: fn(&[u8]) -> Vec<(String, f64)>) {
             loader: &FromRoot,
             params: params(&bytes),
         };
-        let diags = match compile_bytes_with_options(&bytes, &shown, &options) {
+        let diags = match decode_utf8(&bytes).and_then(|s| compile(s, &shown, &options)) {
             Ok(c) => c.warnings,
             Err(d) => d,
         };

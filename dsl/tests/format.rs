@@ -2,7 +2,7 @@
 //! formatted text equals the original's), it is idempotent, it keeps every comment, and it does
 //! not care how the input was spaced.
 
-use clay_dsl::{CompiledGrammar, Diagnostics, compile};
+use clay_dsl::{CompileOptions, CompiledGrammar, Diagnostics, compile};
 use clay_dsl::{comment_spans, format, format_number, print_file};
 use proptest::prelude::*;
 
@@ -56,7 +56,7 @@ fn meaning(source: &str) -> Meaning {
 
 /// [`meaning`] of a file at `path` (where its `mesh` assets are found).
 fn meaning_at(source: &str, path: &str) -> Meaning {
-    match compile(source, path) {
+    match compile(source, path, &CompileOptions::default()) {
         Ok(c) => {
             let mut g = c.grammar;
             g.source.clear();
@@ -419,7 +419,7 @@ const REUSE: &str = "import   \"lib/types.clay\"\nimport \"lib/brick.clay\" // t
 fn imports_and_extends_keep_their_form_and_meaning() {
     let formatted = format(REUSE).unwrap();
     let compiled = |s: &str| {
-        let mut g = clay_dsl::compile_with(s, "x.clay", &Libs)
+        let mut g = clay_dsl::compile(s, "x.clay", &clay_dsl::CompileOptions::with_loader(&Libs))
             .map_err(|d| clay_dsl::render(&d, s, "x.clay", false))
             .unwrap()
             .grammar;

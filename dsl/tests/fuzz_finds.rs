@@ -7,14 +7,14 @@
 use std::path::{Path, PathBuf};
 
 use clay_dsl::analysis::Analysis;
-use clay_dsl::{Diagnostic, Diagnostics, MAX_HUMAN_DIAGNOSTICS, compile, render};
+use clay_dsl::{CompileOptions, Diagnostic, Diagnostics, MAX_HUMAN_DIAGNOSTICS, compile, render};
 
 // ---- 1. syntax errors after multi-byte characters -----------------------------------------------
 
 /// Compiles `text`, which has a syntax error, and checks the diagnostic: E001, its spans on
 /// char boundaries, rendered; the formatter and the editor analysis do not panic on it either.
 fn syntax_error_on_char_boundaries(text: &str) -> Diagnostic {
-    let d = compile(text, "a.clay").expect_err("a syntax error");
+    let d = compile(text, "a.clay", &CompileOptions::default()).expect_err("a syntax error");
     assert_eq!(d.items.len(), 1, "a syntax error stops at the first: {d:?}");
     let e = d.items[0].clone();
     assert_eq!(e.code, "E001", "{text:?}: {e:?}");
@@ -99,7 +99,7 @@ fn a_character_the_grammar_does_not_skip_is_what_the_error_names() {
 #[test]
 fn thirty_unclosed_block_comments_are_one_error_at_the_first() {
     let text = "/* ".repeat(30);
-    let d = compile(&text, "a.clay").expect_err("unclosed");
+    let d = compile(&text, "a.clay", &CompileOptions::default()).expect_err("unclosed");
     assert_eq!(d.items.len(), 1, "{d:?}");
     let e = &d.items[0];
     assert_eq!(
@@ -115,7 +115,7 @@ fn thirty_unclosed_block_comments_are_one_error_at_the_first() {
 #[test]
 fn ten_thousand_unclosed_block_comments_are_too_deep_and_name_the_first() {
     let text = "/* ".repeat(10_000);
-    let d = compile(&text, "a.clay").expect_err("unclosed");
+    let d = compile(&text, "a.clay", &CompileOptions::default()).expect_err("unclosed");
     assert_eq!(d.items.len(), 1, "{d:?}");
     let e = &d.items[0];
     // The nesting guard stops it before pest: at the `*` of the 257th `/*`.
@@ -129,7 +129,7 @@ fn ten_thousand_unclosed_block_comments_are_too_deep_and_name_the_first() {
 #[test]
 fn an_unclosed_comment_after_the_items_points_at_its_opening() {
     let text = "site type a\n/* one /* two */\npiece p {}\n";
-    let d = compile(text, "a.clay").expect_err("unclosed");
+    let d = compile(text, "a.clay", &CompileOptions::default()).expect_err("unclosed");
     let e = &d.items[0];
     assert_eq!(
         (e.code, e.message.as_str()),
@@ -138,7 +138,9 @@ fn an_unclosed_comment_after_the_items_points_at_its_opening() {
     assert_eq!(e.primary.span.start, text.find("/*").unwrap());
     // Inside an expression the `/` reads as a division first; still the comment is the error.
     let text = "let a = 1 /* never closed";
-    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    let e = &compile(text, "a.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items[0];
     assert_eq!(
         (e.message.as_str(), e.primary.span.start),
         ("unclosed block comment", 10)
@@ -148,7 +150,9 @@ fn an_unclosed_comment_after_the_items_points_at_its_opening() {
 #[test]
 fn an_earlier_syntax_error_is_still_the_one_reported() {
     let text = "piece p { vertex }\n/* never closed";
-    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    let e = &compile(text, "a.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items[0];
     assert_eq!(e.code, "E001");
     assert!(e.message.starts_with("expected"), "{}", e.message);
     assert!(e.primary.span.start < text.find("/*").unwrap());
@@ -158,7 +162,9 @@ fn an_earlier_syntax_error_is_still_the_one_reported() {
 fn comment_openers_inside_strings_are_not_comments() {
     // The scan skips strings as the grammar reads them: no unclosed comment, no bracket.
     let text = "import \"a/*b(.clay\" x";
-    let e = &compile(text, "a.clay").unwrap_err().items[0];
+    let e = &compile(text, "a.clay", &CompileOptions::default())
+        .unwrap_err()
+        .items[0];
     assert!(e.message.starts_with("expected"), "{}", e.message);
     assert!(e.secondary.is_empty(), "{e:?}");
     // And the formatter keeps a `//` inside a string as it is, not as a comment.
@@ -190,7 +196,7 @@ fn hut(stmt: &str) -> String {
 fn one_error(dir: &Path, grammar: &str) -> Diagnostic {
     let path = dir.join("hut.clay").to_string_lossy().into_owned();
     std::fs::write(&path, grammar).unwrap();
-    let d = compile(grammar, &path).expect_err("refused");
+    let d = compile(grammar, &path, &CompileOptions::default()).expect_err("refused");
     assert_eq!(d.items.len(), 1, "one error per mistake: {d:?}");
     let e = d.items[0].clone();
     let (line, _) = clay_dsl::line_col(grammar, e.primary.span.start);
@@ -227,9 +233,23 @@ fn an_mtl_colour_with_one_number_is_an_error_naming_its_line() {
     }
     // Three numbers read; a missing `.mtl` only loses the colour.
     std::fs::write(dir.join("hut.mtl"), "newmtl red\nKd 1 0 0\n").unwrap();
-    assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
+    assert!(
+        compile(
+            &grammar,
+            &dir.join("hut.clay").to_string_lossy(),
+            &CompileOptions::default()
+        )
+        .is_ok()
+    );
     std::fs::remove_file(dir.join("hut.mtl")).unwrap();
-    assert!(compile(&grammar, &dir.join("hut.clay").to_string_lossy()).is_ok());
+    assert!(
+        compile(
+            &grammar,
+            &dir.join("hut.clay").to_string_lossy(),
+            &CompileOptions::default()
+        )
+        .is_ok()
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -310,7 +330,10 @@ fn named_pipes_are_refused_before_they_are_opened() {
     for mesh in ["tri.gltf", "hut.obj"] {
         let grammar = hut(&format!("mesh \"{mesh}\""));
         let path = dir.join("hut.clay").to_string_lossy().into_owned();
-        assert!(compile(&grammar, &path).is_ok(), "{mesh}");
+        assert!(
+            compile(&grammar, &path, &CompileOptions::default()).is_ok(),
+            "{mesh}"
+        );
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -327,7 +350,7 @@ fn unknown_pieces(n: usize, one_line: bool) -> String {
 #[test]
 fn a_human_rendering_stops_after_its_limit_and_counts_the_rest() {
     let text = unknown_pieces(3_000, true);
-    let d: Diagnostics = compile(&text, "a.clay").unwrap_err();
+    let d: Diagnostics = compile(&text, "a.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.error_count(), 3_000);
     let shown = render(&d, &text, "a.clay", false);
     assert_eq!(shown.matches("error[E011]").count(), MAX_HUMAN_DIAGNOSTICS);
@@ -352,7 +375,7 @@ fn a_human_rendering_stops_after_its_limit_and_counts_the_rest() {
 #[test]
 fn the_closing_line_counts_errors_and_warnings_and_is_absent_within_the_limit() {
     let text = unknown_pieces(MAX_HUMAN_DIAGNOSTICS, false);
-    let mut d = compile(&text, "a.clay").unwrap_err();
+    let mut d = compile(&text, "a.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.len(), MAX_HUMAN_DIAGNOSTICS);
     assert_eq!(clay_dsl::omitted_line(&d), None);
     assert!(!render(&d, &text, "a.clay", false).contains("... and"));

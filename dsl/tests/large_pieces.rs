@@ -4,7 +4,7 @@
 //! a large piece compiles to the same indices, with its repeats and duplicates reported where
 //! they are written. (Its time is in `benches/check.rs`, `large piece`.)
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 
 /// A ladder of `n` rungs: vertices `b0, t0, b1, t1, ...`, its outline and one diagonal per
 /// bay, sites at either end, and a state `lifted` listing every vertex in reverse order,
@@ -35,7 +35,7 @@ fn ladder(n: usize, extra_vertex: &str, extra_edges: &str) -> String {
 #[test]
 fn a_large_piece_compiles_to_the_indices_its_names_give() {
     let n = 20_000;
-    let out = compile(&ladder(n, "", ""), "big.clay").unwrap();
+    let out = compile(&ladder(n, "", ""), "big.clay", &CompileOptions::default()).unwrap();
     assert!(out.warnings.is_empty(), "{:?}", out.warnings);
     let piece = &out.grammar.pieces[0];
     assert_eq!(piece.vertices.len(), 2 * n);
@@ -57,7 +57,7 @@ fn a_large_piece_reports_its_repeats_where_they_are_written() {
     let n = 20_000;
     // a vertex declared twice, and an edge listed again the other way round
     let src = ladder(n, "    vertex t5 (5, 3)\n", ", t3-b2");
-    let d = compile(&src, "big.clay").unwrap_err();
+    let d = compile(&src, "big.clay", &CompileOptions::default()).unwrap_err();
     let dup: Vec<_> = d.iter().filter(|x| x.code == "E010").collect();
     assert_eq!(
         dup.len(),
@@ -68,7 +68,7 @@ fn a_large_piece_reports_its_repeats_where_they_are_written() {
     let at = dup[0].primary.span.start;
     assert!(src[at..].starts_with("t5 (5, 3)"), "{}", &src[at..at + 20]);
     let src = ladder(n, "", ", t3-b2");
-    let out = compile(&src, "big.clay").unwrap();
+    let out = compile(&src, "big.clay", &CompileOptions::default()).unwrap();
     let repeat: Vec<_> = out
         .warnings
         .iter()

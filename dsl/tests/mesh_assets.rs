@@ -6,7 +6,8 @@ use std::io::{Error, ErrorKind};
 
 use clay_dsl::compiled::ProxyShape;
 use clay_dsl::{
-    CompiledGrammar, Diagnostics, FsLoader, Loader, MAX_MESH_BYTES, MAX_MESH_VERTICES, compile_with,
+    CompileOptions, CompiledGrammar, Diagnostics, FsLoader, Loader, MAX_MESH_BYTES,
+    MAX_MESH_VERTICES,
 };
 
 /// Files served from memory; a path missing from the map does not exist.
@@ -43,7 +44,7 @@ fn hut(mesh: &str) -> String {
 }
 
 fn compile(source: &str, loader: &dyn Loader) -> Result<CompiledGrammar, Diagnostics> {
-    compile_with(source, "g/hut.clay", loader).map(|c| c.grammar)
+    clay_dsl::compile(source, "g/hut.clay", &CompileOptions::with_loader(loader)).map(|c| c.grammar)
 }
 
 /// The one error of a failed compile: its code, and where it points.
@@ -133,7 +134,7 @@ fn missing_unreadable_and_folder_assets_are_their_own_codes() {
     let dir = std::env::temp_dir().join(format!("clay-mesh-dir-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("tower.glb")).unwrap();
     let path = dir.join("hut.clay").to_string_lossy().into_owned();
-    let d = compile_with(&source, &path, &FsLoader).unwrap_err();
+    let d = clay_dsl::compile(&source, &path, &CompileOptions::with_loader(&FsLoader)).unwrap_err();
     let codes: Vec<_> = d.iter().map(|d| d.code).collect();
     assert_eq!(codes, ["E065"], "{d:?}");
     std::fs::remove_dir_all(dir).unwrap();

@@ -1,10 +1,10 @@
 //! W005: a grammar with nothing to sculpt says so once (issue 18: an empty file, or one with no
 //! `model`, checked clean with no word).
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 
 fn codes(source: &str) -> Vec<&'static str> {
-    compile(source, "g.clay")
+    compile(source, "g.clay", &CompileOptions::default())
         .unwrap()
         .warnings
         .iter()

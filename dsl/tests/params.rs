@@ -4,8 +4,8 @@
 
 use clay_dsl::syntax::{ExprKind, Item};
 use clay_dsl::{
-    CompileOptions, Compiled, CompiledGrammar, Diagnostic, Diagnostics, compile,
-    compile_bytes_with_options, compile_with_options, format, parse,
+    CompileOptions, Compiled, CompiledGrammar, Diagnostic, Diagnostics, compile, decode_utf8,
+    format, parse,
 };
 use proptest::prelude::*;
 
@@ -40,7 +40,7 @@ fn with(source: &str, params: &[(&str, f64)]) -> Result<Compiled, Diagnostics> {
     for (name, value) in params {
         options = options.param(*name, *value);
     }
-    compile_with_options(source, "wall.clay", &options)
+    compile(source, "wall.clay", &options)
 }
 
 fn ok(source: &str, params: &[(&str, f64)]) -> CompiledGrammar {
@@ -140,7 +140,7 @@ fn a_fraction_before_the_range_dots_is_still_a_number() {
 fn param_and_in_stay_contextual_keywords() {
     // `param` and `in` may name a vertex, as other keywords may.
     let src = "site type s\npiece p {\n    vertex param (0, 0)\n    vertex in (1, 0)\n    edges param-in\n}\nmodel {\n    x = p\n}\n";
-    compile(src, "t.clay").unwrap();
+    compile(src, "t.clay", &CompileOptions::default()).unwrap();
 }
 
 #[test]
@@ -200,12 +200,16 @@ fn a_param_without_a_range_takes_any_finite_value() {
 #[test]
 fn the_bytes_entry_point_and_the_plain_one_agree() {
     let options = CompileOptions::default().param("bays", 5.0);
-    let a = compile_bytes_with_options(WALL.as_bytes(), "wall.clay", &options).unwrap();
-    let b = compile_with_options(WALL, "wall.clay", &options).unwrap();
+    let a = decode_utf8(WALL.as_bytes())
+        .and_then(|s| compile(s, "wall.clay", &options))
+        .unwrap();
+    let b = compile(WALL, "wall.clay", &options).unwrap();
     assert_eq!(a.grammar, b.grammar);
     // `compile` is the options' default.
     assert_eq!(
-        compile(WALL, "wall.clay").unwrap().grammar,
+        compile(WALL, "wall.clay", &CompileOptions::default())
+            .unwrap()
+            .grammar,
         with(WALL, &[]).unwrap().grammar
     );
 }
@@ -243,14 +247,12 @@ fn a_param_of_an_imported_file_is_a_param_of_the_grammar() {
     const LIB: &str = "param lane = 3 in 2..5\nsite type s\npiece p {\n    vertex a (0, 0)\n    vertex b (lane, 0)\n    edges a-b\n}\n";
     let src = "import \"lib.clay\"\n\nmodel {\n    x = p\n}\n";
     let options = CompileOptions::with_loader(&Lib).param("lane", 4.0);
-    let g = compile_with_options(src, "main.clay", &options)
-        .unwrap()
-        .grammar;
+    let g = compile(src, "main.clay", &options).unwrap().grammar;
     assert_eq!(g.params[0].name, "lane");
     assert_eq!(g.pieces[0].states[0].positions[1].x, 4.0);
     // Its override error points into the library, where the parameter is declared.
     let options = CompileOptions::with_loader(&Lib).param("lane", 9.0);
-    let d = compile_with_options(src, "main.clay", &options).unwrap_err();
+    let d = compile(src, "main.clay", &options).unwrap_err();
     assert_eq!(d.len(), 1);
     assert_eq!(d.items[0].code, "E071");
     assert!(d.items[0].primary.span.start > src.len());
@@ -285,15 +287,11 @@ fn keep_clay_sets_its_wall_height() {
         wall.states[0].geometry[0].extrude.unwrap().height
     };
     let options = CompileOptions::default();
-    let g = compile_with_options(&source, path, &options)
-        .unwrap()
-        .grammar;
+    let g = compile(&source, path, &options).unwrap().grammar;
     assert_eq!(wall_top(&g), 4.0);
     assert_eq!(g.params[0].range, Some([3.0, 6.0]));
     let options = CompileOptions::default().param("wall_height", 5.5);
-    let g = compile_with_options(&source, path, &options)
-        .unwrap()
-        .grammar;
+    let g = compile(&source, path, &options).unwrap().grammar;
     assert_eq!(wall_top(&g), 5.5);
 }
 

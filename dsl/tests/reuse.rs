@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::io;
 
 use clay_dsl::compiled::CompiledGrammar;
-use clay_dsl::{Compiled, Diagnostics, Loader, compile, compile_with, render, to_json};
+use clay_dsl::{CompileOptions, Compiled, Diagnostics, Loader, compile, render, to_json};
 
 /// Files served from memory, as a language server would serve unsaved buffers.
 struct Mem(HashMap<String, Vec<u8>>);
@@ -47,14 +47,23 @@ piece brick {
 ";
 
 fn ok(source: &str, files: &[(&str, &str)]) -> Compiled {
-    match compile_with(source, "g/main.clay", &Mem::new(files)) {
+    match compile(
+        source,
+        "g/main.clay",
+        &CompileOptions::with_loader(&Mem::new(files)),
+    ) {
         Ok(c) => c,
         Err(d) => panic!("{}", render(&d, source, "g/main.clay", false)),
     }
 }
 
 fn err(source: &str, files: &[(&str, &str)]) -> Diagnostics {
-    compile_with(source, "g/main.clay", &Mem::new(files)).expect_err("must not compile")
+    compile(
+        source,
+        "g/main.clay",
+        &CompileOptions::with_loader(&Mem::new(files)),
+    )
+    .expect_err("must not compile")
 }
 
 fn codes(d: &Diagnostics) -> Vec<&'static str> {
@@ -107,7 +116,7 @@ fn examples_written_with_extends_compile_to_the_same_grammars_as_before() {
         assert!(after.len() < before.len(), "{name} is shorter");
         let path = format!("grammars/{name}.clay");
         let json = |src: &str| {
-            let c = compile(src, &path).unwrap();
+            let c = compile(src, &path, &CompileOptions::default()).unwrap();
             assert!(c.warnings.is_empty(), "{:?}", c.warnings);
             serde_json::to_value(&c.grammar).unwrap()
         };
@@ -466,13 +475,13 @@ fn import_failures_are_reported_at_the_import_and_stop_the_compile() {
     assert_eq!(codes(&d), ["E060"]);
     assert!(d.items[0].message.contains("g/lib/nope.clay"));
     // Not UTF-8.
-    let d = compile_with(
+    let d = compile(
         "import \"bin.clay\"",
         "g/main.clay",
-        &Mem(HashMap::from([(
+        &CompileOptions::with_loader(&Mem(HashMap::from([(
             "g/bin.clay".to_string(),
             vec![0xff, 0, 1],
-        )])),
+        )]))),
     )
     .unwrap_err();
     assert_eq!(codes(&d), ["E003"]);
@@ -530,7 +539,7 @@ fn compile_reads_imports_from_the_file_system_relative_to_the_importer() {
     let main = dir.join("main.clay");
     let src =
         "import \"lib/brick.clay\"\nstretch brick from west to east\nmodel { w = chain brick x 2 }";
-    let c = compile(src, &main.to_string_lossy()).unwrap();
+    let c = compile(src, &main.to_string_lossy(), &CompileOptions::default()).unwrap();
     assert_eq!(c.grammar.pieces.len(), 1);
     std::fs::remove_dir_all(&dir).unwrap();
 }

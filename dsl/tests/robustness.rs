@@ -1,7 +1,7 @@
 //! No input makes the compiler panic or hang: random mutations of valid grammars, truncations,
 //! binary junk, absurd numbers and nesting. Every error comes with spans inside the source.
 
-use clay_dsl::{Diagnostics, compile, compile_bytes, render};
+use clay_dsl::{CompileOptions, Diagnostics, compile, decode_utf8, render};
 
 const EMBEDDED: &str = r#"
 solver { merge_distance = 0.3 hysteresis = 0.2 }
@@ -115,7 +115,7 @@ fn assert_spans_valid(diags: &Diagnostics, src: &str, what: &str) {
 }
 
 fn check(src: &str, what: &str) {
-    match compile(src, "fuzz.clay") {
+    match compile(src, "fuzz.clay", &CompileOptions::default()) {
         Ok(c) => {
             for d in &c.warnings {
                 assert!(d.primary.span.end <= src.len(), "{what}");
@@ -149,14 +149,15 @@ fn bases() -> Vec<(String, String)> {
 
 #[test]
 fn the_embedded_grammar_is_valid() {
-    let c = compile(EMBEDDED, "e.clay").map_err(|d| render(&d, EMBEDDED, "e.clay", false));
+    let c = compile(EMBEDDED, "e.clay", &CompileOptions::default())
+        .map_err(|d| render(&d, EMBEDDED, "e.clay", false));
     // The tower's axis names one site twice, which is an error: make sure the fuzz base is
     // interesting (errors and successes both get mutated), and that the message is the one
     // expected.
     let err = c.expect_err("axis north -> north is not two opposite sites");
     assert!(err.contains("E040"), "{err}");
     let fixed = EMBEDDED.replace("    axis north -> north\n", "");
-    compile(&fixed, "e.clay")
+    compile(&fixed, "e.clay", &CompileOptions::default())
         .map_err(|d| render(&d, &fixed, "e.clay", false))
         .unwrap();
 }
@@ -176,7 +177,7 @@ fn thousands_of_mutations_never_panic() {
             let m = mutate(&mut rng, src);
             let what = format!("{name} mutation {k}");
             check(&m, &what);
-            if compile(&m, "f").is_ok() {
+            if compile(&m, "f", &CompileOptions::default()).is_ok() {
                 oks += 1;
             } else {
                 errs += 1;
@@ -201,12 +202,14 @@ fn binary_and_non_utf8_input_is_reported() {
     let mut rng = Rng(42);
     for _ in 0..200 {
         let bytes: Vec<u8> = (0..rng.below(300)).map(|_| rng.next() as u8).collect();
-        match compile_bytes(&bytes, "bin.clay") {
+        match decode_utf8(&bytes).and_then(|s| compile(s, "bin.clay", &CompileOptions::default())) {
             Ok(_) => {}
             Err(d) => assert_spans_valid(&d, &String::from_utf8_lossy(&bytes), "binary"),
         }
     }
-    let d = compile_bytes(b"site type j\n\xff\xfe", "x.clay").unwrap_err();
+    let d = decode_utf8(b"site type j\n\xff\xfe")
+        .and_then(|s| compile(s, "x.clay", &CompileOptions::default()))
+        .unwrap_err();
     assert_eq!(d.items[0].code, "E003");
     assert_eq!(d.items[0].primary.span.start, 12);
 }
@@ -218,12 +221,12 @@ fn deep_nesting_is_rejected_before_parsing() {
         "/*".repeat(10_000),
         format!("model {{ a = b at {} }}", "[".repeat(100_000)),
     ] {
-        let d = compile(&src, "deep.clay").unwrap_err();
+        let d = compile(&src, "deep.clay", &CompileOptions::default()).unwrap_err();
         assert_eq!(d.items[0].code, "E002");
         assert_spans_valid(&d, &src, "deep");
     }
     // Nesting within the limit is an ordinary syntax error.
-    let d = compile(&"(".repeat(200), "x").unwrap_err();
+    let d = compile(&"(".repeat(200), "x", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.items[0].code, "E001");
 }
 
@@ -242,7 +245,7 @@ fn deep_and_absurd_expressions_are_diagnosed_not_crashed() {
     for case in cases {
         let src = base.replacen("(1, 0)", &case, 1);
         assert_ne!(src, base);
-        let d = compile(&src, "x").unwrap_err();
+        let d = compile(&src, "x", &CompileOptions::default()).unwrap_err();
         assert_spans_valid(&d, &src, "expression");
         let codes: Vec<&str> = d.iter().map(|d| d.code).collect();
         assert_eq!(codes.len(), 1, "{}: {codes:?}", &case[..case.len().min(40)]);
@@ -252,15 +255,31 @@ fn deep_and_absurd_expressions_are_diagnosed_not_crashed() {
 #[test]
 fn absurd_numbers_are_diagnosed() {
     let base = EMBEDDED.replace("    axis north -> north\n", "");
-    let d = compile(&base.replace("x 5", "x 100000000"), "x").unwrap_err();
+    let d = compile(
+        &base.replace("x 5", "x 100000000"),
+        "x",
+        &CompileOptions::default(),
+    )
+    .unwrap_err();
     assert!(d.iter().any(|d| d.code == "E014"));
-    let d = compile(&base.replace("(1, 0)", "(1e400, 0)"), "x").unwrap_err();
+    let d = compile(
+        &base.replace("(1, 0)", "(1e400, 0)"),
+        "x",
+        &CompileOptions::default(),
+    )
+    .unwrap_err();
     assert!(d.iter().any(|d| d.code == "E012"));
-    let d = compile(&base.replace("(1, 0)", "(1e300, 0)"), "x").unwrap_err();
+    let d = compile(
+        &base.replace("(1, 0)", "(1e300, 0)"),
+        "x",
+        &CompileOptions::default(),
+    )
+    .unwrap_err();
     assert!(d.iter().any(|d| d.code == "E013"));
     let d = compile(
         &base.replace("wall[0].west", "wall[99999999999999999999999].west"),
         "x",
+        &CompileOptions::default(),
     )
     .unwrap_err();
     assert!(d.iter().any(|d| d.code == "E015"));
@@ -272,10 +291,10 @@ fn a_model_at_the_instance_limit_compiles_and_one_more_is_e014() {
     let limit = clay_dsl::MAX_MODEL_INSTANCES;
     // the embedded model holds one instance besides the chain
     let at = base.replace("x 5", &format!("x {}", limit - 1));
-    let c = compile(&at, "big.clay").unwrap();
+    let c = compile(&at, "big.clay", &CompileOptions::default()).unwrap();
     assert_eq!(c.grammar.assembly.instances.len(), limit);
     let over = base.replace("x 5", &format!("x {limit}"));
-    let d = compile(&over, "big.clay").unwrap_err();
+    let d = compile(&over, "big.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.iter().map(|d| d.code).collect::<Vec<_>>(), ["E014"]);
 }
 
@@ -310,18 +329,32 @@ fn check_imported(main: &str, d: &Diagnostics, what: &str) {
 
 #[test]
 fn imports_of_itself_of_a_missing_file_and_of_a_binary_file_are_diagnosed() {
-    let d = compile("import \"me.clay\"\n", "me.clay").unwrap_err();
+    let d = compile(
+        "import \"me.clay\"\n",
+        "me.clay",
+        &CompileOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(d.items[0].code, "E061");
     assert_spans_valid(&d, "import \"me.clay\"\n", "self");
-    let d = compile("import \"no/such/file.clay\"", "x.clay").unwrap_err();
+    let d = compile(
+        "import \"no/such/file.clay\"",
+        "x.clay",
+        &CompileOptions::default(),
+    )
+    .unwrap_err();
     assert_eq!(d.items[0].code, "E060");
-    let d = compile("import \"\"", "x.clay").unwrap_err();
+    let d = compile("import \"\"", "x.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.items[0].code, "E060", "a folder is not a file");
     let mut rng = Rng(7);
     for _ in 0..50 {
         let bytes: Vec<u8> = (0..rng.below(300)).map(|_| rng.next() as u8).collect();
         let main = "import \"lib.clay\"\nmodel { }";
-        match clay_dsl::compile_with(main, "main.clay", &OneLib(bytes)) {
+        match clay_dsl::compile(
+            main,
+            "main.clay",
+            &clay_dsl::CompileOptions::with_loader(&OneLib(bytes)),
+        ) {
             Ok(c) => check_imported(main, &c.warnings, "binary lib"),
             Err(d) => check_imported(main, &d, "binary lib"),
         }
@@ -344,7 +377,11 @@ model { w = chain brick x 3  t = tower2 at (0, 5)  b = brick2 at (0, 9) }";
             (main.to_string(), mutate(&mut rng, &lib))
         };
         let what = format!("mutation {k}");
-        match clay_dsl::compile_with(&m, "main.clay", &OneLib(l.into_bytes())) {
+        match clay_dsl::compile(
+            &m,
+            "main.clay",
+            &clay_dsl::CompileOptions::with_loader(&OneLib(l.into_bytes())),
+        ) {
             Ok(c) => check_imported(&m, &c.warnings, &what),
             Err(d) => {
                 assert!(d.has_errors(), "{what}");
@@ -364,7 +401,7 @@ fn deep_and_cyclic_extends_chains_give_one_error() {
             src += &format!("piece p{i} extends p{} {{ vertex v{i} ({i}, 1) }}\n", i - 1);
         }
         src += &format!("model {{ x = p{} }}", n - 1);
-        let d = compile(&src, "deep.clay").unwrap_err();
+        let d = compile(&src, "deep.clay", &CompileOptions::default()).unwrap_err();
         assert_eq!(d.items.iter().filter(|d| d.is_error()).count(), 1, "{n}");
         assert_eq!(d.items[0].code, "E063");
         assert_spans_valid(&d, &src, "deep extends");
@@ -374,7 +411,7 @@ fn deep_and_cyclic_extends_chains_give_one_error() {
     for i in 0..5000 {
         src += &format!("piece p{i} extends p{} {{ }}\n", (i + 1) % 5000);
     }
-    let d = compile(&src, "cycle.clay").unwrap_err();
+    let d = compile(&src, "cycle.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(d.error_count(), 1);
     let e = d.items.iter().find(|d| d.is_error()).unwrap();
     assert_eq!(e.code, "E062");
@@ -409,7 +446,7 @@ fn the_deepest_accepted_nesting_fits_a_small_thread_stack() {
         let worker = std::thread::Builder::new()
             .stack_size(512 * 1024)
             .spawn(move || {
-                compile(&src, "deep.clay")
+                compile(&src, "deep.clay", &CompileOptions::default())
                     .map(|_| ())
                     .map_err(|d| (d.items[0].code, d.items[0].message.clone()))
             })
@@ -447,7 +484,9 @@ fn twenty_thousand_site_types_dock_as_written() {
     }
     src += "piece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    vertex c (0, 1)\n    \
             edges a-b-c-a\n    site s: t5 [a, b] out (0, -1)\n}\n";
-    let g = clay_dsl::compile(&src, "types.clay").unwrap().grammar;
+    let g = clay_dsl::compile(&src, "types.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     assert_eq!(g.site_types.len(), n);
     for (i, t) in g.site_types.iter().enumerate() {
         let want: Vec<usize> = if i % 2 == 1 {

@@ -5,7 +5,7 @@
 
 use clay_dsl::Diagnostic;
 use clay_dsl::analysis::{Analysis, TokenKind};
-use clay_dsl::{CompiledGrammar, comment_spans, compile, format, print_file};
+use clay_dsl::{CompileOptions, CompiledGrammar, comment_spans, compile, format, print_file};
 
 fn wall() -> String {
     std::fs::read_to_string(concat!(
@@ -23,7 +23,7 @@ fn wall_with(body: &str) -> String {
 }
 
 fn ok(source: &str) -> CompiledGrammar {
-    match compile(source, "wall.clay") {
+    match compile(source, "wall.clay", &CompileOptions::default()) {
         Ok(c) => {
             assert!(c.warnings.is_empty(), "{:?}", c.warnings);
             c.grammar
@@ -33,7 +33,7 @@ fn ok(source: &str) -> CompiledGrammar {
 }
 
 fn errors(source: &str) -> Vec<Diagnostic> {
-    compile(source, "wall.clay")
+    compile(source, "wall.clay", &CompileOptions::default())
         .expect_err("the grammar must not compile")
         .iter()
         .cloned()

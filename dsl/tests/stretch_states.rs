@@ -1,7 +1,7 @@
 //! A stretch rule's piece and variants are chain elements, whose own alternative rest states
 //! could never become active: each such piece is one E047, and nothing else is reported for it.
 
-use clay_dsl::{Diagnostics, compile, line_col};
+use clay_dsl::{CompileOptions, Diagnostics, compile, line_col};
 
 /// Two pieces of one shape, `brick` (in a chain) and `long` (alone), with `states_b` and
 /// `states_l` inside them and the `rules` after.
@@ -17,7 +17,7 @@ const RIGHT: &str = "    state right { sw (0, 0) se (1, 0) ne (1.2, 0.5) nw (0.2
 
 /// (code, line of the primary span) of every diagnostic.
 fn found(src: &str) -> Vec<(&'static str, usize)> {
-    let d: Diagnostics = match compile(src, "t.clay") {
+    let d: Diagnostics = match compile(src, "t.clay", &CompileOptions::default()) {
         Ok(c) => c.warnings,
         Err(d) => d,
     };
@@ -45,7 +45,7 @@ fn a_variant_with_states_is_a_chain_element_too() {
     let rule = "stretch brick from west to east { variants { brick 0.5, long 0.5 } }";
     let src = grammar("", RIGHT, rule);
     assert_eq!(found(&src), [("E047", line_of(&src, "state right"))]);
-    let d = compile(&src, "t.clay").unwrap_err();
+    let d = compile(&src, "t.clay", &CompileOptions::default()).unwrap_err();
     let e = &d.items[0];
     assert_eq!(
         e.secondary[0].message,
@@ -73,7 +73,7 @@ fn states_outside_any_stretch_rule_are_fine() {
         &format!("{LEFT}{RIGHT}"),
         "stretch brick from west to east",
     );
-    let c = compile(&src, "t.clay").expect("compiles");
+    let c = compile(&src, "t.clay", &CompileOptions::default()).expect("compiles");
     assert_eq!(c.grammar.pieces[1].states.len(), 3);
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
 }

@@ -1,10 +1,10 @@
 //! "Did you mean": a name with two letters swapped is one typo away, so the hint names the
 //! intended declaration (issue 18: `stpe`, `sdie` got a list instead).
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 
 fn hints(source: &str) -> Vec<String> {
-    let d = compile(source, "g.clay").unwrap_err();
+    let d = compile(source, "g.clay", &CompileOptions::default()).unwrap_err();
     d.iter().flat_map(|d| d.hints.clone()).collect()
 }
 
@@ -53,7 +53,7 @@ fn thousands_of_misspelt_names_are_all_reported_the_search_bounded() {
         src += &format!("    i{i} = q{i}\n");
     }
     src += "}\n";
-    let d = compile(&src, "g.clay").unwrap_err();
+    let d = compile(&src, "g.clay", &CompileOptions::default()).unwrap_err();
     let unknown: Vec<_> = d.iter().filter(|d| d.message.contains("unknown")).collect();
     assert_eq!(unknown.len(), n, "every misspelt name is reported");
     let suggested = (unknown.iter())

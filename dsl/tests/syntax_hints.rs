@@ -1,10 +1,10 @@
 //! Syntax errors that say what to do (issue 18): a non-ASCII letter in a name, a stray `;`,
 //! and a number run into a letter each get a hint, besides the one error.
 
-use clay_dsl::compile;
+use clay_dsl::{CompileOptions, compile};
 
 fn only_error(source: &str) -> clay_dsl::Diagnostic {
-    let d = compile(source, "g.clay").unwrap_err();
+    let d = compile(source, "g.clay", &CompileOptions::default()).unwrap_err();
     assert_eq!(
         d.len(),
         1,

@@ -2,11 +2,11 @@
 //! docs/language.md and compiled.rs describe (real numbers, not echoes of the code).
 
 use clay_dsl::compiled::*;
-use clay_dsl::{Compiled, compile};
+use clay_dsl::{CompileOptions, Compiled, compile};
 use glam::DVec2;
 
 fn ok(source: &str) -> Compiled {
-    match compile(source, "test.clay") {
+    match compile(source, "test.clay", &CompileOptions::default()) {
         Ok(c) => c,
         Err(d) => panic!("{}", clay_dsl::render(&d, source, "test.clay", false)),
     }
@@ -385,7 +385,7 @@ fn the_example_grammars_compile() {
         }
         let src = std::fs::read_to_string(&path).unwrap();
         let shown = path.display().to_string();
-        match compile(&src, &shown) {
+        match compile(&src, &shown, &CompileOptions::default()) {
             Ok(c) => assert!(
                 !c.grammar.assembly.instances.is_empty(),
                 "{shown} has an empty model"

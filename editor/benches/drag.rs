@@ -107,7 +107,7 @@ fn walls(parts: usize) -> clay_dsl::compiled::CompiledGrammar {
         source += &format!("    row{r} = chain brick x {BRICKS_PER_ROW} at (0, {y})\n");
     }
     source += "}\n";
-    clay_dsl::compile(&source, "walls.clay")
+    clay_dsl::compile(&source, "walls.clay", &clay_dsl::CompileOptions::default())
         .map(|c| c.grammar)
         .expect("the walls model compiles")
 }

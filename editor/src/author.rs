@@ -150,7 +150,7 @@ impl Authoring {
     fn recompute(&mut self) {
         self.result = compute(&self.work);
         match &self.result {
-            Ok(c) => match compile::compile(&c.text, &self.source_name()) {
+            Ok(c) => match compile::compile(&c.text, &self.source_name(), &[]) {
                 Ok(ok) => {
                     self.problems = ok.warnings;
                     self.compiles = true;

@@ -98,21 +98,17 @@ pub struct Compiled {
     pub imports: Vec<String>,
 }
 
-/// Compiles grammar text. `path` is used in messages and recorded in the grammar.
+/// Compiles grammar text. `path` is used in messages and recorded in the grammar; `params`
+/// are values for the grammar's parameters (`param NAME = ...`) replacing their defaults, by
+/// name (what the Grammar parameters panel sets; `&[]` for none).
 ///
 /// Besides `.clay` text this accepts a compiled grammar in JSON (what `clayc compile` writes),
-/// recognised by its leading `{` (a `.clay` file starts with a keyword or comment).
+/// recognised by its leading `{` (a `.clay` file starts with a keyword or comment); it has its
+/// parameters' values already, and takes none.
 ///
 /// A panic in the compiler is caught and reported as a problem at 1:1 (the caller keeps the
 /// last good model): the editor never exits on what a user wrote.
-pub fn compile(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
-    compile_with_params(source, path, &[])
-}
-
-/// [`compile`] with values for the grammar's parameters (`param NAME = ...`) replacing their
-/// defaults, by name: what the Grammar parameters panel sets. A compiled grammar in JSON has
-/// its parameters' values already, and takes none.
-pub fn compile_with_params(
+pub fn compile(
     source: &str,
     path: &str,
     params: &[(String, f64)],
@@ -140,7 +136,7 @@ pub fn check_grammar(path: &Path) -> Result<Compiled, Vec<Problem>> {
     let shown = path.display().to_string();
     let source = clay_dsl::read_input_string(path, clay_dsl::MAX_SOURCE_BYTES)
         .map_err(|e| vec![Problem::whole_file(&shown, format!("cannot read it: {e}"))])?;
-    compile(&source, &shown)
+    compile(&source, &shown, &[])
 }
 
 /// A grammar with nothing in it: the model shown when the first compile fails.
@@ -195,7 +191,7 @@ fn compile_clay(
         params: params.to_vec(),
         ..Default::default()
     };
-    match clay_dsl::compile_with_options(source, path, &options) {
+    match clay_dsl::compile(source, path, &options) {
         Ok(c) => Ok(Compiled {
             imports: c.imported_files().map(str::to_string).collect(),
             warnings: problems(&c.warnings, source, path),
@@ -263,14 +259,14 @@ mod tests {
 
     #[test]
     fn bundled_castle_compiles() {
-        let c = compile(CASTLE_SOURCE, CASTLE_PATH).unwrap();
+        let c = compile(CASTLE_SOURCE, CASTLE_PATH, &[]).unwrap();
         assert!(!c.grammar.assembly.instances.is_empty());
     }
 
     #[test]
     fn clay_errors_carry_line_and_column() {
         let source = "solver {\n    hysteresis = 0.15\n}\npiece {\n";
-        let problems = compile(source, "bad.clay").unwrap_err();
+        let problems = compile(source, "bad.clay", &[]).unwrap_err();
         assert!(!problems.is_empty());
         let p = &problems[0];
         assert_eq!(p.severity, Severity::Error);
@@ -284,7 +280,7 @@ mod tests {
     #[test]
     fn a_problem_carries_its_line_underline_label_and_hint() {
         let source = CASTLE_SOURCE.replacen("chain wall x 4", "chain wal x 4", 1);
-        let problems = compile(&source, "castle.clay").unwrap_err();
+        let problems = compile(&source, "castle.clay", &[]).unwrap_err();
         let p = problems
             .iter()
             .find(|p| p.code == "E011")
@@ -314,20 +310,20 @@ mod tests {
         std::fs::write(dir.join("lib.clay"), "// line 1\nsite type x docks y\n").unwrap();
         let main = dir.join("main.clay");
         let shown = main.display().to_string();
-        let problems = compile("import \"lib.clay\"\nmodel {}\n", &shown).unwrap_err();
+        let problems = compile("import \"lib.clay\"\nmodel {}\n", &shown, &[]).unwrap_err();
         let p = problems.iter().find(|p| p.code == "E011").unwrap();
         assert_eq!(p.file, dir.join("lib.clay").display().to_string());
         assert_eq!((p.line, p.snippet.as_str()), (2, "site type x docks y"));
         assert!(p.to_string().contains("lib.clay:2:"), "{p}");
         std::fs::write(dir.join("lib.clay"), CASTLE_SOURCE).unwrap();
-        let c = compile("import \"lib.clay\"\nmodel { t = tower }\n", &shown).unwrap();
+        let c = compile("import \"lib.clay\"\nmodel { t = tower }\n", &shown, &[]).unwrap();
         assert_eq!(c.imports, [dir.join("lib.clay").display().to_string()]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn malformed_json_grammar_is_located() {
-        let problems = compile("{\n  \"format_version\": }", "g.json").unwrap_err();
+        let problems = compile("{\n  \"format_version\": }", "g.json", &[]).unwrap_err();
         assert_eq!(problems.len(), 1);
         assert_eq!(problems[0].line, 2);
         assert!(problems[0].to_string().starts_with("g.json:2:"));

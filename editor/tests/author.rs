@@ -221,7 +221,7 @@ fn write_try_and_switch_modes_keep_the_work() {
     app.perform(Action::WriteGrammar(out.clone()));
     let written = std::fs::read_to_string(&out).unwrap();
     assert_eq!(Some(written.as_str()), app.author.text());
-    let compiled = clay_editor::compile::compile(&written, "wall.clay").expect("compiles");
+    let compiled = clay_editor::compile::compile(&written, "wall.clay", &[]).expect("compiles");
     assert!(compiled.warnings.is_empty(), "{:?}", compiled.warnings);
 
     let work = app.author.work().clone();
@@ -403,7 +403,7 @@ fn a_merge_rule_is_written_compiles_and_undoes() {
     assert!(a.message.is_none(), "{:?}", a.message);
     let text = a.text().unwrap();
     assert!(text.contains("merge brick.east onto brick.west"), "{text}");
-    let compiled = clay_editor::compile::compile(text, "wall.clay").expect("compiles");
+    let compiled = clay_editor::compile::compile(text, "wall.clay", &[]).expect("compiles");
     assert_eq!(compiled.grammar.merge_rules.len(), 1);
     assert!(a.compiles && a.problems.is_empty(), "{:?}", a.problems);
 
@@ -447,7 +447,7 @@ fn setting_a_site_type_carries_it_to_docked_sites_compiles_and_undoes() {
     assert!(!text.contains("joint"), "{text}");
     assert!(text.contains("east: mortar"), "{text}");
     assert!(text.contains("west: mortar"), "{text}");
-    let compiled = clay_editor::compile::compile(text, "wall.clay").expect("compiles");
+    let compiled = clay_editor::compile::compile(text, "wall.clay", &[]).expect("compiles");
     let brick = &compiled.grammar.pieces[0];
     let ty = &compiled.grammar.site_types;
     assert!(brick.sites.iter().all(|s| ty[s.site_type].name == "mortar"));
@@ -633,8 +633,8 @@ fn a_posed_copy_becomes_a_second_rest_state_of_the_compiled_piece() {
     assert!(a.message.is_none(), "{:?}", a.message);
     let text = a.text().unwrap();
     assert!(text.contains("state leaning"), "{text}");
-    let compiled =
-        clay_editor::compile::compile(text, "s.clay").unwrap_or_else(|p| panic!("{p:?}\n{text}"));
+    let compiled = clay_editor::compile::compile(text, "s.clay", &[])
+        .unwrap_or_else(|p| panic!("{p:?}\n{text}"));
     let piece = &compiled.grammar.pieces[0];
     assert_eq!(piece.states.len(), 2);
     assert_eq!(piece.states[1].name, "leaning");
@@ -1079,7 +1079,8 @@ fn a_click_that_does_nothing_says_why_in_the_status_bar() {
 
 /// Each piece's fill as compiled from the written text, by piece name.
 fn written_fills(a: &Authoring) -> Vec<(String, [u8; 4])> {
-    let compiled = clay_editor::compile::compile(a.text().unwrap(), "t.clay").expect("compiles");
+    let compiled =
+        clay_editor::compile::compile(a.text().unwrap(), "t.clay", &[]).expect("compiles");
     compiled
         .grammar
         .pieces

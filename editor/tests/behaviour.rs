@@ -59,7 +59,7 @@ struct Player {
 
 impl Player {
     fn new(text: &str) -> Self {
-        let c = compile(text, "generated.clay").expect("the generated grammar compiles");
+        let c = compile(text, "generated.clay", &[]).expect("the generated grammar compiles");
         Self {
             sculpt: Sculpt::new(c.grammar),
             translation: DVec2::ZERO,

@@ -20,7 +20,7 @@ use glam::DVec2;
 fn castle() -> Arc<CompiledGrammar> {
     static CASTLE: OnceLock<Arc<CompiledGrammar>> = OnceLock::new();
     CASTLE
-        .get_or_init(|| compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar)
+        .get_or_init(|| compile(CASTLE_SOURCE, CASTLE_PATH, &[]).unwrap().grammar)
         .clone()
 }
 

@@ -103,7 +103,9 @@ fn turn(h: &mut Harness<'_, EditorApp>, centre: DVec2, angle: f64) {
 /// does (the grammar's solver settings).
 fn replayed(script: &Script) -> (AssemblyData, u64) {
     let source = std::fs::read_to_string(wall_path()).unwrap();
-    let mut grammar = clay_dsl::compile(&source, "wall.clay").unwrap().grammar;
+    let mut grammar = clay_dsl::compile(&source, "wall.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
     let config = configure(&mut grammar, []).unwrap();
     let mut assembly = Assembly::new(Arc::new(grammar));
     let mut session = Session::new(config);
@@ -256,7 +258,7 @@ fn an_undone_gesture_is_not_in_the_saved_script_and_a_redone_one_is() {
 
 fn wall_sculpt() -> clay_editor::sculpt::Sculpt {
     let source = std::fs::read_to_string(wall_path()).unwrap();
-    let compiled = clay_editor::compile::compile(&source, "wall.clay").unwrap();
+    let compiled = clay_editor::compile::compile(&source, "wall.clay", &[]).unwrap();
     clay_editor::sculpt::Sculpt::new(compiled.grammar)
 }
 

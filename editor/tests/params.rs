@@ -283,7 +283,7 @@ fn saved_gestures_say_the_parameters_to_replay_them_with() {
     // Replayed on the grammar compiled with those values: the editor's model.
     let text = std::fs::read_to_string(&path).unwrap();
     let options = clay_dsl::CompileOptions::default().param("bays", 6.0);
-    let grammar = clay_dsl::compile_with_options(&text, "posts.clay", &options)
+    let grammar = clay_dsl::compile(&text, "posts.clay", &options)
         .unwrap()
         .grammar;
     let parsed = clay::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();

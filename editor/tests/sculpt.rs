@@ -12,7 +12,7 @@ use clay_editor::session::{self, SavedSession, SessionError, Settings};
 use glam::DVec2;
 
 fn castle() -> Sculpt {
-    let c = compile(CASTLE_SOURCE, CASTLE_PATH).expect("the bundled castle compiles");
+    let c = compile(CASTLE_SOURCE, CASTLE_PATH, &[]).expect("the bundled castle compiles");
     let mut s = Sculpt::new(c.grammar);
     settle(&mut s);
     s
@@ -258,7 +258,7 @@ fn a_session_round_trips_through_a_file() {
 fn malformed_sessions_are_clear_errors() {
     let good = serde_json::to_value(SavedSession::new(
         CASTLE_PATH.into(),
-        compile(CASTLE_SOURCE, CASTLE_PATH)
+        compile(CASTLE_SOURCE, CASTLE_PATH, &[])
             .unwrap()
             .grammar
             .assembly
@@ -372,7 +372,7 @@ fn a_reload_with_the_same_model_keeps_the_sculpt() {
     let saved_dirty = s.dirty();
 
     // The same source recompiled (as after touching the file): the sculpt stays.
-    let again = compile(CASTLE_SOURCE, CASTLE_PATH).unwrap().grammar;
+    let again = compile(CASTLE_SOURCE, CASTLE_PATH, &[]).unwrap().grammar;
     assert!(s.replace_grammar(again));
     assert_eq!(s.data().positions, sculpted);
     assert_eq!(s.pins().len(), 1);
@@ -384,7 +384,7 @@ fn a_reload_with_the_same_model_keeps_the_sculpt() {
         "    lone = tower at (30, 30)\n    main_gate = gate",
         1,
     );
-    let g = compile(&moved, CASTLE_PATH)
+    let g = compile(&moved, CASTLE_PATH, &[])
         .expect("a castle with an extra tower")
         .grammar;
     assert!(!s.replace_grammar(g.clone()));
@@ -400,7 +400,7 @@ fn a_handle_on_a_stretch_chain_holds_the_brick_under_the_cursor() {
         "/../grammars/wall.clay"
     ))
     .unwrap();
-    let grammar = compile(&source, "grammars/wall.clay").unwrap().grammar;
+    let grammar = compile(&source, "grammars/wall.clay", &[]).unwrap().grammar;
     let mut s = Sculpt::new(grammar);
     // Part 0 spans bricks 0 and 1; press on brick 1.
     let chain = s.data().chains[0].instances.clone();

@@ -114,7 +114,9 @@ pub fn check(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Vec<Diagnostic
     let name = path.display().to_string();
     let compiled = py.detach(|| {
         guard("check", || {
-            Ok(clay_dsl::compile_bytes(&bytes, &name).map(|c| c.warnings))
+            Ok(clay_dsl::decode_utf8(&bytes)
+                .and_then(|s| clay_dsl::compile(s, &name, &clay_dsl::CompileOptions::default()))
+                .map(|c| c.warnings))
         })
     })?;
     let text = String::from_utf8_lossy(&bytes);

@@ -118,7 +118,7 @@ impl Grammar {
                     params,
                     ..CompileOptions::default()
                 };
-                Ok(clay_dsl::compile_bytes_with_options(bytes, path, &options))
+                Ok(clay_dsl::decode_utf8(bytes).and_then(|s| clay_dsl::compile(s, path, &options)))
             })
         })?;
         let text = String::from_utf8_lossy(bytes);

@@ -123,7 +123,8 @@ pub fn author(drawing: &Drawing, options: &AuthorOptions) -> Result<Authored, Au
 /// (code, line, message) and says that this is authoring's fault, not the drawing's.
 pub fn check_authored(text: &str, path: &str) -> Result<(), AuthorError> {
     const SHOWN: usize = 5;
-    let Err(diagnostics) = clay_dsl::compile(text, path) else {
+    let Err(diagnostics) = clay_dsl::compile(text, path, &clay_dsl::CompileOptions::default())
+    else {
         return Ok(());
     };
     let errors: Vec<&clay_dsl::Diagnostic> = diagnostics

@@ -470,7 +470,9 @@ mod tests {
         // (The drawn arrow is render's own; moved here from tests/derived_states.rs when the
         // render module became private.)
         let src = std::fs::read_to_string(format!("{dir}/grammars/bend.clay")).unwrap();
-        let g = clay_dsl::compile(&src, "bend.clay").unwrap().grammar;
+        let g = clay_dsl::compile(&src, "bend.clay", &clay_dsl::CompileOptions::default())
+            .unwrap()
+            .grammar;
         let road = &g.pieces[0];
         let site = |name: &str| road.sites.iter().position(|s| s.name == name).unwrap();
         let state = |name: &str| road.states.iter().position(|s| s.name == name).unwrap();
@@ -658,7 +660,7 @@ mod tests {
     fn grammar(name: &str) -> CompiledGrammar {
         let path = format!("{}/grammars/{name}", env!("CARGO_MANIFEST_DIR"));
         let source = std::fs::read_to_string(&path).unwrap();
-        match clay_dsl::compile(&source, &path) {
+        match clay_dsl::compile(&source, &path, &clay_dsl::CompileOptions::default()) {
             Ok(c) => c.grammar,
             Err(d) => panic!("{}", clay_dsl::render(&d, &source, &path, false)),
         }

@@ -177,7 +177,7 @@ mod tests {
         let source = "site type s\npiece p {\n    vertex a (0, 0)\n    vertex b (1, 0)\n    \
                       vertex c (0, 1)\n    edges a-b-c-a\n    site e: s [a, b] out (0, -1)\n}\n\
                       model {\n    x = p at (0, 0)\n}\n";
-        clay_dsl::compile(source, "t.clay")
+        clay_dsl::compile(source, "t.clay", &clay_dsl::CompileOptions::default())
             .unwrap()
             .grammar
             .assembly

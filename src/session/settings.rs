@@ -96,7 +96,10 @@ mod tests {
         let source =
             std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/grammars/wall.clay"))
                 .unwrap();
-        let mut grammar = clay_dsl::compile(&source, "wall.clay").unwrap().grammar;
+        let mut grammar =
+            clay_dsl::compile(&source, "wall.clay", &clay_dsl::CompileOptions::default())
+                .unwrap()
+                .grammar;
         let config = configure(&mut grammar, [("norm", "2"), ("merge_distance", "0.3")]).unwrap();
         assert_eq!(config.norm, 2.0);
         assert_eq!(grammar.solver.norm, 2.0);

@@ -225,10 +225,11 @@ impl Run {
     }
 
     pub fn with(text: &str, tune: impl FnOnce(&mut SolverConfig)) -> Self {
-        let grammar = match clay_dsl::compile(text, "generated.clay") {
-            Ok(c) => Arc::new(c.grammar),
-            Err(e) => panic!("the generated grammar does not compile: {e:?}\n{text}"),
-        };
+        let grammar =
+            match clay_dsl::compile(text, "generated.clay", &clay_dsl::CompileOptions::default()) {
+                Ok(c) => Arc::new(c.grammar),
+                Err(e) => panic!("the generated grammar does not compile: {e:?}\n{text}"),
+            };
         let mut config = SolverConfig::from_params(&grammar.solver);
         tune(&mut config);
         Self {

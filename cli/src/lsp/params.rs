@@ -23,7 +23,12 @@ pub fn declared(text: &str) -> Option<Vec<Param>> {
         span: tree.span,
     };
     let printed = clay_dsl::print_file(&constants);
-    let compiled = clay_dsl::compile(&printed, "<parameters>").ok()?;
+    let compiled = clay_dsl::compile(
+        &printed,
+        "<parameters>",
+        &clay_dsl::CompileOptions::default(),
+    )
+    .ok()?;
     Some(compiled.grammar.params)
 }
 

@@ -1,10 +1,9 @@
 //! The stable diagnostic codes of the compiler, one constant per kind of problem. The table in
 //! docs/language.md lists them; codes are never reused for a different meaning.
 
+pub use crate::input::NOT_UTF8;
 pub use crate::parse::codes::{NON_FINITE, SYNTAX, TOO_DEEP};
 
-/// The file is not valid UTF-8.
-pub const NOT_UTF8: &str = "E003";
 /// The file cannot be read at all (missing, not readable, a directory): `clayc` reports it;
 /// docs/language.md describes it below the table, as no fixture can show it.
 pub const UNREADABLE: &str = "E004";

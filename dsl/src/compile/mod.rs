@@ -55,7 +55,7 @@ impl Compiled {
 
 /// How to compile a grammar: where its imported files and mesh assets are read from, and the
 /// values of its parameters. `CompileOptions::default()` reads the file system and sets no
-/// parameter, as [`compile`] does.
+/// parameter.
 #[derive(Clone)]
 pub struct CompileOptions<'a> {
     /// Reads imported files and mesh assets ([`FsLoader`] by default).
@@ -99,26 +99,16 @@ impl std::fmt::Debug for CompileOptions<'_> {
     }
 }
 
-/// Compiles the text of a `.clay` file. `path` is recorded in the result, and its folder is where
-/// `import`ed files are read from (through the file system, [`FsLoader`]).
-pub fn compile(source: &str, path: &str) -> Result<Compiled, Diagnostics> {
-    compile_with_options(source, path, &CompileOptions::default())
-}
-
-/// Like [`compile`], reading imported files through `loader` (a language server can serve
-/// unsaved buffers this way). Import paths are resolved against `path`'s folder first
-/// ([`resolve_import`]); the loader gets the resolved path.
-pub fn compile_with(
-    source: &str,
-    path: &str,
-    loader: &dyn Loader,
-) -> Result<Compiled, Diagnostics> {
-    compile_with_options(source, path, &CompileOptions::with_loader(loader))
-}
-
-/// Like [`compile`], with a loader and parameter values ([`CompileOptions`]). The compiled
-/// grammar lists every parameter with the value used ([`CompiledGrammar::params`]).
-pub fn compile_with_options(
+/// Compiles the text of a `.clay` file, the one entry point of the compiler.
+///
+/// `path` is recorded in the result, and its folder is where `import`ed files are resolved
+/// from ([`resolve_import`]); `options` says how they and mesh assets are read (the loader
+/// gets the resolved path; a language server can serve unsaved buffers this way) and sets the
+/// grammar's parameters. `&CompileOptions::default()` reads the file system ([`FsLoader`]) and
+/// sets no parameter. The compiled grammar lists every parameter with the value used
+/// ([`CompiledGrammar::params`]). Bytes read from a file become text through
+/// [`decode_utf8`](crate::decode_utf8) first.
+pub fn compile(
     source: &str,
     path: &str,
     options: &CompileOptions,
@@ -181,43 +171,6 @@ pub(crate) fn compile_tree(
             warnings: diags,
         }),
         _ => Err(diags),
-    }
-}
-
-/// Compiles raw bytes; text that is not UTF-8 is reported (E003) at the first bad byte. Render
-/// the diagnostics against `String::from_utf8_lossy(bytes)`: offsets before that byte agree.
-pub fn compile_bytes(bytes: &[u8], path: &str) -> Result<Compiled, Diagnostics> {
-    compile_bytes_with_options(bytes, path, &CompileOptions::default())
-}
-
-/// [`compile_bytes`] reading imported files through `loader`.
-pub fn compile_bytes_with(
-    bytes: &[u8],
-    path: &str,
-    loader: &dyn Loader,
-) -> Result<Compiled, Diagnostics> {
-    compile_bytes_with_options(bytes, path, &CompileOptions::with_loader(loader))
-}
-
-/// [`compile_bytes`] with a loader and parameter values ([`CompileOptions`]).
-pub fn compile_bytes_with_options(
-    bytes: &[u8],
-    path: &str,
-    options: &CompileOptions,
-) -> Result<Compiled, Diagnostics> {
-    match std::str::from_utf8(bytes) {
-        Ok(source) => compile_with_options(source, path, options),
-        Err(e) => {
-            let at = e.valid_up_to();
-            Err(Diagnostic::error(
-                codes::NOT_UTF8,
-                "file is not valid UTF-8 text",
-                Span::new(at, at + 1),
-                "invalid byte here",
-            )
-            .with_hint("save the file as UTF-8")
-            .into())
-        }
     }
 }
 

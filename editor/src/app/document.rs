@@ -35,11 +35,10 @@ pub(super) fn load_session(path: &Path) -> Result<LoadedSession, String> {
     // The parameters as set when it was saved, so the assembly fits the grammar it was made
     // with.
     let params: Vec<(String, f64)> = s.params.into_iter().collect();
-    let compiled =
-        compile::compile_with_params(&source, &s.grammar, &params).map_err(|problems| {
-            let first = problems.first().map_or(String::new(), |p| p.to_string());
-            format!("the session's grammar does not compile: {first}")
-        })?;
+    let compiled = compile::compile(&source, &s.grammar, &params).map_err(|problems| {
+        let first = problems.first().map_or(String::new(), |p| p.to_string());
+        format!("the session's grammar does not compile: {first}")
+    })?;
     let sculpt = Sculpt::from_saved(compiled.grammar, s.assembly, s.pins, s.settings, s.log)?;
     Ok(LoadedSession {
         sculpt,
@@ -133,7 +132,7 @@ impl EditorApp {
 
     pub(super) fn load_grammar_text(&mut self, path: Option<&Path>, source: &str, shown: &str) {
         self.grammar_path = path.map(Path::to_path_buf);
-        match compile::compile(source, shown) {
+        match compile::compile(source, shown, &[]) {
             Ok(c) => self.adopt(c),
             Err(problems) => {
                 self.param_overrides.clear();

@@ -98,7 +98,7 @@ impl EditorApp {
             }
             None => (CASTLE_SOURCE.to_string(), CASTLE_PATH.to_string()),
         };
-        let plain = compile::compile(&source, &shown)?;
+        let plain = compile::compile(&source, &shown, &[])?;
         if self.param_overrides.is_empty() {
             return Ok(plain);
         }
@@ -106,7 +106,7 @@ impl EditorApp {
         if self.param_overrides.is_empty() {
             return Ok(plain);
         }
-        compile::compile_with_params(&source, &shown, &self.param_overrides)
+        compile::compile(&source, &shown, &self.param_overrides)
     }
 
     /// Fits the overrides to the parameters the grammar declares now; says what changed.

@@ -235,7 +235,7 @@ impl EditorApp {
             Err(e) => return Err(format!("nothing to try: {e}")),
         };
         let name = self.author.source_name();
-        let compiled = compile::compile(&text, &name).map_err(|problems| {
+        let compiled = compile::compile(&text, &name, &[]).map_err(|problems| {
             let first = problems.first().map_or(String::new(), |p| p.to_string());
             format!("the authored grammar does not compile: {first}")
         })?;
