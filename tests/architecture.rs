@@ -6,7 +6,8 @@
 //! solver's settings and report types), rules never import sessions or scripts, protocol types
 //! stay in the language server, a solver frame changes no part, instance or connection, and
 //! the libraries print nothing, every file is read through the one bounded reader, and no
-//! `use` imports a whole crate root. The editor's library and the Python module are graphs too.
+//! `use` imports a whole crate root, and no two public types share a name. The editor's library
+//! and the Python module are graphs too.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -1180,4 +1181,49 @@ fn unoptimised_dependencies_are_none_of_the_cores() {
             "`{p}` is built without optimisation but `clay` depends on it"
         );
     }
+}
+
+/// Architecture Invariant: no two public types of the libraries and the Python module share a
+/// name, so a name read in any of them means one thing (issue 47: `clay::Session` and the
+/// Python module's `Session`). A Python class whose Rust type would repeat a library name is
+/// `Py<Name>` with `#[pyclass(name = "<Name>")]`, as `PySession` is `clay.Session`.
+#[test]
+fn no_two_public_types_share_a_name() {
+    /// Every `pub` struct, enum, union, trait and type alias of a file, inline modules included.
+    struct Types(Vec<(String, usize)>);
+    impl<'a> syn::visit::Visit<'a> for Types {
+        fn visit_item(&mut self, item: &'a syn::Item) {
+            let named = match item {
+                syn::Item::Struct(i) => Some((&i.vis, &i.ident)),
+                syn::Item::Enum(i) => Some((&i.vis, &i.ident)),
+                syn::Item::Union(i) => Some((&i.vis, &i.ident)),
+                syn::Item::Trait(i) => Some((&i.vis, &i.ident)),
+                syn::Item::Type(i) => Some((&i.vis, &i.ident)),
+                _ => None,
+            };
+            if let Some((syn::Visibility::Public(_), ident)) = named {
+                self.0.push((ident.to_string(), ident.span().start().line));
+            }
+            syn::visit::visit_item(self, item);
+        }
+    }
+    let mut homes: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for (dir, krate, _) in crates() {
+        if !["src", "dsl/src", "python/src"].contains(&dir) {
+            continue;
+        }
+        for (_, file, tree) in &krate.files {
+            let mut types = Types(Vec::new());
+            syn::visit::Visit::visit_file(&mut types, tree);
+            for (name, line) in types.0 {
+                homes
+                    .entry(name)
+                    .or_default()
+                    .push(format!("{}:{line}", shown(file)));
+            }
+        }
+    }
+    assert!(homes.contains_key("PySession") && homes.contains_key("Assembly"));
+    let twice: Vec<_> = homes.iter().filter(|(_, at)| at.len() > 1).collect();
+    assert!(twice.is_empty(), "public types of one name: {twice:#?}");
 }

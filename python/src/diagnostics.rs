@@ -19,9 +19,9 @@ pyo3::create_exception!(
 );
 
 /// One error or warning about a grammar, as `clayc check --format json` gives it.
-#[pyclass(module = "clay", frozen, get_all)]
+#[pyclass(module = "clay", name = "Diagnostic", frozen, get_all)]
 #[derive(Clone)]
-pub struct Diagnostic {
+pub struct PyDiagnostic {
     /// The stable code (`E011`, `W001`, ...), listed in docs/language.md.
     pub code: String,
     /// `"error"` or `"warning"`.
@@ -40,7 +40,7 @@ pub struct Diagnostic {
 }
 
 #[pymethods]
-impl Diagnostic {
+impl PyDiagnostic {
     fn __repr__(&self) -> String {
         format!(
             "Diagnostic({} {} at {}:{}:{}: {:?})",
@@ -57,7 +57,7 @@ impl Diagnostic {
     }
 }
 
-impl From<JsonDiagnostic> for Diagnostic {
+impl From<JsonDiagnostic> for PyDiagnostic {
     fn from(d: JsonDiagnostic) -> Self {
         Self {
             code: d.code.to_string(),
@@ -78,10 +78,10 @@ impl From<JsonDiagnostic> for Diagnostic {
 }
 
 /// The diagnostics of a compilation of `source` (the text of `path`), in file order.
-pub fn to_python(diagnostics: &Diagnostics, source: &str, path: &str) -> Vec<Diagnostic> {
+pub fn to_python(diagnostics: &Diagnostics, source: &str, path: &str) -> Vec<PyDiagnostic> {
     clay_dsl::to_json(diagnostics, source, path)
         .into_iter()
-        .map(Diagnostic::from)
+        .map(PyDiagnostic::from)
         .collect()
 }
 
@@ -108,7 +108,7 @@ pub fn grammar_error(py: Python<'_>, diagnostics: &Diagnostics, source: &str, pa
 /// >>> [str(d) for d in clay.check("grammars/wall.clay")]
 /// []
 #[pyfunction]
-pub fn check(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Vec<Diagnostic>> {
+pub fn check(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Vec<PyDiagnostic>> {
     let path: PathBuf = path_of(path)?;
     let bytes = read(&path)?;
     let name = path.display().to_string();

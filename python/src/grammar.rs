@@ -13,13 +13,13 @@ use clay_dsl::CompileOptions;
 use clay_dsl::compiled::CompiledGrammar;
 
 use crate::convert::{guard, path_of, read, type_name};
-use crate::diagnostics::{Diagnostic, grammar_error, to_python};
+use crate::diagnostics::{PyDiagnostic, grammar_error, to_python};
 
 /// A grammar parameter (`param NAME = EXPR in LO..HI`): its value in this compilation, the
 /// value the grammar gives it, and its range (`None`: unbounded).
-#[pyclass(module = "clay", frozen, get_all)]
+#[pyclass(module = "clay", name = "Param", frozen, get_all)]
 #[derive(Clone)]
-pub struct Param {
+pub struct PyParam {
     pub name: String,
     pub value: f64,
     pub default: f64,
@@ -27,7 +27,7 @@ pub struct Param {
 }
 
 #[pymethods]
-impl Param {
+impl PyParam {
     fn __repr__(&self) -> String {
         let range = self
             .range
@@ -40,9 +40,9 @@ impl Param {
 }
 
 /// A piece of the grammar: its name, rest states, vertices and docking sites, by name.
-#[pyclass(module = "clay", frozen, get_all)]
+#[pyclass(module = "clay", name = "Piece", frozen, get_all)]
 #[derive(Clone)]
-pub struct Piece {
+pub struct PyPiece {
     pub name: String,
     pub states: Vec<String>,
     pub vertices: Vec<String>,
@@ -50,7 +50,7 @@ pub struct Piece {
 }
 
 #[pymethods]
-impl Piece {
+impl PyPiece {
     fn __repr__(&self) -> String {
         format!("Piece({}, states={:?})", self.name, self.states)
     }
@@ -62,8 +62,8 @@ impl Piece {
 pub struct Grammar {
     pub compiled: Arc<CompiledGrammar>,
     path: Option<String>,
-    warnings: Vec<Diagnostic>,
-    params: Vec<Param>,
+    warnings: Vec<PyDiagnostic>,
+    params: Vec<PyParam>,
 }
 
 /// Parameter overrides from Python: a mapping of names to numbers.
@@ -126,7 +126,7 @@ impl Grammar {
         // like any other: a GrammarError naming the parameter, its range and the known names.
         let compiled = compiled.map_err(|d| grammar_error(py, &d, &text, path))?;
         let params = (compiled.grammar.params.iter())
-            .map(|p| Param {
+            .map(|p| PyParam {
                 name: p.name.clone(),
                 value: p.value,
                 default: p.default,
@@ -194,23 +194,23 @@ impl Grammar {
 
     /// The compiler's warnings (clay.Diagnostic, severity "warning").
     #[getter]
-    fn warnings(&self) -> Vec<Diagnostic> {
+    fn warnings(&self) -> Vec<PyDiagnostic> {
         self.warnings.clone()
     }
 
     /// The grammar's parameters with the values of this compilation (clay.Param).
     #[getter]
-    fn params(&self) -> Vec<Param> {
+    fn params(&self) -> Vec<PyParam> {
         self.params.clone()
     }
 
     /// The pieces (clay.Piece), in declaration order.
     #[getter]
-    fn pieces(&self) -> Vec<Piece> {
+    fn pieces(&self) -> Vec<PyPiece> {
         self.compiled
             .pieces
             .iter()
-            .map(|p| Piece {
+            .map(|p| PyPiece {
                 name: p.name.clone(),
                 states: p.states.iter().map(|s| s.name.clone()).collect(),
                 vertices: p.vertices.clone(),

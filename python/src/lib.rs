@@ -36,16 +36,16 @@ fn _clay(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("GrammarError", py.get_type::<diagnostics::GrammarError>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
-    m.add_class::<diagnostics::Diagnostic>()?;
+    m.add_class::<diagnostics::PyDiagnostic>()?;
     m.add_function(wrap_pyfunction!(diagnostics::check, m)?)?;
     m.add_class::<grammar::Grammar>()?;
-    m.add_class::<grammar::Param>()?;
-    m.add_class::<grammar::Piece>()?;
-    m.add_class::<session::Session>()?;
-    m.add_class::<session::Instance>()?;
-    m.add_class::<session::RuleEvent>()?;
+    m.add_class::<grammar::PyParam>()?;
+    m.add_class::<grammar::PyPiece>()?;
+    m.add_class::<session::PySession>()?;
+    m.add_class::<session::PyInstance>()?;
+    m.add_class::<session::PyRuleEvent>()?;
     m.add_class::<session::SceneNode>()?;
-    m.add_class::<session::Primitive>()?;
+    m.add_class::<session::PyPrimitive>()?;
     m.add("SOLVER_SETTINGS", clay::SETTING_NAMES.to_vec())?;
     Ok(())
 }

@@ -41,17 +41,17 @@ struct State {
 /// (`hysteresis`, `norm`, `irls_epsilon`, `merge_distance`, `irls_iterations`,
 /// `l2_iterations`, `l2_anderson`, `handle_weight`, `solver="cholesky"|"cg"`). The methods are
 /// the script vocabulary of docs/scripts.md; each runs like the same step of `clayc run`.
-#[pyclass(module = "clay", frozen)]
-pub struct Session {
+#[pyclass(module = "clay", name = "Session", frozen)]
+pub struct PySession {
     /// The grammar with the session's solver settings written into its `solver` block.
     grammar: Arc<CompiledGrammar>,
     state: Mutex<State>,
 }
 
 /// One instance of a piece in the model.
-#[pyclass(module = "clay", frozen, get_all)]
+#[pyclass(module = "clay", name = "Instance", frozen, get_all)]
 #[derive(Clone)]
-pub struct Instance {
+pub struct PyInstance {
     /// Stable identity: survives the rules that keep the instance.
     pub id: u64,
     /// The model's name (`wall[3]`) or a generated one for an inserted instance (`wall#12`).
@@ -71,7 +71,7 @@ pub struct Instance {
 }
 
 #[pymethods]
-impl Instance {
+impl PyInstance {
     fn __repr__(&self) -> String {
         format!(
             "Instance({}, piece={}, state={})",
@@ -83,9 +83,9 @@ impl Instance {
 /// A rule that fired: its kind (`replace`, `stretch`, `shrink`, `merge`, `cut`), the frame
 /// after which it ran, where (metres), the stable ids of the instances involved and a
 /// sentence in the grammar's names.
-#[pyclass(module = "clay", frozen, get_all)]
+#[pyclass(module = "clay", name = "RuleEvent", frozen, get_all)]
 #[derive(Clone)]
-pub struct RuleEvent {
+pub struct PyRuleEvent {
     pub kind: String,
     pub frame: u64,
     pub at: (f64, f64),
@@ -94,7 +94,7 @@ pub struct RuleEvent {
 }
 
 #[pymethods]
-impl RuleEvent {
+impl PyRuleEvent {
     fn __repr__(&self) -> String {
         format!("RuleEvent({}: {})", self.kind, self.detail)
     }
@@ -106,8 +106,8 @@ impl RuleEvent {
 
 /// Triangles of one colour of one instance, flat-shaded, in metres with z up (x east,
 /// y north, z the height `clayc export` gives).
-#[pyclass(module = "clay", frozen, get_all)]
-pub struct Primitive {
+#[pyclass(module = "clay", name = "Primitive", frozen, get_all)]
+pub struct PyPrimitive {
     /// The fill colour, sRGB bytes (r, g, b, a).
     pub colour: (u8, u8, u8, u8),
     /// float32 array of shape (n, 3).
@@ -141,7 +141,7 @@ pub struct SceneNode {
     pub mesh: Option<String>,
     /// In the node's frame: a point `p` of a primitive is at `pivot + R(rotation) p[:2]`,
     /// height `p[2]`.
-    pub primitives: Vec<Py<Primitive>>,
+    pub primitives: Vec<Py<PyPrimitive>>,
 }
 
 #[pymethods]
@@ -239,7 +239,7 @@ fn parse_step(value: Value) -> PyResult<Step> {
     })
 }
 
-impl Session {
+impl PySession {
     fn lock(&self) -> PyResult<MutexGuard<'_, State>> {
         self.state.lock().map_err(|_| {
             InternalError::new_err(
@@ -277,9 +277,9 @@ impl Session {
     }
 }
 
-fn events(log: &[clay::RuleEvent]) -> Vec<RuleEvent> {
+fn events(log: &[clay::RuleEvent]) -> Vec<PyRuleEvent> {
     log.iter()
-        .map(|e| RuleEvent {
+        .map(|e| PyRuleEvent {
             kind: e.kind.name().to_string(),
             frame: e.frame,
             at: (e.at.x, e.at.y),
@@ -290,7 +290,7 @@ fn events(log: &[clay::RuleEvent]) -> Vec<RuleEvent> {
 }
 
 #[pymethods]
-impl Session {
+impl PySession {
     #[new]
     #[pyo3(signature = (grammar, **solver_settings))]
     fn new(
@@ -437,7 +437,7 @@ impl Session {
 
     /// Runs one sculpting frame (a solver frame, then the rules) and returns the rules that
     /// fired in it.
-    fn frame(&self, py: Python<'_>) -> PyResult<Vec<RuleEvent>> {
+    fn frame(&self, py: Python<'_>) -> PyResult<Vec<PyRuleEvent>> {
         py.detach(|| {
             guard("a frame", || {
                 let mut st = self.lock()?;
@@ -518,7 +518,7 @@ impl Session {
 
     /// The model's instances (clay.Instance), in the assembly's order.
     #[getter]
-    fn instances(&self) -> PyResult<Vec<Instance>> {
+    fn instances(&self) -> PyResult<Vec<PyInstance>> {
         let st = self.lock()?;
         let (grammar, data) = (st.asm.grammar(), st.asm.data());
         let mut place = vec![(None, None); data.instances.len()];
@@ -539,7 +539,7 @@ impl Session {
                     .asm
                     .instance_centroid(i)
                     .map_or((f64::NAN, f64::NAN), |c| (c.x, c.y));
-                Instance {
+                PyInstance {
                     id: inst.id,
                     name: inst.name.clone(),
                     piece: piece.map_or(String::new(), |p| p.name.clone()),
@@ -557,7 +557,7 @@ impl Session {
 
     /// Every rule that fired so far, in order (clay.RuleEvent).
     #[getter]
-    fn rule_log(&self) -> PyResult<Vec<RuleEvent>> {
+    fn rule_log(&self) -> PyResult<Vec<PyRuleEvent>> {
         Ok(events(self.lock()?.session.rule_log()))
     }
 
@@ -741,7 +741,7 @@ impl Session {
                 let triangles = PyArray1::from_vec(py, p.indices).reshape([m, 3])?;
                 primitives.push(Py::new(
                     py,
-                    Primitive {
+                    PyPrimitive {
                         colour: (r, g, b, a),
                         positions: positions.into_any().unbind(),
                         triangles: triangles.into_any().unbind(),
