@@ -16,14 +16,14 @@ fn export(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(20));
     group.bench_function("scene + glb", |b| {
         b.iter(|| {
-            clay::to_glb(&scene(&city, &city.assembly, &options))
+            clay::testing::to_glb(&scene(&city, &city.assembly, &options))
                 .unwrap()
                 .len()
         })
     });
     group.bench_function("scene + obj", |b| {
         b.iter(|| {
-            clay::to_obj(&scene(&city, &city.assembly, &options), "city.mtl")
+            clay::testing::to_obj(&scene(&city, &city.assembly, &options), "city.mtl")
                 .0
                 .len()
         })

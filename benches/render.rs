@@ -8,7 +8,8 @@
 use std::fmt::Write;
 use std::time::Duration;
 
-use clay::{RenderOptions, render_png, tessellate_proxy};
+use clay::testing::tessellate_proxy;
+use clay::{RenderOptions, render_png};
 use clay_dsl::compiled::CompiledGrammar;
 use criterion::{Criterion, criterion_group, criterion_main};
 

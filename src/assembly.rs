@@ -224,7 +224,7 @@ impl Assembly {
 
     /// Rules call this after rewriting `data` (parts, vertices, docks). Bumps the generation so
     /// the solver rebuilds its pattern, resizes the rotations, re-reads the vertices of handles
-    /// that hold an instance (see [`HeldInstance`]), and drops handles whose vertices no longer
+    /// that hold an instance (see `HeldInstance`), and drops handles whose vertices no longer
     /// exist (rules that renumber vertices should remap handles first, through
     /// `handles_mut`).
     /// The contract data: positions, instances, docks, chains and parts.
@@ -441,7 +441,7 @@ impl Assembly {
 
     /// Makes a handle over one instance (piece element) at its current pose: the brick the
     /// user grabbed, also when it is an element of a stretch chain, whose parts are two-element
-    /// windows. The handle follows the instance across rules' rewrites (see [`HeldInstance`]).
+    /// windows. The handle follows the instance across rules' rewrites (see `HeldInstance`).
     /// `None` if the instance does not exist or has no vertices.
     pub fn hold_instance(&mut self, instance: usize, kind: HandleKind) -> Option<HandleId> {
         let inst = self.data.instances.get(instance)?;

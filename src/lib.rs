@@ -3,12 +3,14 @@
 //! The surface is flat, as `typst-syntax`'s is: every module is private and each public name
 //! has one path, `clay::Name`. Two families keep a namespace because their names read as
 //! parts of a whole: [`authoring`] (an SVG drawing made into a grammar) and [`session_file`]
-//! (the editor's saved session). Test helpers and the rules' internals that tests reach for
-//! are in `clay::testing`, behind the feature `testing`.
+//! (the editor's saved session). The top level is what the shipped editor, `clayc` and the
+//! Python module use, with the types their signatures name; test helpers, the rules' internals
+//! and every other name only tests and benches use are in `clay::testing`, behind the feature
+//! `testing`.
 //!
 //! A frame flows one way: an [`Assembly`] (a compiled grammar's live model) is sculpted by a
-//! [`Session`] (gestures, the [`Solver`], the [`Rules`]), drawn by [`render_png`] and its
-//! kin, and exported by [`scene`] with [`to_glb`], [`to_gltf`] and [`to_obj`].
+//! [`Session`] (gestures, the [`Solver`], the rules), drawn by [`render_png`] and its kin,
+//! and exported by [`scene`] and [`write_export`] (or [`encode_export`]: glTF, GLB, OBJ).
 
 // The library returns data; printing is the binaries' job (diagnostics at the CLI's edge).
 #![deny(clippy::print_stdout, clippy::print_stderr)]
@@ -31,37 +33,29 @@ pub mod synthetic;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 
-pub use assembly::{Assembly, Compass, Handle, HandleId, HandleKind, HeldInstance};
-pub use export::gltf::{to_glb, to_gltf};
+pub use assembly::{Assembly, Compass, Handle, HandleKind};
 pub use export::iso::iso_pixmap;
-pub use export::obj::to_obj;
 pub use export::{
-    ChainPlace, ExportFileError, ExportFormat, ExportOptions, MAX_NAME_BYTES, MAX_THICKNESS, Node,
-    Primitive, SHARE_TOLERANCE, SHARE_TOLERANCE_PER_METRE, Scene, SharedMesh, encode_export,
-    mtl_path, scene, srgb_to_linear, write_export,
+    ChainPlace, ExportFileError, ExportFormat, ExportOptions, Node, Primitive, Scene, SharedMesh,
+    encode_export, mtl_path, scene, write_export,
 };
 pub use files::write_atomic;
-pub use plane::{nearest_on_segment, polygon_area};
+pub use plane::nearest_on_segment;
 pub use render::{
-    BACKGROUND, CONTOUR_MIN_TRIANGLES, Canvas, MAX_SIDE, Mesh, Overlays, PixmapCanvas, RenderError,
-    RenderOptions, STRAIN_FULL, STRAIN_LEGEND, SiteFrame, Skin, Solid, TessellationCache, View,
-    WorldMesh, bounds, contours, draw_overlays, part_at, pose_assembly, pose_assembly_into,
-    pose_instance, pose_piece, render_pixmap, render_png, render_svg, sheet_pixmap, sheet_png,
-    sheet_svg, site_type_colour, strain_colour, tessellate_polygon, tessellate_polyline,
-    tessellate_proxy,
+    Canvas, MAX_SIDE, Mesh, Overlays, RenderError, RenderOptions, STRAIN_LEGEND, Solid,
+    TessellationCache, View, WorldMesh, bounds, draw_overlays, part_at, pose_assembly_into,
+    render_png, render_svg, sheet_png, sheet_svg, site_type_colour, tessellate_polygon,
 };
-pub use rules::stretch::MAX_GROWTH;
-pub use rules::{Rewrite, RuleEvent, RuleKind, Rules, site_centre, site_out};
+pub use rules::{RuleEvent, RuleKind};
 pub use script::{MAX_FRAMES, Motion, Script, ScriptError, Selector, Step};
 pub use session::{
-    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, apply_setting, configure, pin,
-    pin_at, pin_of, replay, toggle_pin, unpin,
+    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, configure, pin_at, pin_of,
+    replay, toggle_pin,
 };
 pub use solver::{
-    Between, Components, FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind,
-    StateSwitch, bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
+    FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch,
 };
-pub use summary::{FrameMs, Summary, connected_components};
+pub use summary::{FrameMs, Summary};
 
 /// The session file the editor saves and `clayc run|render|export --session` replays: the
 /// grammar's path, its parameters, the solver's settings, the pins and the log of gestures.

@@ -6,8 +6,9 @@
 //! solver's settings and report types), rules never import sessions or scripts, protocol types
 //! stay in the language server, a solver frame changes no part, instance or connection, and
 //! the libraries print nothing, every file is read through the one bounded reader, and no
-//! `use` imports a whole crate root, and no two public types share a name. The editor's library
-//! and the Python module are graphs too.
+//! `use` imports a whole crate root, no two public types share a name, and the library's top
+//! level holds no function or constant only tests use. The editor's library and the Python
+//! module are graphs too.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -513,7 +514,13 @@ const ALLOWED: &[(&str, &[&str])] = &[
     // `synthetic`: only the tests of `solver/chunks.rs`, which build a city.
     ("solver", &["assembly", "fit", "synthetic"]),
     ("summary", &["assembly", "figure", "rules", "solver"]),
-    ("testing", &["rules"]),
+    // `testing`: the re-exports of the names only tests and benches use.
+    (
+        "testing",
+        &[
+            "assembly", "export", "plane", "render", "rules", "session", "solver", "summary",
+        ],
+    ),
     (
         "testing::gallery",
         &[
@@ -788,7 +795,7 @@ fn the_editor_uses_the_librarys_surfaces_only() {
         Some("solver"),
         "{homes:?}"
     );
-    assert_eq!(homes.get("Rules").map(String::as_str), Some("rules"));
+    assert_eq!(homes.get("RuleKind").map(String::as_str), Some("rules"));
     let allowed_solver = ["FrameReport", "SolverConfig", "SolverError"];
     let mut files = Vec::new();
     rust_files(&root().join("editor/src"), &mut files);
@@ -899,7 +906,7 @@ fn a_solver_frame_changes_no_part_instance_or_connection() {
         let east = asm.part_extreme(Compass::East).unwrap();
         asm.hold_part(west, HandleKind::Pin).unwrap();
         let grab = asm.hold_part(east, HandleKind::Grab).unwrap();
-        let size = clay::bbox_diagonal(&asm.data().positions);
+        let size = clay::testing::bbox_diagonal(&asm.data().positions);
         let moves = [
             (DVec2::new(size, 0.0), 0.0),
             (DVec2::new(-0.8 * size, 0.0), 0.0),
@@ -1226,4 +1233,47 @@ fn no_two_public_types_share_a_name() {
     assert!(homes.contains_key("PySession") && homes.contains_key("Assembly"));
     let twice: Vec<_> = homes.iter().filter(|(_, at)| at.len() > 1).collect();
     assert!(twice.is_empty(), "public types of one name: {twice:#?}");
+}
+
+/// Architecture Invariant: `clay`'s top level is what the shipped code uses (issue 47: a
+/// newcomer reads the surface once). Every function and constant re-exported in `src/lib.rs`
+/// is named by the editor, `clayc` or the Python module; one only tests and benches use is
+/// re-exported by `clay::testing` instead. (A type stays on the top level when a signature
+/// there names it: `unnameable_types` keeps that side.)
+#[test]
+fn the_top_level_functions_and_constants_are_the_shipped_codes() {
+    let homes = surface_homes();
+    let mut used = BTreeSet::new();
+    let mut files = Vec::new();
+    for dir in ["editor/src", "cli/src", "python/src"] {
+        rust_files(&root().join(dir), &mut files);
+    }
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let file = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        used.extend(clay_names(&file).into_iter().map(|(name, _)| name));
+    }
+    assert!(
+        used.contains("render_png") && used.contains("Session"),
+        "{used:?}"
+    );
+    let type_name = |name: &str| {
+        name.starts_with(|c: char| c.is_ascii_uppercase())
+            && name.contains(|c: char| c.is_ascii_lowercase())
+    };
+    let unused: Vec<&String> = homes
+        .iter()
+        .filter(|(name, home)| name != home && !type_name(name) && !used.contains(*name))
+        .map(|(name, _)| name)
+        .collect();
+    assert!(
+        homes.len() > 60,
+        "only {} names read from src/lib.rs",
+        homes.len()
+    );
+    assert!(
+        unused.is_empty(),
+        "on clay's top level but used by no shipped code (re-export them in \
+         src/testing/mod.rs): {unused:?}"
+    );
 }

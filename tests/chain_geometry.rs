@@ -2,7 +2,8 @@
 //! stretch rule gives the element an axis, but only `skinned` geometry follows it; `rigid`
 //! geometry keeps its rest size and follows the element's best rigid motion.
 
-use clay::{TessellationCache, pose_assembly};
+use clay::TessellationCache;
+use clay::testing::pose_assembly;
 use clay_dsl::compiled::CompiledGrammar;
 
 /// grammars/wall.clay with its brick's face (and course line) bound as `binding`.

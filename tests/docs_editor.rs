@@ -4,7 +4,8 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, RuleKind, Script, SolverConfig, strain_colour};
+use clay::testing::strain_colour;
+use clay::{Assembly, RuleKind, Script, SolverConfig};
 
 /// docs/editor.md with every run of whitespace one space (its lines wrap anywhere).
 fn editor_md() -> String {

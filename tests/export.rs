@@ -6,9 +6,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use clay::testing::pose_assembly;
 use clay::{
-    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
-    pose_assembly, scene,
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache, scene,
 };
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 
@@ -128,7 +128,10 @@ fn glb_and_gltf_read_back_with_the_assemblys_nodes_names_and_triangles() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        for bytes in [clay::to_glb(&s).unwrap(), clay::to_gltf(&s).unwrap()] {
+        for bytes in [
+            clay::testing::to_glb(&s).unwrap(),
+            clay::testing::to_gltf(&s).unwrap(),
+        ] {
             let doc = ::gltf::Gltf::from_slice(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
             let blob = match &doc.blob {
                 Some(b) => b.clone(),
@@ -184,7 +187,7 @@ fn obj_loads_in_tobj_with_every_triangle_and_material() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        let (obj_text, mtl_text) = clay::to_obj(&s, "model.mtl");
+        let (obj_text, mtl_text) = clay::testing::to_obj(&s, "model.mtl");
         let (models, materials) = tobj::load_obj_buf(
             &mut obj_text.as_bytes(),
             &tobj::LoadOptions {
@@ -216,7 +219,7 @@ fn the_iso_view_draws_the_scene_the_same_way_every_time() {
     let a = clay::iso_pixmap(&s, 400, 300).unwrap();
     let b = clay::iso_pixmap(&s, 400, 300).unwrap();
     assert_eq!(a.data(), b.data(), "deterministic");
-    let background = clay::BACKGROUND.0;
+    let background = clay::testing::BACKGROUND.0;
     let drawn = a.pixels().iter().filter(|p| {
         let c = p.demultiply();
         [c.red(), c.green(), c.blue()] != [background[0], background[1], background[2]]

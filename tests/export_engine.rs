@@ -8,9 +8,9 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
+use clay::testing::{pose_assembly, srgb_to_linear};
 use clay::{
-    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
-    pose_assembly, scene, srgb_to_linear,
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache, scene,
 };
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use glam::{DQuat, DVec2, DVec3};
@@ -290,14 +290,14 @@ fn every_example_exports_a_root_with_placed_shared_named_closed_meshes() {
             let what = format!("{name} {when}");
             check_gltf(
                 &format!("{what} .glb"),
-                &clay::to_glb(&s).unwrap(),
+                &clay::testing::to_glb(&s).unwrap(),
                 &g,
                 &a,
                 &s,
             );
             check_gltf(
                 &format!("{what} .gltf"),
-                &clay::to_gltf(&s).unwrap(),
+                &clay::testing::to_gltf(&s).unwrap(),
                 &g,
                 &a,
                 &s,
@@ -316,7 +316,7 @@ fn identical_instances_share_one_mesh() {
     assert_eq!(s.meshes[0].users, 8);
     assert_eq!(s.meshes[0].name, "brick__base");
     assert_eq!(s.triangle_count(), 8 * s.mesh_triangle_count());
-    let doc = ::gltf::Gltf::from_slice(&clay::to_glb(&s).unwrap()).unwrap();
+    let doc = ::gltf::Gltf::from_slice(&clay::testing::to_glb(&s).unwrap()).unwrap();
     assert_eq!(doc.meshes().count(), 1);
     let xs: Vec<f32> = doc
         .nodes()
@@ -399,7 +399,7 @@ fn obj_has_uvs_and_glb_colours_and_the_nodes_names() {
     for name in EXAMPLES {
         let g = grammar(name);
         let s = scene(&g, &g.assembly, &ExportOptions::default());
-        let (obj_text, mtl_text) = clay::to_obj(&s, "model.mtl");
+        let (obj_text, mtl_text) = clay::testing::to_obj(&s, "model.mtl");
         let (models, materials) = tobj::load_obj_buf(
             &mut obj_text.as_bytes(),
             &tobj::LoadOptions {
@@ -412,7 +412,7 @@ fn obj_has_uvs_and_glb_colours_and_the_nodes_names() {
         .unwrap();
         let materials = materials.unwrap();
         // Kd is glTF's linear base colour factor.
-        let doc = ::gltf::Gltf::from_slice(&clay::to_glb(&s).unwrap()).unwrap();
+        let doc = ::gltf::Gltf::from_slice(&clay::testing::to_glb(&s).unwrap()).unwrap();
         for (m, gm) in materials.iter().zip(doc.materials()) {
             let kd = m.diffuse.unwrap();
             let base = gm.pbr_metallic_roughness().base_color_factor();

@@ -256,8 +256,8 @@ fn compiled(input: &[u8]) -> Result<(), String> {
     };
     let _ = clay::render_png(&grammar, asm.data(), &options);
     let scene = clay::scene(&grammar, asm.data(), &Default::default());
-    let glb = clay::to_glb(&scene)?;
-    let (obj, _) = clay::to_obj(&scene, "fuzz.mtl");
+    let glb = clay::testing::to_glb(&scene)?;
+    let (obj, _) = clay::testing::to_obj(&scene, "fuzz.mtl");
     if obj.contains("NaN") || obj.contains("inf") {
         return Err("the OBJ export has a non-finite number".into());
     }

@@ -854,8 +854,8 @@ fn accepted(g: &CompiledGrammar) -> Result<(), String> {
             }
         }
     }
-    clay::to_glb(&s).map_err(|e| format!("the glTF export failed: {e}"))?;
-    let (text, _) = clay::to_obj(&s, "fuzz.mtl");
+    clay::testing::to_glb(&s).map_err(|e| format!("the glTF export failed: {e}"))?;
+    let (text, _) = clay::testing::to_obj(&s, "fuzz.mtl");
     let lower = text.to_ascii_lowercase();
     if lower.contains("nan") || lower.contains("inf") {
         return Err("the OBJ export writes a non-finite number".into());

@@ -6,7 +6,8 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 
-use clay::{Assembly, RuleKind, SolverConfig, site_centre, site_out, testing::merge};
+use clay::testing::{merge, site_centre, site_out};
+use clay::{Assembly, RuleKind, SolverConfig};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, InstanceSite};
 use glam::DVec2;
 
@@ -249,7 +250,7 @@ fn drag_b(translation: DVec2, angle: f64) -> usize {
     let data = asm.data();
     let a = data.instances.iter().position(|i| i.name == "a").unwrap();
     let b = data.instances.iter().position(|i| i.name == "b").unwrap();
-    clay::pin(&mut asm, a).unwrap();
+    clay::testing::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     let mut merges = 0;
     for k in 1..=30 {
@@ -293,7 +294,7 @@ fn a_cut_pair_turned_away_and_back_within_reach_stays_apart_until_it_parts() {
         .iter()
         .position(|i| i.name == "b")
         .unwrap();
-    clay::pin(&mut asm, a).unwrap();
+    clay::testing::pin(&mut asm, a).unwrap();
     session.grab(&mut asm, b).unwrap();
     // `b` turned by `angle` about its west site, held at (1.2, 0.25), 0.2 m from `a`'s east
     // site: its centre starts at (3.5, 0.25), half a metre east of that site.

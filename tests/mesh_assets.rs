@@ -6,9 +6,9 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use clay::testing::pose_assembly;
 use clay::{
-    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache,
-    pose_assembly, scene,
+    Assembly, ExportOptions, Scene, Script, Session, SolverConfig, TessellationCache, scene,
 };
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, ProxyShape, Rgba};
 
@@ -140,7 +140,10 @@ fn keep_with_its_roofs_reads_back_with_the_gltf_crate() {
     let g = keep();
     let after = after_script(&g);
     let s = scene(&g, &after, &ExportOptions::default());
-    for bytes in [clay::to_glb(&s).unwrap(), clay::to_gltf(&s).unwrap()] {
+    for bytes in [
+        clay::testing::to_glb(&s).unwrap(),
+        clay::testing::to_gltf(&s).unwrap(),
+    ] {
         let doc = ::gltf::Gltf::from_slice(&bytes).unwrap();
         // One root whose children are the instances, their assembly names in the extras.
         let root = doc.default_scene().unwrap().nodes().next().unwrap();
@@ -254,7 +257,7 @@ fn a_skinned_mesh_follows_the_skin_of_its_polygon_and_keeps_its_heights() {
 fn keep_with_its_roofs_loads_as_obj_in_tobj() {
     let g = keep();
     let s = scene(&g, &after_script(&g), &ExportOptions::default());
-    let (obj_text, mtl_text) = clay::to_obj(&s, "keep.mtl");
+    let (obj_text, mtl_text) = clay::testing::to_obj(&s, "keep.mtl");
     let (models, materials) = tobj::load_obj_buf(
         &mut obj_text.as_bytes(),
         &tobj::LoadOptions::default(),
@@ -316,9 +319,9 @@ fn an_asset_at_the_coordinate_limit_exports_only_finite_numbers() {
                     assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
                 }
             }
-            let (obj, _) = clay::to_obj(&s, "far.mtl");
+            let (obj, _) = clay::testing::to_obj(&s, "far.mtl");
             assert!(!obj.contains("inf") && !obj.contains("NaN"));
-            assert!(clay::to_glb(&s).is_ok());
+            assert!(clay::testing::to_glb(&s).is_ok());
         }
         std::fs::remove_dir_all(dir).unwrap();
     }

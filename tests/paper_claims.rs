@@ -8,7 +8,8 @@ use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use clay::{Assembly, Components, RuleKind, Script, SolverConfig, bbox, max_edge_strain};
+use clay::testing::{Components, bbox, max_edge_strain};
+use clay::{Assembly, RuleKind, Script, SolverConfig};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 

@@ -2,9 +2,9 @@
 //! have no holes, rigid connectors keep their area when turned, output is deterministic and
 //! never carries NaN.
 
+use clay::testing::{pose_assembly, render_pixmap};
 use clay::{
-    Overlays, RenderOptions, TessellationCache, View, pose_assembly, render_pixmap, render_png,
-    render_svg, sheet_png, sheet_svg,
+    Overlays, RenderOptions, TessellationCache, View, render_png, render_svg, sheet_png, sheet_svg,
 };
 use clay_dsl::compiled::{
     AssemblyData, Binding, CompiledGrammar, FORMAT_VERSION, Instance, Piece, Proxy, ProxyShape,
@@ -375,7 +375,7 @@ fn svg_has_one_filled_path_per_mesh() {
 #[test]
 fn a_large_mesh_filled_by_its_contours_looks_as_filled_by_its_triangles() {
     use clay::Canvas;
-    use clay::PixmapCanvas;
+    use clay::testing::PixmapCanvas;
     // A 20,000-point star with a hole, about 300 px across: far above the contour threshold.
     let ring = |n: usize, centre: DVec2, scale: f64| -> Vec<DVec2> {
         (0..n)
@@ -388,9 +388,9 @@ fn a_large_mesh_filled_by_its_contours_looks_as_filled_by_its_triangles() {
     let outer = ring(20_000, DVec2::splat(160.0), 150.0);
     let hole = ring(600, DVec2::new(120.0, 170.0), 40.0);
     let (v, t) = clay::tessellate_polygon(&outer, &[hole]).unwrap();
-    assert!(t.len() > clay::CONTOUR_MIN_TRIANGLES);
+    assert!(t.len() > clay::testing::CONTOUR_MIN_TRIANGLES);
     let points: Vec<[f32; 2]> = v.iter().map(|p| [p.x as f32, p.y as f32]).collect();
-    let contours = clay::contours(&points, &t).unwrap();
+    let contours = clay::testing::contours(&points, &t).unwrap();
     assert_eq!(contours.len(), 2, "the outer ring and the hole");
     let mut by_triangles = PixmapCanvas::new(320, 320, BG).unwrap();
     by_triangles.fill_triangles(&points, &t, RED);

@@ -1,7 +1,8 @@
 //! Tessellation of proxy geometry: exact areas for concave polygons with holes, and no panic or
 //! non-finite output on arbitrary (degenerate, self-crossing) input.
 
-use clay::{polygon_area, tessellate_polygon, tessellate_polyline, tessellate_proxy};
+use clay::tessellate_polygon;
+use clay::testing::{polygon_area, tessellate_polyline, tessellate_proxy};
 
 fn polygon_area_of(ring: &[glam::DVec2]) -> f64 {
     polygon_area(ring.iter().copied())

@@ -160,7 +160,7 @@ fn rewrite(
     g: &clay_dsl::compiled::CompiledGrammar,
     d: &mut clay_dsl::compiled::AssemblyData,
     at: (usize, usize),
-) -> Result<clay::Rewrite, String> {
+) -> Result<clay::testing::Rewrite, String> {
     let state = d
         .parts
         .iter()

@@ -76,7 +76,7 @@ fn ids(d: &AssemblyData, chain: usize) -> Vec<u64> {
 }
 
 fn centre(g: &CompiledGrammar, d: &AssemblyData, instance: usize, site: usize) -> DVec2 {
-    clay::site_centre(g, d, InstanceSite { instance, site }).unwrap()
+    clay::testing::site_centre(g, d, InstanceSite { instance, site }).unwrap()
 }
 
 #[test]
@@ -231,7 +231,7 @@ fn inserted_variants_follow_the_rules_frequencies() {
 fn a_free_street_end_near_a_side_merges_into_a_tee_and_a_cut_undoes_it() {
     let g = file("junction.clay");
     let mut d = data_of(&g);
-    assert_eq!(clay::connected_components(&d), 2);
+    assert_eq!(clay::testing::connected_components(&d), 2);
     assert!(
         merge::find(&g, &d).is_none(),
         "the dead end starts out of reach"
@@ -264,7 +264,7 @@ fn a_free_street_end_near_a_side_merges_into_a_tee_and_a_cut_undoes_it() {
     let r = merge::apply(&g, &mut d, &m).unwrap();
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Merge);
-    assert_eq!(clay::connected_components(&d), 1);
+    assert_eq!(clay::testing::connected_components(&d), 1);
     assert_eq!(d.docks.len(), docks + 1);
     let tee = g.pieces.iter().position(|p| p.name == "tee").unwrap();
     let tees: Vec<usize> = (0..d.instances.len())
@@ -302,7 +302,7 @@ fn a_free_street_end_near_a_side_merges_into_a_tee_and_a_cut_undoes_it() {
     let r = cut::cut_at(&g, &mut d, at + DVec2::new(0.1, 0.1)).unwrap();
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Cut);
-    assert_eq!(clay::connected_components(&d), 2);
+    assert_eq!(clay::testing::connected_components(&d), 2);
     assert!(!d.instances.iter().any(|i| i.piece == tee));
     let mut lens: Vec<usize> = d.chains.iter().map(|c| c.instances.len()).collect();
     lens.sort();
@@ -319,7 +319,7 @@ fn a_plain_cut_splits_a_chain_and_duplicates_the_shared_vertices() {
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Cut);
     assert_eq!(d.positions.len(), n + 2);
-    assert_eq!(clay::connected_components(&d), 2);
+    assert_eq!(clay::testing::connected_components(&d), 2);
     let mut lens: Vec<usize> = d.chains.iter().map(|c| c.instances.len()).collect();
     lens.sort();
     assert_eq!(lens, vec![3, 3]);
@@ -366,7 +366,7 @@ model {
     d.check(&g).unwrap();
     assert_eq!(r.event.kind, RuleKind::Merge);
     assert_eq!(d.positions.len(), n - 2);
-    assert_eq!(clay::connected_components(&d), 1);
+    assert_eq!(clay::testing::connected_components(&d), 1);
     assert_eq!(d.chains.len(), 1, "welded chain ends make one chain");
     assert_eq!(d.chains[0].instances.len(), 6);
     assert_eq!(d.parts.len(), 5);
@@ -379,7 +379,7 @@ fn rewrite(
     g: &clay_dsl::compiled::CompiledGrammar,
     d: &mut clay_dsl::compiled::AssemblyData,
     at: (usize, usize),
-) -> Result<clay::Rewrite, String> {
+) -> Result<clay::testing::Rewrite, String> {
     let state = d
         .parts
         .iter()

@@ -50,7 +50,7 @@ fn replay(name: &str) -> Outcome {
     Outcome {
         fired,
         pieces,
-        components: clay::connected_components(asm.data()),
+        components: clay::testing::connected_components(asm.data()),
         notes: session.notes().to_vec(),
     }
 }

@@ -6,7 +6,8 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use clay::{Assembly, Compass, HandleKind, Script, SolverConfig, max_edge_strain};
+use clay::testing::max_edge_strain;
+use clay::{Assembly, Compass, HandleKind, Script, SolverConfig};
 use clay_dsl::compiled::CompiledGrammar;
 
 fn grammar(name: &str) -> CompiledGrammar {
@@ -355,18 +356,18 @@ fn handles_follow_their_bricks_when_the_rules_rewrite_the_held_pair() {
 #[test]
 fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
     let mut s = Session::new(grammar("junction.clay"), None);
-    assert_eq!(clay::connected_components(s.asm.data()), 2);
+    assert_eq!(clay::testing::connected_components(s.asm.data()), 2);
     // The side street's free end is at (9, 2); the main street's north edge at y = 0.5.
     s.run(
         r#"{"steps": [{"pin": {"extreme": "west"}}, {"pin": {"at": [15, 0]}}, {"grab": {"at": [9, 3]}},
         {"drag": {"by": [0, -1.3], "frames": 40}}, {"hold": {"frames": 10}}]}"#,
     );
     assert_eq!(s.count("tee"), 1, "merged into a tee");
-    assert_eq!(clay::connected_components(s.asm.data()), 1);
+    assert_eq!(clay::testing::connected_components(s.asm.data()), 1);
     // Dragging on (sideways and up) does not un-merge it.
     s.run(r#"{"steps": [{"drag": {"by": [1, 1], "frames": 30}}, {"hold": {"frames": 10}}]}"#);
     assert_eq!(s.count("tee"), 1);
-    assert_eq!(clay::connected_components(s.asm.data()), 1);
+    assert_eq!(clay::testing::connected_components(s.asm.data()), 1);
     // Cut at the stem and pull the side street away.
     let tee = s
         .asm
@@ -381,7 +382,7 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
         .iter()
         .position(|x| x.name == "north")
         .unwrap();
-    let at = clay::site_centre(
+    let at = clay::testing::site_centre(
         g,
         s.asm.data(),
         clay_dsl::compiled::InstanceSite {
@@ -396,7 +397,7 @@ fn the_dead_end_merges_into_a_tee_stays_merged_and_a_cut_takes_it_apart() {
     ));
     assert_eq!(s.fired(clay::RuleKind::Cut), 1, "{:?}", s.replay.notes());
     assert_eq!(s.count("tee"), 0);
-    assert_eq!(clay::connected_components(s.asm.data()), 2);
+    assert_eq!(clay::testing::connected_components(s.asm.data()), 2);
 }
 
 #[test]

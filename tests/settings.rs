@@ -1,5 +1,5 @@
 //! One truth per setting (issue 47): a grammar's `solver { }` block and `clayc run --set`
-//! (`clay::apply_setting`, which the editor and the Python package call too) accept the same
+//! (`clay::testing::apply_setting`, which the editor and the Python package call too) accept the same
 //! values of every setting, the ones the settings table (`clay_dsl::settings`) allows; and a
 //! session runs at every setting's bounds without panicking (`--set l2_iterations=0` with a
 //! stretch indexed past the end of the pose once), on the wall's whole script and the first
@@ -7,7 +7,8 @@
 
 use std::sync::Arc;
 
-use clay::{Assembly, Script, Session, SolverConfig, apply_setting, configure, replay};
+use clay::testing::apply_setting;
+use clay::{Assembly, Script, Session, SolverConfig, configure, replay};
 use clay_dsl::settings::{Range, SETTINGS};
 
 const WALL: &str = include_str!("../grammars/wall.clay");

@@ -99,9 +99,9 @@ fn a_street_bent_round_a_pinned_end_switches_segments_to_turns() {
     assert!(session.rules_fired()[&clay::RuleKind::Replace] >= 1);
     // the turned street is not torn: every edge is within 35% of its rest length
     assert!(
-        clay::max_edge_strain(&asm) < 0.35,
+        clay::testing::max_edge_strain(&asm) < 0.35,
         "strain {}",
-        clay::max_edge_strain(&asm)
+        clay::testing::max_edge_strain(&asm)
     );
 }
 
@@ -112,7 +112,7 @@ fn a_street_bent_at_any_speed_is_never_torn() {
     // by more than 35%.
     for frames in [20, 30, 60, 80, 120] {
         let (asm, _) = bend_session(frames);
-        let strain = clay::max_edge_strain(&asm);
+        let strain = clay::testing::max_edge_strain(&asm);
         assert!(strain < 0.35, "{frames} frames: strain {strain}");
     }
 }
@@ -217,7 +217,7 @@ fn cg_and_cholesky_agree_within_the_cg_tolerance() {
             replay(&mut asm, &script, &mut Session::without_rules(config)).unwrap();
             positions.push(asm.data().positions.clone());
         }
-        let size = clay::bbox_diagonal(&positions[0]);
+        let size = clay::testing::bbox_diagonal(&positions[0]);
         let worst = positions[0]
             .iter()
             .zip(&positions[1])
@@ -300,7 +300,7 @@ fn a_stretched_wall_settles_after_the_drag_and_a_converged_frame_is_a_fixed_poin
     );
     let before = asm.data().positions.clone();
     let states: Vec<usize> = asm.data().parts.iter().map(|p| p.active).collect();
-    let size = clay::bbox_diagonal(&before);
+    let size = clay::testing::bbox_diagonal(&before);
     let r = solver.frame(&mut asm).unwrap();
     assert!(
         r.switches.is_empty() && r.moved <= 1e-6 * size,
@@ -330,7 +330,7 @@ fn a_budgeted_frame_stops_early_but_shows_a_least_squares_pose() {
         .copied()
         .filter(|p| p.y >= 0.0)
         .collect();
-    let (lo, hi) = clay::bbox(&grid).unwrap();
+    let (lo, hi) = clay::testing::bbox(&grid).unwrap();
     let pin = asm.part_nearest(lo).unwrap();
     asm.hold_part(pin, HandleKind::Pin);
     let h = asm
@@ -385,7 +385,7 @@ fn irls_refactors_every_iteration_and_keeps_the_displayed_pose_exact() {
     // once per pass-1 iteration, and every frame ends with the displayed-pose guarantees.
     {
         let mut asm = Assembly::new(Arc::new(synthetic::city(1_000)));
-        let (lo, hi) = clay::bbox(&asm.data().positions).unwrap();
+        let (lo, hi) = clay::testing::bbox(&asm.data().positions).unwrap();
         asm.hold_part(asm.part_nearest(lo).unwrap(), HandleKind::Pin);
         let h = asm
             .hold_part(asm.part_nearest(hi).unwrap(), HandleKind::Grab)

@@ -138,7 +138,7 @@ fn exporting_a_saved_session_exports_the_sculpted_assembly() {
     let cli = gltf_json(&std::fs::read(&out_path).unwrap());
 
     let direct = scene(&grammar, asm.data(), &ExportOptions::default());
-    let direct = gltf_json(&clay::to_gltf(&direct).unwrap());
+    let direct = gltf_json(&clay::testing::to_gltf(&direct).unwrap());
     let (cli_nodes, direct_nodes) = (nodes_with_instances(&cli), nodes_with_instances(&direct));
     assert_eq!(cli_nodes.len(), instances);
     assert_eq!(

@@ -23,7 +23,8 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clay::{TessellationCache, pose_assembly, synthetic};
+use clay::testing::pose_assembly;
+use clay::{TessellationCache, synthetic};
 use clay_editor::EditorApp;
 use clay_editor::sculpt::Sculpt;
 use egui::epaint::Primitive;

@@ -123,7 +123,7 @@ fn assert_same_sculpt(editor: &AssemblyData, replay: &AssemblyData) {
     let states = |d: &AssemblyData| d.parts.iter().map(|p| p.active).collect::<Vec<_>>();
     assert_eq!(states(editor), states(replay), "the parts' rest states");
     assert_eq!(editor.positions.len(), replay.positions.len());
-    let size = clay::bbox_diagonal(&editor.positions);
+    let size = clay::testing::bbox_diagonal(&editor.positions);
     let gap = (editor.positions.iter().zip(&replay.positions))
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max);

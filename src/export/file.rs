@@ -45,7 +45,7 @@ pub const MAX_THICKNESS: f64 = 1000.0;
 
 impl ExportOptions {
     /// The default options with flat proxy geometry `thickness` metres high; an error (in
-    /// words for the user) unless it is above 0 and at most [`MAX_THICKNESS`].
+    /// words for the user) unless it is above 0 and at most `MAX_THICKNESS` (1000 m).
     pub fn with_thickness(thickness: f64) -> Result<Self, String> {
         if thickness.is_finite() && thickness > 0.0 && thickness <= MAX_THICKNESS {
             Ok(Self {

@@ -40,11 +40,11 @@ use crate::render::tessellate::shown_geometry;
 use crate::render::{Mesh, Solid, TessellationCache, WorldMesh, pose_assembly};
 use solid::{Blend, Prism, Shape};
 
-pub use file::{
-    ExportFileError, ExportFormat, MAX_THICKNESS, encode_export, mtl_path, write_export,
-};
-pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh, srgb_to_linear};
-pub use names::MAX_NAME_BYTES;
+pub use file::{ExportFileError, ExportFormat, encode_export, mtl_path, write_export};
+pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh};
+// Names only the tests use, re-exported as `clay::testing::X`.
+#[cfg(any(test, feature = "testing"))]
+pub use {file::MAX_THICKNESS, model::srgb_to_linear, names::MAX_NAME_BYTES};
 
 /// How far apart (metres, per coordinate) two instances' local geometry may be and still share
 /// one mesh, at the origin; it grows with the distance from the origin as f32's precision

@@ -17,18 +17,22 @@ pub(crate) mod tessellate;
 pub(crate) mod text;
 
 // The rendering surface, re-exported once more at the crate's root as `clay::X`.
-pub use contour::{CONTOUR_MIN_TRIANGLES, contours};
 pub use draw::{
-    BACKGROUND, Canvas, Overlays, RenderOptions, STRAIN_FULL, STRAIN_LEGEND, View, bounds,
-    draw_overlays, site_type_colour, strain_colour,
+    Canvas, Overlays, RenderOptions, STRAIN_LEGEND, View, bounds, draw_overlays, site_type_colour,
 };
 pub use pick::part_at;
-pub use pose::{
-    SiteFrame, Skin, WorldMesh, pose_assembly, pose_assembly_into, pose_instance, pose_piece,
-};
-pub use raster::{MAX_SIDE, PixmapCanvas, RenderError, render_pixmap, render_png};
-pub use sheet::{sheet_pixmap, sheet_png, sheet_svg};
+pub use pose::{WorldMesh, pose_assembly, pose_assembly_into};
+pub use raster::{MAX_SIDE, RenderError, render_png};
+pub use sheet::{sheet_png, sheet_svg};
 pub use svg::render_svg;
-pub use tessellate::{
-    Mesh, Solid, TessellationCache, tessellate_polygon, tessellate_polyline, tessellate_proxy,
+pub use tessellate::{Mesh, Solid, TessellationCache, tessellate_polygon};
+// Names only the tests and benches use, re-exported as `clay::testing::X`.
+#[cfg(any(test, feature = "testing"))]
+pub use {
+    contour::{CONTOUR_MIN_TRIANGLES, contours},
+    draw::{BACKGROUND, STRAIN_FULL, strain_colour},
+    pose::{SiteFrame, Skin, pose_instance, pose_piece},
+    raster::{PixmapCanvas, render_pixmap},
+    sheet::sheet_pixmap,
+    tessellate::{tessellate_polyline, tessellate_proxy},
 };

@@ -43,7 +43,9 @@ pub struct Skin {
 
 impl Skin {
     /// Builds the skin from rest and current positions of the piece's vertices; `None` when the
-    /// sites are empty, out of range, coincide, or positions are not finite.
+    /// sites are empty, out of range, coincide, or positions are not finite. Only the tests
+    /// build a skin by hand (posing builds it from the rest data once).
+    #[cfg(any(test, feature = "testing"))]
     pub fn new(
         rest: &[DVec2],
         current: &[DVec2],
@@ -173,6 +175,8 @@ pub struct WorldMesh {
 
 /// Poses one instance's geometry for its active rest state. Instances whose indices or
 /// positions are broken give no meshes; triangles touching a non-finite vertex are dropped.
+/// The tests' reference (posing goes through [`pose_assembly_into`]).
+#[cfg(any(test, feature = "testing"))]
 pub fn pose_instance(
     grammar: &CompiledGrammar,
     assembly: &AssemblyData,
@@ -222,9 +226,9 @@ pub fn pose_assembly(
     out
 }
 
-/// [`pose_assembly`] into `out`, reusing its meshes' buffers: what the editor calls on every
+/// `pose_assembly` into `out`, reusing its meshes' buffers: what the editor calls on every
 /// solver frame, where a fresh `Vec` of fresh meshes would cost most of the posing time in the
-/// allocator. Afterwards `out` holds exactly what [`pose_assembly`] returns.
+/// allocator. Afterwards `out` holds exactly what `pose_assembly` (the tests') returns.
 pub fn pose_assembly_into(
     grammar: &CompiledGrammar,
     assembly: &AssemblyData,

@@ -23,7 +23,10 @@ mod sites;
 pub mod stretch;
 
 pub use rewrite::{Rewrite, RuleEvent, RuleKind};
-pub use sites::{site_centre, site_out};
+pub use sites::site_centre;
+// Only the tests read a site's outward direction (`clay::testing::site_out`).
+#[cfg(any(test, feature = "testing"))]
+pub use sites::site_out;
 
 use std::collections::HashSet;
 

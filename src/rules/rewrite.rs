@@ -45,7 +45,7 @@ impl RuleKind {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RuleEvent {
     pub kind: RuleKind,
-    /// The frame after which the rule ran (set by [`Rules`](super::Rules); 0 from the pure rewrites).
+    /// The frame after which the rule ran (set by the session's rules; 0 from the pure rewrites).
     pub frame: u64,
     /// Where it happened (the centre of the rewritten region), in metres.
     pub at: DVec2,

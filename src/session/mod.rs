@@ -19,7 +19,10 @@ mod gesture;
 mod settings;
 
 pub use gesture::{Grab, pin, pin_at, pin_of, toggle_pin, unpin};
-pub use settings::{SETTING_NAMES, apply_setting, configure};
+pub use settings::{SETTING_NAMES, configure};
+// Only the tests set one setting by name (`clay::testing::apply_setting`).
+#[cfg(any(test, feature = "testing"))]
+pub use settings::apply_setting;
 
 use crate::assembly::{Assembly, HandleId};
 use crate::figure::rests_better;

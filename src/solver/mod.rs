@@ -38,12 +38,12 @@ mod turns;
 mod units;
 
 pub use config::{SolverConfig, SolverKind};
-pub use follow::Components;
-pub use measure::{
-    bbox, bbox_diagonal, edge_strain, edge_strains, elastic_energy, max_edge_strain,
-};
+pub use measure::{bbox, bbox_diagonal, edge_strain, elastic_energy, max_edge_strain};
+// Names only the tests use, re-exported as `clay::testing::X`.
 pub use report::{FrameReport, PhaseTimes, Proposal, SolverError, StateSwitch};
 pub use state::Solver;
+#[cfg(any(test, feature = "testing"))]
+pub use {follow::Components, measure::edge_strains};
 
 use std::time::{Duration, Instant};
 

@@ -14,7 +14,8 @@ use std::sync::Arc;
 
 pub mod assembly;
 
-use clay::{Assembly, RuleKind, Script, SolverConfig, bbox, bbox_diagonal, edge_strains};
+use clay::testing::{bbox, bbox_diagonal, edge_strains};
+use clay::{Assembly, RuleKind, Script, SolverConfig};
 use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
