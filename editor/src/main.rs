@@ -109,7 +109,7 @@ fn main() -> ExitCode {
             app.use_desktop(clay_editor::files::Desktop::detect());
             if args.follow {
                 let channel = clay_dsl::analysis::follow::channel();
-                app.follow = Some(clay_editor::follow::Follow::new(channel));
+                app.follow = Some(clay_editor::sculpt::follow::Follow::new(channel));
             }
             Ok(Box::new(app))
         }),

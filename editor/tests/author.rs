@@ -8,8 +8,8 @@ use clay::{authoring::Drawing, authoring::Polyline, authoring::StretchChoice, au
 use clay_editor::EditorApp;
 use clay_editor::action::Action;
 use clay_editor::app::Mode;
+use clay_editor::author::canvas::{SnapKind, Tool};
 use clay_editor::author::{AuthorCommand, Authoring};
-use clay_editor::author_canvas::{SnapKind, Tool};
 use egui::{Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -1091,7 +1091,7 @@ fn written_fills(a: &Authoring) -> Vec<(String, [u8; 4])> {
 
 #[test]
 fn the_canvas_fills_each_piece_with_the_colour_the_grammar_writes() {
-    use clay_editor::author_canvas::piece_colour;
+    use clay_editor::author::canvas::piece_colour;
     // SVG fills: a blue and a green region.
     let mut blue = rect(0.0, 0.0, 1.0, 1.0);
     blue.fill = Some([0x33, 0x66, 0xcc]);

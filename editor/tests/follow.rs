@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use clay_dsl::analysis::Analysis;
 use clay_dsl::analysis::follow::{self, Focus};
 use clay_editor::EditorApp;
-use clay_editor::follow::Follow;
+use clay_editor::sculpt::follow::Follow;
 use egui_kittest::kittest::Queryable;
 
 use common::{harness, settle};

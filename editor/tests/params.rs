@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use clay_editor::EditorApp;
 use clay_editor::action::Action;
-use clay_editor::panels::ParamChange;
+use clay_editor::sculpt::panels::ParamChange;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 

@@ -11,6 +11,7 @@ use std::time::Duration;
 use clay_editor::EditorApp;
 use clay_editor::compile::CASTLE_SOURCE;
 use clay_editor::sculpt::Command;
+use clay_editor::sculpt::panels::NAMES_NOTE;
 use egui::Shape;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -547,7 +548,7 @@ fn the_inspector_and_parameters_say_what_they_mean() {
 fn inserted_elements_names_are_explained_beside_the_grammars() {
     let mut h = harness(EditorApp::open(&grammar("wall.clay")));
     settle(&mut h);
-    assert!(h.query_by_label(clay_editor::panels::NAMES_NOTE).is_none());
+    assert!(h.query_by_label(NAMES_NOTE).is_none());
     let at = h.state().sculpt.assembly().part_centroid(0);
     h.state_mut().command(Command::TogglePin { part: 0, at });
     settle(&mut h);
@@ -558,7 +559,7 @@ fn inserted_elements_names_are_explained_beside_the_grammars() {
     );
     h.step();
     // The rule log says `wall#N` and `wall[N]`: the note says what each is.
-    h.get_by_label(clay_editor::panels::NAMES_NOTE);
+    h.get_by_label(NAMES_NOTE);
 }
 
 #[test]

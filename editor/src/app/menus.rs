@@ -5,7 +5,7 @@ use egui::{Key, Modifiers};
 
 use crate::action::Action;
 use crate::author::AuthorCommand;
-use crate::author_canvas::Tool;
+use crate::author::canvas::Tool;
 use crate::files::FileKind;
 use crate::sculpt::Command;
 

@@ -6,8 +6,10 @@
 //! The jobs are in the children: `document` (the open grammar, hot reload, sessions),
 //! `params` (the grammar's parameters set from the editor), `perform` (file actions),
 //! `export`, `menus` (menu bar, shortcuts, status bar), `dialogs` (modal prompts) and
-//! `sculpt_view` (sculpt mode's canvas and side panels). They import this module; it imports
-//! none of them.
+//! `sculpt_view` (sculpt mode's canvas and side panels, from `crate::sculpt`, over the app's
+//! state). They import this module; it imports none of them. Each mode's state, canvas and
+//! panels are its own module's (`crate::sculpt`, `crate::author`); this module holds both and
+//! lays them out.
 
 mod dialogs;
 mod document;
@@ -23,15 +25,17 @@ use std::time::Duration;
 use egui::Key;
 
 use crate::action::Action;
-use crate::author::{AuthorCommand, Authoring};
-use crate::author_canvas::AuthorCanvas;
-use crate::author_panel::{self, AuthorForm};
-use crate::canvas::Canvas;
+use crate::author::canvas::AuthorCanvas;
+use crate::author::panel::AuthorForm;
+use crate::author::{self, AuthorCommand, Authoring};
 use crate::compile::{CASTLE_PATH, CASTLE_SOURCE, Problem, empty_grammar};
+use crate::diagnostics::SourceView;
 use crate::files::{Desktop, FileKind, NativeDialog, Recent};
-use crate::overlay::ViewOverlays;
-use crate::panels;
 use crate::recovery::Recovery;
+use crate::sculpt::canvas::Canvas;
+use crate::sculpt::follow::{Follow, Highlight};
+use crate::sculpt::overlay::ViewOverlays;
+use crate::sculpt::panels::ParamChange;
 use crate::sculpt::{Command, Sculpt};
 use crate::watch::FileWatch;
 
@@ -116,13 +120,13 @@ pub struct EditorApp {
     /// stayed.
     pub refused: Option<(String, Vec<Problem>)>,
     /// The source line the user clicked in the diagnostics.
-    pub source_view: Option<panels::SourceView>,
+    pub source_view: Option<SourceView>,
     /// Following the text editor's cursor (`--follow`).
-    pub follow: Option<crate::follow::Follow>,
+    pub follow: Option<Follow>,
     /// Values the user set for the grammar's parameters (the Grammar parameters panel), by
     /// name: the open document's, kept across hot reloads, dropped when another grammar opens.
     param_overrides: Vec<(String, f64)>,
-    param_changes: Vec<panels::ParamChange>,
+    param_changes: Vec<ParamChange>,
 }
 
 impl EditorApp {
@@ -210,7 +214,7 @@ impl EditorApp {
     }
 
     /// What the text editor's cursor is on, in the model (`--follow`).
-    pub fn followed(&self) -> crate::follow::Highlight {
+    pub fn followed(&self) -> Highlight {
         self.follow.as_ref().map_or_else(Default::default, |f| {
             f.followed(self.grammar_path.as_deref(), &self.imports, &self.sculpt)
         })
@@ -288,7 +292,7 @@ impl EditorApp {
                     Mode::Author => {
                         ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
                         egui::ScrollArea::both().show(ui, |ui| {
-                            author_panel::show(
+                            author::panel::show(
                                 ui,
                                 &self.author,
                                 &mut self.author_canvas,

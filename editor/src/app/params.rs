@@ -8,7 +8,7 @@ use std::path::Path;
 use clay_dsl::compiled::Param;
 
 use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem};
-use crate::panels::ParamChange;
+use crate::sculpt::panels::ParamChange;
 
 use super::EditorApp;
 

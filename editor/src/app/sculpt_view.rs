@@ -1,9 +1,11 @@
 //! Sculpt mode's part of the window: the model's canvas (a panic while drawing caught) and the
 //! side panels (diagnostics, source, inspector, solver, parameters, grammar
-//! parameters, rule log).
+//! parameters, rule log), laid out from `crate::sculpt`'s canvas and panels over the app's
+//! state (its problems, source view and `--follow` highlight), which is why it is the app's.
 
 use crate::compile::{CASTLE_PATH, CASTLE_SOURCE, Problem, Severity};
-use crate::panels;
+use crate::diagnostics::{self, SourceView};
+use crate::sculpt::{follow, panels};
 
 use super::EditorApp;
 
@@ -29,7 +31,7 @@ impl EditorApp {
             self.canvas
                 .show(ui, &self.sculpt, &self.overlays, &mut self.commands);
             let (grammar, data) = (self.sculpt.grammar(), self.sculpt.data());
-            crate::follow::paint(ui, &self.canvas, grammar, data, &self.followed());
+            follow::paint(ui, &self.canvas, grammar, data, &self.followed());
         });
         if let Err(why) = drawn {
             let why = format!("internal error while drawing ({why})");
@@ -51,7 +53,7 @@ impl EditorApp {
             .show(ui, |ui| {
                 if let Some((file, problems)) = &self.refused {
                     let banner = format!("{file} was not opened: the current model stays.");
-                    clicked = panels::diagnostics(ui, problems, Some(&banner)).cloned();
+                    clicked = diagnostics::diagnostics(ui, problems, Some(&banner)).cloned();
                     ui.separator();
                 }
                 let banner = (self.stale && errors > 0).then(|| {
@@ -61,7 +63,7 @@ impl EditorApp {
                         "The file does not compile: the last good model stays live."
                     }
                 });
-                if let Some(p) = panels::diagnostics(ui, &self.problems, banner) {
+                if let Some(p) = diagnostics::diagnostics(ui, &self.problems, banner) {
                     clicked = Some(p.clone());
                 }
             });
@@ -71,7 +73,7 @@ impl EditorApp {
         if let Some(view) = &self.source_view {
             egui::CollapsingHeader::new("Source")
                 .default_open(true)
-                .show(ui, |ui| panels::source(ui, view));
+                .show(ui, |ui| diagnostics::source(ui, view));
         }
         egui::CollapsingHeader::new("Inspector")
             .default_open(true)
@@ -116,7 +118,7 @@ impl EditorApp {
                 return;
             }
         };
-        self.source_view = Some(panels::SourceView {
+        self.source_view = Some(SourceView {
             problem: p.clone(),
             file: p.file.clone(),
             text,

@@ -1,6 +1,14 @@
-//! The sculpt: the live assembly, its solver, the user's grab and pins, and the undo history of
-//! whole gestures. Everything the canvas and panels change goes through [`Command`]s applied
-//! here, so it is tested without a window.
+//! Sculpting mode. This module is the sculpt: the live assembly, its solver, the user's grab
+//! and pins, and the undo history of whole gestures. Everything the canvas and panels change
+//! goes through [`Command`]s applied here, so it is tested without a window.
+//!
+//! The model's parts are private children: `gestures` (the grab, pins and cuts as the
+//! session's gestures), `history` (undo), `record` (the gestures as a script), `frame` and
+//! `solving` (a frame on the UI thread or on the background `worker`), `log` (the rule log)
+//! and `inspect` (the inspector's report). The mode's view is in public ones: `canvas` (the
+//! model drawn, pointer and keys to [`Command`]s), its `overlay` (the View overlays) and `iso`
+//! (the isometric 3D view), `panels` (the side panels) and `follow` (`--follow`'s highlight).
+//! The children import this module; it imports only the model's children, never the view's.
 
 use std::sync::Arc;
 
@@ -9,6 +17,12 @@ use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use glam::DVec2;
 
 use crate::session::{Pin, Settings};
+
+pub mod canvas;
+pub mod follow;
+pub mod iso;
+pub mod overlay;
+pub mod panels;
 
 mod frame;
 mod gestures;

@@ -14,7 +14,7 @@ use clay::{
 use egui::{Align2, Color32, FontId, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
-use crate::author::{AuthorCommand, Authoring, short};
+use super::{AuthorCommand, Authoring, short};
 use crate::camera::{Camera, dv, pos};
 
 /// Pointer distance (screen points) within which a point or edge counts as under it.
@@ -642,7 +642,7 @@ impl AuthorCanvas {
             painter.text(
                 s + Vec2::new(10.0, -10.0),
                 Align2::LEFT_BOTTOM,
-                format!("{} {}", k.label(), crate::author::coords(t)),
+                format!("{} {}", k.label(), super::coords(t)),
                 FontId::proportional(11.0),
                 colour,
             );

@@ -12,8 +12,8 @@ use clay_dsl::analysis::follow::{self, Focus};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar};
 use egui::{Color32, Key, Stroke};
 
-use crate::canvas::Canvas;
-use crate::sculpt::Sculpt;
+use super::Sculpt;
+use super::canvas::Canvas;
 
 /// How often the cursor file is looked at.
 pub const POLL: Duration = Duration::from_millis(150);

@@ -7,9 +7,9 @@ use clay_dsl::compiled::AssemblyData;
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::DVec2;
 
+use super::overlay::ViewOverlays;
+use super::{Command, Sculpt};
 use crate::camera::{Camera, dv, pos};
-use crate::overlay::ViewOverlays;
-use crate::sculpt::{Command, Sculpt};
 
 /// Pointer distance (screen points) within which an edge or connection counts as under it.
 const PICK_RADIUS: f64 = 10.0;
@@ -55,7 +55,7 @@ pub struct Canvas {
     /// Show the model in the isometric 3D view instead of the floor plan (View menu, I).
     pub iso: bool,
     /// The isometric view's last picture.
-    pub iso_picture: Option<crate::iso::IsoPicture>,
+    pub iso_picture: Option<super::iso::IsoPicture>,
 }
 
 impl Default for Canvas {
@@ -142,7 +142,7 @@ impl Canvas {
                 commands.push(Command::Release);
             }
             (self.hovered, self.cut_target) = (None, None);
-            crate::iso::paint(ui, &painter, self.rect, sculpt, &mut self.iso_picture);
+            super::iso::paint(ui, &painter, self.rect, sculpt, &mut self.iso_picture);
             return;
         }
 
@@ -253,7 +253,7 @@ impl Canvas {
         }
 
         self.paint(&painter, sculpt);
-        crate::overlay::paint(&painter, self.rect, &self.camera, sculpt, overlays);
+        super::overlay::paint(&painter, self.rect, &self.camera, sculpt, overlays);
         self.label_parts(ui, sculpt);
     }
 

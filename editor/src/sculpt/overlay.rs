@@ -7,8 +7,8 @@ use clay::{Overlays, View, draw_overlays};
 use clay_dsl::compiled::Rgba;
 use egui::{Color32, Pos2, Rect, Shape, Stroke, Vec2};
 
+use super::Sculpt;
 use crate::camera::Camera;
-use crate::sculpt::Sculpt;
 
 /// Which overlays are on (the View menu's toggles).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -7,7 +7,7 @@
 use clay::{ExportOptions, iso_pixmap, scene};
 use egui::{Color32, ColorImage, Rect, TextureHandle, TextureOptions};
 
-use crate::sculpt::Sculpt;
+use super::Sculpt;
 
 /// The last picture: what it shows (grammar, revision, size in pixels) and its texture.
 pub struct IsoPicture {

@@ -1,8 +1,12 @@
-//! Authoring mode's state: the author's work (`clay::authoring::Work`: the drawing, its
-//! cuts and the rule declarations) with its undo history, the grammar the library computes
-//! from it (`clay::authoring::compute`, the same steps as `clayc author`) with the
+//! Authoring mode. This module is its state: the author's work (`clay::authoring::Work`: the
+//! drawing, its cuts and the rule declarations) with its undo history, the grammar the library
+//! computes from it (`clay::authoring::compute`, the same steps as `clayc author`) with the
 //! compiler's diagnostics, and what the last command has to say. Every change is an
 //! [`AuthorCommand`]; changes to the work are undoable as whole steps.
+//!
+//! The mode's view is in the children: `canvas` (the drawing and the design drawn, the draw,
+//! cut and site tools) and `panel` (the side panel). They import this module; it imports
+//! neither.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +19,9 @@ use clay::{
 use glam::DVec2;
 
 use crate::compile::{self, Problem};
+
+pub mod canvas;
+pub mod panel;
 
 /// Name the authored grammar is compiled under before it has been written to a file.
 pub const UNSAVED_NAME: &str = "authored.clay";

@@ -14,11 +14,11 @@ use clay::{
 use egui::{Color32, RichText};
 
 use crate::action::Action;
+use crate::diagnostics;
 use crate::files::FileKind;
 
-use crate::author::{AuthorCommand, Authoring};
-use crate::author_canvas::{AuthorCanvas, Tool, piece_colour, site_colour};
-use crate::panels;
+use super::canvas::{AuthorCanvas, Tool, piece_colour, site_colour};
+use super::{AuthorCommand, Authoring};
 
 /// Text the user is typing in the panel, kept between frames.
 pub struct AuthorForm {
@@ -711,7 +711,7 @@ fn grammar(ui: &mut egui::Ui, author: &Authoring, actions: &mut Vec<Action>) {
             RichText::new("The grammar does not compile.").color(Color32::from_rgb(200, 40, 40)),
         );
     }
-    panels::diagnostics(ui, &author.problems, None);
+    diagnostics::diagnostics(ui, &author.problems, None);
     if let Some(text) = author.text() {
         egui::CollapsingHeader::new("Text")
             .default_open(false)
