@@ -3,7 +3,8 @@
 //! counted, over an import graph parsed whole with `syn`, the `clayc` binary included), the library's
 //! top-level modules import one another only along the documented table of allowed edges,
 //! the editor uses only the library's surfaces (the session, rendering, authoring, and the
-//! solver's settings and report types), rules never import sessions or scripts, protocol types
+//! solver's settings and report types) and its two modes import neither each other nor the app
+//! that holds them, rules never import sessions or scripts, protocol types
 //! stay in the language server, a solver frame changes no part, instance or connection, and
 //! the libraries print nothing, every file is read through the one bounded reader, and no
 //! `use` imports a whole crate root, no two public types share a name, and the library's top
@@ -726,6 +727,41 @@ fn rules_know_nothing_of_sessions_and_scripts() {
                 );
             }
         }
+    }
+}
+
+/// Architecture Invariant: the editor is laid out by mode. A mode (`sculpt`, `author`) imports
+/// neither the other mode nor the app that holds both; what both modes use (`camera`,
+/// `compile`, `diagnostics`, ...) imports no mode and not the app.
+#[test]
+fn the_editors_modes_import_neither_each_other_nor_the_app() {
+    let editor = Crate::read(&root().join("editor/src/lib.rs"));
+    let imports = imports(&editor, None);
+    let modes = ["sculpt", "author"];
+    let mut seen = BTreeSet::new();
+    for i in &imports {
+        let (from, to) = (top(&i.from), top(&i.to));
+        seen.insert(from.clone());
+        if from.is_empty() || to.is_empty() || from == to || from == "app" {
+            continue;
+        }
+        assert!(
+            to != "app" && !modes.contains(&to.as_str()),
+            "{}:{}: `{}` imports `{}`: {} imports `{to}` (docs/architecture.md, \
+             `clay-editor`: the modes import neither each other nor the app)",
+            shown(&i.file),
+            i.line,
+            i.from,
+            i.to,
+            if modes.contains(&from.as_str()) {
+                format!("the mode `{from}`")
+            } else {
+                format!("`{from}`, which both modes share,")
+            }
+        );
+    }
+    for m in modes {
+        assert!(seen.contains(m), "editor/src has no mode `{m}`: {seen:?}");
     }
 }
 
