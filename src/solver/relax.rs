@@ -171,8 +171,7 @@ impl Solver {
             }
         }
         // a chain of turning elements: the count its ends' turn asks for (`turns.rs`)
-        let lengths = relaxed_lengths(asm, &families, &f);
-        for counts in counts_from_turns(asm, &lengths, &f, hysteresis) {
+        for counts in counts_from_turns(asm, &f, hysteresis) {
             alternatives.push(Proposal {
                 counts,
                 states: self.relaxed_states(&data.parts, &forced, &f),

@@ -8,12 +8,11 @@
 use std::cmp::Ordering;
 
 use clay_dsl::compiled::{
-    AssemblyData, CompiledGrammar, InstanceSite, Part, PartKind, STRETCH_TWO, StretchPart,
-    StretchRule,
+    AssemblyData, CompiledGrammar, Part, PartKind, STRETCH_TWO, StretchPart, StretchRule,
 };
 use glam::DVec2;
 
-use super::rounding::{Relaxed, held_elements, runs};
+use super::rounding::{held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
 
@@ -99,8 +98,6 @@ struct ChainTurn {
     /// In the pose: the chain's first site's vertices, its last site's.
     from: Vec<DVec2>,
     to: Vec<DVec2>,
-    /// An element's length at rest (its step's).
-    element: f64,
     count: usize,
     off: f64,
     first: usize,
@@ -146,7 +143,6 @@ impl ChainTurn {
             step,
             rest_from,
             rest_to,
-            element: step.apply(step.from_centre).distance(step.from_centre),
             from,
             to,
             count: n,
@@ -170,20 +166,6 @@ impl ChainTurn {
         last
     }
 
-    /// How far the chain's first site's centre moves when it has `m` elements at rest and
-    /// its last site stays where the pose has it.
-    fn first_moves(&self, m: usize) -> Option<DVec2> {
-        let onto = rigid_motion(&self.rest_last(m), &self.to)?;
-        Some(onto.apply(centre(&self.rest_from)) - centre(&self.from))
-    }
-
-    /// How far its last site's centre moves when it has `m` elements at rest and its first
-    /// site stays where the pose has it.
-    fn last_moves(&self, m: usize) -> Option<DVec2> {
-        let onto = rigid_motion(&self.rest_from, &self.from)?;
-        Some(onto.apply(centre(&self.rest_last(m))) - centre(&self.to))
-    }
-
     /// How far apart its first and last sites' centres are at rest with `m` elements.
     fn chord(&self, m: usize) -> Option<f64> {
         let d = centre(&self.rest_last(m)).distance(centre(&self.rest_from));
@@ -194,30 +176,25 @@ impl ChainTurn {
     fn span(&self) -> f64 {
         centre(&self.to).distance(centre(&self.from))
     }
-
-    /// Its direction in the pose, first site to last.
-    fn direction(&self) -> DVec2 {
-        (centre(&self.to) - centre(&self.from)).normalize_or_zero()
-    }
 }
 
 /// Proposals of counts (each a list of `(chain, first, count)` as a [`Proposal`]'s) for
-/// every chain of turning elements whose count does not match the turn it is held to in
+/// every chain of turning elements whose count does not match a turn it is held to in
 /// `pose` (the relaxed pose): the count whose turn matches best, when better than the
 /// chain's own by the `hysteresis` margin (paper 4.3, in elements' turns), within the rule's
 /// bounds, among counts a whole turn apart the one whose ends are as far apart at rest as
-/// in the pose, then the fewest (no extra loop); alone, and with a straight chain docked to
-/// either end taking up what its ends move by (its count from its relaxed length in
-/// `lengths`). A chain's turn from its first site to its last grows by one element's turn
-/// with each element, modulo a whole turn. The turn it
-/// is held to: its own, or, where it is the one turning chain of chains in series
+/// in the pose, then the fewest (no extra loop). A chain's turn from its first site to its
+/// last grows by one element's turn with each element, modulo a whole turn. The turns it
+/// may be held to: its own; where it is the one turning chain of chains in series
 /// (`rounding::runs`: a straight wall and an arc docked end to end), theirs all together,
-/// since only the run's ends are held by rigid pieces and a straight chain rests straight.
+/// since a straight chain rests straight; and the turn along each path between two held
+/// pieces through it ([`held_paths`]). The session judges each with the lengths it then
+/// asks for (`Proposal::then_lengths`), so the straight chains it moves are re-counted
+/// there, not here.
 ///
 /// [`Proposal`]: super::report::Proposal
 pub(super) fn counts_from_turns(
     asm: &Assembly,
-    lengths: &[Relaxed],
     pose: &[DVec2],
     hysteresis: f64,
 ) -> Vec<Vec<(usize, usize, usize)>> {
@@ -281,10 +258,10 @@ pub(super) fn counts_from_turns(
             }
         }
         for off in offs {
-            for change in from_turn(asm, c, t, off, &turns, lengths, hysteresis) {
-                if !out.contains(&change) {
-                    out.push(change);
-                }
+            if let Some(change) = from_turn(c, t, off, hysteresis).map(|x| vec![x])
+                && !out.contains(&change)
+            {
+                out.push(change);
             }
         }
     }
@@ -336,19 +313,10 @@ pub(super) fn counts_from_turns(
     out
 }
 
-/// The proposals for turning chain `c` (`t`) held to a turn `off` (radians) from its rest
-/// turn: the count whose turn matches best, when better than its own by the `hysteresis`
-/// margin, alone and with a straight chain docked to either end taking up what its ends move
-/// by (`lengths`: the relaxed lengths of the straight ones).
-fn from_turn(
-    asm: &Assembly,
-    c: usize,
-    t: &ChainTurn,
-    off: f64,
-    turns: &[Option<ChainTurn>],
-    lengths: &[Relaxed],
-    hysteresis: f64,
-) -> Vec<Vec<(usize, usize, usize)>> {
+/// The count for turning chain `c` (`t`) held to a turn `off` (radians) from its rest
+/// turn, as [`counts_from_turns`] says; `None` when none matches better than its own by the
+/// `hysteresis` margin.
+fn from_turn(c: usize, t: &ChainTurn, off: f64, hysteresis: f64) -> Option<(usize, usize, usize)> {
     let n = t.count;
     // how far `m` elements' turn is from the one held, in element turns
     // (to a millionth: counts a whole turn apart miss alike, not by rounding)
@@ -370,31 +338,8 @@ fn from_turn(
     let best = (t.min..=hi)
         .filter(|&m| m != n)
         .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
-    let Some(m) = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5) else {
-        return Vec::new();
-    };
-    let change = (c, t.first, m);
-    let mut out = vec![vec![change]];
-    // a straight chain docked to either end takes up what the turning one's new count
-    // moves that end by, its other end staying (a wall between a tower and an arc)
-    for (before, moved) in [(true, t.first_moves(m)), (false, t.last_moves(m))] {
-        let Some((d, moved)) = neighbour(asm, c, before).zip(moved) else {
-            continue;
-        };
-        let Some(s) = turns[d].as_ref().filter(|s| !s.turns() && s.element > 0.0) else {
-            continue;
-        };
-        let along = moved.dot(s.direction()) / s.element;
-        let length = (lengths.iter())
-            .find(|r| r.chain == d)
-            .map_or(s.count as f64, |r| r.length);
-        let want = length + if before { along } else { -along };
-        let want = (want.round().max(s.min as f64) as usize).min(s.max.unwrap_or(usize::MAX));
-        if want != s.count {
-            out.push(vec![change, (d, s.first, want)]);
-        }
-    }
-    out
+    let m = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5)?;
+    Some((c, t.first, m))
 }
 
 /// A step of a path between held pieces ([`held_paths`]).
@@ -517,35 +462,6 @@ fn piece_off(
     };
     let (e, l) = (angles(enter)?, angles(leave)?);
     Some(wrap((l.1 - e.1) - (l.0 - e.0)))
-}
-
-/// The chain docked to chain `c`'s first site (`before`) or to its last: the one whose last
-/// (first) element's site is docked there.
-fn neighbour(asm: &Assembly, c: usize, before: bool) -> Option<usize> {
-    let (data, grammar) = (asm.data(), asm.grammar());
-    let chain = data.chains.get(c)?;
-    let rule = grammar.stretch_rules.get(chain.rule)?;
-    let end = if before {
-        InstanceSite {
-            instance: *chain.instances.first()?,
-            site: rule.from,
-        }
-    } else {
-        InstanceSite {
-            instance: *chain.instances.last()?,
-            site: rule.to,
-        }
-    };
-    let other = (data.docks.iter())
-        .find_map(|d| (d.a == end).then_some(d.b).or((d.b == end).then_some(d.a)))?;
-    (data.chains.iter().enumerate()).find_map(|(d, x)| {
-        let at = if before {
-            x.instances.last()
-        } else {
-            x.instances.first()
-        };
-        (d != c && at == Some(&other.instance)).then_some(d)
-    })
 }
 
 #[cfg(test)]
