@@ -282,6 +282,29 @@ fn compiled_grammars_mutated_never_panic() {
     );
 }
 
+/// The compiled grammars the long runs found (`tests/fixtures/fuzz_finds/compiled/`, one
+/// JSON file each), through the same checks, each within the hang limit. The first: the
+/// junction's stretch part with its `two` state bent (one vertex 1 m out of line), so its
+/// elements turned by a few thousandths of a radian; the turn along the path between the
+/// grab and the model's far end asked a chain of 8 for 172 elements (a whole turn more),
+/// and trying that took 5 s a frame in release (`CLAY_FUZZ_CASES=1000000`, seed 20261206,
+/// case 147394: over 20 s there, under load). The bound that fixed it is pinned by the unit
+/// test `a_chain_is_proposed_at_most_twice_its_count` (`src/solver/turns.rs`); this test
+/// keeps every find running through the fuzzer's checks.
+#[test]
+fn compiled_grammar_finds_neither_panic_nor_hang() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz_finds/compiled");
+    let mut files = Vec::new();
+    files_under(&dir, "json", &mut files);
+    assert!(!files.is_empty(), "no finds under {}", dir.display());
+    for f in files {
+        let input = std::fs::read(&f).unwrap();
+        if let Err(why) = fuzzing::within_hang(move || compiled(&input)) {
+            panic!("{}: {why}", f.display());
+        }
+    }
+}
+
 /// The wall's grammar, compiled once: the grammar every session of the session fuzzer names.
 fn wall_grammar() -> std::sync::Arc<clay_dsl::CompiledGrammar> {
     static WALL: std::sync::OnceLock<std::sync::Arc<clay_dsl::CompiledGrammar>> =

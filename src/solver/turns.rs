@@ -332,9 +332,11 @@ fn from_turn(c: usize, t: &ChainTurn, off: f64, hysteresis: f64) -> Option<(usiz
         let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
         ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
     };
-    // up to a whole turn more than it has (and twice its count)
-    let turn = (std::f64::consts::TAU / t.theta.abs()).ceil() as usize;
-    let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
+    // at most twice its count (and two more), as a stretch grows a chain in one rewrite:
+    // with elements that turn little, a whole turn more is hundreds of elements, and a
+    // misfit the relaxation spread along a path reads as one of them (a corrupted grammar's
+    // chain of 8 was proposed 172 and the trial took seconds)
+    let hi = t.max.unwrap_or(usize::MAX).min(2 * n + 2);
     let best = (t.min..=hi)
         .filter(|&m| m != n)
         .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
@@ -466,8 +468,42 @@ fn piece_off(
 
 #[cfg(test)]
 mod tests {
-    use super::wrap;
+    use super::{counts_from_turns, wrap};
     use std::f64::consts::PI;
+
+    #[test]
+    fn a_chain_is_proposed_at_most_twice_its_count() {
+        // the junction's stretch part with its `two` state bent (a fuzz find): its elements
+        // turn by thousandths of a radian, and a whole turn more is hundreds of elements
+        let json =
+            include_str!("../../tests/fixtures/fuzz_finds/compiled/turns_of_a_bent_two_state.json");
+        let grammar: clay_dsl::CompiledGrammar = serde_json::from_str(json).unwrap();
+        let grammar = std::sync::Arc::new(grammar);
+        let mut asm = crate::assembly::Assembly::new(grammar.clone());
+        // the instance furthest east grabbed and dragged by (1, 0.5) over three frames
+        let east = (0..asm.data().instances.len())
+            .max_by(|&a, &b| {
+                let x = |i| asm.instance_centroid(i).map_or(f64::NEG_INFINITY, |c| c.x);
+                x(a).total_cmp(&x(b))
+            })
+            .unwrap();
+        let grab = asm
+            .hold_instance(east, crate::assembly::HandleKind::Grab)
+            .unwrap();
+        let mut solver =
+            crate::solver::Solver::new(crate::solver::SolverConfig::from_params(&grammar.solver));
+        for k in 1..=3 {
+            let by = glam::DVec2::new(1.0, 0.5) * (k as f64 / 3.0);
+            asm.move_handle(grab, by, 0.0);
+            solver.frame(&mut asm).unwrap();
+        }
+        let pose = asm.data().positions.clone();
+        let proposals = counts_from_turns(&asm, &pose, 0.15);
+        for (chain, _, count) in proposals.into_iter().flatten() {
+            let n = asm.data().chains[chain].instances.len();
+            assert!(count <= 2 * n + 2, "chain {chain} of {n} proposed {count}");
+        }
+    }
 
     #[test]
     fn wrap_is_the_turn_to_the_nearest_whole_turn() {

@@ -12,6 +12,21 @@ use proptest::test_runner::{RngAlgorithm, TestRng};
 /// Longer than any case may take: a case over it is reported as a hang.
 pub const HANG: Duration = Duration::from_secs(20);
 
+/// Runs `check` on its own thread: its outcome, a panic's text, or a hang when it takes
+/// longer than [`HANG`].
+pub fn within_hang(
+    check: impl FnOnce() -> Result<(), String> + Send + 'static,
+) -> Result<(), String> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(check))
+            .unwrap_or_else(|p| Err(format!("panic: {}", panic_text(p.as_ref()))));
+        let _ = tx.send(outcome);
+    });
+    rx.recv_timeout(HANG)
+        .unwrap_or_else(|_| Err(format!("ran over {HANG:?}")))
+}
+
 /// Text that is likely to matter to the parsers: comment and bracket openers, multi-byte
 /// characters, a byte-order mark, odd numbers, keywords.
 pub const TOKENS: &[&str] = &[
