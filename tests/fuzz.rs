@@ -289,7 +289,7 @@ fn compiled_grammars_mutated_never_panic() {
 /// grab and the model's far end asked a chain of 8 for 172 elements (a whole turn more),
 /// and trying that took 5 s a frame in release (`CLAY_FUZZ_CASES=1000000`, seed 20261206,
 /// case 147394: over 20 s there, under load). The bound that fixed it is pinned by the unit
-/// test `a_chain_is_proposed_at_most_twice_its_count` (`src/solver/turns.rs`); this test
+/// test `a_chain_is_proposed_at_most_a_bounded_turn_more` (`src/solver/turns.rs`); this test
 /// keeps every find running through the fuzzer's checks.
 #[test]
 fn compiled_grammar_finds_neither_panic_nor_hang() {

@@ -20,6 +20,10 @@ use crate::fit::{RigidMotion, align, rigid_motion};
 /// chain's turn says nothing of its count.
 const STRAIGHT: f64 = 1e-3;
 
+/// The most elements a whole turn more adds to a chain in one proposal ([`from_turn`]):
+/// twelve 30-degree wedges, or 64 elements of 5.6 degrees.
+const WHOLE_TURN_MOST: usize = 64;
+
 /// The centre of points.
 fn centre(ps: &[DVec2]) -> DVec2 {
     ps.iter().sum::<DVec2>() / ps.len().max(1) as f64
@@ -332,11 +336,12 @@ fn from_turn(c: usize, t: &ChainTurn, off: f64, hysteresis: f64) -> Option<(usiz
         let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
         ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
     };
-    // at most twice its count (and two more), as a stretch grows a chain in one rewrite:
-    // with elements that turn little, a whole turn more is hundreds of elements, and a
-    // misfit the relaxation spread along a path reads as one of them (a corrupted grammar's
-    // chain of 8 was proposed 172 and the trial took seconds)
-    let hi = t.max.unwrap_or(usize::MAX).min(2 * n + 2);
+    // up to a whole turn more than it has (and twice its count), a whole turn being at most
+    // WHOLE_TURN_MOST elements: with elements that turn by thousandths of a radian it is
+    // hundreds, and a misfit the relaxation spread reads as one of them (a fuzzed grammar's
+    // chain of 8 was proposed 172, and judging it took seconds)
+    let turn = ((std::f64::consts::TAU / t.theta.abs()).ceil() as usize).min(WHOLE_TURN_MOST);
+    let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
     let best = (t.min..=hi)
         .filter(|&m| m != n)
         .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
@@ -472,7 +477,7 @@ mod tests {
     use std::f64::consts::PI;
 
     #[test]
-    fn a_chain_is_proposed_at_most_twice_its_count() {
+    fn a_chain_is_proposed_at_most_a_bounded_turn_more() {
         // the junction's stretch part with its `two` state bent (a fuzz find): its elements
         // turn by thousandths of a radian, and a whole turn more is hundreds of elements
         let json =
@@ -501,7 +506,8 @@ mod tests {
         let proposals = counts_from_turns(&asm, &pose, 0.15);
         for (chain, _, count) in proposals.into_iter().flatten() {
             let n = asm.data().chains[chain].instances.len();
-            assert!(count <= 2 * n + 2, "chain {chain} of {n} proposed {count}");
+            let most = (2 * n).max(n + super::WHOLE_TURN_MOST) + 2;
+            assert!(count <= most, "chain {chain} of {n} proposed {count}");
         }
     }
 
