@@ -651,6 +651,11 @@ impl AssemblyData {
                 continue;
             }
         }
+        // each dock both ways, looked up per pair of elements (a scan of every dock per pair
+        // made each rule's check quadratic in the model: half of a fuzzed sculpt's time)
+        let docked: std::collections::HashSet<(InstanceSite, InstanceSite)> = (self.docks.iter())
+            .flat_map(|d| [(d.a, d.b), (d.b, d.a)])
+            .collect();
         for (ci, chain) in self.chains.iter().enumerate() {
             let Some(rule) = grammar.stretch_rules.get(chain.rule) else {
                 out.push(format!(
@@ -674,11 +679,7 @@ impl AssemblyData {
                     instance: w[1],
                     site: rule.from,
                 };
-                let docked = self
-                    .docks
-                    .iter()
-                    .any(|d| (d.a == to && d.b == from) || (d.a == from && d.b == to));
-                if !docked {
+                if !docked.contains(&(to, from)) {
                     out.push(format!(
                         "chain {ci}: elements {} and {} are not docked",
                         w[0], w[1]

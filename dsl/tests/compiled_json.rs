@@ -73,3 +73,38 @@ fn indices_that_do_not_hold_read_without_parts_and_without_a_panic() {
         }
     }
 }
+
+#[test]
+fn a_chain_whose_elements_are_not_docked_is_reported_either_way_round() {
+    for (name, grammar) in examples() {
+        let Some(chain) = grammar
+            .assembly
+            .chains
+            .iter()
+            .find(|c| c.instances.len() >= 2)
+        else {
+            continue;
+        };
+        let pair = [chain.instances[0], chain.instances[1]];
+        assert!(grammar.assembly.problems(&grammar).is_empty(), "{name}");
+        // the dock between the first two elements, written the other way round: still docked
+        let mut turned = grammar.clone();
+        for d in &mut turned.assembly.docks {
+            if pair.contains(&d.a.instance) && pair.contains(&d.b.instance) {
+                std::mem::swap(&mut d.a, &mut d.b);
+            }
+        }
+        assert!(turned.assembly.problems(&turned).is_empty(), "{name}");
+        // and taken away: the chain is reported
+        let mut broken = grammar.clone();
+        broken
+            .assembly
+            .docks
+            .retain(|d| !(pair.contains(&d.a.instance) && pair.contains(&d.b.instance)));
+        let problems = broken.assembly.problems(&broken);
+        assert!(
+            problems.iter().any(|p| p.contains("are not docked")),
+            "{name}: {problems:?}"
+        );
+    }
+}
