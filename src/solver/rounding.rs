@@ -68,14 +68,7 @@ pub(super) fn runs(
     held: &[u64],
 ) -> Vec<Vec<usize>> {
     let n = data.chains.len();
-    let mut chain_of = vec![None; data.instances.len()];
-    for (c, chain) in data.chains.iter().enumerate() {
-        for &i in &chain.instances {
-            if let Some(slot) = chain_of.get_mut(i) {
-                *slot = Some(c);
-            }
-        }
-    }
+    let chain_of = chain_of(data);
     let mut partner: std::collections::HashMap<InstanceSite, InstanceSite> = Default::default();
     let mut docks_of = vec![0usize; data.instances.len()];
     for d in &data.docks {
@@ -293,6 +286,19 @@ const CLOSE: f64 = 0.1;
 
 /// The most combinations of counts [`decide_run`] searches across a run's whole length.
 const WIDEST: usize = 100_000;
+
+/// The chain each instance is an element of, by instance index (`None`: no chain's).
+pub(super) fn chain_of(data: &AssemblyData) -> Vec<Option<usize>> {
+    let mut chain_of = vec![None; data.instances.len()];
+    for (c, chain) in data.chains.iter().enumerate() {
+        for &i in &chain.instances {
+            if let Some(slot) = chain_of.get_mut(i) {
+                *slot = Some(c);
+            }
+        }
+    }
+    chain_of
+}
 
 /// The stable ids of the instances the handles hold.
 pub(super) fn held_elements(asm: &Assembly) -> Vec<u64> {

@@ -12,7 +12,7 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
-use super::rounding::{held_elements, runs};
+use super::rounding::{chain_of, held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
 
@@ -369,14 +369,7 @@ enum Step {
 /// turning chains' counts must match together. The fewest instances' path where several
 /// join the same two.
 fn held_paths(data: &AssemblyData, held: &[u64]) -> Vec<Vec<Step>> {
-    let mut chain_of = vec![None; data.instances.len()];
-    for (c, chain) in data.chains.iter().enumerate() {
-        for &i in &chain.instances {
-            if let Some(slot) = chain_of.get_mut(i) {
-                *slot = Some(c);
-            }
-        }
-    }
+    let chain_of = chain_of(data);
     // each instance's docked neighbours: (neighbour, own site, neighbour's site)
     let mut next = vec![Vec::new(); data.instances.len()];
     for d in &data.docks {
