@@ -53,7 +53,7 @@ pub use session::{
     replay, toggle_pin,
 };
 pub use solver::{
-    FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch,
+    FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch, Stop,
 };
 pub use summary::{FrameMs, Summary};
 

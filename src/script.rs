@@ -47,6 +47,11 @@ pub enum Step {
     Release,
     /// Run frames without moving anything.
     Hold { frames: u64 },
+    /// The next frame's passes stop after at most `pass1` and `pass2` iterations: an
+    /// editor's time budget stopped that frame there (its report's `pass1_iterations` and
+    /// `l2_iterations`), so its replay stops there too. Runs no frame itself; a budget never
+    /// adds iterations to what the solver's settings allow.
+    Budget { pass1: u64, pass2: u64 },
     /// Cut the connection nearest the point (needs the rules hook).
     Cut { at: DVec2 },
 }
@@ -146,13 +151,18 @@ fn point(v: &Value, what: &str) -> Result<DVec2, Fault> {
 }
 
 fn frames(obj: &serde_json::Map<String, Value>, kind: &str) -> Result<u64, String> {
+    count(obj, kind, "frames")
+}
+
+/// The whole number `obj[key]`, from 0 to [`MAX_FRAMES`].
+fn count(obj: &serde_json::Map<String, Value>, kind: &str, key: &str) -> Result<u64, String> {
     let v = obj
-        .get("frames")
-        .ok_or_else(|| format!("{kind} needs \"frames\""))?;
+        .get(key)
+        .ok_or_else(|| format!("{kind} needs \"{key}\""))?;
     match v.as_u64() {
         Some(n) if n <= MAX_FRAMES => Ok(n),
         _ => Err(format!(
-            "{kind}: \"frames\" must be an integer from 0 to {MAX_FRAMES}, found {v}"
+            "{kind}: \"{key}\" must be an integer from 0 to {MAX_FRAMES}, found {v}"
         )),
     }
 }
@@ -205,7 +215,7 @@ fn step(v: &Value) -> Result<Step, Fault> {
         .ok_or_else(|| format!("a step must be an object, found {v}"))?;
     if obj.len() != 1 {
         return Err(format!(
-            "a step must have exactly one key (grab, pin, unpin, drag, rotate, release, hold, cut), found {}",
+            "a step must have exactly one key (grab, pin, unpin, drag, rotate, release, hold, budget, cut), found {}",
             if obj.is_empty() {
                 "none".to_string()
             } else {
@@ -256,6 +266,14 @@ fn step(v: &Value) -> Result<Step, Fault> {
                 frames: frames(o, "hold")?,
             })
         }
+        "budget" => {
+            let o = object(body, "budget")?;
+            only_keys(o, "budget", &["pass1", "pass2"])?;
+            Ok(Step::Budget {
+                pass1: count(o, "budget", "pass1")?,
+                pass2: count(o, "budget", "pass2")?,
+            })
+        }
         "cut" => {
             let o = object(body, "cut")?;
             only_keys(o, "cut", &["at"])?;
@@ -264,7 +282,7 @@ fn step(v: &Value) -> Result<Step, Fault> {
             })
         }
         other => Err(format!(
-            "unknown step \"{other}\" (expected grab, pin, unpin, drag, rotate, release, hold or cut)"
+            "unknown step \"{other}\" (expected grab, pin, unpin, drag, rotate, release, hold, budget or cut)"
         )
         .into()),
     }
@@ -395,6 +413,7 @@ impl Step {
             }
             Step::Release => json!({"release": {}}),
             Step::Hold { frames } => json!({"hold": {"frames": frames}}),
+            Step::Budget { pass1, pass2 } => json!({"budget": {"pass1": pass1, "pass2": pass2}}),
             Step::Cut { at } => json!({"cut": {"at": point(*at)}}),
         }
     }

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use clay::{Assembly, RuleKind, Script, Session, SolverConfig, replay};
+use clay::{Assembly, RuleKind, Script, Session, SolverConfig, Step, replay};
 
 fn grammar(name: &str) -> clay_dsl::compiled::CompiledGrammar {
     let dir = env!("CARGO_MANIFEST_DIR");
@@ -99,4 +99,56 @@ fn an_unpinned_brick_follows_the_wall_again() {
         notes[0].contains("unpin found no pinned instance"),
         "{notes:?}"
     );
+}
+
+/// A frame an editor's time budget stopped replays bit for bit from a `budget` step with the
+/// iterations its report gave (the trials of other rest states run whole whatever the
+/// budget), and only with it: the same frames run to the end land elsewhere.
+#[test]
+fn a_frame_the_budget_stopped_replays_from_its_iterations() {
+    let g = Arc::new(grammar("wall"));
+    let config = SolverConfig::from_params(&g.solver);
+    let start = Script::parse(
+        r#"{"steps": [{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}},
+            {"drag": {"by": [2.5, 0.8], "frames": 0}}]}"#,
+    )
+    .unwrap();
+    // the editor: frames with no time at all, so every pass stops as early as it may
+    let mut edited = Assembly::new(g.clone());
+    let mut editor = Session::new(config);
+    replay(&mut edited, &start, &mut editor).unwrap();
+    let mut steps = start.steps.clone();
+    let mut stopped = 0;
+    for _ in 0..20 {
+        let report = editor
+            .frame_within(&mut edited, std::time::Duration::ZERO)
+            .unwrap()
+            .report;
+        if !report.complete {
+            stopped += 1;
+            steps.push(Step::Budget {
+                pass1: report.pass1_iterations as u64,
+                pass2: report.l2_iterations as u64,
+            });
+        }
+        steps.push(Step::Hold { frames: 1 });
+    }
+    assert!(stopped >= 10, "the budget stopped {stopped} of 20 frames");
+    // the script with its budget steps lands exactly where the editor did
+    let mut replayed = Assembly::new(g.clone());
+    replay(
+        &mut replayed,
+        &Script {
+            steps: steps.clone(),
+        },
+        &mut Session::new(config),
+    )
+    .unwrap();
+    assert_eq!(replayed.data().instances, edited.data().instances);
+    assert_eq!(replayed.data().positions, edited.data().positions);
+    // without them the frames run to the end, elsewhere
+    steps.retain(|s| !matches!(s, Step::Budget { .. }));
+    let mut whole = Assembly::new(g);
+    replay(&mut whole, &Script { steps }, &mut Session::new(config)).unwrap();
+    assert_ne!(whole.data().positions, edited.data().positions);
 }

@@ -29,7 +29,7 @@ use crate::figure::rests_better;
 use crate::rules::cut::CUT_REACH;
 use crate::rules::{RuleEvent, RuleKind, Rules, replace};
 use crate::script::{Motion, Script, Selector, Step};
-use crate::solver::{FrameReport, Solver, SolverConfig, SolverError};
+use crate::solver::{FrameReport, Solver, SolverConfig, SolverError, Stop};
 use crate::summary::{Summary, summarize};
 
 /// What one sculpting frame did.
@@ -82,6 +82,9 @@ pub struct Session {
     /// Remarks about steps and requests that did nothing, in order.
     notes: Vec<String>,
     last_report: Option<FrameReport>,
+    /// Where the next [`Session::frame`]'s passes stop: a script's `budget` step replays a
+    /// frame an editor's time budget stopped ([`Stop::After`]); never, else.
+    next_stop: Stop,
 }
 
 impl Session {
@@ -104,6 +107,7 @@ impl Session {
             frame_ms: Vec::new(),
             notes: Vec::new(),
             last_report: None,
+            next_stop: Stop::Never,
         }
     }
 
@@ -166,9 +170,11 @@ impl Session {
         self.grab.map(|g| g.handle())
     }
 
-    /// One sculpting frame: a solver frame, then the rules.
+    /// One sculpting frame: a solver frame, then the rules (its passes stopped where a
+    /// script's `budget` step just before it says, if one did).
     pub fn frame(&mut self, asm: &mut Assembly) -> Result<Frame, SolverError> {
-        self.run_frame(asm, None)
+        let stop = std::mem::take(&mut self.next_stop);
+        self.run_frame(asm, stop)
     }
 
     /// One sculpting frame whose solver part stops within `budget` (it continues next frame;
@@ -178,23 +184,18 @@ impl Session {
         asm: &mut Assembly,
         budget: Duration,
     ) -> Result<Frame, SolverError> {
-        self.run_frame(asm, Some(budget))
+        self.run_frame(asm, Stop::within(budget))
     }
 
-    fn run_frame(
-        &mut self,
-        asm: &mut Assembly,
-        budget: Option<Duration>,
-    ) -> Result<Frame, SolverError> {
+    fn run_frame(&mut self, asm: &mut Assembly, stop: Stop) -> Result<Frame, SolverError> {
         let start = Instant::now();
-        let deadline = budget.and_then(|b| start.checked_add(b));
         let mut events = Vec::new();
         // Paper 5.2: pass 1 decides the topology, the rules that change it run, and pass 2
         // solves the new structure for display; merges act on the displayed pose after it.
         let rules = &mut self.rules;
         let report = self
             .solver
-            .frame_with(asm, deadline, &mut |asm, report, pass1| {
+            .frame_with(asm, stop, &mut |asm, report, pass1| {
                 events = match rules.as_mut() {
                     Some(rules) => rules.after_pass1(asm, report, pass1),
                     None => {
@@ -213,7 +214,7 @@ impl Session {
         }
         let proposals = self.solver.take_proposals(asm);
         if !proposals.is_empty() {
-            events.extend(self.try_proposals(asm, report.energy, &proposals, deadline));
+            events.extend(self.try_proposals(asm, report.energy, &proposals));
         }
         for e in &events {
             *self.rules_fired.entry(e.kind).or_default() += 1;
@@ -229,13 +230,14 @@ impl Session {
     /// the lowest energy replaces `asm` when that is below `(1 - hysteresis)` times the energy
     /// of `asm` as it is, settled the same way (or `energy`, the frame's, if lower: paper 4.2,
     /// 4.3: the structure changes where a rest state fits better, judged by energy).
-    /// Alternatives are tried while the frame's `deadline` allows. Returns the events kept.
+    /// Every alternative is tried, whatever the frame's budget: what a frame does must not
+    /// depend on the clock but through where its passes stopped ([`Stop`]), or a sculpt
+    /// would not replay. Returns the events kept.
     fn try_proposals(
         &mut self,
         asm: &mut Assembly,
         energy: f64,
         proposals: &[crate::solver::Proposal],
-        deadline: Option<Instant>,
     ) -> Vec<RuleEvent> {
         let Some(rules) = &mut self.rules else {
             return Vec::new();
@@ -246,15 +248,9 @@ impl Session {
             l2_iterations: SETTLE_ITERATIONS,
             ..config
         };
-        let remaining = || match deadline {
-            Some(d) => d.checked_duration_since(Instant::now()),
-            None => Some(Duration::MAX),
-        };
         // the model as it is, settled as the alternatives are: what they must beat
         let mut current = asm.clone();
-        let Some(Ok(report)) =
-            remaining().map(|b| Solver::new(settle).frame_budgeted(&mut current, b))
-        else {
+        let Ok(report) = Solver::new(settle).frame(&mut current) else {
             return Vec::new();
         };
         let energy = report.energy.min(energy);
@@ -266,16 +262,15 @@ impl Session {
         };
         for proposal in proposals {
             let Some((after, trial, events, mut solver)) =
-                restructured(rules, asm, proposal, settle, remaining())
+                restructured(rules, asm, proposal, settle)
             else {
                 continue;
             };
             if proposal.then_lengths {
                 // the counts a turn asks for, with the lengths they then ask for
-                let deadline = remaining().and_then(|b| Instant::now().checked_add(b));
-                for then in solver.relaxed_after(&trial, deadline) {
+                for then in solver.relaxed_after(&trial) {
                     if let Some((after, trial, more, _)) =
-                        restructured(rules, &trial, &then, settle, remaining())
+                        restructured(rules, &trial, &then, settle)
                     {
                         keep((after, trial, [events.clone(), more].concat()));
                     }
@@ -406,15 +401,14 @@ impl Session {
 }
 
 /// A copy of `asm` restructured by the rules as `proposal` says (laid out from its pose)
-/// and settled by a solver of config `settle` within `budget`: its energy, the copy, the
-/// rules' events and the solver (which has run a frame on the copy). `None` when the rules
-/// change nothing, the time is out or the settling fails.
+/// and settled by a solver of config `settle`: its energy, the copy, the rules' events and
+/// the solver (which has run a frame on the copy). `None` when the rules change nothing or
+/// the settling fails.
 fn restructured(
     rules: &mut Rules,
     asm: &Assembly,
     proposal: &crate::solver::Proposal,
     settle: SolverConfig,
-    budget: Option<Duration>,
 ) -> Option<(f64, Assembly, Vec<RuleEvent>, Solver)> {
     if proposal.pose.len() != asm.data().positions.len() {
         return None;
@@ -426,7 +420,7 @@ fn restructured(
         return None;
     }
     let mut solver = Solver::new(settle);
-    let report = solver.frame_budgeted(&mut trial, budget?).ok()?;
+    let report = solver.frame(&mut trial).ok()?;
     Some((report.energy, trial, events, solver))
 }
 
@@ -533,6 +527,12 @@ impl Session {
                 for _ in 0..frames {
                     self.frame(asm)?;
                 }
+            }
+            Step::Budget { pass1, pass2 } => {
+                self.next_stop = Stop::After {
+                    pass1: pass1 as usize,
+                    pass2: pass2 as usize,
+                };
             }
             Step::Cut { at } => {
                 if let Err(why) = self.cut(asm, at) {

@@ -37,6 +37,7 @@ mod trials;
 mod turns;
 mod units;
 
+pub use clock::Stop;
 pub use config::{SolverConfig, SolverKind};
 pub use measure::{bbox, bbox_diagonal, edge_strain, elastic_energy, max_edge_strain};
 // Names only the tests use, re-exported as `clay::testing::X`.
@@ -102,13 +103,9 @@ impl Solver {
     /// What the relaxation proposes for `asm` as it is (after a frame of this solver on it),
     /// its turns' proposals aside: the lengths a restructured copy then asks for
     /// ([`Proposal::then_lengths`]). Empty when the relaxation fails.
-    pub(crate) fn relaxed_after(
-        &mut self,
-        asm: &Assembly,
-        deadline: Option<Instant>,
-    ) -> Vec<Proposal> {
+    pub(crate) fn relaxed_after(&mut self, asm: &Assembly) -> Vec<Proposal> {
         let warm = asm.data().positions.clone();
-        let mut found = self.relax(asm, &warm, deadline).unwrap_or_default();
+        let mut found = self.relax(asm, &warm).unwrap_or_default();
         found.retain(|p| !p.then_lengths);
         found
     }
@@ -126,7 +123,7 @@ impl Solver {
 
     /// Runs one frame on `asm`: moves its positions, active states and rotations.
     pub fn frame(&mut self, asm: &mut Assembly) -> Result<FrameReport, SolverError> {
-        self.frame_within(asm, None, &mut |_, _, _| {})
+        self.frame_within(asm, Stop::Never, &mut |_, _, _| {})
     }
 
     /// Runs one frame with `between` called after pass 1 (paper 5.2: "after having
@@ -135,14 +132,14 @@ impl Solver {
     /// frame's report so far (switches, claims) and the pass-1 pose, and may rewrite the
     /// assembly's structure (the stretch and shrink rules); pass 2 then runs on the rewritten
     /// assembly, from its positions, so what is displayed is the least-squares pose of the
-    /// new structure. `deadline` as for [`Solver::frame_budgeted`] (`None`: no deadline).
+    /// new structure. Its passes stop as `stop` says ([`Stop`]).
     pub fn frame_with(
         &mut self,
         asm: &mut Assembly,
-        deadline: Option<Instant>,
+        stop: Stop,
         between: &mut Between,
     ) -> Result<FrameReport, SolverError> {
-        self.frame_within(asm, deadline, between)
+        self.frame_within(asm, stop, between)
     }
 
     /// Runs one frame that stops early once `budget` is (about to be) spent, for an editor
@@ -152,28 +149,30 @@ impl Solver {
     /// proper least-squares pose of the current states even when cut short. A further
     /// iteration is started only if the previous one of its pass fits in the time left. When
     /// cut short, the report has `complete == false` and `converged == false`; call again next
-    /// frame: the positions and active states carry the work over. A
-    /// budget of `Duration::MAX` behaves like [`Solver::frame`].
+    /// frame: the positions and active states carry the work over. Only the passes stop
+    /// early (the trials of other rest states run whole), and the report's
+    /// `pass1_iterations` and `l2_iterations` say where, so [`Stop::After`] with them
+    /// replays the frame bit for bit. A budget of `Duration::MAX` behaves like
+    /// [`Solver::frame`].
     pub fn frame_budgeted(
         &mut self,
         asm: &mut Assembly,
         budget: Duration,
     ) -> Result<FrameReport, SolverError> {
-        let deadline = Instant::now().checked_add(budget);
-        self.frame_within(asm, deadline, &mut |_, _, _| {})
+        self.frame_within(asm, Stop::within(budget), &mut |_, _, _| {})
     }
 
     fn frame_within(
         &mut self,
         asm: &mut Assembly,
-        deadline: Option<Instant>,
+        stop: Stop,
         between: &mut Between,
     ) -> Result<FrameReport, SolverError> {
         let start = Instant::now();
         let on_pool = self.frame_uses_pool(asm);
         let mut run = || {
             self.prepare(asm)?;
-            self.frame_prepared(asm, deadline, start, between)
+            self.frame_prepared(asm, stop, start, between)
         };
         // A frame whose steps go to both cores runs as one task of the pool
         // (`chunks::on_pool`): each step is pushed to the pool from inside it rather than
@@ -200,7 +199,7 @@ impl Solver {
     fn frame_prepared(
         &mut self,
         asm: &mut Assembly,
-        deadline: Option<Instant>,
+        stop: Stop,
         start: Instant,
         between: &mut Between,
     ) -> Result<FrameReport, SolverError> {
@@ -219,7 +218,7 @@ impl Solver {
         let mut pose = self.pass1_start(asm, &warm);
         report.phases.bookkeeping += ms_since(start);
         // 3. Pass 1: the sparse norm by IRLS; its local steps choose the states (pass1.rs).
-        let pass1 = self.pass1(&mut asm.data_mut().parts, &mut pose, deadline, &mut report);
+        let pass1 = self.pass1(&mut asm.data_mut().parts, &mut pose, stop, &mut report);
         self.pass1_pose = pose;
         // 4. Claims: how many elements each chain gains or loses, by its length (chains.rs).
         self.collect_claims(asm, &mut report);
@@ -227,7 +226,7 @@ impl Solver {
         self.work.start.valid.take_if(|_| pass1.is_err());
         let pass1_converged = pass1?;
         // 5. Trials: a held model that stopped strained tries other rest states (trials.rs).
-        self.trials(asm, &mut warm, deadline, &mut report)?;
+        self.trials(asm, &mut warm, &mut report)?;
         // 6. The rules (`between`); pass 2 starts from their layout if they rewrote (handles.rs).
         let t = Instant::now();
         let before = asm.generation();
@@ -238,7 +237,7 @@ impl Solver {
         report.phases.bookkeeping += ms_since(t);
         // 7. Pass 2: least squares with the states fixed, from the displayed pose (pass2.rs).
         let (parts, handles, tolerance) = (&asm.data().parts, asm.handles(), self.config.tolerance);
-        let pass2 = self.pass2(parts, handles, warm, tolerance, deadline, &mut report);
+        let pass2 = self.pass2(parts, handles, warm, tolerance, stop, &mut report);
         self.work.start.valid.take_if(|_| pass2.is_err());
         let (f, terms, pass2_converged) = pass2?;
         // 8. Pass 2's pose shown, kept for the next frame, and judged converged (pass2.rs).

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use clay_dsl::compiled::Part;
 use glam::DVec2;
 
-use super::clock::{ms_since, out_of_time};
+use super::clock::{Stop, ms_since};
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError};
 use super::state::Solver;
@@ -54,13 +54,13 @@ impl Solver {
     /// displayed pose, the handles moved); its local steps decide the active rest states.
     /// Iterates until no vertex moves more than [`SolverConfig::pass1_tolerance`] times the
     /// mean rest edge and no state switches, or the configured count, or (after
-    /// [`MIN_PASS1_ITERATIONS`]) the deadline. Leaves its pose in `pose`; returns whether it
+    /// [`MIN_PASS1_ITERATIONS`]) `stop`. Leaves its pose in `pose`; returns whether it
     /// converged.
     pub(super) fn pass1(
         &mut self,
         parts: &mut [Part],
         pose: &mut Vec<DVec2>,
-        deadline: Option<Instant>,
+        stop: Stop,
         report: &mut FrameReport,
     ) -> Result<bool, SolverError> {
         let cfg = self.config;
@@ -74,7 +74,7 @@ impl Solver {
         let mut last_iteration = Duration::ZERO;
         let mut result = Ok(());
         for it in 0..iterations {
-            if it >= MIN_PASS1_ITERATIONS && out_of_time(deadline, last_iteration) {
+            if it >= MIN_PASS1_ITERATIONS && stop.before(false, it, last_iteration) {
                 report.complete = false;
                 break;
             }

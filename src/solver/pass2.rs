@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
-use super::clock::{ms_since, out_of_time};
+use super::clock::{Stop, ms_since};
 use super::config::SolverConfig;
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError};
@@ -41,7 +41,7 @@ impl Solver {
 
     /// Pass 2 (paper 5.2): plain least squares with the states fixed, from the displayed pose
     /// `warm` (iterated in place), until no vertex moves more than `tolerance`, or the
-    /// configured count, or (after one iteration) the deadline. With no pass-2 iterations
+    /// configured count, or (after one iteration) `stop`. With no pass-2 iterations
     /// configured, shows the pass-1 pose. Returns the pose, its objective's terms (its
     /// rotations and edge targets left in the work buffers) and whether it converged.
     pub(super) fn pass2(
@@ -50,7 +50,7 @@ impl Solver {
         handles: &[Handle],
         warm: Vec<DVec2>,
         tolerance: f64,
-        deadline: Option<Instant>,
+        stop: Stop,
         report: &mut FrameReport,
     ) -> Result<(Vec<DVec2>, Terms, bool), SolverError> {
         let cfg = self.config;
@@ -97,7 +97,7 @@ impl Solver {
             cfg.l2_iterations
         };
         for it in 0..iterations {
-            if it > 0 && out_of_time(deadline, last_iteration) {
+            if it > 0 && stop.before(true, it, last_iteration) {
                 report.complete = false;
                 break;
             }

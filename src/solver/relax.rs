@@ -13,12 +13,9 @@
 //! it): an `impl Solver` block over the state of `state.rs`, imported from that sibling rather
 //! than from `mod.rs`, so no child imports its parent.
 
-use std::time::{Duration, Instant};
-
 use clay_dsl::compiled::{Part, PartKind, STRETCH_TWO};
 use glam::DVec2;
 
-use super::clock::out_of_time;
 use super::global_step::Pass;
 use super::growth::ChainLength;
 use super::local::{self, StretchEnds};
@@ -121,7 +118,6 @@ impl Solver {
         &mut self,
         asm: &Assembly,
         warm: &[DVec2],
-        deadline: Option<Instant>,
     ) -> Result<Vec<Proposal>, SolverError> {
         let data = asm.data();
         let families: Vec<Option<Family>> = (data.parts.iter())
@@ -133,11 +129,10 @@ impl Solver {
             .collect();
         let hysteresis = self.config.hysteresis;
         let mut f = warm.to_vec();
-        let forced = self.relaxed_piece_states(asm, &families, &mut f, deadline)?;
+        let forced = self.relaxed_piece_states(asm, &families, &mut f)?;
         let mut found: Vec<(Vec<Option<usize>>, Vec<DVec2>)> = Vec::new();
         for pick in [Pick::Nearest, Pick::Furthest] {
-            let Some((decided, g, first)) =
-                self.round_counts(asm, &families, &forced, &f, pick, deadline)?
+            let Some((decided, g, first)) = self.round_counts(asm, &families, &forced, &f, pick)?
             else {
                 return Ok(Vec::new());
             };
@@ -196,7 +191,6 @@ impl Solver {
         forced: &[(usize, usize)],
         start: &[DVec2],
         pick: Pick,
-        deadline: Option<Instant>,
     ) -> Result<Option<Rounded>, SolverError> {
         let data = asm.data();
         let held = held_elements(asm);
@@ -207,7 +201,7 @@ impl Solver {
         let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
         loop {
             let fixed = fixed_scales(asm, &decided, &held);
-            self.relax_from(asm, families, &fixed, forced, &mut f, deadline)?;
+            self.relax_from(asm, families, &fixed, forced, &mut f)?;
             if f.iter().any(|p| !p.is_finite()) {
                 return Ok(None);
             }
@@ -249,9 +243,6 @@ impl Solver {
                     None => decided[r.chain] = Some(r.decide(hysteresis)),
                 }
             }
-            if out_of_time(deadline, Duration::ZERO) {
-                break;
-            }
         }
         let first = first.unwrap_or_else(|| f.clone());
         Ok(Some((decided, f, first)))
@@ -270,26 +261,22 @@ impl Solver {
         asm: &Assembly,
         families: &[Option<Family>],
         f: &mut Vec<DVec2>,
-        deadline: Option<Instant>,
     ) -> Result<Vec<(usize, usize)>, SolverError> {
         let parts = &asm.data().parts;
         let free = vec![None; parts.len()];
         let mut forced: Vec<(usize, usize)> = Vec::new();
-        let mut energy = self.relax_from(asm, families, &free, &forced, f, deadline)?;
+        let mut energy = self.relax_from(asm, families, &free, &forced, f)?;
         let margin = 1.0 - self.config.hysteresis;
         for _ in 0..STATE_ROUNDS {
             // (relaxed objective, the states kept, the relaxed pose)
             let mut best: Option<(f64, States, Vec<DVec2>)> = None;
             for m in self.state_candidates(parts, &forced, f) {
-                if out_of_time(deadline, Duration::ZERO) {
-                    break;
-                }
                 let mut trial: Vec<(usize, usize)> = (forced.iter().copied())
                     .filter(|x| m.iter().all(|y| y.0 != x.0))
                     .collect();
                 trial.extend(&m);
                 let mut g = f.clone();
-                let e = self.relax_from(asm, families, &free, &trial, &mut g, deadline)?;
+                let e = self.relax_from(asm, families, &free, &trial, &mut g)?;
                 if e < margin * energy && best.as_ref().is_none_or(|b| e < b.0) {
                     best = Some((e, trial, g));
                 }
@@ -373,7 +360,6 @@ impl Solver {
         fixed: &[Option<[f64; 2]>],
         forced: &[(usize, usize)],
         f: &mut Vec<DVec2>,
-        deadline: Option<Instant>,
     ) -> Result<f64, SolverError> {
         let parts = &asm.data().parts;
         let handles = asm.handles();
@@ -387,12 +373,7 @@ impl Solver {
         let mut objective = self.relaxed_targets(parts, families, fixed, forced, f, &mut scales)
             + handle_term(handles, f, weight);
         let mut kept = self.work.targets.clone();
-        let mut last = Duration::ZERO;
         for _ in 0..ITERATIONS {
-            if out_of_time(deadline, last) {
-                break;
-            }
-            let start = Instant::now();
             self.work.targets.clone_from(&kept);
             self.solve_global(f, &mut next, Pass::LeastSquares, &mut report)?;
             let mixed = anderson.mix(f, &mut next);
@@ -416,7 +397,6 @@ impl Solver {
             kept.clone_from(&self.work.targets);
             let flat = objective - e <= FLAT * objective;
             objective = e;
-            last = start.elapsed();
             if flat {
                 break;
             }

@@ -7,12 +7,10 @@
 //! seldom and long: an `impl Solver` block over the state of `state.rs`, imported from that
 //! sibling rather than from `mod.rs`, so no child imports its parent.
 
-use std::time::{Duration, Instant};
-
 use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
-use super::clock::out_of_time;
+use super::clock::Stop;
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError, StateSwitch};
 use super::state::Solver;
@@ -20,7 +18,7 @@ use super::{chunks, layout, local};
 use crate::assembly::{Assembly, Handle};
 
 impl Solver {
-    /// The frame's trials: when it is [`Solver::settling`] and time is left, other rest states
+    /// The frame's trials: when it is [`Solver::settling`], other rest states
     /// are tried ([`Solver::try_states`]), and an assignment kept from the rest layout moves
     /// `warm` (where pass 2 starts) there. Notes the handles' targets for the next frame's
     /// stillness test.
@@ -28,13 +26,12 @@ impl Solver {
         &mut self,
         asm: &mut Assembly,
         warm: &mut [DVec2],
-        deadline: Option<Instant>,
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
         let settling = self.settling(report, asm.handles().is_empty());
         self.work.last_targets.clone_from(&self.work.handle_sum);
         self.proposals = None;
-        if settling && !out_of_time(deadline, Duration::ZERO) {
+        if settling {
             let handles = asm.handles().to_vec();
             let parts = &mut asm.data_mut().parts;
             if let Some(laid) = self.try_states(parts, &handles, warm, report)? {
@@ -42,9 +39,9 @@ impl Solver {
             }
             // nothing the states could do: what the relaxed model proposes (`relax.rs`); not
             // with least squares, whose structure follows the drag alone (paper Fig. 8)
-            if self.work.tried && self.config.norm < 2.0 && !out_of_time(deadline, Duration::ZERO) {
+            if self.work.tried && self.config.norm < 2.0 {
                 let generation = asm.generation();
-                self.proposals = Some((generation, self.relax(asm, warm, deadline)?));
+                self.proposals = Some((generation, self.relax(asm, warm)?));
             }
         }
         Ok(())
@@ -52,8 +49,8 @@ impl Solver {
 
     /// Whether this frame tries other rest states ([`Solver::try_states`]): the handles
     /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
-    /// pose all but still and yet not at rest, and no try since the handles, the states or
-    /// the structure last changed.
+    /// pose all but still (or its energy creeping down: [`CREEP`]) and yet not at rest, and
+    /// no try since the handles, the states or the structure last changed.
     pub(super) fn settling(&mut self, report: &FrameReport, free: bool) -> bool {
         let w = &mut self.work;
         let held_still = w.last_targets == w.handle_sum;
@@ -66,10 +63,7 @@ impl Solver {
         }
         let stopped = w.last_moved <= 1e-3;
         // nothing held and the energy all but flat: a long, thin chain unbending, which
-        // least squares would take hundreds of frames over (or a fold it never leaves). Not
-        // while held: a held model that creeps would try during the editor's pauses, where
-        // the frame's time budget decides whether a try runs, and the gesture saved as a
-        // script would no longer replay into the same sculpt (`editor/tests/gesture_script.rs`)
+        // least squares would take hundreds of frames over (or a fold it never leaves)
         let [last, before] = w.last_energy;
         let creeping = free && last > CREEP * before;
         let untried = !w.tried;
@@ -275,7 +269,7 @@ impl Solver {
         self.config.l2_iterations = SETTLE_ITERATIONS;
         self.work.start.valid = None;
         // the sizes measured when the frame began (the same model, a pose near it)
-        let settled = self.pass2(parts, handles, f, cfg.tolerance, None, &mut report);
+        let settled = self.pass2(parts, handles, f, cfg.tolerance, Stop::Never, &mut report);
         self.config = cfg;
         let (_, terms, _) = settled?;
         Ok(terms.total())

@@ -125,13 +125,29 @@ impl Recording {
         }
     }
 
-    /// A solver frame ran. Right after a move it is that move's frame (`"frames": 1` runs the
-    /// frame after the jump, as a jump and a held frame do).
-    pub(super) fn frame(&mut self) {
-        if self.held == 0
+    /// A solver frame ran; `stopped`: the iterations of its two passes when the time budget
+    /// stopped it early (`FrameReport::complete` false). Right after a move it is that move's
+    /// frame (`"frames": 1` runs the frame after the jump, as a jump and a held frame do). A
+    /// stopped frame is written as a `budget` step and a held frame after the frames before
+    /// it, so the replay stops where the editor's clock did.
+    pub(super) fn frame(&mut self, stopped: Option<(u64, u64)>) {
+        let after_move = self.held == 0
+            && matches!(
+                self.steps.last(),
+                Some(Step::Drag { frames: 0, .. } | Step::Rotate { frames: 0, .. })
+            );
+        if let Some((pass1, pass2)) = stopped {
+            if !self.on() {
+                return;
+            }
+            self.write_held();
+            self.append(Step::Budget { pass1, pass2 });
+            self.held = 1;
+            return;
+        }
+        if after_move
             && let Some(Step::Drag { frames, .. } | Step::Rotate { frames, .. }) =
                 self.steps.last_mut()
-            && *frames == 0
         {
             *frames = 1;
             return;
@@ -194,22 +210,22 @@ mod tests {
     #[test]
     fn moves_become_steps_when_a_frame_sees_them() {
         let mut r = Recording::new();
-        r.frame();
-        r.frame();
+        r.frame(None);
+        r.frame(None);
         r.grab(DVec2::new(7.0, 0.0));
         // Two moves before a frame: only the last is seen.
         r.moved(DVec2::new(0.5, 0.0), 0.0);
         r.moved(DVec2::new(1.0, 0.0), 0.0);
         r.frame_starts();
-        r.frame();
+        r.frame(None);
         r.frame_starts();
-        r.frame();
+        r.frame(None);
         r.moved(DVec2::new(1.0, 0.5), 0.25);
         r.frame_starts();
-        r.frame();
+        r.frame(None);
         r.release();
         r.pin(DVec2::new(8.0, 0.0), true);
-        r.frame();
+        r.frame(None);
         let steps = r.script().unwrap().steps;
         assert_eq!(
             steps,
@@ -237,11 +253,42 @@ mod tests {
     }
 
     #[test]
+    fn a_frame_the_budget_stopped_is_a_budget_step_before_its_frame() {
+        let mut r = Recording::new();
+        r.frame(None);
+        r.frame(None);
+        // a held frame stopped: the frames before it, then its budget and itself
+        r.frame(Some((2, 1)));
+        r.frame(None);
+        r.grab(DVec2::new(7.0, 0.0));
+        r.moved(DVec2::new(1.0, 0.0), 0.0);
+        r.frame_starts();
+        // a move's frame stopped: the move jumps, then the budget and the frame
+        r.frame(Some((3, 4)));
+        let budget = |pass1, pass2| Step::Budget { pass1, pass2 };
+        assert_eq!(
+            r.script().unwrap().steps,
+            vec![
+                Step::Hold { frames: 2 },
+                budget(2, 1),
+                Step::Hold { frames: 2 },
+                Step::Grab(Selector::At(DVec2::new(7.0, 0.0))),
+                Step::Drag {
+                    motion: Motion::By(DVec2::new(1.0, 0.0)),
+                    frames: 0
+                },
+                budget(3, 4),
+                Step::Hold { frames: 1 },
+            ]
+        );
+    }
+
+    #[test]
     fn copies_share_the_steps_and_the_script_keeps_their_order() {
         let mut r = Recording::new();
         for k in 0..(3 * CHUNK + 5) {
             r.pin(DVec2::new(k as f64, 0.0), k % 2 == 0);
-            r.frame();
+            r.frame(None);
         }
         let copy = r.clone();
         // a pin and a held frame each, less the last frame (held, not yet a step)
@@ -266,7 +313,7 @@ mod tests {
     fn a_sculpt_from_elsewhere_has_no_script() {
         let mut r = Recording::unknown("opened from a session".into());
         r.grab(DVec2::ZERO);
-        r.frame();
+        r.frame(None);
         assert_eq!(r.script(), Err("opened from a session".to_string()));
     }
 }

@@ -143,7 +143,9 @@ impl Sculpt {
         match outcome.report {
             Ok(report) => {
                 self.frame += 1;
-                self.record.frame();
+                let stopped = (!report.complete)
+                    .then_some((report.pass1_iterations as u64, report.l2_iterations as u64));
+                self.record.frame(stopped);
                 self.revision += 1;
                 self.frames_last_step += 1;
                 for (message, at) in outcome.notes {
