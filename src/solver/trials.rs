@@ -1,5 +1,5 @@
 //! Trials of other rest states (`docs/solver.md`, "Folds"): a held model that stopped
-//! strained, or a free one that creeps, tries other assignments of rest states once (the
+//! strained, or one that creeps, tries other assignments of rest states once (the
 //! nearest single switches, a bend handed to a neighbour, bends reverted, the rest layout),
 //! each settled by a few iterations, and keeps one that is clearly better.
 //!
@@ -28,7 +28,7 @@ impl Solver {
         warm: &mut [DVec2],
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
-        let settling = self.settling(report, asm.handles().is_empty());
+        let settling = self.settling(report);
         self.work.last_targets.clone_from(&self.work.handle_sum);
         self.proposals = None;
         if settling {
@@ -51,7 +51,7 @@ impl Solver {
     /// stayed where they were and pass 1 switched nothing, the last frame left the displayed
     /// pose all but still (or its energy creeping down: [`CREEP`]) and yet not at rest, and
     /// no try since the handles, the states or the structure last changed.
-    pub(super) fn settling(&mut self, report: &FrameReport, free: bool) -> bool {
+    pub(super) fn settling(&mut self, report: &FrameReport) -> bool {
         let w = &mut self.work;
         let held_still = w.last_targets == w.handle_sum;
         if !held_still {
@@ -62,10 +62,13 @@ impl Solver {
             w.tried = false;
         }
         let stopped = w.last_moved <= 1e-3;
-        // nothing held and the energy all but flat: a long, thin chain unbending, which
-        // least squares would take hundreds of frames over (or a fold it never leaves)
+        // the energy all but flat: a long, thin chain unbending, which least squares would
+        // take hundreds of frames over (or a fold it never leaves), free or held (a held
+        // tree whose arcs must turn further creeps towards its strained pose for hundreds of
+        // frames). The tries run whole whatever the frame's budget, so a gesture saved as a
+        // script replays into the same sculpt (`Stop`, `editor/tests/gesture_script.rs`)
         let [last, before] = w.last_energy;
-        let creeping = free && last > CREEP * before;
+        let creeping = last > CREEP * before;
         let untried = !w.tried;
         still && (stopped || creeping) && untried && self.strained(self.work.start.elastic)
     }
@@ -281,6 +284,6 @@ impl Solver {
 /// between it and the handle, which least squares settles slowly.
 const SETTLE_ITERATIONS: usize = 60;
 
-/// A model with nothing held whose energy fell by less than this factor's complement over a
-/// frame (5%) creeps: it tries other states and the rest layout without waiting to stop.
+/// A model whose energy fell by less than this factor's complement over a frame (5%)
+/// creeps, held or free: it tries other states and the rest layout without waiting to stop.
 const CREEP: f64 = 0.95;
