@@ -1,10 +1,11 @@
 //! The fuzzer the project keeps (issue 37): seeded in-process mutation of every example and
 //! fixture grammar and script, fed to the grammar parser, compiler, formatter and editor
-//! analysis and to the script parser; and of every example's compiled grammar (`clayc
-//! build`'s JSON, issue 47), fed to what `render` and `export` do with one. Properties: no panic; no input that takes longer than
-//! `HANG` (a hang guard, not a speed bound: a case takes milliseconds); every grammar diagnostic
-//! on char boundaries of its file with a 1-based line and column, and rendered; `fmt`
-//! idempotent and meaning-preserving. `CLAY_FUZZ_CASES=N` runs N cases (default 10,000),
+//! analysis and to the script parser; of every example's compiled grammar (`clayc build`'s
+//! JSON, issue 47), fed to what `render` and `export` do with one; of saved sessions; and
+//! solver settings mixed at and beyond their bounds, fed to `--set` and a sculpt. Properties:
+//! no panic; no input that takes longer than `HANG` (a hang guard, not a speed bound: a case
+//! takes milliseconds); every grammar diagnostic on char boundaries of its file with a 1-based
+//! line and column, and rendered; `fmt` idempotent and meaning-preserving. `CLAY_FUZZ_CASES=N` runs N cases (default 10,000),
 //! `CLAY_FUZZ_SEED` another seed; a failure prints the input (escaped) to reproduce it.
 
 mod fuzzing;
@@ -13,6 +14,7 @@ mod located;
 
 use std::path::{Path, PathBuf};
 
+use clay_dsl::settings::{Range, SETTINGS};
 use fuzzing::fuzz;
 use located::located;
 
@@ -412,3 +414,148 @@ fn session_files_mutated_never_panic() {
         "only {used} of {cases} mutants were opened"
     );
 }
+
+/// The bundled examples a settings case runs, compiled once each, with their scripts.
+fn example(name: &str) -> (clay_dsl::CompiledGrammar, clay::Script) {
+    type Compiled = Vec<(String, clay_dsl::CompiledGrammar, clay::Script)>;
+    static EXAMPLES: std::sync::OnceLock<Compiled> = std::sync::OnceLock::new();
+    let all = EXAMPLES.get_or_init(|| {
+        SETTINGS_EXAMPLES
+            .iter()
+            .map(|name| {
+                let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("grammars");
+                let text = std::fs::read_to_string(dir.join(format!("{name}.clay"))).unwrap();
+                let options = clay_dsl::CompileOptions::default();
+                let grammar = clay_dsl::compile(&text, name, &options).unwrap().grammar;
+                let script = std::fs::read_to_string(dir.join(format!("{name}.script.json")));
+                let script = clay::Script::parse(&script.unwrap()).unwrap();
+                (name.to_string(), grammar, script)
+            })
+            .collect()
+    });
+    let (_, g, s) = (all.iter().find(|e| e.0 == name)).unwrap_or(&all[0]);
+    (g.clone(), s.clone())
+}
+
+/// The examples a settings case runs: a stretch chain, and merges and cuts.
+const SETTINGS_EXAMPLES: [&str; 2] = ["wall", "junction"];
+
+/// Frames of an example's script a settings case runs.
+const SETTINGS_FRAMES: u64 = 6;
+
+/// A value for a setting of `range`: three times in four at a bound, just inside one or in
+/// the middle (a closed bound itself, an open one refused); else just outside a bound, far
+/// out, not finite, a word of another setting, or not a number.
+fn setting_value(rng: &mut proptest::test_runner::TestRng, range: Range) -> String {
+    use proptest::prelude::RngExt;
+    let (lo, hi) = match range {
+        Range::Word(words) => {
+            return match rng.random_range(0..6) {
+                0 => "nonsense".into(),
+                1 => String::new(),
+                _ => words[rng.random_range(0..words.len())].to_string(),
+            };
+        }
+        Range::Count { max } => (0.0, f64::from(max)),
+        Range::Number { lo, hi, .. } => (lo, hi),
+    };
+    let near = |b: f64, side: f64| b + side * 1e-9 * b.abs().max(1.0);
+    let x = if rng.random_range(0..4) > 0 {
+        let top = hi.min(1e9);
+        let within = [
+            lo,
+            top,
+            near(lo, 1.0),
+            near(top, -1.0),
+            lo + (top - lo) * rng.random::<f64>(),
+        ];
+        within[rng.random_range(0..within.len())]
+    } else {
+        let out = [
+            near(lo, -1.0),
+            near(hi, 1.0),
+            -1.0,
+            1e300,
+            f64::NAN,
+            f64::INFINITY,
+        ];
+        match rng.random_range(0..out.len() + 2) {
+            k if k < out.len() => out[k],
+            k if k == out.len() => return "cg".into(),
+            _ => return "1..2".into(),
+        }
+    };
+    if matches!(range, Range::Count { .. }) && rng.random::<bool>() {
+        format!("{}", x.round())
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A settings case: an example's name, then one to four `name=value` lines.
+fn settings_case(rng: &mut proptest::test_runner::TestRng, input: &[u8], _: &[Vec<u8>]) -> Vec<u8> {
+    use proptest::prelude::RngExt;
+    let mut case = String::from_utf8_lossy(input).into_owned();
+    for _ in 0..rng.random_range(1..=4) {
+        let s = &SETTINGS[rng.random_range(0..SETTINGS.len())];
+        case.push_str(&format!("\n{}={}", s.name, setting_value(rng, s.range)));
+    }
+    case.into_bytes()
+}
+
+/// What `--set` does with a case's settings (`clay::configure`, over the example grammar's
+/// own `solver` block): every value the settings table allows is accepted and any other
+/// refused; accepted, the example's script runs its first frames with no panic, no error and
+/// every coordinate and figure finite.
+fn settings(input: &[u8]) -> Result<(), String> {
+    let text = std::str::from_utf8(input).map_err(|e| e.to_string())?;
+    let mut lines = text.lines();
+    let (mut grammar, script) = example(lines.next().unwrap_or_default());
+    let pairs: Vec<(&str, &str)> = lines.filter_map(|l| l.split_once('=')).collect();
+    let allowed = pairs.iter().all(|&(name, value)| {
+        let range = clay_dsl::settings::setting(name).unwrap().range;
+        match range {
+            Range::Word(words) => words.contains(&value),
+            _ => value.parse::<f64>().is_ok_and(|x| range.allows(x)),
+        }
+    });
+    let config = match (
+        clay::configure(&mut grammar, pairs.iter().copied()),
+        allowed,
+    ) {
+        (Ok(config), true) => config,
+        (Err(_), false) => return Ok(()),
+        (Ok(_), false) => return Err("--set accepted a value the settings table refuses".into()),
+        (Err(e), true) => return Err(format!("--set refused what the table allows: {e}")),
+    };
+    let mut first = clay::Script::default();
+    for step in script.steps {
+        if first.frame_count() >= SETTINGS_FRAMES {
+            break;
+        }
+        first.steps.push(step);
+    }
+    SETTINGS_USED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let mut asm = clay::Assembly::new(std::sync::Arc::new(grammar));
+    let summary = clay::replay(&mut asm, &first, &mut clay::Session::new(config))
+        .map_err(|e| format!("the replay failed: {e}"))?;
+    if !summary.finite {
+        return Err("a non-finite figure".into());
+    }
+    Ok(())
+}
+
+/// Issue 47: solver settings at their documented bounds, mixed (each alone at each bound is
+/// `tests/settings.rs`), and values just outside them, not finite or not numbers.
+#[test]
+fn solver_settings_at_their_bounds_never_panic() {
+    let corpus = SETTINGS_EXAMPLES.iter().map(|e| e.as_bytes().to_vec());
+    let cases = fuzzing::cases_or(300);
+    fuzzing::fuzz_cases("settings", cases, corpus.collect(), settings_case, settings);
+    // the cases must reach the solver, not only be refused
+    let used = SETTINGS_USED.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(used * 5 >= cases, "only {used} of {cases} cases ran");
+}
+
+/// How many settings cases were accepted and run.
+static SETTINGS_USED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
