@@ -341,3 +341,16 @@ fn a_held_tree_that_creeps_tries_and_rests() {
     let run = replay("held_tree_turned");
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 4.2, 5.1 (issue 46): the turn between two holds fixes how many elements' turns the
+/// path between them takes, not how its arcs share them. A tree whose arcs of 10-degree
+/// elements, 3 then 2, meet at a free hub, its far hub led to where 2 then 3 rest: it stayed
+/// 3 and 2 at strain 0.03 (the same turn, the free hub elsewhere), and nothing was proposed,
+/// since neither arc's count misses the turn.
+#[test]
+fn arcs_through_a_free_hub_share_the_turn_as_the_holds_ask() {
+    let run = replay("arcs_share_a_turn");
+    let arcs = [run.chain_count("l2x0"), run.chain_count("l3x0")];
+    assert_eq!(arcs, [2, 3], "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}

@@ -217,6 +217,21 @@ pub(super) fn counts_from_turns(
     let held = held_elements(asm);
     let series = runs(asm.grammar(), data, &held);
     let paths = held_paths(data, &held);
+    // each path's turn off its rest: its chains' and free pieces' misfits added up
+    let alongs: Vec<Option<f64>> = (paths.iter())
+        .map(|path| {
+            (path.iter())
+                .map(|s| match *s {
+                    Step::Chain(d, sign) => turns[d].as_ref().map(|d| sign * d.off),
+                    Step::Piece {
+                        instance,
+                        enter,
+                        leave,
+                    } => piece_off(asm.grammar(), data, pose, (instance, enter, leave)),
+                })
+                .sum()
+        })
+        .collect();
     let mut out = Vec::new();
     for (c, t) in turns.iter().enumerate() {
         let Some(t) = t.as_ref().filter(|t| t.turns()) else {
@@ -240,23 +255,13 @@ pub(super) fn counts_from_turns(
                     .sum(),
             ));
         }
-        for path in &paths {
+        for (path, along) in paths.iter().zip(&alongs) {
             let Some(sign) = path.iter().find_map(|s| match *s {
                 Step::Chain(d, sign) if d == c => Some(sign),
                 _ => None,
             }) else {
                 continue;
             };
-            let along: Option<f64> = (path.iter())
-                .map(|s| match *s {
-                    Step::Chain(d, sign) => turns[d].as_ref().map(|d| sign * d.off),
-                    Step::Piece {
-                        instance,
-                        enter,
-                        leave,
-                    } => piece_off(asm.grammar(), data, pose, (instance, enter, leave)),
-                })
-                .sum();
             if let Some(along) = along {
                 offs.push(wrap(sign * along));
             }
@@ -266,6 +271,16 @@ pub(super) fn counts_from_turns(
                 && !out.contains(&change)
             {
                 out.push(change);
+            }
+        }
+    }
+    // the same turn between the holds split otherwise between a path's turning chains
+    for (path, along) in paths.iter().zip(&alongs) {
+        if let Some(along) = along {
+            for counts in splits(path, &turns, *along) {
+                if !out.contains(&counts) {
+                    out.push(counts);
+                }
             }
         }
     }
@@ -316,6 +331,76 @@ pub(super) fn counts_from_turns(
     }
     out
 }
+
+/// Counts for two or more of the turning chains on a held `path` (its turn `along` off its
+/// rest), each one element more, fewer or as it is, that leave the path's turn as near its
+/// rest as any such counts do and as the counts it has: the turn between two holds fixes
+/// how many elements' turns the path takes, not how they are shared, and one element
+/// moved from an arc to another through a free hub moves the hub (a tree whose arcs of 3
+/// and 2 rest only as 2 and 3 when its far hub is led round: strain 0.03 at 3 and 2, the
+/// same turn). At most [`SPLIT_CHAINS`] turning chains, [`SPLIT_MOST`] proposals, fewest
+/// changes first; one chain alone is [`from_turn`]'s. The session judges each by energy.
+fn splits(
+    path: &[Step],
+    turns: &[Option<ChainTurn>],
+    along: f64,
+) -> Vec<Vec<(usize, usize, usize)>> {
+    let on: Vec<(&ChainTurn, f64, usize)> = (path.iter())
+        .filter_map(|s| match *s {
+            Step::Chain(d, sign) => turns[d]
+                .as_ref()
+                .filter(|t| t.turns())
+                .map(|t| (t, sign, d)),
+            Step::Piece { .. } => None,
+        })
+        .collect();
+    if on.len() < 2 || on.len() > SPLIT_CHAINS {
+        return Vec::new();
+    }
+    let smallest = on
+        .iter()
+        .map(|c| c.0.theta.abs())
+        .fold(f64::INFINITY, f64::min);
+    // the path's misfit, in the smallest element's turns, with each chain changed by `by`
+    let miss = |by: &[i64]| {
+        let turned: f64 = (on.iter().zip(by))
+            .map(|(c, &k)| c.1 * k as f64 * c.0.theta)
+            .sum();
+        let x = wrap(along - turned).abs() / smallest;
+        (x * 1e6).round() / 1e6
+    };
+    let allowed = |by: &[i64]| {
+        (on.iter().zip(by)).all(|(c, &k)| {
+            let m = c.0.count as i64 + k;
+            m >= c.0.min as i64 && c.0.max.is_none_or(|x| m <= x as i64)
+        })
+    };
+    let mut all: Vec<Vec<i64>> = vec![Vec::new()];
+    for _ in 0..on.len() {
+        all = (all.into_iter())
+            .flat_map(|v| (-1..=1).map(move |k| [v.clone(), vec![k]].concat()))
+            .collect();
+    }
+    all.retain(|by| by.iter().filter(|&&k| k != 0).count() >= 2 && allowed(by));
+    let least = all.iter().map(|by| miss(by)).fold(f64::INFINITY, f64::min);
+    let now = miss(&vec![0; on.len()]);
+    all.retain(|by| miss(by) <= least.min(now));
+    all.sort_by_key(|by| by.iter().map(|k| k.abs()).sum::<i64>());
+    (all.iter().take(SPLIT_MOST))
+        .map(|by| {
+            (on.iter().zip(by))
+                .filter(|(_, k)| **k != 0)
+                .map(|(c, &k)| (c.2, c.0.first, (c.0.count as i64 + k) as usize))
+                .collect()
+        })
+        .collect()
+}
+
+/// Most turning chains on one held path whose shares of its turn [`splits`] tries.
+const SPLIT_CHAINS: usize = 4;
+
+/// Most proposals [`splits`] makes for one path.
+const SPLIT_MOST: usize = 4;
 
 /// The count for turning chain `c` (`t`) held to a turn `off` (radians) from its rest
 /// turn, as [`counts_from_turns`] says; `None` when none matches better than its own by the
