@@ -131,23 +131,15 @@ impl Recording {
     /// stopped frame is written as a `budget` step and a held frame after the frames before
     /// it, so the replay stops where the editor's clock did.
     pub(super) fn frame(&mut self, stopped: Option<(u64, u64)>) {
-        let after_move = self.held == 0
-            && matches!(
-                self.steps.last(),
-                Some(Step::Drag { frames: 0, .. } | Step::Rotate { frames: 0, .. })
-            );
         if let Some((pass1, pass2)) = stopped {
-            if !self.on() {
-                return;
-            }
-            self.write_held();
-            self.append(Step::Budget { pass1, pass2 });
+            self.push(Step::Budget { pass1, pass2 });
             self.held = 1;
             return;
         }
-        if after_move
+        if self.held == 0
             && let Some(Step::Drag { frames, .. } | Step::Rotate { frames, .. }) =
                 self.steps.last_mut()
+            && *frames == 0
         {
             *frames = 1;
             return;
