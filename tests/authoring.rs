@@ -508,6 +508,44 @@ fn numbers_beyond_the_drawing_or_the_grammar_are_errors() {
     );
 }
 
+/// Issue 47, found by the 10^6-case fuzz run: a circle of radius 1e38 units is over three
+/// million curve segments in usvg; flattened it was 26 million points (half a gigabyte) before
+/// the graph refused the first. It is refused at that first point, as the graph says it.
+#[test]
+fn a_path_beyond_the_drawings_reach_is_refused_before_it_is_flattened() {
+    let circle = |r: &str| {
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"100\" height=\"100\">\n\
+             <rect id=\"square\" x=\"40\" y=\"40\" width=\"10\" height=\"10\"/>\n\
+             <circle id=\"v0\" cx=\"90\" cy=\"60\" r=\"{r}\"/></svg>"
+        )
+    };
+    // Not `unwrap_err`: a drawing that comes back is millions of points to print.
+    let refused = |svg: &str| match drawing_from_svg(svg, 0.01) {
+        Ok(d) => panic!(
+            "accepted: {} points",
+            d.polylines.iter().map(|p| p.points.len()).sum::<usize>()
+        ),
+        Err(e) => e.0,
+    };
+    let err = refused(&circle("1e38"));
+    assert!(
+        err.starts_with("path `v0` has a point at") && err.contains("beyond the 1e8 m"),
+        "{err}"
+    );
+    // Within reach (1e7 m at a centimetre a unit), the circle is a drawing of a few points.
+    let near = drawing_from_svg(&circle("1e9"), 0.01).unwrap();
+    let points: usize = near.polylines.iter().map(|p| p.points.len()).sum();
+    assert!((8..1000).contains(&points), "{points} points");
+    // An unnamed path is named as what it is.
+    let unnamed = circle("1e38").replace(" id=\"v0\"", "");
+    let err = refused(&unnamed);
+    assert!(
+        err.starts_with("a path without an id has a point at"),
+        "{err}"
+    );
+}
+
 #[test]
 fn the_last_check_refuses_a_grammar_that_does_not_compile() {
     use clay::authoring::check_authored;

@@ -11,6 +11,7 @@
 use glam::DVec2;
 
 use super::drawing::{AuthorError, Drawing, Polyline};
+use super::graph::{MAX_COORDINATE, metres};
 
 /// Straight segments per Bezier curve segment.
 pub const CURVE_SEGMENTS: usize = 8;
@@ -25,7 +26,7 @@ pub fn drawing_from_svg(text: &str, scale: f64) -> Result<Drawing, AuthorError> 
     let tree = usvg::Tree::from_str(text, &usvg::Options::default())
         .map_err(|e| AuthorError(format!("not a readable SVG: {e}")))?;
     let mut drawing = Drawing::default();
-    collect(tree.root(), scale, &mut drawing);
+    collect(tree.root(), scale, &mut drawing)?;
     if drawing.polylines.is_empty() {
         return Err(AuthorError("the SVG has no paths".into()));
     }
@@ -48,22 +49,40 @@ pub fn line_of_id(text: &str, id: &str) -> Option<usize> {
     })
 }
 
-fn collect(group: &usvg::Group, scale: f64, drawing: &mut Drawing) {
+fn collect(group: &usvg::Group, scale: f64, drawing: &mut Drawing) -> Result<(), AuthorError> {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => collect(g, scale, drawing),
-            usvg::Node::Path(p) => add_path(p, scale, drawing),
+            usvg::Node::Group(g) => collect(g, scale, drawing)?,
+            usvg::Node::Path(p) => add_path(p, scale, drawing)?,
             _ => {}
         }
     }
+    Ok(())
 }
 
-fn add_path(path: &usvg::Path, scale: f64, drawing: &mut Drawing) {
+/// Adds a path's polylines, or refuses it at its first point beyond [`MAX_COORDINATE`] (as
+/// the graph would) before flattening on: usvg gives a circle of radius 1e38 units over three
+/// million curve segments, flattened 26 million points and half a gigabyte, only for the graph
+/// to refuse the first (issue 47).
+fn add_path(path: &usvg::Path, scale: f64, drawing: &mut Drawing) -> Result<(), AuthorError> {
     let ts = path.abs_transform();
     let to_metres = |pt: usvg::tiny_skia_path::Point| {
         let mut pt = pt;
         ts.map_point(&mut pt);
         DVec2::new(f64::from(pt.x) * scale, -f64::from(pt.y) * scale)
+    };
+    let within_reach = |p: DVec2| {
+        if p.is_finite() && p.abs().max_element() <= MAX_COORDINATE {
+            return Ok(p);
+        }
+        let name = match path.id() {
+            "" => "a path without an id".to_string(),
+            id => format!("path `{id}`"),
+        };
+        Err(AuthorError(format!(
+            "{name} has a point at {}, beyond the {MAX_COORDINATE:e} m a drawing may reach; check its coordinates and the scale",
+            metres(p)
+        )))
     };
     let fill = path.fill().and_then(|f| match f.paint() {
         usvg::Paint::Color(c) => Some([c.red, c.green, c.blue]),
@@ -88,19 +107,19 @@ fn add_path(path: &usvg::Path, scale: f64, drawing: &mut Drawing) {
         match seg {
             S::MoveTo(p) => {
                 flush(&mut current, false, drawing);
-                last = to_metres(p);
+                last = within_reach(to_metres(p))?;
                 current.push(last);
             }
             S::LineTo(p) => {
-                last = to_metres(p);
+                last = within_reach(to_metres(p))?;
                 current.push(last);
             }
             S::QuadTo(c, p) => {
                 let (c, p) = (to_metres(c), to_metres(p));
                 for k in 1..=CURVE_SEGMENTS {
                     let t = k as f64 / CURVE_SEGMENTS as f64;
-                    current
-                        .push(last * (1.0 - t) * (1.0 - t) + c * 2.0 * t * (1.0 - t) + p * t * t);
+                    let q = last * (1.0 - t) * (1.0 - t) + c * 2.0 * t * (1.0 - t) + p * t * t;
+                    current.push(within_reach(q)?);
                 }
                 last = p;
             }
@@ -109,12 +128,11 @@ fn add_path(path: &usvg::Path, scale: f64, drawing: &mut Drawing) {
                 for k in 1..=CURVE_SEGMENTS {
                     let t = k as f64 / CURVE_SEGMENTS as f64;
                     let u = 1.0 - t;
-                    current.push(
-                        last * u * u * u
-                            + c1 * 3.0 * u * u * t
-                            + c2 * 3.0 * u * t * t
-                            + p * t * t * t,
-                    );
+                    let q = last * u * u * u
+                        + c1 * 3.0 * u * u * t
+                        + c2 * 3.0 * u * t * t
+                        + p * t * t * t;
+                    current.push(within_reach(q)?);
                 }
                 last = p;
             }
@@ -122,4 +140,5 @@ fn add_path(path: &usvg::Path, scale: f64, drawing: &mut Drawing) {
         }
     }
     flush(&mut current, false, drawing);
+    Ok(())
 }
