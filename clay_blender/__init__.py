@@ -45,7 +45,7 @@ def _clay():
     except ImportError as e:  # pragma: no cover - depends on the installation
         raise ImportError(
             "the Python package `clay` is not installed in Blender's Python: "
-            "see docs/blender.md (pip install the clay wheel with Blender's python)"
+            "see docs/blender.md (pip install the clay-sculpt wheel with Blender's python)"
         ) from e
     return clay
 

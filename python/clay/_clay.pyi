@@ -12,7 +12,10 @@ __version__: str
 SOLVER_SETTINGS: list[str]
 
 StrPath = str | os.PathLike[str]
-Point = tuple[float, float] | Sequence[float]
+#: Any pair of numbers: a tuple, a list, a numpy array of two (numpy's scalars too).
+Point = tuple[float, float] | Sequence[float] | npt.ArrayLike
+#: A whole number: Python's int or numpy's integers.
+Count = int | np.integer[Any]
 Compass = Literal["east", "west", "north", "south"]
 Overlay = Literal["graph", "sites", "strain", "handles", "states"]
 
@@ -221,12 +224,12 @@ class Session:
     def unpin(self, at: Point | None = None, extreme: Compass | None = None) -> None:
         """Lets go of the pin on the selected instance."""
     def drag(
-        self, by: Point | None = None, to: Point | None = None, frames: int = 1
+        self, by: Point | None = None, to: Point | None = None, frames: Count = 1
     ) -> None:
         """Moves the grab by an offset, or its centroid to a point, over ``frames`` frames."""
-    def rotate(self, degrees: float, frames: int = 1) -> None:
+    def rotate(self, degrees: float, frames: Count = 1) -> None:
         """Turns the grab about its centroid over ``frames`` frames."""
-    def hold(self, frames: int = 1) -> None:
+    def hold(self, frames: Count = 1) -> None:
         """Runs frames without moving anything."""
     def release(self) -> None:
         """Lets go of the grab."""

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 
 use crate::InternalError;
 
@@ -89,18 +90,93 @@ pub fn finite(value: f64, what: &str) -> PyResult<serde_json::Value> {
         })
 }
 
-/// A point `(x, y)` of finite numbers, as a JSON array for a step.
-pub fn point(value: &Bound<'_, PyAny>, what: &str) -> PyResult<serde_json::Value> {
-    let (x, y): (f64, f64) = value.extract().map_err(|_| {
+/// Whether `value` is a truth value: Python's `bool` or numpy's (`numpy.bool_`, which is no
+/// subclass of `bool`). A number argument refuses them: `True` for a frame count is a mistake.
+pub fn is_bool(value: &Bound<'_, PyAny>) -> bool {
+    value.is_instance_of::<PyBool>() || matches!(type_name(value).as_str(), "bool" | "bool_")
+}
+
+/// A number: a Python `int` or `float` or anything that converts as one (numpy's scalars,
+/// a `Fraction`, a `Decimal`), not a truth value or a string. Not yet checked for finiteness.
+pub fn number(value: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
+    if is_bool(value) {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be a number, found bool"
+        )));
+    }
+    if value.is_instance_of::<PyString>() || value.is_instance_of::<PyBytes>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be a number, found {}",
+            type_name(value)
+        )));
+    }
+    value.extract::<f64>().map_err(|_| {
         PyTypeError::new_err(format!(
-            "{what} must be a pair of numbers (x, y), found {}",
+            "{what} must be a number, found {}",
+            type_name(value)
+        ))
+    })
+}
+
+/// A whole number given as one: a Python `int` or anything with `__index__` (numpy's
+/// integers), not a truth value; `None` when `value` is not of an integer type (a float, to
+/// be judged as a number). Too large for 64 bits is a `ValueError`.
+pub fn integer(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<i64>> {
+    if is_bool(value) {
+        return Err(PyTypeError::new_err(format!(
+            "{what} must be a number, found bool"
+        )));
+    }
+    let index = if value.is_instance_of::<PyInt>() {
+        value.clone()
+    } else if value.hasattr("__index__")? && !value.is_instance_of::<PyFloat>() {
+        value.call_method0("__index__")?
+    } else {
+        return Ok(None);
+    };
+    index.extract::<i64>().map(Some).map_err(|_| {
+        PyValueError::new_err(format!(
+            "{what} is too large: {}",
             value
                 .repr()
                 .map_or_else(|_| type_name(value), |r| r.to_string())
         ))
-    })?;
+    })
+}
+
+/// A point `(x, y)` of finite numbers, as a JSON array for a step: a tuple, a list, a numpy
+/// array or any other iterable of exactly two numbers (numpy's scalars too).
+pub fn point(value: &Bound<'_, PyAny>, what: &str) -> PyResult<serde_json::Value> {
+    let shown = || {
+        value
+            .repr()
+            .map_or_else(|_| type_name(value), |r| r.to_string())
+    };
+    let wrong = || {
+        PyTypeError::new_err(format!(
+            "{what} must be a pair of numbers (x, y), found {}",
+            shown()
+        ))
+    };
+    // A string iterates as characters and a dict as its keys: neither is a point.
+    if value.is_instance_of::<PyString>()
+        || value.is_instance_of::<PyBytes>()
+        || value.is_instance_of::<PyDict>()
+    {
+        return Err(wrong());
+    }
+    let items: Vec<Bound<'_, PyAny>> = value
+        .try_iter()
+        .map_err(|_| wrong())?
+        .take(3)
+        .collect::<PyResult<_>>()
+        .map_err(|_| wrong())?;
+    let [x, y] = items.as_slice() else {
+        return Err(wrong());
+    };
+    let coordinate = |c: &Bound<'_, PyAny>| number(c, what).map_err(|_| wrong());
     Ok(serde_json::Value::Array(vec![
-        finite(x, what)?,
-        finite(y, what)?,
+        finite(coordinate(x)?, what)?,
+        finite(coordinate(y)?, what)?,
     ]))
 }

@@ -11,7 +11,7 @@ use clay_dsl::{Diagnostics, JsonDiagnostic, Severity};
 use crate::convert::{guard, path_of, read};
 
 pyo3::create_exception!(
-    _clay,
+    clay,
     GrammarError,
     pyo3::exceptions::PyValueError,
     "A grammar did not compile. `.diagnostics` lists every error and warning \

@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use clay_dsl::CompileOptions;
 use clay_dsl::compiled::CompiledGrammar;
 
-use crate::convert::{guard, path_of, read, type_name};
+use crate::convert::{guard, number, path_of, read, type_name};
 use crate::diagnostics::{PyDiagnostic, grammar_error, to_python};
 
 /// A grammar parameter (`param NAME = EXPR in LO..HI`): its value in this compilation, the
@@ -85,17 +85,7 @@ fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, f64
                 type_name(&k)
             ))
         })?;
-        if v.is_instance_of::<pyo3::types::PyBool>() {
-            return Err(PyTypeError::new_err(format!(
-                "params: {name} must be a number, found bool"
-            )));
-        }
-        let value: f64 = v.extract().map_err(|_| {
-            PyTypeError::new_err(format!(
-                "params: {name} must be a number, found {}",
-                type_name(&v)
-            ))
-        })?;
+        let value = number(&v, &format!("params: {name}"))?;
         out.insert(name, value);
     }
     Ok(out)
@@ -238,11 +228,12 @@ impl Grammar {
     }
 
     fn __repr__(&self) -> String {
+        let count = |n: usize, one: &str| format!("{n} {one}{}", if n == 1 { "" } else { "s" });
         format!(
-            "Grammar({}, {} pieces, {} instances)",
+            "Grammar({}, {}, {})",
             self.path.as_deref().unwrap_or("<string>"),
-            self.compiled.pieces.len(),
-            self.compiled.assembly.instances.len()
+            count(self.compiled.pieces.len(), "piece"),
+            count(self.compiled.assembly.instances.len(), "instance")
         )
     }
 }

@@ -16,14 +16,14 @@ mod grammar;
 mod session;
 
 pyo3::create_exception!(
-    _clay,
+    clay,
     SolverError,
     pyo3::exceptions::PyRuntimeError,
     "A solver frame failed (the step it failed in is named in the message)."
 );
 
 pyo3::create_exception!(
-    _clay,
+    clay,
     InternalError,
     pyo3::exceptions::PyRuntimeError,
     "A bug in Clay: the library failed where it should not. Please report it with the message."

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString};
+use pyo3::types::{PyBytes, PyDict, PyList, PyString};
 use serde_json::{Value, json};
 
 use clay::{
@@ -18,7 +18,9 @@ use clay::{
 };
 use clay_dsl::compiled::CompiledGrammar;
 
-use crate::convert::{finite, guard, os_error, path_of, point, type_name};
+use crate::convert::{
+    finite, guard, integer, is_bool, number, os_error, path_of, point, type_name,
+};
 use crate::grammar::Grammar;
 use crate::{InternalError, SolverError};
 
@@ -117,6 +119,19 @@ pub struct PyPrimitive {
     pub triangles: Py<PyAny>,
 }
 
+#[pymethods]
+impl PyPrimitive {
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let rows = |a: &Py<PyAny>| -> PyResult<usize> { a.bind(py).len() };
+        let (r, g, b, a) = self.colour;
+        Ok(format!(
+            "Primitive(#{r:02x}{g:02x}{b:02x}{a:02x}, {} vertices, {} triangles)",
+            rows(&self.positions)?,
+            rows(&self.triangles)?
+        ))
+    }
+}
+
 /// One instance's 3D meshes, as `clayc export` writes its node: the same name, pivot, turn
 /// and local geometry.
 #[pyclass(module = "clay", frozen, get_all)]
@@ -155,49 +170,34 @@ impl SceneNode {
     }
 }
 
-/// A solver setting's value as `--set` would spell it.
+/// A solver setting's value as `--set` would spell it: a string as it is, an integer (numpy's
+/// too) in digits, another number as Rust writes an `f64` (it reads back as the same number).
 fn setting_value(name: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
     if value.is_instance_of::<PyString>() {
         return value.extract();
     }
-    if value.is_instance_of::<PyBool>() {
-        return Err(PyTypeError::new_err(format!(
-            "solver setting {name} must be a number, found bool"
-        )));
+    let what = format!("solver setting {name}");
+    if let Some(n) = integer(value, &what)? {
+        return Ok(n.to_string());
     }
-    if value.is_instance_of::<PyInt>() || value.is_instance_of::<PyFloat>() {
-        // repr of a float reads back as the same number.
-        return Ok(value.repr()?.to_string());
-    }
-    Err(PyTypeError::new_err(format!(
-        "solver setting {name} must be a number (or \"cholesky\"/\"cg\" for solver), found {}",
-        type_name(value)
-    )))
+    number(value, &what).map(|x| format!("{x:?}")).map_err(|e| {
+        if is_bool(value) {
+            e
+        } else {
+            PyTypeError::new_err(format!(
+                "{what} must be a number (or \"cholesky\"/\"cg\" for solver), found {}",
+                type_name(value)
+            ))
+        }
+    })
 }
 
 /// A frame count or other number for a JSON step: ints stay ints (as JSON has them), floats
 /// must be finite; the step's own check says what is allowed.
 fn json_number(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Value> {
-    if value.is_instance_of::<PyBool>() {
-        return Err(PyTypeError::new_err(format!(
-            "{what} must be a number, found bool"
-        )));
-    }
-    if value.is_instance_of::<PyInt>() {
-        return match value.extract::<i64>() {
-            Ok(n) => Ok(Value::from(n)),
-            Err(_) => Err(PyValueError::new_err(format!(
-                "{what} is too large: {}",
-                value.repr()?
-            ))),
-        };
-    }
-    match value.extract::<f64>() {
-        Ok(x) => finite(x, what),
-        Err(_) => Err(PyTypeError::new_err(format!(
-            "{what} must be a number, found {}",
-            type_name(value)
-        ))),
+    match integer(value, what)? {
+        Some(n) => Ok(Value::from(n)),
+        None => finite(number(value, what)?, what),
     }
 }
 

@@ -556,3 +556,75 @@ def test_the_package_has_stubs_and_docstrings():
     for method in ["grab", "pin", "unpin", "drag", "rotate", "hold", "release", "cut", "frame",
                    "run_script", "summary", "export", "render_png", "scene"]:
         assert getattr(clay.Session, method).__doc__, method
+
+
+# --- Python as Python users write it (issue 48, item 6) -------------------------------------
+
+
+def test_points_are_any_pair_of_numbers_and_counts_numpy_integers(grammars):
+    """A list, a numpy array or numpy scalars give the very session a tuple of floats gives."""
+    g = clay.Grammar.open(grammars / "wall.clay")
+    plain, numpyish = clay.Session(g), clay.Session(g)
+    plain.pin(at=(0.25, 0.25))
+    plain.grab(at=(7.5, 0.25))
+    plain.drag(to=(10.0, 1.0), frames=3)
+    plain.drag(by=(1.0, 0.0), frames=2)
+    plain.cut(at=(3.0, 0.25))
+    numpyish.pin(at=np.array([0.25, 0.25]))
+    numpyish.grab(at=[7.5, 0.25])
+    numpyish.drag(to=[np.float32(10), np.int64(1)], frames=np.int64(3))
+    numpyish.drag(by=np.array([1, 0]), frames=np.uint8(2))
+    numpyish.cut(at=(x for x in (3.0, 0.25)))
+    assert numpyish.frames == plain.frames == 5
+    assert np.array_equal(numpyish.positions, plain.positions)
+    assert without_times(numpyish.summary()) == without_times(plain.summary())
+    # Solver settings and parameters take numpy numbers too.
+    assert clay.Session(g, l2_iterations=np.int64(40), norm=np.float64(0.5)) is not None
+
+
+def test_what_is_not_a_point_or_a_count_is_a_type_error(grammars):
+    s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
+    for bad in ["xy", b"xy", {1: 2, 3: 4}, [1], [1, 2, 3], np.zeros(3), np.zeros((2, 2)), 5, None,
+                [True, 0], ["1", 2]]:
+        with pytest.raises(TypeError, match="must be a pair of numbers"):
+            s.cut(at=bad)
+    with pytest.raises(TypeError, match="bool"):
+        s.hold(frames=np.bool_(True))
+    with pytest.raises(ValueError, match="too large"):
+        s.hold(frames=np.uint64(2**63))
+    with pytest.raises(ValueError, match="finite"):
+        s.cut(at=np.array([np.nan, 0.0]))
+    assert s.frames == 0
+
+
+def test_exceptions_and_classes_live_in_clay_and_read_well(grammars, fence):
+    for name in ["GrammarError", "SolverError", "InternalError"]:
+        assert getattr(clay, name).__module__ == "clay", name
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.parse("piece {")
+    assert type(caught.value).__module__ == "clay"
+    g = clay.Grammar.open(grammars / "wall.clay")
+    s = clay.Session(g)
+    s.pin(extreme="west")
+    s.grab(extreme="east")
+    s.drag(by=(8.0, 0.0), frames=100)
+    prim = next(n for n in s.scene() if n.primitives).primitives[0]
+    shown = [g, g.pieces[0], s, s.instances[0], s.rule_log[0], s.scene()[0], prim,
+             caught.value.diagnostics[0], clay.Grammar.open(fence).params[0]]
+    for obj in shown:
+        text = repr(obj)
+        assert text.startswith(type(obj).__name__ + "("), text
+        assert " object at 0x" not in text, text
+    assert repr(prim) == (
+        f"Primitive(#{''.join(f'{c:02x}' for c in prim.colour)}, "
+        f"{len(prim.positions)} vertices, {len(prim.triangles)} triangles)"
+    )
+
+
+def test_the_distribution_is_clay_sculpt_and_imports_as_clay():
+    """`clay` on the package index is another project; ours installs as clay-sculpt."""
+    from importlib import metadata
+
+    assert metadata.version("clay-sculpt") == clay.__version__
+    top = (metadata.distribution("clay-sculpt").read_text("top_level.txt") or "clay").split()
+    assert top == ["clay"]
