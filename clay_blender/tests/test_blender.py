@@ -2,6 +2,7 @@
 CPython 3.11): register, import the castle through the operator, compare with the Python
 package's instances, reload, and render a small picture."""
 
+import math
 import struct
 from pathlib import Path
 
@@ -124,6 +125,50 @@ def test_an_exported_glb_imports_with_an_origin_per_instance(tmp_path):
     [coll] = clay_collections()
     added = bounds(list(coll.objects))
     for a, b in zip(imported, added):
+        assert a == pytest.approx(b, abs=1e-4)
+
+
+def test_an_exported_usd_imports_with_blenders_usd_importer(tmp_path):
+    """Issue 48, item 4: Blender's USD importer reads `clayc export`'s .usda (Z up, metres) as a
+    root with an object per instance at its pivot and turn, named as the export names it, the
+    extras as its properties, the geometry instanced from shared prototypes, and the same
+    world-space geometry as the add-on's import."""
+    fresh_file()
+    session = clay.Session(clay.Grammar.open(CASTLE))
+    session.run_script(CASTLE_SCRIPT)
+    usda = tmp_path / "castle.usda"
+    session.export(usda)
+    assert bpy.ops.wm.usd_import(filepath=str(usda)) == {"FINISHED"}
+    nodes = {n.name: n for n in session.scene()}
+    [root] = [o for o in bpy.data.objects if o.parent is None and o.type == "EMPTY"]
+    assert root.name == "castle"
+    # The instances, and the materials' scope (an Empty in Blender).
+    children = [o for o in bpy.data.objects if o.parent == root and "clay:instance" in o]
+    assert [o.name for o in root.children if o not in children] == ["Looks"]
+    assert sorted(o.name for o in children) == sorted(nodes)
+    for obj in children:
+        node = nodes[obj.name]
+        w = obj.matrix_world.translation
+        assert (w.x, w.y, w.z) == pytest.approx((*node.pivot, 0), abs=1e-4)
+        assert obj.matrix_world.to_euler().z == pytest.approx(node.rotation, abs=1e-5)
+        assert obj["clay:instance"] == node.instance and obj["clay:piece"] == node.piece
+        assert obj["clay:state"] == node.state and obj.get("clay:index") == node.index
+        # Its geometry is an instance of a prototype collection, not a copy.
+        [geometry] = obj.children
+        assert geometry.instance_type == "COLLECTION" and geometry.instance_collection
+    # The instanced meshes, where the depsgraph places them, span what the add-on imports.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+    for inst in depsgraph.object_instances:
+        if inst.is_instance and inst.object.type == "MESH":
+            for v in inst.object.data.vertices:
+                p = inst.matrix_world @ v.co
+                lo = [min(a, b) for a, b in zip(lo, p)]
+                hi = [max(a, b) for a, b in zip(hi, p)]
+    bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
+    [coll] = clay_collections()
+    added = bounds(list(coll.objects))
+    for a, b in zip((lo, hi), added):
         assert a == pytest.approx(b, abs=1e-4)
 
 

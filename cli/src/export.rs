@@ -1,5 +1,6 @@
 //! `clayc export`: the assembly (initial, or after a sculpting script) as 3D meshes: glTF 2.0
-//! (`.glb`, `.gltf`) or Wavefront OBJ (`.obj` with its `.mtl` beside it). docs/export.md.
+//! (`.glb`, `.gltf`), Wavefront OBJ (`.obj` with its `.mtl` beside it) or USD (`.usda`).
+//! docs/export.md.
 
 use std::path::PathBuf;
 
@@ -14,13 +15,14 @@ pub enum Format {
     Glb,
     Gltf,
     Obj,
+    Usda,
 }
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
     #[command(flatten)]
     pub model: crate::from_session::ModelArgs,
-    /// The file to write: .glb, .gltf or .obj (the .mtl is written beside an .obj); `-` writes
+    /// The file to write: .glb, .gltf, .obj (the .mtl is written beside an .obj) or .usda; `-` writes
     /// to standard output (glb unless --format says otherwise; an .obj's materials are then
     /// not written).
     #[arg(short, long)]
@@ -51,6 +53,7 @@ impl From<Format> for ExportFormat {
             Format::Glb => ExportFormat::Glb,
             Format::Gltf => ExportFormat::Gltf,
             Format::Obj => ExportFormat::Obj,
+            Format::Usda => ExportFormat::Usda,
         }
     }
 }
@@ -64,8 +67,9 @@ pub fn export(args: ExportArgs) -> u8 {
         None if to_stdout => ExportFormat::Glb,
         None => {
             errln!(
-                "error: cannot tell the format of `{}`: name it .glb, .gltf or .obj, or pass --format",
-                args.output.display()
+                "error: cannot tell the format of `{}`: {}, or pass --format",
+                args.output.display(),
+                ExportFormat::unknown(&args.output)
             );
             return IO_ERROR;
         }

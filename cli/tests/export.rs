@@ -11,7 +11,7 @@ fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
         "{}/../grammars/wall.script.json",
         env!("CARGO_MANIFEST_DIR")
     );
-    for ext in ["glb", "gltf", "obj"] {
+    for ext in ["glb", "gltf", "obj", "usda"] {
         let out = dir.join(format!("wall.{ext}"));
         let status = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
             .args(["export", &wall, "--script", &script, "-o"])
@@ -28,8 +28,17 @@ fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
         .output()
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&bad.stderr).contains(".glb, .gltf or .obj"));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains(".glb, .gltf, .obj or .usda"));
     assert!(!dir.join("wall.fbx").exists());
+    // USD's binary form is not written; the refusal says how to make it from the text form.
+    let usdc = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("wall.usdc"))
+        .output()
+        .unwrap();
+    assert_eq!(usdc.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&usdc.stderr).contains("usdcat MODEL.usda -o MODEL.usdc"));
+    assert!(!dir.join("wall.usdc").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

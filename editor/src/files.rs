@@ -34,7 +34,7 @@ impl FileKind {
             FileKind::SaveSession => "Save session as",
             FileKind::Png => "Export view as PNG",
             FileKind::Json => "Export deformed assembly as JSON",
-            FileKind::Model3d => "Export 3D model (glTF or OBJ)",
+            FileKind::Model3d => "Export 3D model (glTF, OBJ or USD)",
             FileKind::WriteGrammar => "Write grammar as",
             FileKind::GestureScript => "Save gestures as script",
         }
@@ -60,7 +60,7 @@ impl FileKind {
             FileKind::OpenSession | FileKind::SaveSession => ("Clay session", &["json"]),
             FileKind::Png => ("PNG image", &["png"]),
             FileKind::Json => ("JSON", &["json"]),
-            FileKind::Model3d => ("3D model", &["glb", "gltf", "obj"]),
+            FileKind::Model3d => ("3D model", &["glb", "gltf", "obj", "usda"]),
             FileKind::WriteGrammar => ("Clay grammar", &["clay"]),
             FileKind::GestureScript => ("Clay script", &["json"]),
         }

@@ -357,7 +357,7 @@ fn the_3d_export_writes_gltf_and_obj_of_the_sculpted_model() {
     assert_eq!(with_mesh, app.sculpt.data().instances.len());
     // An unknown extension is an error that names the formats, and writes nothing.
     let err = app.export_3d(&dir.join("m.fbx")).unwrap_err();
-    assert!(err.contains(".glb, .gltf or .obj"), "{err}");
+    assert!(err.contains(".glb, .gltf, .obj or .usda"), "{err}");
     assert!(!dir.join("m.fbx").exists());
 }
 

@@ -587,8 +587,8 @@ impl PySession {
         Ok(d)
     }
 
-    /// Writes the model as 3D meshes, as `clayc export` does: `.glb` or `.gltf` (glTF 2.0) or
-    /// `.obj` (with its `.mtl` beside it), by the path's extension. `thickness` is the height
+    /// Writes the model as 3D meshes, as `clayc export` does: `.glb` or `.gltf` (glTF 2.0),
+    /// `.obj` (with its `.mtl` beside it) or `.usda` (USD, Z up), by the path's extension. `thickness` is the height
     /// of flat proxy geometry in metres. Raises `ValueError` for another extension, `OSError`
     /// when the file cannot be written.
     #[pyo3(signature = (path, thickness = None))]
@@ -602,8 +602,9 @@ impl PySession {
         let options = export_options(thickness)?;
         let Some(format) = ExportFormat::of_path(&path) else {
             return Err(PyValueError::new_err(format!(
-                "cannot tell the format of `{}`: name it .glb, .gltf or .obj",
-                path.display()
+                "cannot tell the format of `{}`: {}",
+                path.display(),
+                ExportFormat::unknown(&path)
             )));
         };
         py.detach(|| {

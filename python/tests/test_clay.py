@@ -444,7 +444,7 @@ def test_exports_load(grammars, tmp_path):
 
 def test_export_errors(grammars, tmp_path):
     s = clay.Session(clay.Grammar.open(grammars / "wall.clay"))
-    with pytest.raises(ValueError, match="name it .glb, .gltf or .obj"):
+    with pytest.raises(ValueError, match="name it .glb, .gltf, .obj or .usda"):
         s.export(tmp_path / "wall.stl")
     with pytest.raises(FileNotFoundError):
         s.export(tmp_path / "no" / "such" / "dir" / "wall.glb")
@@ -628,3 +628,61 @@ def test_the_distribution_is_clay_sculpt_and_imports_as_clay():
     assert metadata.version("clay-sculpt") == clay.__version__
     top = (metadata.distribution("clay-sculpt").read_text("top_level.txt") or "clay").split()
     assert top == ["clay"]
+
+
+# --- USD (issue 48, item 4) -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["castle", "keep"])
+def test_the_usd_export_opens_validates_and_places_every_point_as_the_scene(grammars, tmp_path, name):
+    """usd-core opens the .usda, every validator of its registry passes, metres and Z up are
+    declared, one Xform per instance under one root carries the instance's names, the meshes are
+    shared by instancing, and every point lands where the scene (the glTF's nodes) has it."""
+    from pxr import Gf, Usd, UsdGeom, UsdShade, UsdValidation
+
+    s = clay.Session(clay.Grammar.open(grammars / f"{name}.clay"))
+    script = grammars / f"{name}.script.json"
+    if script.is_file():
+        s.run_script(script)
+    path = tmp_path / f"{name}.usda"
+    s.export(path)
+    stage = Usd.Stage.Open(str(path))
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
+    assert UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    root = stage.GetDefaultPrim()
+    assert root.GetName() == name and root.IsA(UsdGeom.Xform)
+    registry = UsdValidation.ValidationRegistry()
+    errors = UsdValidation.ValidationContext(registry.GetOrLoadAllValidators()).Validate(stage)
+    assert [(e.GetName(), e.GetMessage()) for e in errors] == []
+
+    nodes = s.scene()
+    xforms = [p for p in root.GetChildren() if p.HasAttribute("clay:instance")]
+    assert [p.GetName() for p in xforms] == [n.name for n in nodes]
+    cache = UsdGeom.XformCache()
+    colours = {}
+    for prim, n in zip(xforms, nodes):
+        get = lambda a: prim.GetAttribute(a).Get()
+        assert (get("clay:instance"), get("clay:piece"), get("clay:state"), get("clay:id")) == (
+            n.instance, n.piece, n.state, n.id)
+        assert get("clay:chain") == n.chain and get("clay:index") == n.index
+        meshes = [m for m in Usd.PrimRange(prim, Usd.TraverseInstanceProxies()) if m.IsA(UsdGeom.Mesh)]
+        assert len(meshes) == len(n.primitives), n.name
+        c, sn = math.cos(n.rotation), math.sin(n.rotation)
+        for mesh, p in zip(meshes, n.primitives):
+            m = cache.GetLocalToWorldTransform(mesh)
+            world = np.array([list(m.Transform(Gf.Vec3d(*map(float, q)))) for q in UsdGeom.Mesh(mesh).GetPointsAttr().Get()])
+            local = p.positions.astype(np.float64)
+            expected = np.column_stack([np.array(n.pivot) + local[:, :2] @ np.array([[c, sn], [-sn, c]]), local[:, 2]])
+            assert world == pytest.approx(expected, abs=1e-4), n.name
+            indices = np.array(UsdGeom.Mesh(mesh).GetFaceVertexIndicesAttr().Get()).reshape(-1, 3)
+            assert np.array_equal(indices, p.triangles), n.name
+            material, _ = UsdShade.MaterialBindingAPI(mesh).ComputeBoundMaterial()
+            shader = UsdShade.Shader(material.GetSurfaceOutput().GetConnectedSources()[0][0].source.GetPrim())
+            assert shader.GetIdAttr().Get() == "UsdPreviewSurface"
+            colours[material.GetPath()] = p.colour, shader.GetInput("diffuseColor").Get()
+    # Meshes shared: one prototype per distinct mesh of the scene.
+    assert len(stage.GetPrototypes()) == len({n.mesh for n in nodes if n.mesh is not None})
+    # Colours linear, as glTF's factor.
+    linear = lambda b: (b / 255 / 12.92) if b / 255 <= 0.04045 else ((b / 255 + 0.055) / 1.055) ** 2.4
+    for srgb, diffuse in colours.values():
+        assert list(diffuse) == pytest.approx([linear(b) for b in srgb[:3]], abs=1e-5)

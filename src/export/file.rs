@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use super::model::{ExportOptions, Scene};
-use super::{gltf, obj};
+use super::{gltf, obj, usd};
 
 /// The formats Clay exports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,11 +16,13 @@ pub enum ExportFormat {
     Gltf,
     /// Wavefront OBJ, its materials in a `.mtl` beside it.
     Obj,
+    /// USD in its text form, metres and Z up.
+    Usda,
 }
 
 impl ExportFormat {
     /// Every format, in the order the help lists them.
-    pub const ALL: [Self; 3] = [Self::Glb, Self::Gltf, Self::Obj];
+    pub const ALL: [Self; 4] = [Self::Glb, Self::Gltf, Self::Obj, Self::Usda];
 
     /// Its file extension, lower case without the dot.
     pub fn extension(self) -> &'static str {
@@ -28,7 +30,28 @@ impl ExportFormat {
             Self::Glb => "glb",
             Self::Gltf => "gltf",
             Self::Obj => "obj",
+            Self::Usda => "usda",
         }
+    }
+
+    /// Why `path` names no format, for a message after "cannot tell the format of `PATH`: ":
+    /// the extensions there are, and for USD's binary form how to make it.
+    pub fn unknown(path: &Path) -> String {
+        let names: Vec<String> = Self::ALL
+            .iter()
+            .map(|f| format!(".{}", f.extension()))
+            .collect();
+        let (last, rest) = names.split_last().expect("formats");
+        let mut why = format!("name it {} or {last}", rest.join(", "));
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("usdc") || e.eq_ignore_ascii_case("usd"))
+        {
+            why.push_str(
+                " (USD's binary form is not written: export .usda and convert it with `usdcat MODEL.usda -o MODEL.usdc`)",
+            );
+        }
+        why
     }
 
     /// The format a path's extension names (any case), if any.
@@ -81,6 +104,7 @@ pub fn encode_export(
             let (obj, mtl) = obj::to_obj(scene, &mtl_name);
             Ok((obj.into_bytes(), Some(mtl.into_bytes())))
         }
+        ExportFormat::Usda => Ok((usd::to_usda(scene).into_bytes(), None)),
     }
 }
 
@@ -138,7 +162,12 @@ mod tests {
             ExportFormat::of_path(Path::new("b.Obj")),
             Some(ExportFormat::Obj)
         );
+        assert_eq!(
+            ExportFormat::of_path(Path::new("b.USDA")),
+            Some(ExportFormat::Usda)
+        );
         assert_eq!(ExportFormat::of_path(Path::new("b.mtl")), None);
+        assert_eq!(ExportFormat::of_path(Path::new("b.usdc")), None);
         assert_eq!(ExportFormat::of_path(Path::new("b")), None);
     }
 

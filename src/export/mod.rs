@@ -9,7 +9,7 @@
 //!
 //! Data flows one way: assembly -> [`scene`] ([`Scene`]: a root named after the model, one
 //! [`Node`] per instance at its pivot, one [`SharedMesh`] per distinct geometry, one
-//! [`Primitive`] per fill colour) -> [`gltf`] (`.glb`, `.gltf`) or [`obj`] (`.obj` + `.mtl`).
+//! [`Primitive`] per fill colour) -> [`gltf`] (`.glb`, `.gltf`), [`obj`] (`.obj` + `.mtl`) or [`usd`] (`.usda`, Z up).
 //!
 //! Coordinates: metres, y up (glTF's convention): the floor plan's x (east) is x and its y
 //! (north) is -z, so a map seen from above keeps its orientation; heights are y. A node stands
@@ -29,6 +29,7 @@ mod model;
 mod names;
 pub mod obj;
 mod solid;
+pub mod usd;
 
 use std::collections::HashMap;
 

@@ -85,12 +85,13 @@ impl EditorApp {
     }
 
     /// Writes the sculpted model as 3D meshes with `clayc export`'s code; the format comes from
-    /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it).
+    /// the extension (`.glb`, `.gltf`, `.obj`, whose `.mtl` is written beside it, `.usda`).
     pub fn export_3d(&self, path: &Path) -> Result<(), String> {
         let Some(format) = clay::ExportFormat::of_path(path) else {
             return Err(format!(
-                "{}: name the file .glb, .gltf or .obj to say the format",
-                path.display()
+                "cannot tell the format of `{}`: {}",
+                path.display(),
+                clay::ExportFormat::unknown(path)
             ));
         };
         let scene = clay::scene(

@@ -181,7 +181,9 @@ impl EditorApp {
         }
         if ui
             .button("Export 3D model…")
-            .on_hover_text("glTF (.glb, .gltf) or OBJ: heights from `extrude` (docs/export.md)")
+            .on_hover_text(
+                "glTF (.glb, .gltf), OBJ or USD (.usda): heights from `extrude` (docs/export.md)",
+            )
             .clicked()
         {
             self.actions.push(Action::Ask(FileKind::Model3d));
