@@ -1,12 +1,18 @@
 """Clay grammars in Blender: File > Import > Clay grammar (.clay).
 
-A grammar (and, optionally, a sculpting script) is imported as one collection: an object per
-instance at its own pivot (the instance's centroid) and turned as its rest state is, named as
-in ``clayc export``'s glTF (``wall_n_4``, the fifth brick of chain ``wall_n``; custom
-properties ``clay_instance``, ``clay_piece``, ``clay_state``, ``clay_chain``, ``clay_index``),
-identical instances sharing one mesh, one material per fill colour, heights as ``clayc export`` gives them (metres,
-z up). The grammar's parameters become properties of the collection (Properties > Collection
-> Clay); Reload re-reads the grammar, with those values, and its script.
+A grammar (and, optionally, a sculpting script) is imported as one collection: a root Empty
+named after the grammar and under it an object per instance at its own pivot (the instance's
+centroid), turned as its rest state is, named as in ``clayc export``'s glTF (``wall_n_4``, the
+fifth brick of chain ``wall_n``) with the properties Blender's glTF importer gives from its
+extras (``instance``, ``piece``, ``state``, ``id``, ``chain``, ``index``); identical instances
+share one mesh with a planar ``UVMap``, one material per fill colour named as in every export
+(``fill_9a958cff``), heights as ``clayc export`` gives them (metres, z up). The grammar's
+parameters become properties of the collection (Properties > Collection > Clay).
+
+Reload (and a parameter change) updates the collection in place: an instance that is still
+there keeps its object, with the user's modifiers, object materials, children and properties;
+new instances are added, gone ones removed (their children stay, under the root); objects Clay
+did not make are never touched. Paths are stored relative to the .blend once it is saved.
 
 The meshes come from the Python package ``clay`` (docs/python.md), which must be importable
 by Blender's Python: docs/blender.md says how to install it.
@@ -34,6 +40,11 @@ PATH = "clay_path"
 SCRIPT = "clay_script"
 THICKNESS = "clay_thickness"
 PARAMS = "clay_params"
+# Custom properties on what the add-on made: an object's export node name (its identity across
+# reloads), the root Empty's mark, a mesh's export mesh name.
+NODE = "clay_node"
+ROOT = "clay_root"
+MESH = "clay_mesh"
 
 DEFAULT_THICKNESS = 0.05
 
@@ -57,9 +68,10 @@ def srgb_to_linear(c):
 
 
 def material_for(colour):
-    """The material of a fill colour (sRGB bytes r, g, b, a), made once per file."""
+    """The material of a fill colour (sRGB bytes r, g, b, a), made once per file and named as
+    every export names it (``fill_9a958cff``)."""
     r, g, b, a = colour
-    name = f"clay #{r:02x}{g:02x}{b:02x}{a:02x}"
+    name = f"fill_{r:02x}{g:02x}{b:02x}{a:02x}"
     mat = bpy.data.materials.get(name)
     if mat is not None:
         return mat
@@ -80,59 +92,144 @@ def material_for(colour):
     return mat
 
 
-def mesh_data(node):
-    """The node's primitives as one Blender mesh in the node's frame, a material each."""
+def fill_mesh(mesh, node):
+    """Writes the node's primitives into `mesh` (in the node's frame): its geometry, a
+    ``UVMap`` layer (planar, metres, as the exports' UVs) and a material slot per primitive.
+    A mesh Clay filled before keeps its slots when their number is unchanged, so a material
+    the user put in a slot stays there."""
     import numpy as np
 
-    verts, faces, slots = [], [], []
+    verts, faces, slots, uvs = [], [], [], []
     base = 0
     for k, prim in enumerate(node.primitives):
         p = np.asarray(prim.positions, dtype=np.float64)
-        t = np.asarray(prim.triangles, dtype=np.int64) + base
         verts.append(p)
-        faces.append(t)
-        slots.append(np.full(len(t), k, dtype=np.int32))
+        faces.append(np.asarray(prim.triangles, dtype=np.int64) + base)
+        slots.append(np.full(len(prim.triangles), k, dtype=np.int32))
+        uvs.append(np.asarray(prim.uvs, dtype=np.float64))
         base += len(p)
-    mesh = bpy.data.meshes.new(node.mesh or node.name)
-    if verts:
-        v = np.concatenate(verts)
-        f = np.concatenate(faces)
-        mesh.from_pydata(v.tolist(), [], f.tolist())
+    mesh.clear_geometry()
+    if len(mesh.materials) != len(node.primitives):
+        mesh.materials.clear()
         for prim in node.primitives:
             mesh.materials.append(material_for(prim.colour))
+    if verts:
+        v, f = np.concatenate(verts), np.concatenate(faces)
+        mesh.from_pydata(v.tolist(), [], f.tolist())
         mesh.polygons.foreach_set("material_index", np.concatenate(slots))
         mesh.polygons.foreach_set("use_smooth", np.zeros(len(f), dtype=bool))
+        uv = mesh.uv_layers.new(name="UVMap")
+        corners = np.empty(len(mesh.loops), dtype=np.int64)
+        mesh.loops.foreach_get("vertex_index", corners)
+        uv.data.foreach_set("uv", np.concatenate(uvs)[corners].ravel())
         mesh.validate()
         mesh.update()
+    mesh[MESH] = node.mesh or node.name
     return mesh
 
 
-def mesh_object(node, collection, meshes):
-    """One instance as an object at its pivot, turned as the export's node, with the node's
-    shared mesh (`meshes`: the meshes made so far, by name)."""
+def set_node(obj, node, root):
+    """Places a Clay object as the export's node under the root, with the glTF importer's
+    properties (the export's extras: ``instance``, ``piece``, ``state``, ``id``, ``chain``,
+    ``index``) and its node name, the identity it keeps across reloads."""
     import math
 
-    mesh = meshes.get(node.mesh) if node.mesh is not None else None
-    if mesh is None:
-        mesh = mesh_data(node)
-        if node.mesh is not None:
-            meshes[node.mesh] = mesh
-    obj = bpy.data.objects.new(node.name, mesh)
     x, y = node.pivot
     turn = node.rotation
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(turn)):
         x, y, turn = 0.0, 0.0, 0.0
+    if obj.parent != root:
+        obj.parent = root
+        obj.matrix_parent_inverse.identity()
     obj.location = (x, y, 0.0)
     obj.rotation_euler = (0.0, 0.0, turn)
-    obj["clay_instance"] = node.instance
-    obj["clay_piece"] = node.piece
-    obj["clay_state"] = node.state
-    obj["clay_id"] = node.id
-    if node.chain is not None:
-        obj["clay_chain"] = node.chain
-        obj["clay_index"] = node.index
-    collection.objects.link(obj)
-    return obj
+    obj[NODE] = node.name
+    obj["instance"] = node.instance
+    obj["piece"] = node.piece
+    obj["state"] = node.state
+    obj["id"] = node.id
+    for key, value in (("chain", node.chain), ("index", node.index)):
+        if value is None:
+            obj.pop(key, None)
+        else:
+            obj[key] = value
+
+
+def root_of(collection):
+    """The collection's root Empty, made (named after the collection) when it has none."""
+    for obj in collection.objects:
+        if obj.get(ROOT):
+            return obj
+    root = bpy.data.objects.new(collection.name, None)
+    root.empty_display_type = "PLAIN_AXES"
+    root[ROOT] = True
+    collection.objects.link(root)
+    return root
+
+
+def update_objects(collection, nodes):
+    """Brings the collection's Clay objects to `nodes`, in place: an object whose node is still
+    there keeps its object (the user's modifiers, object materials, children, properties),
+    takes the node's placement and mesh; a new node gets an object under the root; a gone
+    node's object is removed, its children kept under the root where they are. Objects Clay
+    did not make are never touched."""
+    root = root_of(collection)
+    old = {o[NODE]: o for o in collection.objects if NODE in o}
+    old_meshes = {}
+    for obj in old.values():
+        if obj.type == "MESH" and MESH in obj.data:
+            old_meshes.setdefault(obj.data[MESH], obj.data)
+    meshes = {}
+    for node in nodes:
+        key = node.mesh or node.name
+        mesh = meshes.get(key)
+        if mesh is None:
+            mesh = old_meshes.pop(key, None) or bpy.data.meshes.new(key)
+            meshes[key] = fill_mesh(mesh, node)
+        obj = old.pop(node.name, None)
+        if obj is None:
+            obj = bpy.data.objects.new(node.name, mesh)
+            collection.objects.link(obj)
+        elif obj.data != mesh:
+            obj.data = mesh
+        set_node(obj, node, root)
+    for obj in old.values():
+        for child in list(obj.children):
+            world = child.matrix_world.copy()
+            child.parent = root
+            child.matrix_world = world
+        bpy.data.objects.remove(obj, do_unlink=True)
+    for mesh in old_meshes.values():
+        if mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+
+
+def stored_path(path, blend=None):
+    """A path as the collection keeps it: relative to the .blend (``//grammars/wall.clay``)
+    when the .blend has a place (`blend`, else the open file's) and the path is on its drive,
+    else absolute. `path` may be relative to the open .blend itself."""
+    if not path:
+        return ""
+    path = os.path.abspath(bpy.path.abspath(path))
+    blend = blend or bpy.data.filepath
+    if blend:
+        try:
+            return bpy.path.relpath(path, start=os.path.dirname(os.path.abspath(blend)))
+        except ValueError:  # another drive (Windows)
+            pass
+    return path
+
+
+@bpy.app.handlers.persistent  # kept across file loads, as the add-on is
+def make_paths_relative(target=None, *_args):
+    """Before a save (``save_pre``, given the file's new path): the paths of every Clay
+    collection relative to where the .blend is written, so the .blend and its grammars move
+    together and reopen from anywhere."""
+    blend = target if isinstance(target, str) and target else None
+    for coll in bpy.data.collections:
+        for key in (PATH, SCRIPT):
+            if coll.get(key):
+                coll[key] = stored_path(coll[key], blend)
 
 
 def collection_params(collection):
@@ -142,29 +239,25 @@ def collection_params(collection):
 
 
 def build(collection, path, script, params, thickness):
-    """Fills `collection` with the grammar's model (after the script, when one is given);
-    sets the collection's properties. Raises the package's errors (clay.GrammarError,
+    """Brings `collection` to the grammar's model (after the script, when one is given), in
+    place (`update_objects`); sets the collection's properties. `path` and `script` may be
+    relative to the .blend (``//``). Raises the package's errors (clay.GrammarError,
     ValueError, OSError) before anything in the collection changes."""
     clay = _clay()
+    grammar_path = bpy.path.abspath(path)
+    script_path = bpy.path.abspath(script) if script else ""
     if params:
         # Values for parameters the grammar no longer declares (its text changed) are dropped.
-        known = {p.name for p in clay.Grammar.open(path).params}
+        known = {p.name for p in clay.Grammar.open(grammar_path).params}
         params = {k: v for k, v in params.items() if k in known}
-    grammar = clay.Grammar.open(path, params=params or None)
+    grammar = clay.Grammar.open(grammar_path, params=params or None)
     session = clay.Session(grammar)
-    if script:
-        session.run_script(script)
+    if script_path:
+        session.run_script(script_path)
     nodes = session.scene(thickness=thickness)
-    for obj in list(collection.objects):
-        mesh = obj.data if obj.type == "MESH" else None
-        bpy.data.objects.remove(obj, do_unlink=True)
-        if mesh is not None and mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
-    meshes = {}
-    for node in nodes:
-        mesh_object(node, collection, meshes)
-    collection[PATH] = str(path)
-    collection[SCRIPT] = str(script or "")
+    update_objects(collection, nodes)
+    collection[PATH] = stored_path(path)
+    collection[SCRIPT] = stored_path(script)
     collection[THICKNESS] = float(thickness)
     for stale in json.loads(collection.get(PARAMS, "[]")):
         if stale in collection:
@@ -316,9 +409,12 @@ def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.TOPBAR_MT_file_import.append(menu_import)
+    bpy.app.handlers.save_pre.append(make_paths_relative)
 
 
 def unregister():
+    if make_paths_relative in bpy.app.handlers.save_pre:
+        bpy.app.handlers.save_pre.remove(make_paths_relative)
     bpy.types.TOPBAR_MT_file_import.remove(menu_import)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

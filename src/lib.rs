@@ -37,7 +37,7 @@ pub use assembly::{Assembly, Compass, Handle, HandleKind};
 pub use export::iso::iso_pixmap;
 pub use export::{
     ChainPlace, ExportFileError, ExportFormat, ExportOptions, Node, Primitive, Scene, SharedMesh,
-    encode_export, mtl_path, scene, write_export,
+    chain_places, encode_export, material_name, mtl_path, scene, write_export,
 };
 pub use files::write_atomic;
 pub use plane::nearest_on_segment;

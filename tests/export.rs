@@ -265,3 +265,75 @@ fn extruded_proxies_keep_their_heights_when_the_floor_plan_deforms() {
         ]
     );
 }
+
+/// Issue 48, item 5: the glTF, the OBJ's material library and the USD name every fill colour's
+/// material the same (`clay::material_name`, `fill_` and the sRGB bytes), and the USD's
+/// instances are the glTF's nodes, with the extras under the same words.
+#[test]
+fn every_format_names_materials_nodes_and_extras_alike() {
+    for name in EXAMPLES {
+        let g = grammar(name);
+        let a = sculpted(name, &g).unwrap_or_else(|| g.assembly.clone());
+        let s = scene(&g, &a, &ExportOptions::default());
+        let expected: Vec<String> = s
+            .materials
+            .iter()
+            .map(|&c| clay::material_name(c))
+            .collect();
+        assert!(
+            expected
+                .iter()
+                .all(|m| m.starts_with("fill_") && m.len() == 13)
+        );
+        let encode = |f: clay::ExportFormat, file: &str| {
+            clay::encode_export(&s, f, Path::new(file)).unwrap()
+        };
+        let (gltf, _) = encode(clay::ExportFormat::Gltf, "m.gltf");
+        let doc: serde_json::Value = serde_json::from_slice(&gltf).unwrap();
+        let gltf_names: Vec<&str> = doc["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(gltf_names, expected, "{name}: glTF");
+        let (obj, mtl) = encode(clay::ExportFormat::Obj, "m.obj");
+        let (obj, mtl) = (
+            String::from_utf8(obj).unwrap(),
+            String::from_utf8(mtl.unwrap()).unwrap(),
+        );
+        let newmtl: Vec<&str> = mtl
+            .lines()
+            .filter_map(|l| l.strip_prefix("newmtl "))
+            .collect();
+        assert_eq!(newmtl, expected, "{name}: MTL");
+        assert!(
+            obj.lines()
+                .filter_map(|l| l.strip_prefix("usemtl "))
+                .all(|m| expected.iter().any(|e| e == m))
+        );
+        let usda = String::from_utf8(encode(clay::ExportFormat::Usda, "m.usda").0).unwrap();
+        let looks: Vec<&str> = usda
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("def Material \""))
+            .map(|l| l.trim_end_matches('"'))
+            .collect();
+        assert_eq!(looks, expected, "{name}: USD");
+        // Every binding names one of them.
+        for line in usda.lines().filter(|l| l.contains("material:binding")) {
+            let target = line.rsplit('/').next().unwrap().trim_end_matches('>');
+            assert!(expected.iter().any(|e| e == target), "{name}: {line}");
+        }
+        for node in &s.nodes {
+            assert!(
+                usda.contains(&format!("def Xform \"{}\"", node.name)),
+                "{name}: {}",
+                node.name
+            );
+            assert!(usda.contains(&format!("userProperties:instance = \"{}\"", node.instance)));
+            if let Some(c) = &node.chain {
+                assert!(usda.contains(&format!("userProperties:chain = \"{}\"", c.name)));
+            }
+        }
+    }
+}

@@ -7,6 +7,7 @@ import struct
 from pathlib import Path
 
 import bpy
+import numpy as np
 import pytest
 
 import clay
@@ -25,6 +26,11 @@ def clay_collections():
     return [c for c in bpy.data.collections if clay_blender.PATH in c]
 
 
+def instances_of(coll):
+    """The collection's instance objects (not its root Empty, nor objects the user added)."""
+    return [o for o in coll.objects if clay_blender.NODE in o]
+
+
 def test_the_operator_imports_the_castle_as_one_collection():
     fresh_file()
     result = bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
@@ -36,9 +42,13 @@ def test_the_operator_imports_the_castle_as_one_collection():
     session = clay.Session(clay.Grammar.open(CASTLE))
     session.run_script(CASTLE_SCRIPT)
     instances = session.instances
-    objects = list(coll.objects)
+    objects = instances_of(coll)
     # 35 at the start; dragging the tower out inserts five wall elements.
     assert len(objects) == len(instances) == 40
+    # Under one root Empty named after the grammar, as the glTF's root node.
+    [root] = [o for o in coll.objects if o not in objects]
+    assert root.name == "castle" and root.type == "EMPTY"
+    assert all(o.parent == root for o in objects)
 
     # Named as the glTF export names its nodes; each at its instance's centroid, turned as
     # the export's node, its instance's name, piece, id and chain place as properties.
@@ -48,15 +58,17 @@ def test_the_operator_imports_the_castle_as_one_collection():
     by_instance = {i.name: i for i in instances}
     for node in nodes:
         obj = by_name[node.name]
-        inst = by_instance[obj["clay_instance"]]
+        inst = by_instance[obj["instance"]]
         assert node.instance == inst.name
         assert obj.location.x == pytest.approx(inst.centroid[0], abs=1e-6)
         assert obj.location.y == pytest.approx(inst.centroid[1], abs=1e-6)
         assert obj.location.z == 0
         assert tuple(obj.rotation_euler) == pytest.approx((0, 0, node.rotation), abs=1e-6)
-        assert obj["clay_piece"] == inst.piece
-        assert obj["clay_id"] == inst.id
-        assert obj.get("clay_index") == inst.index
+        # The glTF importer's properties (the export's extras), the same words everywhere.
+        assert obj["piece"] == inst.piece and obj["state"] == inst.state
+        assert obj["id"] == inst.id
+        assert obj.get("chain") == inst.chain == node.chain
+        assert obj.get("index") == inst.index
     # Identical instances share one mesh, as in the glTF.
     assert len({o.data.name for o in objects}) == len({n.mesh for n in nodes})
     assert len({o.data.name for o in objects}) < len(objects)
@@ -74,22 +86,30 @@ def test_the_operator_imports_the_castle_as_one_collection():
     materials = {m.name for o in objects for m in o.data.materials}
     colours = {p.colour for n in session.scene() for p in n.primitives}
     assert len(materials) == len(colours)
-    assert all(name.startswith("clay #") for name in materials)
+    assert materials == {"fill_" + "".join(f"{b:02x}" for b in c) for c in colours}
+    # A planar UV layer, as the exports have: one UV per corner, the primitives' own.
+    for node in nodes:
+        mesh = by_name[node.name].data
+        assert [uv.name for uv in mesh.uv_layers] == ["UVMap"]
+        uvs = np.array([tuple(d.uv) for d in mesh.uv_layers[0].data])
+        corners = [l.vertex_index for l in mesh.loops]
+        flat = np.concatenate([p.uvs for p in node.primitives])
+        assert uvs == pytest.approx(flat[corners], abs=1e-6)
 
 
 def test_reload_rebuilds_from_the_file_and_keeps_the_collection():
     fresh_file()
     bpy.ops.clay.import_grammar(filepath=str(CASTLE))
     [coll] = clay_collections()
-    assert len(coll.objects) == 35
+    assert len(instances_of(coll)) == 35
     assert coll[clay_blender.SCRIPT] == ""
     # The script is a property of the collection: set it and reload.
     coll[clay_blender.SCRIPT] = str(CASTLE_SCRIPT)
-    before = {o.name: tuple(o.location) for o in coll.objects}
+    before = {o.name: tuple(o.location) for o in instances_of(coll)}
     assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
     [again] = clay_collections()
     assert again == coll
-    after = {o.name: tuple(o.location) for o in coll.objects}
+    after = {o.name: tuple(o.location) for o in instances_of(coll)}
     assert len(before) == 35 and len(after) == 40
     assert after != before, "the script's drag moved nothing"
     assert not [o for o in bpy.data.objects if o.users == 0]
@@ -123,7 +143,7 @@ def test_an_exported_glb_imports_with_an_origin_per_instance(tmp_path):
     imported = bounds(children)
     bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
     [coll] = clay_collections()
-    added = bounds(list(coll.objects))
+    added = bounds(instances_of(coll))
     for a, b in zip(imported, added):
         assert a == pytest.approx(b, abs=1e-4)
 
@@ -143,7 +163,7 @@ def test_an_exported_usd_imports_with_blenders_usd_importer(tmp_path):
     [root] = [o for o in bpy.data.objects if o.parent is None and o.type == "EMPTY"]
     assert root.name == "castle"
     # The instances, and the materials' scope (an Empty in Blender).
-    children = [o for o in bpy.data.objects if o.parent == root and "clay:instance" in o]
+    children = [o for o in bpy.data.objects if o.parent == root and "instance" in o]
     assert [o.name for o in root.children if o not in children] == ["Looks"]
     assert sorted(o.name for o in children) == sorted(nodes)
     for obj in children:
@@ -151,8 +171,10 @@ def test_an_exported_usd_imports_with_blenders_usd_importer(tmp_path):
         w = obj.matrix_world.translation
         assert (w.x, w.y, w.z) == pytest.approx((*node.pivot, 0), abs=1e-4)
         assert obj.matrix_world.to_euler().z == pytest.approx(node.rotation, abs=1e-5)
-        assert obj["clay:instance"] == node.instance and obj["clay:piece"] == node.piece
-        assert obj["clay:state"] == node.state and obj.get("clay:index") == node.index
+        # The glTF importer's properties (the glTF's extras), from USD's userProperties.
+        assert obj["instance"] == node.instance and obj["piece"] == node.piece
+        assert obj["state"] == node.state and obj["id"] == node.id
+        assert obj.get("chain") == node.chain and obj.get("index") == node.index
         # Its geometry is an instance of a prototype collection, not a copy.
         [geometry] = obj.children
         assert geometry.instance_type == "COLLECTION" and geometry.instance_collection
@@ -167,7 +189,7 @@ def test_an_exported_usd_imports_with_blenders_usd_importer(tmp_path):
                 hi = [max(a, b) for a, b in zip(hi, p)]
     bpy.ops.clay.import_grammar(filepath=str(CASTLE), script=str(CASTLE_SCRIPT))
     [coll] = clay_collections()
-    added = bounds(list(coll.objects))
+    added = bounds(instances_of(coll))
     for a, b in zip((lo, hi), added):
         assert a == pytest.approx(b, abs=1e-4)
 
@@ -206,36 +228,121 @@ def test_parameters_are_collection_properties_and_reload_reads_them(tmp_path):
     assert coll["bays"] == 4.0 and coll["width"] == 1.0
     ui = coll.id_properties_ui("bays").as_dict()
     assert (ui["min"], ui["max"], ui["default"]) == (2.0, 12.0, 4.0)
-    assert len(coll.objects) == 4
+    assert len(instances_of(coll)) == 4
     # Heights from the grammar's extrude, as clayc export gives them.
-    lo, hi = bounds(coll.objects)
+    lo, hi = bounds(instances_of(coll))
     assert (lo[2], hi[2]) == pytest.approx((0.0, 1.2), abs=1e-5)
 
     coll["bays"] = 7.0
     coll["width"] = 1.5
     assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
-    assert len(coll.objects) == 7
-    lo, hi = bounds(coll.objects)
+    assert len(instances_of(coll)) == 7
+    lo, hi = bounds(instances_of(coll))
     assert hi[0] - lo[0] == pytest.approx(7 * 1.5, abs=1e-4)
 
     # A value outside the range is reported; the collection keeps what it had.
     coll["bays"] = 30.0
     with pytest.raises(RuntimeError, match="E071"):
         bpy.ops.clay.reload(collection=coll.name)
-    assert len(coll.objects) == 7
+    assert len(instances_of(coll)) == 7
 
     # The text file changed: Reload reads it again.
     wider = FENCE.replace("param bays = 4 in 2..12", "param bays = 4 in 2..40")
     grammar.write_text(wider)
     assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
-    assert len(coll.objects) == 30
+    assert len(instances_of(coll)) == 30
 
     # A parameter the text no longer declares is dropped from the collection.
     grammar.write_text(wider.replace("param width = 1 in 0.5..2", "let width = 1"))
     assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
     assert "width" not in coll and coll["bays"] == 30.0
-    lo, hi = bounds(coll.objects)
+    lo, hi = bounds(instances_of(coll))
     assert hi[0] - lo[0] == pytest.approx(30 * 1.0, abs=1e-4)
+
+
+def test_reload_after_a_parameter_change_keeps_the_users_work(tmp_path):
+    """Issue 48, item 1: the user adds an Empty to the collection, a modifier, an object
+    material and a child to a post; a parameter change and Reload keep all of them, keep the
+    surviving posts' very objects, add the new posts and remove the gone ones (their children
+    stay where they were, under the root)."""
+    fresh_file()
+    grammar = tmp_path / "fence.clay"
+    grammar.write_text(FENCE)
+    assert bpy.ops.clay.import_grammar(filepath=str(grammar)) == {"FINISHED"}
+    [coll] = clay_collections()
+    posts = {o[clay_blender.NODE]: o for o in instances_of(coll)}
+    assert sorted(posts) == ["fence_0", "fence_1", "fence_2", "fence_3"]
+    # The user's work: an Empty of their own, a modifier and an object-level material on the
+    # first post, a camera parented to the last one, a property on the second.
+    marker = bpy.data.objects.new("my marker", None)
+    coll.objects.link(marker)
+    first, second, last = posts["fence_0"], posts["fence_1"], posts["fence_3"]
+    first.modifiers.new("my bevel", "BEVEL")
+    mine = bpy.data.materials.new("my paint")
+    first.material_slots[0].link = "OBJECT"
+    first.material_slots[0].material = mine
+    second["my note"] = "keep me"
+    camera = bpy.data.objects.new("my camera", bpy.data.cameras.new("my camera"))
+    coll.objects.link(camera)
+    camera.parent = last
+    camera.location = (0, -5, 2)
+    bpy.context.view_layer.update()
+    camera_at = camera.matrix_world.copy()
+    pointers = {k: o.as_pointer() for k, o in posts.items()}
+
+    coll["bays"] = 6.0
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    after = {o[clay_blender.NODE]: o for o in instances_of(coll)}
+    assert sorted(after) == [f"fence_{k}" for k in range(6)]
+    for k in pointers:
+        assert after[k].as_pointer() == pointers[k], f"{k} was made again"
+    assert "my marker" in coll.objects and bpy.data.objects["my marker"] == marker
+    assert [m.name for m in first.modifiers] == ["my bevel"]
+    assert first.material_slots[0].material == mine
+    assert second["my note"] == "keep me"
+    assert camera.parent == last
+    # New posts stand beyond the old ones along the fence.
+    xs = [after[f"fence_{k}"].location.x for k in range(6)]
+    assert xs == sorted(xs)
+
+    coll["bays"] = 2.0
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    assert sorted(o[clay_blender.NODE] for o in instances_of(coll)) == ["fence_0", "fence_1"]
+    assert [m.name for m in first.modifiers] == ["my bevel"]
+    # The last post went; its camera stays where it was, under the root.
+    bpy.context.view_layer.update()
+    root = first.parent
+    assert camera.name in bpy.data.objects and camera.parent == root
+    assert np.allclose(np.array(camera.matrix_world), np.array(camera_at), atol=1e-6)
+    assert "my marker" in coll.objects
+    assert not [m for m in bpy.data.meshes if m.users == 0], "a mesh left behind"
+
+
+def test_paths_are_kept_relative_to_the_blend_and_reopen_from_elsewhere(tmp_path, monkeypatch):
+    """Issue 48, item 1: docs/blender.md's relative paths broke once the .blend was opened from
+    another folder. Saved, the collection keeps its grammar relative to the .blend; the project
+    folder moved and reopened from elsewhere, Reload still finds it."""
+    fresh_file()
+    project = tmp_path / "project"
+    (project / "grammars").mkdir(parents=True)
+    grammar = project / "grammars" / "fence.clay"
+    grammar.write_text(FENCE)
+    monkeypatch.chdir(project)
+    assert bpy.ops.clay.import_grammar(filepath="grammars/fence.clay") == {"FINISHED"}
+    [coll] = clay_collections()
+    blend = project / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    assert coll[clay_blender.PATH] == "//grammars/fence.clay"
+    moved = tmp_path / "moved"
+    project.rename(moved)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    bpy.ops.wm.open_mainfile(filepath=str(moved / "scene.blend"))
+    [coll] = clay_collections()
+    coll["bays"] = 5.0
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    assert len(instances_of(coll)) == 5
 
 
 def test_errors_are_reported_not_raised_into_blender(tmp_path):

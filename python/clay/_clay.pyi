@@ -135,8 +135,8 @@ class Instance:
     def state(self) -> str:
         """The active rest state's name."""
     @property
-    def chain(self) -> int | None:
-        """The stretch chain it is an element of (an index), or None."""
+    def chain(self) -> str | None:
+        """The stretch chain it is an element of, named as every export names it (``wall_n``), or None."""
     @property
     def index(self) -> int | None:
         """Its place in that chain (0 first), or None."""
@@ -174,6 +174,9 @@ class Primitive:
     @property
     def triangles(self) -> npt.NDArray[np.uint32]:
         """Shape (m, 3), counter-clockwise seen from outside."""
+    @property
+    def uvs(self) -> npt.NDArray[np.float32]:
+        """Shape (n, 2): planar texture coordinates in metres, v up, one per position."""
 
 class SceneNode:
     """One instance's 3D meshes as ``clayc export`` writes its node: name, pivot, turn, mesh."""

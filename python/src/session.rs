@@ -61,9 +61,9 @@ pub struct PyInstance {
     pub piece: String,
     /// The active rest state's name.
     pub state: String,
-    /// The stretch chain the instance is an element of (an index into the model's chains),
-    /// or `None`.
-    pub chain: Option<usize>,
+    /// The stretch chain the instance is an element of, by the name every export gives it
+    /// (`wall_n`, as `SceneNode.chain`), or `None`.
+    pub chain: Option<String>,
     /// The instance's place in its chain (0 first), or `None`.
     pub index: Option<usize>,
     /// Global vertex indices (rows of `Session.positions`), one per piece vertex.
@@ -117,6 +117,10 @@ pub struct PyPrimitive {
     /// uint32 array of shape (m, 3): the triangles' corners, counter-clockwise seen from
     /// outside.
     pub triangles: Py<PyAny>,
+    /// float32 array of shape (n, 2): each position's planar texture coordinates in metres,
+    /// v up (a face looking up is mapped from above, x and y; a wall along itself, v its
+    /// height), as the USD and OBJ exports have them (the glTF's with v turned).
+    pub uvs: Py<PyAny>,
 }
 
 #[pymethods]
@@ -521,14 +525,8 @@ impl PySession {
     fn instances(&self) -> PyResult<Vec<PyInstance>> {
         let st = self.lock()?;
         let (grammar, data) = (st.asm.grammar(), st.asm.data());
-        let mut place = vec![(None, None); data.instances.len()];
-        for (c, chain) in data.chains.iter().enumerate() {
-            for (k, &i) in chain.instances.iter().enumerate() {
-                if let Some(slot) = place.get_mut(i) {
-                    *slot = (Some(c), Some(k));
-                }
-            }
-        }
+        // The export's chain names and places (`clay::chain_places`): one vocabulary.
+        let place = clay::chain_places(data);
         Ok(data
             .instances
             .iter()
@@ -546,8 +544,8 @@ impl PySession {
                     state: piece
                         .and_then(|p| p.states.get(inst.state))
                         .map_or(String::new(), |s| s.name.clone()),
-                    chain: place[i].0,
-                    index: place[i].1,
+                    chain: place.get(i).cloned().flatten().map(|p| p.name),
+                    index: place.get(i).cloned().flatten().map(|p| p.index),
                     vertices: inst.vertices.clone(),
                     centroid,
                 }
@@ -740,12 +738,15 @@ impl PySession {
                 let positions = PyArray1::from_vec(py, flat).reshape([n, 3])?;
                 let m = p.indices.len() / 3;
                 let triangles = PyArray1::from_vec(py, p.indices).reshape([m, 3])?;
+                let uv: Vec<f32> = p.uvs.iter().flat_map(|t| [t[0], -t[1]]).collect();
+                let uvs = PyArray1::from_vec(py, uv).reshape([p.uvs.len(), 2])?;
                 primitives.push(Py::new(
                     py,
                     PyPrimitive {
                         colour: (r, g, b, a),
                         positions: positions.into_any().unbind(),
                         triangles: triangles.into_any().unbind(),
+                        uvs: uvs.into_any().unbind(),
                     },
                 )?);
             }

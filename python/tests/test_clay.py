@@ -656,15 +656,15 @@ def test_the_usd_export_opens_validates_and_places_every_point_as_the_scene(gram
     assert [(e.GetName(), e.GetMessage()) for e in errors] == []
 
     nodes = s.scene()
-    xforms = [p for p in root.GetChildren() if p.HasAttribute("clay:instance")]
+    xforms = [p for p in root.GetChildren() if p.HasAttribute("userProperties:instance")]
     assert [p.GetName() for p in xforms] == [n.name for n in nodes]
     cache = UsdGeom.XformCache()
     colours = {}
     for prim, n in zip(xforms, nodes):
-        get = lambda a: prim.GetAttribute(a).Get()
-        assert (get("clay:instance"), get("clay:piece"), get("clay:state"), get("clay:id")) == (
+        get = lambda a: prim.GetAttribute(f"userProperties:{a}").Get()
+        assert (get("instance"), get("piece"), get("state"), get("id")) == (
             n.instance, n.piece, n.state, n.id)
-        assert get("clay:chain") == n.chain and get("clay:index") == n.index
+        assert get("chain") == n.chain and get("index") == n.index
         meshes = [m for m in Usd.PrimRange(prim, Usd.TraverseInstanceProxies()) if m.IsA(UsdGeom.Mesh)]
         assert len(meshes) == len(n.primitives), n.name
         c, sn = math.cos(n.rotation), math.sin(n.rotation)
@@ -676,6 +676,9 @@ def test_the_usd_export_opens_validates_and_places_every_point_as_the_scene(gram
             assert world == pytest.approx(expected, abs=1e-4), n.name
             indices = np.array(UsdGeom.Mesh(mesh).GetFaceVertexIndicesAttr().Get()).reshape(-1, 3)
             assert np.array_equal(indices, p.triangles), n.name
+            st = np.array(UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st").Get())
+            assert p.uvs.dtype == np.float32 and p.uvs.shape == (len(p.positions), 2)
+            assert np.array_equal(st, p.uvs), n.name
             material, _ = UsdShade.MaterialBindingAPI(mesh).ComputeBoundMaterial()
             shader = UsdShade.Shader(material.GetSurfaceOutput().GetConnectedSources()[0][0].source.GetPrim())
             assert shader.GetIdAttr().Get() == "UsdPreviewSurface"

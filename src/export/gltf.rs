@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use base64::Engine as _;
 use gltf::json::{self, validation::Checked::Valid, validation::USize64};
 
-use super::model::{Scene, srgb_to_linear};
+use super::model::{Scene, material_name, srgb_to_linear};
 
 /// The binary data and the accessors into it, as they are appended.
 struct Buffers {
@@ -175,10 +175,10 @@ fn document(scene: &Scene) -> (json::Root, Vec<u8>) {
 
 /// A material per fill colour: its linear base colour, blended when not opaque.
 fn push_materials(b: &mut Buffers, scene: &Scene) {
-    for (i, c) in scene.materials.iter().enumerate() {
+    for c in &scene.materials {
         let [r, g, bl, a] = c.0;
         b.root.push(json::Material {
-            name: Some(format!("fill #{r:02x}{g:02x}{bl:02x}{a:02x} ({i})")),
+            name: Some(material_name(*c)),
             alpha_mode: Valid(if a == 255 {
                 json::material::AlphaMode::Opaque
             } else {

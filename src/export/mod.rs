@@ -42,7 +42,8 @@ use crate::render::{Mesh, Solid, TessellationCache, WorldMesh, pose_assembly};
 use solid::{Blend, Prism, Shape};
 
 pub use file::{ExportFileError, ExportFormat, encode_export, mtl_path, write_export};
-pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh};
+pub use model::{ChainPlace, ExportOptions, Node, Primitive, Scene, SharedMesh, material_name};
+pub use names::chain_places;
 // Names only the tests use, re-exported as `clay::testing::X`.
 #[cfg(any(test, feature = "testing"))]
 pub use {file::MAX_THICKNESS, model::srgb_to_linear, names::MAX_NAME_BYTES};

@@ -103,6 +103,15 @@ impl Node {
     }
 }
 
+/// The name of the material of fill colour `c` in every output (glTF, OBJ, USD, the Blender
+/// add-on): `fill_` and its sRGB bytes in hex, `fill_9a958cff`. One colour, one material, so
+/// the name is unique in a scene and the same in every file of the same grammar; letters,
+/// digits and `_`, so OBJ and USD take it as it is.
+pub fn material_name(c: Rgba) -> String {
+    let [r, g, b, a] = c.0;
+    format!("fill_{r:02x}{g:02x}{b:02x}{a:02x}")
+}
+
 /// One mesh of the file, written once and placed by every node that refers to it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SharedMesh {

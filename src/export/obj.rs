@@ -11,7 +11,7 @@
 
 use std::fmt::Write as _;
 
-use super::model::{Scene, srgb_to_linear};
+use super::model::{Scene, material_name, srgb_to_linear};
 
 /// The OBJ text (referring to the material library `mtl_name`) and the MTL text.
 pub fn to_obj(scene: &Scene, mtl_name: &str) -> (String, String) {
@@ -48,7 +48,7 @@ pub fn to_obj(scene: &Scene, mtl_name: &str) -> (String, String) {
                 let d = node.direction_to_world(n).normalize_or_zero().as_vec3();
                 let _ = writeln!(obj, "vn {} {} {}", d.x, d.y, d.z);
             }
-            let _ = writeln!(obj, "usemtl fill_{}", p.material);
+            let _ = writeln!(obj, "usemtl {}", material_name(scene.materials[p.material]));
             for t in p.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize + next);
                 let _ = writeln!(obj, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
@@ -62,9 +62,9 @@ pub fn to_obj(scene: &Scene, mtl_name: &str) -> (String, String) {
         "# clayc {} export: Kd linear, as glTF's baseColorFactor",
         env!("CARGO_PKG_VERSION")
     );
-    for (i, c) in scene.materials.iter().enumerate() {
+    for &c in &scene.materials {
         let [r, g, b, a] = c.0;
-        let _ = writeln!(mtl, "newmtl fill_{i}");
+        let _ = writeln!(mtl, "newmtl {}", material_name(c));
         let _ = writeln!(
             mtl,
             "Kd {} {} {}",

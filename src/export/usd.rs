@@ -10,10 +10,12 @@
 //! is written once, as a prototype under the abstract `class` prim `Prototypes`; each node has a
 //! child `geometry` that references its prototype and is `instanceable`, so a castle of 40
 //! bricks holds one brick. A prototype holds one `Mesh` per fill colour, bound to a
-//! `UsdPreviewSurface` material under `Looks` (`fill_0`, as the OBJ's materials are named;
+//! `UsdPreviewSurface` material under `Looks` (named as in every output, `fill_9a958cff`;
 //! diffuse colour linear, as glTF's factor). The instance's assembly name, piece, rest state, id
-//! and place in its stretch chain are custom attributes `clay:instance`, `clay:piece`,
-//! `clay:state`, `clay:id`, `clay:chain` and `clay:index` on its `Xform`.
+//! and place in its stretch chain are custom attributes `userProperties:instance`, `:piece`,
+//! `:state`, `:id`, `:chain` and `:index` on its `Xform`: USD's namespace for user data, which
+//! Blender's importer reads as the custom properties `instance`, `piece`, ... that its glTF
+//! importer gives from the glTF's extras.
 //!
 //! Names: prim names must be identifiers; node and mesh names are letters, digits and `_`
 //! already (`names.rs`), so only one that starts with a digit (a grammar file `1st.clay`) gets
@@ -22,7 +24,7 @@
 
 use std::fmt::Write as _;
 
-use super::model::{Node, Primitive, Scene, srgb_to_linear};
+use super::model::{Node, Primitive, Scene, material_name, srgb_to_linear};
 
 /// The `.usda` text of `scene`.
 pub fn to_usda(scene: &Scene) -> String {
@@ -44,7 +46,7 @@ pub fn to_usda(scene: &Scene) -> String {
             prim_name(&mesh.name)
         );
         for p in &node.primitives {
-            primitive(p, &root, &mut out);
+            primitive(scene, p, &root, &mut out);
         }
         let _ = writeln!(out, "        }}");
     }
@@ -85,12 +87,13 @@ fn quoted(s: &str) -> String {
 /// The materials: one `UsdPreviewSurface` per fill colour.
 fn looks(scene: &Scene, root: &str, out: &mut String) {
     let _ = writeln!(out, "    def Scope \"Looks\"\n    {{");
-    for (i, c) in scene.materials.iter().enumerate() {
+    for &c in &scene.materials {
+        let name = material_name(c);
         let [r, g, b, a] = c.0;
         let [r, g, b] = [r, g, b].map(srgb_to_linear);
         let _ = writeln!(
             out,
-            "        def Material \"fill_{i}\"\n        {{\n            token outputs:surface.connect = </{root}/Looks/fill_{i}/Surface.outputs:surface>\n\n            def Shader \"Surface\"\n            {{\n                uniform token info:id = \"UsdPreviewSurface\"\n                color3f inputs:diffuseColor = ({r}, {g}, {b})\n                float inputs:opacity = {}\n                float inputs:roughness = 0.8\n                token outputs:surface\n            }}\n        }}",
+            "        def Material \"{name}\"\n        {{\n            token outputs:surface.connect = </{root}/Looks/{name}/Surface.outputs:surface>\n\n            def Shader \"Surface\"\n            {{\n                uniform token info:id = \"UsdPreviewSurface\"\n                color3f inputs:diffuseColor = ({r}, {g}, {b})\n                float inputs:opacity = {}\n                float inputs:roughness = 0.8\n                token outputs:surface\n            }}\n        }}",
             a as f32 / 255.0
         );
     }
@@ -114,7 +117,7 @@ fn array<const N: usize>(items: impl Iterator<Item = [f32; N]>) -> String {
 
 /// One colour of a prototype: a triangle mesh with its normals, texture coordinates (`st`,
 /// v up as USD has it), extent and material.
-fn primitive(p: &Primitive, root: &str, out: &mut String) {
+fn primitive(scene: &Scene, p: &Primitive, root: &str, out: &mut String) {
     let points: Vec<[f32; 3]> = p.positions.iter().copied().map(z_up).collect();
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
@@ -129,10 +132,10 @@ fn primitive(p: &Primitive, root: &str, out: &mut String) {
     }
     let counts = vec!["3"; p.indices.len() / 3].join(", ");
     let indices: Vec<String> = p.indices.iter().map(u32::to_string).collect();
-    let m = p.material;
+    let m = material_name(scene.materials[p.material]);
     let _ = writeln!(
         out,
-        "            def Mesh \"fill_{m}\" (\n                prepend apiSchemas = [\"MaterialBindingAPI\"]\n            )\n            {{\n                uniform bool doubleSided = 0\n                float3[] extent = {}\n                int[] faceVertexCounts = [{counts}]\n                int[] faceVertexIndices = [{}]\n                rel material:binding = </{root}/Looks/fill_{m}>\n                normal3f[] normals = {} (\n                    interpolation = \"vertex\"\n                )\n                point3f[] points = {}\n                texCoord2f[] primvars:st = {} (\n                    interpolation = \"vertex\"\n                )\n                uniform token subdivisionScheme = \"none\"\n            }}",
+        "            def Mesh \"{m}\" (\n                prepend apiSchemas = [\"MaterialBindingAPI\"]\n            )\n            {{\n                uniform bool doubleSided = 0\n                float3[] extent = {}\n                int[] faceVertexCounts = [{counts}]\n                int[] faceVertexIndices = [{}]\n                rel material:binding = </{root}/Looks/{m}>\n                normal3f[] normals = {} (\n                    interpolation = \"vertex\"\n                )\n                point3f[] points = {}\n                texCoord2f[] primvars:st = {} (\n                    interpolation = \"vertex\"\n                )\n                uniform token subdivisionScheme = \"none\"\n            }}",
         array([lo, hi].into_iter()),
         indices.join(", "),
         array(p.normals.iter().copied().map(z_up)),
@@ -152,16 +155,22 @@ fn instance(scene: &Scene, node: &Node, root: &str, out: &mut String) {
     let _ = writeln!(out, "\n    def Xform \"{}\"\n    {{", prim_name(&node.name));
     let _ = writeln!(
         out,
-        "        custom string clay:instance = {}\n        custom string clay:piece = {}\n        custom string clay:state = {}\n        custom uint64 clay:id = {}",
+        "        custom string userProperties:instance = {}\n        custom string userProperties:piece = {}\n        custom string userProperties:state = {}\n        custom {} userProperties:id = {}",
         quoted(&node.instance),
         quoted(&node.piece),
         quoted(&node.state),
+        // Blender's importer takes 32-bit integers only.
+        if i32::try_from(node.id).is_ok() {
+            "int"
+        } else {
+            "int64"
+        },
         node.id
     );
     if let Some(c) = &node.chain {
         let _ = writeln!(
             out,
-            "        custom string clay:chain = {}\n        custom int clay:index = {}",
+            "        custom string userProperties:chain = {}\n        custom int userProperties:index = {}",
             quoted(&c.name),
             c.index
         );
