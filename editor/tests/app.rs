@@ -563,6 +563,71 @@ fn a_new_session_file_is_suggested_beside_the_grammar_not_in_the_working_folder(
     }
 }
 
+/// Issue 48: "Save gestures as script" suggested `grammars/wall.script.json`, the bundled
+/// demo, and replaced it. A typed path that exists is written only after Replace; Cancel
+/// leaves the file as it was.
+#[test]
+fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
+    let dir = temp_dir("save-replace");
+    let grammar = dir.join("wall.clay");
+    let script = dir.join("wall.script.json");
+    let demo = "{\"steps\": [{\"hold\": {\"frames\": 3}}]}\n";
+    std::fs::write(&grammar, include_str!("../../grammars/wall.clay")).unwrap();
+    std::fs::write(&script, demo).unwrap();
+    let mut h = harness(EditorApp::open(&grammar));
+    h.step();
+    let ask = |h: &mut Harness<'_, EditorApp>| {
+        h.get_by_label("File").click();
+        h.step();
+        h.step();
+        h.get_by_label("Save gestures as script…").click();
+        for _ in 0..4 {
+            h.step();
+        }
+        let by = egui_kittest::kittest::By::new()
+            .role(egui::accesskit::Role::TextInput)
+            .label_contains("Path (relative");
+        h.get(by).value().unwrap_or_default()
+    };
+    let type_path = |h: &mut Harness<'_, EditorApp>, path: &std::path::Path| {
+        h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+        h.step();
+        h.get_by_role(egui::accesskit::Role::TextInput)
+            .type_text(&path.display().to_string());
+        h.step();
+        h.key_press(egui::Key::Enter);
+        for _ in 0..3 {
+            h.step();
+        }
+    };
+    // The suggestion is a name no file has.
+    let suggested = ask(&mut h);
+    assert_eq!(
+        std::path::Path::new(&suggested),
+        std::path::absolute(dir.join("wall-2.script.json")).unwrap()
+    );
+    // The demo's own name typed: asked, not written; Cancel keeps it.
+    type_path(&mut h, &script);
+    h.get_by_label_contains("exists. Replace it?");
+    assert_eq!(std::fs::read_to_string(&script).unwrap(), demo);
+    h.get_by_label("Cancel").click();
+    for _ in 0..3 {
+        h.step();
+    }
+    assert_eq!(std::fs::read_to_string(&script).unwrap(), demo);
+    // Asked again, and Replace: now it is written.
+    ask(&mut h);
+    type_path(&mut h, &script);
+    h.get_by_label("Replace").click();
+    for _ in 0..4 {
+        h.step();
+    }
+    let written = std::fs::read_to_string(&script).unwrap();
+    assert_ne!(written, demo);
+    assert!(clay::Script::parse(&written).is_ok(), "{written}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Drags `part` by `by` metres with the left button and lets go, then lets the model settle.
 fn drag_part(h: &mut Harness<'_, EditorApp>, part: usize, by: glam::DVec2) {
     let at = h.get_by_label(&format!("part {part}")).rect().center();

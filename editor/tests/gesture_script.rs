@@ -165,7 +165,8 @@ fn the_gestures_saved_as_a_script_replay_into_the_same_sculpt() {
     let sculpt = h.state().sculpt.data().clone();
 
     // File > Save gestures as script..., in the typed-path dialog (no desktop dialog here),
-    // which suggests the name beside the grammar.
+    // which suggests a name beside the grammar that no file has: `wall.script.json` is the
+    // bundled demo (issue 48: accepting the suggestion replaced it), so `wall-2.script.json`.
     h.get_by_label("File").click();
     h.step();
     h.step();
@@ -179,10 +180,12 @@ fn the_gestures_saved_as_a_script_replay_into_the_same_sculpt() {
         .label_contains("Path (relative");
     let suggested = h.get(by).value().unwrap_or_default();
     let grammar_folder = std::path::absolute(wall_path()).unwrap();
+    assert!(grammar_folder.with_file_name("wall.script.json").is_file());
     assert_eq!(
         Path::new(&suggested),
-        grammar_folder.with_file_name("wall.script.json")
+        grammar_folder.with_file_name("wall-2.script.json")
     );
+    assert!(!Path::new(&suggested).exists());
     h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
     h.step();
     h.get_by_role(egui::accesskit::Role::TextInput)

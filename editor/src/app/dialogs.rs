@@ -157,8 +157,17 @@ impl EditorApp {
                     }
                 }
             }
+            let typed = PathBuf::from(d.text.trim());
+            let asked = d.replace.as_ref() == Some(&typed);
+            if asked {
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    format!("{} exists. Replace it?", typed.display()),
+                );
+            }
             ui.horizontal(|ui| {
-                if ui.button("OK").on_hover_text("Enter").clicked() || enter {
+                let ok = if asked { "Replace" } else { "OK" };
+                if ui.button(ok).on_hover_text("Enter").clicked() || enter {
                     done = Some(true);
                 }
                 if ui.button("Cancel").on_hover_text("Esc").clicked() {
@@ -168,6 +177,16 @@ impl EditorApp {
         });
         if r.should_close() && done.is_none() {
             done = Some(false);
+        }
+        // A Save to a file that exists waits for Replace (the second OK).
+        let path = PathBuf::from(d.text.trim());
+        if done == Some(true)
+            && d.kind.writes()
+            && path.is_file()
+            && d.replace.as_ref() != Some(&path)
+        {
+            d.replace = Some(path);
+            done = None;
         }
         match done {
             Some(true) if !d.text.trim().is_empty() => {

@@ -68,6 +68,9 @@ pub enum Mode {
 struct PathDialog {
     kind: FileKind,
     text: String,
+    /// The file a Save was asked to write exists: it is replaced only once the user says so
+    /// (issue 48: the bundled demo script was overwritten without a word).
+    replace: Option<PathBuf>,
 }
 
 /// The editor.

@@ -181,7 +181,11 @@ impl EditorApp {
         if self.desktop.native_dialogs {
             self.native = Some(NativeDialog::open(kind, Path::new(&text)));
         } else {
-            self.dialog = Some(PathDialog { kind, text });
+            self.dialog = Some(PathDialog {
+                kind,
+                text,
+                replace: None,
+            });
         }
     }
 
@@ -201,11 +205,23 @@ impl EditorApp {
 
     /// A new file's suggested path: in [`Self::folder`], named after the grammar with
     /// `extension` (`castle.png`), or `sculpt.EXTENSION` for a grammar with no file.
+    /// A new file's suggested name: the grammar's stem and `extension` beside it, numbered
+    /// (`wall-2.script.json`) past files that exist, so accepting a suggestion never replaces
+    /// one (the bundled `wall.script.json` was).
     fn suggested(&self, extension: &str) -> PathBuf {
         let stem = (self.grammar_path.as_deref())
             .and_then(Path::file_stem)
             .map_or("sculpt".to_string(), |s| s.to_string_lossy().into_owned());
-        self.folder().join(format!("{stem}.{extension}"))
+        let folder = self.folder();
+        let first = folder.join(format!("{stem}.{extension}"));
+        if !first.exists() {
+            return first;
+        }
+        // All taken: the first, and the dialog asks before replacing it.
+        (2..1000)
+            .map(|k| folder.join(format!("{stem}-{k}.{extension}")))
+            .find(|p| !p.exists())
+            .unwrap_or(first)
     }
 
     /// Takes the native dialog's answer once it has one.
