@@ -67,11 +67,11 @@ def srgb_to_linear(c):
     return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
 
 
-def material_for(colour):
-    """The material of a fill colour (sRGB bytes r, g, b, a), made once per file and named as
-    every export names it (``fill_9a958cff``)."""
-    r, g, b, a = colour
-    name = f"fill_{r:02x}{g:02x}{b:02x}{a:02x}"
+def material_for(prim):
+    """The material of a primitive's fill colour, made once per file and named as every export
+    names it (``prim.material``, ``fill_9a958cff``)."""
+    r, g, b, a = prim.colour
+    name = prim.material
     mat = bpy.data.materials.get(name)
     if mat is not None:
         return mat
@@ -112,7 +112,7 @@ def fill_mesh(mesh, node):
     if len(mesh.materials) != len(node.primitives):
         mesh.materials.clear()
         for prim in node.primitives:
-            mesh.materials.append(material_for(prim.colour))
+            mesh.materials.append(material_for(prim))
     if verts:
         v, f = np.concatenate(verts), np.concatenate(faces)
         mesh.from_pydata(v.tolist(), [], f.tolist())

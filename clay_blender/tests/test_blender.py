@@ -87,6 +87,7 @@ def test_the_operator_imports_the_castle_as_one_collection():
     colours = {p.colour for n in session.scene() for p in n.primitives}
     assert len(materials) == len(colours)
     assert materials == {"fill_" + "".join(f"{b:02x}" for b in c) for c in colours}
+    assert materials == {p.material for n in nodes for p in n.primitives}
     # A planar UV layer, as the exports have: one UV per corner, the primitives' own.
     for node in nodes:
         mesh = by_name[node.name].data

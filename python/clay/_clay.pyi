@@ -169,6 +169,9 @@ class Primitive:
     def colour(self) -> tuple[int, int, int, int]:
         """sRGB bytes (r, g, b, a)."""
     @property
+    def material(self) -> str:
+        """Its material's name in every export and the Blender add-on (``fill_9a958cff``)."""
+    @property
     def positions(self) -> npt.NDArray[np.float32]:
         """Shape (n, 3)."""
     @property

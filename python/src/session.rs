@@ -112,6 +112,8 @@ impl PyRuleEvent {
 pub struct PyPrimitive {
     /// The fill colour, sRGB bytes (r, g, b, a).
     pub colour: (u8, u8, u8, u8),
+    /// Its material's name in every export and the Blender add-on (`fill_9a958cff`).
+    pub material: String,
     /// float32 array of shape (n, 3).
     pub positions: Py<PyAny>,
     /// uint32 array of shape (m, 3): the triangles' corners, counter-clockwise seen from
@@ -744,6 +746,7 @@ impl PySession {
                     py,
                     PyPrimitive {
                         colour: (r, g, b, a),
+                        material: clay::material_name(clay_dsl::compiled::Rgba([r, g, b, a])),
                         positions: positions.into_any().unbind(),
                         triangles: triangles.into_any().unbind(),
                         uvs: uvs.into_any().unbind(),

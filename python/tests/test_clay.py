@@ -682,6 +682,7 @@ def test_the_usd_export_opens_validates_and_places_every_point_as_the_scene(gram
             material, _ = UsdShade.MaterialBindingAPI(mesh).ComputeBoundMaterial()
             shader = UsdShade.Shader(material.GetSurfaceOutput().GetConnectedSources()[0][0].source.GetPrim())
             assert shader.GetIdAttr().Get() == "UsdPreviewSurface"
+            assert material.GetPrim().GetName() == p.material
             colours[material.GetPath()] = p.colour, shader.GetInput("diffuseColor").Get()
     # Meshes shared: one prototype per distinct mesh of the scene.
     assert len(stage.GetPrototypes()) == len({n.mesh for n in nodes if n.mesh is not None})
