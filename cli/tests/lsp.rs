@@ -1321,6 +1321,29 @@ for _, r in pairs(replies or {}) do
     table.insert(lines, 'hover ' .. (r.result.contents.value:gsub('\n', ' | ')))
   end
 end
+-- K, as the documented setup maps it: a floating window with the hover.
+vim.api.nvim_win_set_cursor(0, { row, col })
+vim.api.nvim_feedkeys('K', 'x', false)
+local float
+vim.wait(20000, function()
+  for _, w in ipairs(vim.api.nvim_list_wins()) do
+    if vim.api.nvim_win_get_config(w).relative ~= '' then
+      float = w
+      return true
+    end
+  end
+  return false
+end, 50)
+if float then
+  local shown = vim.api.nvim_buf_get_lines(vim.api.nvim_win_get_buf(float), 0, -1, false)
+  table.insert(lines, 'K ' .. table.concat(shown, ' | '))
+  vim.api.nvim_win_close(float, true)
+end
+-- Ctrl-], as mapped: the cursor goes to the definition.
+vim.api.nvim_win_set_cursor(0, { row, col })
+vim.api.nvim_feedkeys(vim.api.nvim_replace_termcodes('<C-]>', true, false, true), 'x', false)
+vim.wait(20000, function() return vim.api.nvim_win_get_cursor(0)[1] ~= row end, 50)
+table.insert(lines, 'definition line ' .. vim.api.nvim_win_get_cursor(0)[1])
 vim.fn.writefile(lines, os.getenv('CLAY_NVIM_OUT'))
 vim.cmd('qa!')
 "#;
@@ -1410,6 +1433,17 @@ fn neovim_with_the_documented_setup_shows_e011_and_hovers() {
         "{out}"
     );
     assert!(out.contains("hover ```clay | piece brick |"), "{out}");
+    // K and Ctrl-] as the block maps them (0.7 maps neither to the server).
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("K ") && l.contains("piece brick")),
+        "{out}"
+    );
+    let piece = typo[..typo.find("piece brick").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    assert!(out.contains(&format!("definition line {piece}")), "{out}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
