@@ -15,6 +15,7 @@ pub mod diagnostics;
 pub mod files;
 pub mod guard;
 pub mod help;
+pub mod prose;
 pub mod recovery;
 pub mod sculpt;
 pub mod session;

@@ -533,8 +533,9 @@ fn the_inspector_and_parameters_say_what_they_mean() {
     // The sentence names the active state's misfit as the table shows it, and what the other
     // state's must fall below: no "fits 100% better".
     h.get_by_label_contains("would take over once its misfit is below");
+    // (The names in the monospace font, without backticks: prose.)
     h.get_by_label_contains(&format!(
-        "`{}`'s {:.4} (the hysteresis)",
+        "{}'s {:.4} (the hysteresis)",
         active.0, active.1
     ));
     h.get_by_label(&format!("{:.4}", active.1));
@@ -548,7 +549,9 @@ fn the_inspector_and_parameters_say_what_they_mean() {
 fn inserted_elements_names_are_explained_beside_the_grammars() {
     let mut h = harness(EditorApp::open(&grammar("wall.clay")));
     settle(&mut h);
-    assert!(h.query_by_label(NAMES_NOTE).is_none());
+    // Shown as prose: the names in the monospace font, without their backticks.
+    let note = NAMES_NOTE.replace('`', "");
+    assert!(h.query_by_label(&note).is_none());
     let at = h.state().sculpt.assembly().part_centroid(0);
     h.state_mut().command(Command::TogglePin { part: 0, at });
     settle(&mut h);
@@ -559,7 +562,11 @@ fn inserted_elements_names_are_explained_beside_the_grammars() {
     );
     h.step();
     // The rule log says `wall#N` and `wall[N]`: the note says what each is.
-    h.get_by_label(NAMES_NOTE);
+    h.get_by_label(&note);
+    assert!(
+        h.query_by_label(NAMES_NOTE).is_none(),
+        "backticks on screen"
+    );
 }
 
 #[test]

@@ -307,7 +307,7 @@ impl EditorApp {
                 }
                 if let Some(m) = &self.message {
                     ui.separator();
-                    ui.label(m);
+                    crate::prose::label(ui, m);
                 }
             });
         });

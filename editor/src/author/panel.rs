@@ -82,7 +82,7 @@ pub fn show(
     let design = match &author.result {
         Ok(c) => &c.design,
         Err(e) => {
-            ui.label(e);
+            crate::prose::label(ui, e);
             return;
         }
     };
@@ -113,7 +113,7 @@ pub fn show(
                 ui.label("Nothing to note.");
             }
             for n in &design.notes {
-                ui.label(RichText::new(n).color(Color32::from_rgb(180, 120, 0)));
+                crate::prose::coloured_label(ui, Color32::from_rgb(180, 120, 0), n);
             }
         });
     egui::CollapsingHeader::new("Grammar")

@@ -13,12 +13,15 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         ui.label("Hover a part to inspect it.");
         return;
     };
-    ui.label(format!(
-        "{} ({}){}",
-        report.covers,
-        report.piece,
-        if report.pinned { ", pinned" } else { "" }
-    ))
+    crate::prose::label(
+        ui,
+        &format!(
+            "{} ({}){}",
+            report.covers,
+            report.piece,
+            if report.pinned { ", pinned" } else { "" }
+        ),
+    )
     .on_hover_text(format!("part {} of the solver", report.why.part));
     if report.covers.contains('#') {
         names_note(ui);
@@ -29,9 +32,9 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
         .get(report.why.active)
         .map_or("?", |s| s.0.as_str());
     if report.why.at_rest {
-        ui.label(format!("rests as `{active_name}`"));
+        crate::prose::label(ui, &format!("rests as `{active_name}`"));
     } else {
-        ui.label(format!("in `{active_name}`, strained (not at rest)"));
+        crate::prose::label(ui, &format!("in `{active_name}`, strained (not at rest)"));
     }
     if let Some((_, length)) = report.why.candidate {
         ui.label(format!("its two elements span {length:.2} elements"));
@@ -52,19 +55,25 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
                 .states
                 .get(report.why.active)
                 .map_or(0.0, |s| s.1);
-            ui.label(format!(
-                "`{name}` would take over once its misfit is below {:.4}, {:.0}% under \
+            crate::prose::label(
+                ui,
+                &format!(
+                    "`{name}` would take over once its misfit is below {:.4}, {:.0}% under \
                  `{active_name}`'s {active_misfit:.4} (the hysteresis); `{name}`'s is {d:.4} now",
-                report.why.switch_below,
-                100.0 * report.why.hysteresis
-            ));
+                    report.why.switch_below,
+                    100.0 * report.why.hysteresis
+                ),
+            );
         }
         for (i, (name, _)) in report.why.states.iter().enumerate() {
             if report.why.available.get(i) == Some(&false) {
-                ui.label(format!(
-                    "`{name}` is ruled out now: the chain's length or its `min`/`max` does \
+                crate::prose::label(
+                    ui,
+                    &format!(
+                        "`{name}` is ruled out now: the chain's length or its `min`/`max` does \
                      not call for it"
-                ));
+                    ),
+                );
             }
         }
     }
@@ -95,7 +104,8 @@ pub const NAMES_NOTE: &str = "`wall[3]`: element 3 (from 0) of the chain `wall` 
      by its place in the chain.";
 
 fn names_note(ui: &mut egui::Ui) {
-    ui.label(RichText::new(NAMES_NOTE).small().weak());
+    let job = crate::prose::styled(NAMES_NOTE, ui.style(), |r| r.small().weak());
+    ui.label(job);
 }
 
 /// Solver statistics of the last frame.
@@ -259,9 +269,9 @@ pub fn rule_log(ui: &mut egui::Ui, sculpt: &Sculpt) {
             for e in sculpt.log().iter().rev() {
                 let text = format!("frame {}: {}", e.frame, e.message);
                 if e.outside {
-                    ui.colored_label(Color32::from_rgb(200, 40, 40), text);
+                    crate::prose::coloured_label(ui, Color32::from_rgb(200, 40, 40), &text);
                 } else {
-                    ui.label(text);
+                    crate::prose::label(ui, &text);
                 }
             }
         });
