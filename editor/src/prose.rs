@@ -50,6 +50,13 @@ pub fn label(ui: &mut egui::Ui, text: &str) -> egui::Response {
     ui.label(job)
 }
 
+/// A one-line label of [`prose`] cut with an ellipsis where it does not fit (the status line:
+/// issue 48, messages ran past the window's edge); the whole sentence shows on hover.
+pub fn line_label(ui: &mut egui::Ui, text: &str) -> egui::Response {
+    let job = prose(text, ui.style(), None);
+    ui.add(egui::Label::new(job).truncate())
+}
+
 /// A coloured label of [`prose`].
 pub fn coloured_label(ui: &mut egui::Ui, colour: Color32, text: &str) -> egui::Response {
     let job = prose(text, ui.style(), Some(colour));

@@ -293,3 +293,39 @@ fn saved_gestures_say_the_parameters_to_replay_them_with() {
     assert_eq!(asm.data().instances.len(), instances(&h));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 48, item 7: at 1280 px the reset button sat past the side panel's edge, cut off. It is
+/// on screen and inside the panel, left of its slider, with a long parameter name too.
+#[test]
+fn the_reset_button_is_on_screen_at_1280_px() {
+    let dir = temp_dir("params-1280");
+    let path = dir.join("posts.clay");
+    let long = posts(RANGE, "#b5651d").replace("bays", "number_of_bays_along_the_fence");
+    std::fs::write(&path, &long).unwrap();
+    let mut h = Harness::builder()
+        .with_size(egui::Vec2::new(1280.0, 800.0))
+        .with_max_steps(8)
+        .build_ui_state(
+            |ui, app: &mut EditorApp| app.frame(ui),
+            EditorApp::open(&path),
+        );
+    settle(&mut h);
+    assert!(h.state().problems.is_empty(), "{:?}", h.state().problems);
+    h.state_mut().param_change(ParamChange::Set(
+        "number_of_bays_along_the_fence".into(),
+        6.0,
+    ));
+    settle(&mut h);
+    let reset = h.get_by_label("reset").rect();
+    let long_slider = egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::Slider)
+        .label("number_of_bays_along_the_fence");
+    let slider = h.get(long_slider).rect();
+    assert!(reset.max.x <= 1280.0 && reset.min.x > 640.0, "{reset:?}");
+    assert!(reset.max.x <= slider.min.x, "{reset:?} {slider:?}");
+    h.get_by_label("default 4");
+    h.get_by_label("reset").click();
+    h.step();
+    h.step();
+    assert!(overrides(&h).is_empty());
+}

@@ -534,10 +534,7 @@ fn the_inspector_and_parameters_say_what_they_mean() {
     // state's must fall below: no "fits 100% better".
     h.get_by_label_contains("would take over once its misfit is below");
     // (The names in the monospace font, without backticks: prose.)
-    h.get_by_label_contains(&format!(
-        "{}'s {:.4} (the hysteresis)",
-        active.0, active.1
-    ));
+    h.get_by_label_contains(&format!("{}'s {:.4} (the hysteresis)", active.0, active.1));
     h.get_by_label(&format!("{:.4}", active.1));
     assert!(h.query_by_label_contains("better").is_none());
     // The slider says which number it is.
@@ -617,4 +614,24 @@ fn open_recent_lists_the_command_line_grammar_and_a_tried_one() {
     h.get_by_label(&shown(&wall));
     let kept = clay_editor::files::Recent::load(Some(&store));
     assert_eq!(kept.files[0].path, std::path::absolute(&tried).unwrap());
+}
+
+/// Issue 48, item 7: a long status message ran past the window's edge. The status line is one
+/// line; the message is cut to the width left, and reads whole on hover.
+#[test]
+fn a_long_status_message_fits_the_status_line() {
+    let mut h = harness(EditorApp::open(&grammar("wall.clay")));
+    settle(&mut h);
+    let long = format!(
+        "{} the end",
+        "`wall[5]` and `wall[6]` became three bricks: `wall#12` inserted; ".repeat(12)
+    );
+    h.state_mut().message = Some(long.clone());
+    h.step();
+    h.step();
+    let shown = long.replace('`', "");
+    let label = h.get_by_label(&shown);
+    let r = label.rect();
+    assert!(r.max.x <= 1200.5, "{r:?}");
+    assert!(r.height() < 30.0, "one line: {r:?}");
 }

@@ -267,8 +267,9 @@ impl EditorApp {
     }
 
     pub(super) fn status_bar(&mut self, ui: &mut egui::Ui) {
+        // One line: the message last, cut to the width left (the whole of it on hover).
         egui::Panel::bottom("status").show(ui, |ui| {
-            ui.horizontal_wrapped(|ui| {
+            ui.horizontal(|ui| {
                 let dirty = if self.sculpt.dirty() {
                     " (unsaved)"
                 } else {
@@ -307,7 +308,7 @@ impl EditorApp {
                 }
                 if let Some(m) = &self.message {
                     ui.separator();
-                    crate::prose::label(ui, m);
+                    crate::prose::line_label(ui, m);
                 }
             });
         });

@@ -189,10 +189,19 @@ pub fn grammar_parameters(
     params: &[clay_dsl::compiled::Param],
     changes: &mut Vec<ParamChange>,
 ) {
+    // The reset button first, the slider (with the name) after it, the default under it: at
+    // 1280 px the side panel cut off a reset button placed last (issue 48).
     egui::Grid::new("grammar parameters")
-        .num_columns(3)
+        .num_columns(2)
         .show(ui, |ui| {
             for p in params {
+                let reset = ui
+                    .add_enabled(p.value != p.default, egui::Button::new("reset").small())
+                    .on_hover_text(format!("Back to the default, {}", p.default))
+                    .on_disabled_hover_text(format!("At the default, {}", p.default));
+                if reset.clicked() {
+                    changes.push(ParamChange::Reset(p.name.clone()));
+                }
                 let id = egui::Id::unique(("grammar parameter", &p.name));
                 let mut v = ui.data(|d| d.get_temp::<f64>(id)).unwrap_or(p.value);
                 let whole = |x: f64| x.fract() == 0.0;
@@ -221,11 +230,12 @@ pub fn grammar_parameters(
                     }
                 };
                 let r = r.on_hover_text(format!(
-                    "`param {}` of the grammar{}: a change recompiles it, keeping the \
-                     sculpt where the structure allows",
+                    "param {} of the grammar{}, default {}: a change recompiles it, keeping \
+                     the sculpt where the structure allows",
                     p.name,
                     p.range
-                        .map_or(String::new(), |[lo, hi]| format!(", in {lo}..{hi}"))
+                        .map_or(String::new(), |[lo, hi]| format!(", in {lo}..{hi}")),
+                    p.default
                 ));
                 let released = r.drag_stopped()
                     || r.clicked()
@@ -240,13 +250,13 @@ pub fn grammar_parameters(
                 } else {
                     ui.data_mut(|d| d.remove::<f64>(id));
                 }
-                ui.label(RichText::new(format!("default {}", p.default)).weak());
-                let reset = ui
-                    .add_enabled(p.value != p.default, egui::Button::new("reset"))
-                    .on_hover_text(format!("Back to the default, {}", p.default));
-                if reset.clicked() {
-                    changes.push(ParamChange::Reset(p.name.clone()));
-                }
+                ui.end_row();
+                ui.label("");
+                ui.label(
+                    RichText::new(format!("default {}", p.default))
+                        .weak()
+                        .small(),
+                );
                 ui.end_row();
             }
         });
