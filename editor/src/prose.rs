@@ -31,7 +31,8 @@ pub fn styled(text: &str, style: &Style, look: impl Fn(RichText) -> RichText) ->
         }
         let mut rich = look(RichText::new(s));
         if code {
-            rich = rich.monospace();
+            // The family only: the size stays the sentence's (a small note's names are small).
+            rich = rich.family(egui::FontFamily::Monospace);
         }
         rich.append_to(&mut job, style, FontSelection::Default, Align::Center);
     };
