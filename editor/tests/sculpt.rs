@@ -510,3 +510,47 @@ fn commands_wait_for_a_background_frame_and_a_drop_lands_at_the_pointer() {
     assert!(!s.solving_in_background());
     assert!(s.data() == &before, "two undos restore the castle");
 }
+
+/// Issue 48, item 7: a drag that inserts bricks pointed the inspector (and hover, and P) at a
+/// pair mid-wall: the grabbed part's index was the one from before the rule renumbered the
+/// parts. While the rules insert bricks, the grabbed part is one that holds the grabbed
+/// instance, the one under the grab.
+#[test]
+fn the_grabbed_part_follows_the_grab_while_rules_insert_bricks() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../grammars/wall.clay");
+    let c = compile(&std::fs::read_to_string(path).unwrap(), path, &[]).unwrap();
+    let mut s = Sculpt::new(c.grammar);
+    settle(&mut s);
+    let west = s.assembly().part_extreme(clay::Compass::West).unwrap();
+    let at = s.assembly().part_centroid(west);
+    s.apply(Command::TogglePin { part: west, at });
+    let east = s.assembly().part_extreme(clay::Compass::East).unwrap();
+    let at = s.assembly().part_centroid(east) + DVec2::new(0.3, 0.0);
+    s.apply(Command::Grab { part: east, at });
+    let before = s.data().instances.len();
+    for k in 1..=40 {
+        s.apply(Command::MoveGrab {
+            translation: DVec2::new(0.2 * k as f64, 0.0),
+            angle: 0.0,
+        });
+        s.step(Duration::from_millis(50));
+        let part = s.grabbed().expect("still grabbed");
+        let data = s.data();
+        let target = s.grab_target().unwrap().0;
+        // The grabbed part is the one nearest the grab's target among the parts: the east end.
+        let nearest = (0..data.parts.len())
+            .min_by(|&a, &b| {
+                let d = |p| (s.assembly().part_centroid(p) - target).length();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        assert_eq!(
+            part, nearest,
+            "step {k}: part {part}, the grab is at {target}"
+        );
+    }
+    assert!(
+        s.data().instances.len() > before + 2,
+        "bricks were inserted"
+    );
+}

@@ -92,16 +92,27 @@ impl Grab {
         }
     }
 
-    /// After a rule renumbered the parts: the part whose vertices the handle still holds.
+    /// After a rule renumbered the parts: the part holding the most of the grabbed vertices,
+    /// nearest the grab (the one a pointer on the grabbed instance would be over).
     /// Returns `false` when the handle is gone (the grab is over).
     pub fn follow(&mut self, asm: &Assembly) -> bool {
         let Some(h) = asm.handle(self.handle) else {
             return false;
         };
+        // The part that holds the most of the grabbed vertices, and of those the one nearest
+        // the grab: a chain element lies in two pair parts, and a part wholly held need not
+        // exist. Issue 48: only a part wholly held was looked for, none was found for a chain
+        // element, and the index from before the rewrite pointed at a pair mid-wall.
         let held: std::collections::HashSet<usize> = h.vertices.iter().copied().collect();
-        if let Some(p) = (asm.data().parts.iter())
-            .position(|p| !p.vertices.is_empty() && p.vertices.iter().all(|v| held.contains(v)))
-        {
+        let centre = h.target_centre();
+        let best = (asm.data().parts.iter().enumerate())
+            .map(|(p, part)| {
+                let shared = part.vertices.iter().filter(|v| held.contains(v)).count();
+                (p, shared, (asm.part_centroid(p) - centre).length())
+            })
+            .filter(|&(_, shared, _)| shared > 0)
+            .max_by(|a, b| a.1.cmp(&b.1).then(b.2.total_cmp(&a.2)));
+        if let Some((p, _, _)) = best {
             self.part = Some(p);
         }
         true
