@@ -8,7 +8,7 @@ pub type Row = (&'static str, &'static str);
 pub const SCULPT: &[Row] = &[
     (
         "Drag a part",
-        "pull it: the part is the handle, the model follows elastically",
+        "pull it: the part is the handle, the model follows elastically; held near the view's edge, the view follows the drag",
     ),
     (
         "Right-drag, or Shift + drag",

@@ -628,6 +628,53 @@ fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Issue 48, item 7: the README's first drag (wall.clay at the default zoom, the leftmost
+/// brick pinned, the rightmost dragged right) had no room: the fitted wall reaches the canvas's
+/// edge. Held at the edge, the view follows the drag, and the wall grows bricks.
+#[test]
+fn the_readmes_first_drag_has_room_at_the_default_zoom() {
+    let mut h = harness(EditorApp::open(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/wall.clay"),
+    ));
+    settle(&mut h);
+    let first = h.get_by_label("part 0").rect().center();
+    h.hover_at(first);
+    h.step();
+    h.key_press(egui::Key::P);
+    h.step();
+    settle(&mut h);
+    let bricks = h.state().sculpt.data().instances.len();
+    let last = h.state().sculpt.data().parts.len() - 1;
+    let at = h.get_by_label(&format!("part {last}")).rect().center();
+    let edge = h.state().canvas.rect.max.x - 2.0;
+    assert!(
+        edge - at.x < 200.0,
+        "the fitted wall ends {} px from the edge",
+        edge - at.x
+    );
+    h.hover_at(at);
+    h.step();
+    h.drag_at(at);
+    h.step();
+    let to = Pos2::new(edge, at.y);
+    for k in 1..=8 {
+        h.hover_at(at + (to - at) * (k as f32 / 8.0));
+        h.step();
+    }
+    // Held at the edge for about two seconds of frames.
+    for _ in 0..120 {
+        h.hover_at(to);
+        h.step();
+    }
+    let grown = h.state().sculpt.data().instances.len();
+    h.drop_at(to);
+    h.step();
+    assert!(
+        grown >= bricks + 3,
+        "{bricks} bricks, {grown} while held at the edge"
+    );
+}
+
 /// Drags `part` by `by` metres with the left button and lets go, then lets the model settle.
 fn drag_part(h: &mut Harness<'_, EditorApp>, part: usize, by: glam::DVec2) {
     let at = h.get_by_label(&format!("part {part}")).rect().center();

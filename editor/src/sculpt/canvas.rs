@@ -13,6 +13,12 @@ use crate::camera::{Camera, dv, pos};
 
 /// Pointer distance (screen points) within which an edge or connection counts as under it.
 const PICK_RADIUS: f64 = 10.0;
+/// How near the canvas's edge (pixels) a drag held still makes the view follow it, and how
+/// fast the view moves at the edge and beyond (pixels a frame).
+const EDGE_ZONE: f32 = 40.0;
+const EDGE_SPEED: f64 = 10.0;
+/// How many frames a drag is held still near the edge before the view follows it.
+const EDGE_STILL_FRAMES: u32 = 8;
 const HOVER: Color32 = Color32::from_rgba_premultiplied(120, 90, 0, 90);
 const GRABBED: Color32 = Color32::from_rgb(220, 30, 60);
 const PINNED: Color32 = Color32::from_rgb(30, 80, 220);
@@ -44,6 +50,8 @@ pub struct Canvas {
     /// The sculpt (grammar and revision) `meshes` were posed from.
     posed: Option<(usize, u64)>,
     drag: Option<Drag>,
+    /// Frames a drag has been held still near the canvas's edge.
+    edge_still: u32,
     /// Fit the view to the model at the next frame.
     fit_pending: bool,
     /// The part under the cursor in the last frame.
@@ -66,6 +74,7 @@ impl Default for Canvas {
             meshes: Vec::new(),
             posed: None,
             drag: None,
+            edge_still: 0,
             fit_pending: true,
             hovered: None,
             cut_target: None,
@@ -212,6 +221,23 @@ impl Canvas {
                 )),
                 Drag::Move { start } => {
                     if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
+                        // Near the canvas's edge the view follows the drag, so a part can be
+                        // pulled past what the view shows (issue 48: at the default zoom the
+                        // wall's end had no room to be pulled).
+                        // Only once the pointer is held still there for a few frames: a drag
+                        // that moves past the edge and is let go lands where it is let go.
+                        let push = edge_push(self.rect, p);
+                        let still = ui.input(|i| i.pointer.delta().length()) < 1.0;
+                        self.edge_still = match (push != DVec2::ZERO, still) {
+                            (true, true) => self.edge_still.saturating_add(1),
+                            _ => 0,
+                        };
+                        if push != DVec2::ZERO {
+                            if self.edge_still > EDGE_STILL_FRAMES {
+                                self.camera.pan(-push);
+                            }
+                            ui.ctx().request_repaint();
+                        }
                         let w = self.camera.to_world(dv(p), mid);
                         commands.push(Command::MoveGrab {
                             translation: w - start,
@@ -236,6 +262,7 @@ impl Canvas {
                     commands.push(Command::Release);
                 }
                 self.drag = None;
+                self.edge_still = 0;
             }
         }
         if response.clicked()
@@ -419,4 +446,24 @@ fn append(mesh: &mut egui::Mesh, m: &WorldMesh, screen: impl Fn(DVec2) -> Pos2, 
             mesh.add_triangle(base + a, base + b, base + c);
         }
     }
+}
+
+/// How far a drag at `p` pushes the view this frame (screen pixels, toward the edge it is
+/// near): nothing inside the canvas away from its edges, growing to [`EDGE_SPEED`] at the edge
+/// and beyond it.
+fn edge_push(rect: egui::Rect, p: egui::Pos2) -> DVec2 {
+    let axis = |x: f32, lo: f32, hi: f32| -> f64 {
+        let zone = EDGE_ZONE.min((hi - lo) / 4.0);
+        if x > hi - zone {
+            EDGE_SPEED * f64::from(((x - (hi - zone)) / zone).min(1.0))
+        } else if x < lo + zone {
+            -EDGE_SPEED * f64::from(((lo + zone - x) / zone).min(1.0))
+        } else {
+            0.0
+        }
+    };
+    DVec2::new(
+        axis(p.x, rect.min.x, rect.max.x),
+        axis(p.y, rect.min.y, rect.max.y),
+    )
 }
