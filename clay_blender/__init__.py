@@ -252,8 +252,15 @@ def build(collection, path, script, params, thickness):
         params = {k: v for k, v in params.items() if k in known}
     grammar = clay.Grammar.open(grammar_path, params=params or None)
     session = clay.Session(grammar)
+    notes = []
     if script_path:
-        session.run_script(script_path)
+        try:
+            session.run_script(script_path)
+        except clay.ScriptParamsError as e:
+            # Recorded with other parameter values: replayed here it would fold the model
+            # (issue 48). The model is shown without it, and the user told why.
+            session = clay.Session(grammar)
+            notes.append(f"the script was not replayed: {e}")
     nodes = session.scene(thickness=thickness)
     update_objects(collection, nodes)
     collection[PATH] = stored_path(path)
@@ -273,7 +280,7 @@ def build(collection, path, script, params, thickness):
         ui.update(**options)
         names.append(p.name)
     collection[PARAMS] = json.dumps(names)
-    return len(nodes)
+    return len(nodes), notes
 
 
 def import_grammar(context, path, script="", thickness=DEFAULT_THICKNESS):
@@ -281,12 +288,12 @@ def import_grammar(context, path, script="", thickness=DEFAULT_THICKNESS):
     name = os.path.splitext(os.path.basename(path))[0] or "clay"
     collection = bpy.data.collections.new(name)
     try:
-        count = build(collection, path, script, {}, thickness)
+        count, notes = build(collection, path, script, {}, thickness)
     except BaseException:
         bpy.data.collections.remove(collection)
         raise
     context.scene.collection.children.link(collection)
-    return collection, count
+    return collection, count, notes
 
 
 def report_error(op, e):
@@ -320,11 +327,13 @@ class CLAY_OT_import_grammar(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         try:
-            collection, count = import_grammar(
+            collection, count, notes = import_grammar(
                 context, self.filepath, bpy.path.abspath(self.script), self.thickness
             )
         except Exception as e:
             return report_error(self, e)
+        for note in notes:
+            self.report({"WARNING"}, f"Clay: {note}")
         self.report({"INFO"}, f"Clay: {count} instances into collection {collection.name}")
         return {"FINISHED"}
 
@@ -360,7 +369,7 @@ class CLAY_OT_reload(bpy.types.Operator):
             self.report({"ERROR"}, "Clay: the collection was not imported from a Clay grammar")
             return {"CANCELLED"}
         try:
-            count = build(
+            count, notes = build(
                 coll,
                 coll[PATH],
                 coll.get(SCRIPT, ""),
@@ -369,6 +378,8 @@ class CLAY_OT_reload(bpy.types.Operator):
             )
         except Exception as e:
             return report_error(self, e)
+        for note in notes:
+            self.report({"WARNING"}, f"Clay: {note}")
         self.report({"INFO"}, f"Clay: {count} instances reloaded into {coll.name}")
         return {"FINISHED"}
 

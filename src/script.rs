@@ -60,6 +60,10 @@ pub enum Step {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Script {
     pub steps: Vec<Step>,
+    /// The grammar parameters the gestures were made with (`"params": {"bays": 6}`), when
+    /// the script says: a gesture grabs what is under a point, so on a model of other counts
+    /// it grabs something else and folds the model ([`Script::check_params`]).
+    pub params: std::collections::BTreeMap<String, f64>,
 }
 
 /// A malformed script: which step (if any), where it is and what is wrong.
@@ -331,15 +335,39 @@ impl Script {
                 start,
             )
         })?;
-        if let Some(k) = obj.keys().find(|k| *k != "steps") {
+        if let Some(k) = obj.keys().find(|k| *k != "steps" && *k != "params") {
             let at = keys
                 .iter()
                 .find(|(name, ..)| name == k)
                 .map_or(start, |k| k.1);
             return Err(whole(
-                format!("unknown top-level field \"{k}\" (expected \"steps\")"),
+                format!("unknown top-level field \"{k}\" (expected \"steps\" or \"params\")"),
                 at,
             ));
+        }
+        let mut params = std::collections::BTreeMap::new();
+        if let Some(v) = obj.get("params") {
+            let at = keys
+                .iter()
+                .find(|(name, ..)| name == "params")
+                .map_or(start, |k| k.2);
+            let table = v.as_object().ok_or_else(|| {
+                whole(
+                    "\"params\" must be an object of parameter names to numbers".into(),
+                    at,
+                )
+            })?;
+            for (name, value) in table {
+                match value.as_f64().filter(|x| x.is_finite()) {
+                    Some(x) => params.insert(name.clone(), x),
+                    None => {
+                        return Err(whole(
+                            format!("\"params\": {name} must be a finite number, found {value}"),
+                            at,
+                        ));
+                    }
+                };
+            }
         }
         let value_at = keys
             .iter()
@@ -364,7 +392,39 @@ impl Script {
                 })
             })
             .collect::<Result<_, _>>()?;
-        Ok(Self { steps })
+        Ok(Self { steps, params })
+    }
+
+    /// Whether the script may replay on `grammar`: every parameter it says it was made with
+    /// has that value there. A gesture is recorded as points and offsets; on a model of other
+    /// counts it grabs another part and folds the model (issue 48: Blender's Reload did), so a
+    /// script that says its parameters refuses any other values, in words with what to do.
+    pub fn check_params(
+        &self,
+        grammar: &clay_dsl::compiled::CompiledGrammar,
+    ) -> Result<(), String> {
+        let differ: Vec<String> = (self.params.iter())
+            .filter_map(
+                |(name, &recorded)| match grammar.params.iter().find(|p| p.name == *name) {
+                    Some(p) if p.value == recorded => None,
+                    Some(p) => Some(format!("{name} = {recorded} (the grammar has {})", p.value)),
+                    None => Some(format!(
+                        "{name} = {recorded} (the grammar has no such parameter)"
+                    )),
+                },
+            )
+            .collect();
+        if differ.is_empty() {
+            return Ok(());
+        }
+        let with: Vec<String> = (self.params.iter())
+            .map(|(n, v)| format!("--param {n}={v}"))
+            .collect();
+        Err(format!(
+            "the script was recorded with {}: its gestures would grab other parts of this model; compile the grammar with its values ({}), or record the gestures again",
+            differ.join(", "),
+            with.join(" ")
+        ))
     }
 
     /// Total solver frames the script runs.
@@ -424,10 +484,18 @@ impl Script {
     /// [`Script::parse`] reads back as this script.
     pub fn to_json(&self) -> String {
         let steps: Vec<String> = self.steps.iter().map(|s| s.to_json().to_string()).collect();
+        let params = if self.params.is_empty() {
+            String::new()
+        } else {
+            let table: serde_json::Map<String, Value> = (self.params.iter())
+                .map(|(n, v)| (n.clone(), Value::from(*v)))
+                .collect();
+            format!("\"params\": {}, ", Value::Object(table))
+        };
         if steps.is_empty() {
-            return "{\"steps\": []}\n".to_string();
+            return format!("{{{params}\"steps\": []}}\n");
         }
-        format!("{{\"steps\": [\n  {}\n]}}\n", steps.join(",\n  "))
+        format!("{{{params}\"steps\": [\n  {}\n]}}\n", steps.join(",\n  "))
     }
 }
 
@@ -565,6 +633,7 @@ mod tests {
                     at: DVec2::new(6.0, 0.0),
                 },
             ],
+            ..Script::default()
         };
         let text = script.to_json();
         assert_eq!(Script::parse(&text), Ok(script.clone()), "{text}");
@@ -577,6 +646,54 @@ mod tests {
             Script::parse(&Script::default().to_json()),
             Ok(Script::default())
         );
+    }
+
+    #[test]
+    fn the_parameters_a_script_says_read_back_and_refuse_other_values() {
+        let mut script = Script::parse("{\"steps\": [{\"hold\": {\"frames\": 2}}]}").unwrap();
+        assert!(script.params.is_empty());
+        script.params.insert("bays".into(), 6.0);
+        script.params.insert("width".into(), 1.5);
+        let text = script.to_json();
+        assert!(
+            text.starts_with("{\"params\": {\"bays\":6.0,\"width\":1.5}, "),
+            "{text}"
+        );
+        assert_eq!(Script::parse(&text), Ok(script.clone()));
+        // Against a grammar: the same values pass; another value, or a name it lacks, refuses
+        // with the values to use.
+        let source = "param bays = 4 in 2..12\nparam width = 1 in 0.5..2\nsite type j\n\
+                      piece b { vertex a (0, 0) vertex c (width, 0) vertex d (width, 1) edges a-c-d-a }\n\
+                      model { x = b }\n";
+        let compile = |bays: f64, width: f64| {
+            let options = clay_dsl::CompileOptions::default()
+                .param("bays", bays)
+                .param("width", width);
+            clay_dsl::compile(source, "g.clay", &options)
+                .unwrap()
+                .grammar
+        };
+        assert_eq!(script.check_params(&compile(6.0, 1.5)), Ok(()));
+        let why = script.check_params(&compile(4.0, 1.5)).unwrap_err();
+        assert!(why.contains("bays = 6 (the grammar has 4)"), "{why}");
+        assert!(why.contains("--param bays=6 --param width=1.5"), "{why}");
+        script.params.insert("height".into(), 2.0);
+        let why = script.check_params(&compile(6.0, 1.5)).unwrap_err();
+        assert!(
+            why.contains("height = 2 (the grammar has no such parameter)"),
+            "{why}"
+        );
+        // A script that says nothing replays anywhere.
+        assert_eq!(Script::default().check_params(&compile(4.0, 1.0)), Ok(()));
+        // What is not a table of finite numbers is refused where it is.
+        for bad in [
+            "{\"params\": [1], \"steps\": []}",
+            "{\"params\": {\"bays\": \"6\"}, \"steps\": []}",
+        ] {
+            let e = Script::parse(bad).unwrap_err();
+            assert_eq!(e.position, Some((1, 12)), "{bad}: {e}");
+            assert!(e.message.starts_with("\"params\""), "{e}");
+        }
     }
 
     #[test]

@@ -140,6 +140,7 @@ fn a_frame_the_budget_stopped_replays_from_its_iterations() {
         &mut replayed,
         &Script {
             steps: steps.clone(),
+            ..Script::default()
         },
         &mut Session::new(config),
     )
@@ -149,6 +150,14 @@ fn a_frame_the_budget_stopped_replays_from_its_iterations() {
     // without them the frames run to the end, elsewhere
     steps.retain(|s| !matches!(s, Step::Budget { .. }));
     let mut whole = Assembly::new(g);
-    replay(&mut whole, &Script { steps }, &mut Session::new(config)).unwrap();
+    replay(
+        &mut whole,
+        &Script {
+            steps,
+            ..Script::default()
+        },
+        &mut Session::new(config),
+    )
+    .unwrap();
     assert_ne!(whole.data().positions, edited.data().positions);
 }

@@ -319,6 +319,35 @@ def test_reload_after_a_parameter_change_keeps_the_users_work(tmp_path):
     assert not [m for m in bpy.data.meshes if m.users == 0], "a mesh left behind"
 
 
+def test_a_script_recorded_with_other_parameters_is_not_replayed_on_reload(tmp_path):
+    """Issue 48: Reload replayed a script written for the old count and folded the model. A
+    script that says its parameters is replayed only with those values; after a parameter
+    change the model is rebuilt without it (and the operator warns)."""
+    fresh_file()
+    grammar = tmp_path / "fence.clay"
+    grammar.write_text(FENCE)
+    script = tmp_path / "pull.script.json"
+    script.write_text(
+        '{"params": {"bays": 4}, "steps": [{"pin": {"extreme": "west"}}, '
+        '{"grab": {"extreme": "east"}}, {"drag": {"by": [0, 3], "frames": 30}}]}'
+    )
+    assert bpy.ops.clay.import_grammar(filepath=str(grammar), script=str(script)) == {"FINISHED"}
+    [coll] = clay_collections()
+    east = max(instances_of(coll), key=lambda o: o.location.x)
+    assert east.location.y > 1.0, "the script pulled the east post north"
+    coll["bays"] = 6.0
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    posts = sorted(instances_of(coll), key=lambda o: o.location.x)
+    assert len(posts) == 6
+    # Not replayed on six posts: the fence stands as the grammar builds it, in a line.
+    assert all(abs(o.location.y - posts[0].location.y) < 1e-6 for o in posts)
+    # Back to the values it was recorded with, it is replayed again.
+    coll["bays"] = 4.0
+    assert bpy.ops.clay.reload(collection=coll.name) == {"FINISHED"}
+    east = max(instances_of(coll), key=lambda o: o.location.x)
+    assert east.location.y > 1.0
+
+
 def test_paths_are_kept_relative_to_the_blend_and_reopen_from_elsewhere(tmp_path, monkeypatch):
     """Issue 48, item 1: docs/blender.md's relative paths broke once the .blend was opened from
     another folder. Saved, the collection keeps its grammar relative to the .blend; the project

@@ -183,6 +183,10 @@ pub(crate) fn sculpted(
             errln!("{}", e.located(path));
             INPUT_ERROR
         })?;
+        if let Err(why) = script.check_params(assembly.grammar()) {
+            errln!("error: {}: {why}", path.display());
+            return Err(INPUT_ERROR);
+        }
         if let Err(e) = clay::replay(&mut assembly, &script, &mut Session::new(config)) {
             errln!("error: {}: {e}", path.display());
             return Err(INPUT_ERROR);

@@ -126,6 +126,11 @@ pub fn run(args: RunArgs) -> u8 {
             return 2;
         }
     };
+    if let Err(why) = script.check_params(assembly.grammar()) {
+        let shown = args.script.as_deref().map(|p| p.display().to_string());
+        errln!("error: {}: {why}", shown.unwrap_or_default());
+        return 1;
+    }
     let mut session = Session::new(config);
     let summary = match replay(&mut assembly, &script, &mut session) {
         Ok(r) => r,

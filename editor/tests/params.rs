@@ -287,6 +287,13 @@ fn saved_gestures_say_the_parameters_to_replay_them_with() {
         .unwrap()
         .grammar;
     let parsed = clay::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();
+    // The script says them too, and refuses the grammar's defaults (issue 48, item 3).
+    assert_eq!(parsed.params.get("bays"), Some(&6.0));
+    assert_eq!(parsed.check_params(&grammar), Ok(()));
+    let defaults = clay_dsl::compile(&text, "posts.clay", &clay_dsl::CompileOptions::default())
+        .unwrap()
+        .grammar;
+    assert!(parsed.check_params(&defaults).is_err());
     let mut asm = clay::Assembly::new(std::sync::Arc::new(grammar.clone()));
     let mut session = clay::Session::new(clay::SolverConfig::from_params(&grammar.solver));
     clay::replay(&mut asm, &parsed, &mut session).unwrap();

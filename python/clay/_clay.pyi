@@ -34,6 +34,10 @@ class SolverError(RuntimeError):
 class InternalError(RuntimeError):
     """A bug in Clay: the library failed where it should not."""
 
+class ScriptParamsError(ValueError):
+    """A script recorded with other grammar parameters than the session's: its gestures
+    would grab other parts of this model."""
+
 class Diagnostic:
     """One error or warning about a grammar, as ``clayc check --format json`` gives it."""
 

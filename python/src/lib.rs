@@ -29,6 +29,14 @@ pyo3::create_exception!(
     "A bug in Clay: the library failed where it should not. Please report it with the message."
 );
 
+pyo3::create_exception!(
+    clay,
+    ScriptParamsError,
+    pyo3::exceptions::PyValueError,
+    "A script says it was recorded with grammar parameters other than the session's: its \
+     gestures would grab other parts of this model (a ValueError)."
+);
+
 #[pymodule]
 fn _clay(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -36,6 +44,7 @@ fn _clay(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("GrammarError", py.get_type::<diagnostics::GrammarError>())?;
     m.add("SolverError", py.get_type::<SolverError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add("ScriptParamsError", py.get_type::<ScriptParamsError>())?;
     m.add_class::<diagnostics::PyDiagnostic>()?;
     m.add_function(wrap_pyfunction!(diagnostics::check, m)?)?;
     m.add_class::<grammar::Grammar>()?;

@@ -22,7 +22,7 @@ use crate::convert::{
     finite, guard, integer, is_bool, number, os_error, path_of, point, type_name,
 };
 use crate::grammar::Grammar;
-use crate::{InternalError, SolverError};
+use crate::{InternalError, ScriptParamsError, SolverError};
 
 /// Largest picture side, as `clayc render --size` allows.
 const MAX_SIDE: u32 = clay::MAX_SIDE;
@@ -485,6 +485,9 @@ impl PySession {
                     .to_string(),
             )
         })?;
+        script
+            .check_params(&self.grammar)
+            .map_err(|why| ScriptParamsError::new_err(format!("{}: {why}", name.display())))?;
         self.run_steps(py, &script.steps, true)
     }
 

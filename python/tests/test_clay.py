@@ -690,3 +690,25 @@ def test_the_usd_export_opens_validates_and_places_every_point_as_the_scene(gram
     linear = lambda b: (b / 255 / 12.92) if b / 255 <= 0.04045 else ((b / 255 + 0.055) / 1.055) ** 2.4
     for srgb, diffuse in colours.values():
         assert list(diffuse) == pytest.approx([linear(b) for b in srgb[:3]], abs=1e-5)
+
+
+def test_a_script_recorded_with_other_parameters_raises_script_params_error(fence, tmp_path):
+    """Issue 48, item 3: a script says the parameters it was recorded with; on other values
+    its gestures would grab other parts, so it is refused (before any step runs) naming them."""
+    script = {
+        "params": {"bays": 6},
+        "steps": [{"pin": {"extreme": "west"}}, {"grab": {"extreme": "east"}},
+                  {"drag": {"by": [2, 0], "frames": 10}}],
+    }
+    s = clay.Session(clay.Grammar.open(fence))
+    with pytest.raises(clay.ScriptParamsError, match=r"bays = 6 \(the grammar has 4\)") as caught:
+        s.run_script(script)
+    assert isinstance(caught.value, ValueError)
+    assert s.frames == 0
+    path = tmp_path / "pull.script.json"
+    path.write_text(json.dumps(script))
+    with pytest.raises(clay.ScriptParamsError, match="pull.script.json"):
+        s.run_script(path)
+    ok = clay.Session(clay.Grammar.open(fence, params={"bays": 6}))
+    ok.run_script(path)
+    assert ok.frames == 10

@@ -149,7 +149,12 @@ impl Sculpt {
     /// [`clay::replay`], it makes this sculpt. Gestures undone are not in it. `Err`
     /// says why there is none (a sculpt opened from a session).
     pub fn gesture_script(&self) -> Result<Script, String> {
-        self.record.script()
+        let mut script = self.record.script()?;
+        // The parameters the model was made with: the script refuses to replay on others.
+        script.params = (self.assembly.grammar().params.iter())
+            .map(|p| (p.name.clone(), p.value))
+            .collect();
+        Ok(script)
     }
 
     /// After a rule renumbered the parts, the grabbed part is the one the handle still holds.

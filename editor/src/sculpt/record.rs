@@ -191,7 +191,10 @@ impl Recording {
             .chain(&done.steps)
             .cloned()
             .collect();
-        Ok(Script { steps })
+        Ok(Script {
+            steps,
+            ..Script::default()
+        })
     }
 }
 
