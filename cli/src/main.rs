@@ -44,7 +44,7 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Render an assembly to PNG (or SVG).
     Render(render::RenderArgs),
-    /// Export the assembly as 3D meshes (glTF or OBJ).
+    /// Export the assembly as 3D meshes (glTF, OBJ or USD).
     Export(export::ExportArgs),
     /// Render every piece and rest state of a grammar side by side.
     Sheet(render::SheetArgs),

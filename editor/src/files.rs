@@ -18,7 +18,7 @@ pub enum FileKind {
     SaveSession,
     Png,
     Json,
-    /// The sculpted model as 3D meshes (glTF or OBJ, by extension).
+    /// The sculpted model as 3D meshes (glTF, OBJ or USD, by extension).
     Model3d,
     /// Authoring: the file the grammar is written to.
     WriteGrammar,

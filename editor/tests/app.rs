@@ -13,7 +13,7 @@ use egui::{Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
-use common::{harness, settle};
+use common::{harness, settle, type_path};
 
 /// The first tower part (a piece part) of the castle.
 fn tower(app: &EditorApp) -> usize {
@@ -351,15 +351,7 @@ fn save_in_the_prompt_saves_the_session_then_opens() {
     // No session file yet: Save asks where (the typed path where no desktop dialog exists).
     h.step();
     h.get_by_label("Save session as");
-    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-    h.step();
-    h.get_by_role(egui::accesskit::Role::TextInput)
-        .type_text(&session.display().to_string());
-    h.step();
-    h.key_press(egui::Key::Enter);
-    for _ in 0..4 {
-        h.step();
-    }
+    type_path(&mut h, &session, 4);
     assert!(session.exists(), "the session was saved first");
     assert_eq!(
         h.state().grammar_path(),
@@ -589,17 +581,6 @@ fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
             .label_contains("Path (relative");
         h.get(by).value().unwrap_or_default()
     };
-    let type_path = |h: &mut Harness<'_, EditorApp>, path: &std::path::Path| {
-        h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-        h.step();
-        h.get_by_role(egui::accesskit::Role::TextInput)
-            .type_text(&path.display().to_string());
-        h.step();
-        h.key_press(egui::Key::Enter);
-        for _ in 0..3 {
-            h.step();
-        }
-    };
     // The suggestion is a name no file has.
     let suggested = ask(&mut h);
     assert_eq!(
@@ -607,7 +588,7 @@ fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
         std::path::absolute(dir.join("wall-2.script.json")).unwrap()
     );
     // The demo's own name typed: asked, not written; Cancel keeps it.
-    type_path(&mut h, &script);
+    type_path(&mut h, &script, 3);
     h.get_by_label_contains("exists. Replace it?");
     assert_eq!(std::fs::read_to_string(&script).unwrap(), demo);
     h.get_by_label("Cancel").click();
@@ -617,7 +598,7 @@ fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
     assert_eq!(std::fs::read_to_string(&script).unwrap(), demo);
     // Asked again, and Replace: now it is written.
     ask(&mut h);
-    type_path(&mut h, &script);
+    type_path(&mut h, &script, 3);
     h.get_by_label("Replace").click();
     for _ in 0..4 {
         h.step();

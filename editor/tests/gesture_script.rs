@@ -18,7 +18,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::DVec2;
 
-use common::{harness, settle};
+use common::{harness, settle, type_path};
 
 fn wall_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/wall.clay")
@@ -186,15 +186,7 @@ fn the_gestures_saved_as_a_script_replay_into_the_same_sculpt() {
         grammar_folder.with_file_name("wall-2.script.json")
     );
     assert!(!Path::new(&suggested).exists());
-    h.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-    h.step();
-    h.get_by_role(egui::accesskit::Role::TextInput)
-        .type_text(&file.display().to_string());
-    h.step();
-    h.key_press(egui::Key::Enter);
-    for _ in 0..4 {
-        h.step();
-    }
+    type_path(&mut h, &file, 4);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("saved "), "{message}");
     assert!(message.contains("clayc run"), "{message}");

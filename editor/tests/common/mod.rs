@@ -23,3 +23,19 @@ pub fn settle(h: &mut Harness<'_, EditorApp>) {
     }
     panic!("the model did not settle");
 }
+
+/// In the typed-path dialog (no desktop dialog in tests): replaces the path with `path` and
+/// presses Enter, then steps `frames` frames.
+#[allow(dead_code)] // not every test binary that shares this module types a path
+pub fn type_path(h: &mut Harness<'_, EditorApp>, path: &std::path::Path, frames: usize) {
+    use egui_kittest::kittest::Queryable;
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    h.step();
+    h.get_by_role(egui::accesskit::Role::TextInput)
+        .type_text(&path.display().to_string());
+    h.step();
+    h.key_press(egui::Key::Enter);
+    for _ in 0..frames {
+        h.step();
+    }
+}
