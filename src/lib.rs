@@ -49,8 +49,8 @@ pub use render::{
 pub use rules::{RuleEvent, RuleKind};
 pub use script::{MAX_FRAMES, Motion, Script, ScriptError, Selector, Step};
 pub use session::{
-    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, configure, pin_at, pin_of,
-    replay, toggle_pin,
+    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, carried_targets, configure,
+    pin_at, pin_of, replay, toggle_pin,
 };
 pub use solver::{
     FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch, Stop,

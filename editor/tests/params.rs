@@ -336,3 +336,94 @@ fn the_reset_button_is_on_screen_at_1280_px() {
     h.step();
     assert!(overrides(&h).is_empty());
 }
+
+/// Issue 48, item 3: a parameter change that rebuilds the model dropped every pin ("model
+/// rebuilt"). The pins of instances the new model still has (by name) stay, each holding its
+/// instance where it was pinned; a pin on an instance that is gone goes.
+#[test]
+fn a_count_change_keeps_the_pins_of_the_instances_that_survive() {
+    let dir = temp_dir("params-pins");
+    let path = dir.join("posts.clay");
+    std::fs::write(&path, posts(RANGE, "#b5651d")).unwrap();
+    let mut h = harness(EditorApp::open(&path));
+    settle(&mut h);
+    let name_of = |h: &Harness<'_, EditorApp>, v: &[usize]| {
+        let data = h.state().sculpt.data();
+        (data.instances.iter())
+            .find(|i| i.vertices == v)
+            .map(|i| i.name.clone())
+    };
+    // The west post pinned, then dragged 1.5 m north (a pinned part is pinned where dropped);
+    // the east post (row[3]) pinned where it is.
+    let data = h.state().sculpt.data();
+    let last = data.parts.len() - 1;
+    let west = h
+        .state()
+        .sculpt
+        .assembly()
+        .part_extreme(clay::Compass::West)
+        .unwrap();
+    let at = h.state().sculpt.assembly().part_centroid(west) - glam::DVec2::new(0.3, 0.0);
+    h.state_mut()
+        .command(clay_editor::sculpt::Command::TogglePin { part: west, at });
+    h.state_mut()
+        .command(clay_editor::sculpt::Command::Grab { part: west, at });
+    h.state_mut()
+        .command(clay_editor::sculpt::Command::MoveGrab {
+            translation: glam::DVec2::new(0.0, 1.5),
+            angle: 0.0,
+        });
+    settle(&mut h);
+    h.state_mut().command(clay_editor::sculpt::Command::Release);
+    let east_at = h.state().sculpt.assembly().part_centroid(last) + glam::DVec2::new(0.3, 0.0);
+    h.state_mut()
+        .command(clay_editor::sculpt::Command::TogglePin {
+            part: last,
+            at: east_at,
+        });
+    settle(&mut h);
+    let pins = h.state().sculpt.pins();
+    let mut before: Vec<(String, Vec<glam::DVec2>)> = pins
+        .iter()
+        .map(|p| (name_of(&h, &p.vertices).unwrap(), p.at.clone()))
+        .collect();
+    before.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(
+        before.iter().map(|p| p.0.as_str()).collect::<Vec<_>>(),
+        ["row[0]", "row[3]"]
+    );
+
+    // Six bays: both posts are still there; their pins hold them where they were.
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 6.0));
+    settle(&mut h);
+    assert_eq!(instances(&h), 6);
+    let mut after: Vec<(String, Vec<glam::DVec2>)> = (h.state().sculpt.pins().iter())
+        .map(|p| (name_of(&h, &p.vertices).unwrap(), p.at.clone()))
+        .collect();
+    after.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(after.len(), 2, "{after:?}");
+    for ((n0, a0), (n1, a1)) in before.iter().zip(&after) {
+        assert_eq!(n0, n1);
+        let gap = a0
+            .iter()
+            .zip(a1)
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0, f64::max);
+        assert!(gap < 1e-9, "{n0}'s pin moved by {gap} m");
+    }
+    let west_now = h.state().sculpt.assembly().instance_centroid(0).unwrap();
+    assert!(west_now.y > 1.4, "the west post stays north: {west_now}");
+    let m = h.state().message.clone().unwrap_or_default();
+    assert!(m.contains("2 pins kept"), "{m}");
+
+    // Two bays: row[3] is gone, and so is its pin; row[0]'s stays.
+    h.state_mut()
+        .param_change(ParamChange::Set("bays".into(), 2.0));
+    settle(&mut h);
+    let kept: Vec<String> = (h.state().sculpt.pins().iter())
+        .map(|p| name_of(&h, &p.vertices).unwrap())
+        .collect();
+    assert_eq!(kept, ["row[0]"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

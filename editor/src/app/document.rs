@@ -210,10 +210,14 @@ impl EditorApp {
                     self.canvas.request_fit();
                 }
                 let what = change.map_or_else(|| format!("reloaded {shown}"), str::to_string);
-                let mut m = if kept {
-                    format!("{what}; sculpt kept")
-                } else {
-                    format!("{what}; model rebuilt")
+                let pins = self.sculpt.pins().len();
+                let mut m = match (kept, pins) {
+                    (true, _) => format!("{what}; sculpt kept"),
+                    (false, 0) => format!("{what}; model rebuilt"),
+                    (false, n) => format!(
+                        "{what}; model rebuilt, {n} pin{} kept",
+                        if n == 1 { "" } else { "s" }
+                    ),
                 };
                 for n in notes {
                     m.push_str("; ");

@@ -25,6 +25,73 @@ impl Sculpt {
         }
     }
 
+    /// The new grammar's initial model with what of the sculpt survives a rebuild (issue 48: a
+    /// parameter change dropped every pin): each pin of an instance the new model has (by its
+    /// name, `row[0]`, `t_ne`) holds it where it was pinned, at its new shape
+    /// ([`clay::carried_targets`]); each piece instance that survives keeps its rest state when
+    /// its piece still has one of that name.
+    pub(super) fn carried(&self, grammar: Arc<CompiledGrammar>) -> Snapshot {
+        let mut snapshot = self.initial(grammar);
+        let (old, old_grammar) = (self.assembly.data(), self.assembly.grammar());
+        let new = &snapshot.data;
+        let named = |name: &str| new.instances.iter().position(|i| i.name == name);
+        let rest = |g: &CompiledGrammar, i: &clay_dsl::compiled::Instance| {
+            (g.pieces.get(i.piece)?.states.get(i.state)).map(|s| s.positions.clone())
+        };
+        let mut pins = Vec::new();
+        for pin in self.pins() {
+            let Some(was) = old.instances.iter().find(|i| i.vertices == pin.vertices) else {
+                continue;
+            };
+            let Some(now) = named(&was.name).map(|k| &new.instances[k]) else {
+                continue;
+            };
+            let (Some(from), Some(to)) = (rest(old_grammar, was), rest(&snapshot.grammar, now))
+            else {
+                continue;
+            };
+            if let Some(at) = clay::carried_targets(&from, &pin.at, &to) {
+                pins.push(crate::session::Pin {
+                    vertices: now.vertices.clone(),
+                    at,
+                });
+            }
+        }
+        snapshot.pins = pins;
+        // Rest states of the piece instances that survive, by state name.
+        let state_of = |name: &str| {
+            let i = old.instances.iter().find(|i| i.name == name)?;
+            let piece = old_grammar.pieces.get(i.piece)?;
+            Some((piece.name.clone(), piece.states.get(i.state)?.name.clone()))
+        };
+        let mut data = snapshot.data.clone();
+        for k in 0..data.instances.len() {
+            let inst = &data.instances[k];
+            let Some((piece, state)) = state_of(&inst.name) else {
+                continue;
+            };
+            let Some(p) = snapshot.grammar.pieces.get(inst.piece) else {
+                continue;
+            };
+            if p.name == piece
+                && let Some(s) = p.states.iter().position(|st| st.name == state)
+            {
+                data.instances[k].state = s;
+                for part in &mut data.parts {
+                    if part.kind == (clay_dsl::compiled::PartKind::Piece { instance: k })
+                        && s < part.states.len()
+                    {
+                        part.active = s;
+                    }
+                }
+            }
+        }
+        if data.check(&snapshot.grammar).is_ok() {
+            snapshot.data = data;
+        }
+        snapshot
+    }
+
     /// Records the model before a gesture.
     pub(super) fn checkpoint(&mut self) {
         self.history += 1;

@@ -385,14 +385,18 @@ impl Sculpt {
                 record: self.record.clone(),
             }
         } else {
-            self.initial(grammar)
+            self.carried(grammar)
         };
+        let carried = snapshot.pins.len();
         self.restore(snapshot);
         self.note(
-            if keep {
-                "grammar reloaded; sculpt kept".to_string()
-            } else {
-                "grammar reloaded; model rebuilt".to_string()
+            match (keep, carried) {
+                (true, _) => "grammar reloaded; sculpt kept".to_string(),
+                (false, 0) => "grammar reloaded; model rebuilt".to_string(),
+                (false, n) => format!(
+                    "grammar reloaded; model rebuilt, {n} pin{} kept",
+                    if n == 1 { "" } else { "s" }
+                ),
             },
             None,
         );
