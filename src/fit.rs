@@ -1,7 +1,7 @@
 //! Least-squares maps between corresponding point sets: the best rigid motion (2D Procrustes:
 //! posing rigid proxy geometry, placing a junction over the instance it replaces, handles'
-//! rest placement) and a rest state's alignment with its shape distance (the solver's local
-//! step), both from one closed form, and the best affine map (laying new chain elements into a
+//! rest placement, a pin carried to a recompiled grammar) and a rest state's alignment with its
+//! shape distance (the solver's local step), both from one closed form, and the best affine map (laying new chain elements into a
 //! deformed pose). The one home of these fits, so the solver, the renderer, the rules and the
 //! assembly agree exactly.
 
@@ -244,6 +244,19 @@ pub fn affine(from: &[DVec2], to: &[DVec2]) -> PointMap {
     }
 }
 
+/// The targets of a pin carried to another compilation of the grammar (a parameter changed):
+/// `at`, the targets of an instance whose rest positions (piece-local) are `from`, moved
+/// rigidly onto `to`, the rest positions of the instance it is carried to (same vertices in
+/// the same order): the rigid motion that takes `from` to `at`, applied to `to`. So a pinned
+/// post stays where the user put it, at its new width. `None` when the counts differ.
+pub fn carried_targets(from: &[DVec2], at: &[DVec2], to: &[DVec2]) -> Option<Vec<DVec2>> {
+    if from.len() != at.len() || from.len() != to.len() {
+        return None;
+    }
+    let motion = rigid_motion(from, at)?;
+    Some(to.iter().map(|&p| motion.apply(p)).collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -288,5 +301,31 @@ mod tests {
         let shifted: Vec<DVec2> = line.iter().map(|p| *p + DVec2::Y).collect();
         let m = affine(&line, &shifted);
         assert!(m.apply(DVec2::X).distance(DVec2::new(1.0, 1.0)) < 1e-12);
+    }
+
+    #[test]
+    fn a_carried_pin_moves_the_new_shape_as_the_old_was_moved() {
+        // A 1 m post pinned turned a quarter and 5 m east; carried to a 2 m post.
+        let from = [
+            DVec2::ZERO,
+            DVec2::X,
+            DVec2::new(1.0, 0.5),
+            DVec2::new(0.0, 0.5),
+        ];
+        let turn = |p: DVec2| DVec2::new(5.0 - p.y, p.x);
+        let at: Vec<DVec2> = from.iter().map(|&p| turn(p)).collect();
+        let to = [
+            DVec2::ZERO,
+            DVec2::new(2.0, 0.0),
+            DVec2::new(2.0, 0.5),
+            DVec2::new(0.0, 0.5),
+        ];
+        let carried = carried_targets(&from, &at, &to).unwrap();
+        // The piece's own frame moves as the old post's did: its corner at the origin goes
+        // where the old one's went, and the post turns the same.
+        assert!((carried[0] - at[0]).length() < 1e-12, "{:?}", carried[0]);
+        let along = carried[1] - carried[0];
+        assert!((along - DVec2::new(0.0, 2.0)).length() < 1e-12, "{along}");
+        assert_eq!(carried_targets(&from, &at, &to[..3]), None);
     }
 }

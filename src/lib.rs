@@ -40,6 +40,7 @@ pub use export::{
     chain_places, encode_export, material_name, mtl_path, scene, write_export,
 };
 pub use files::write_atomic;
+pub use fit::carried_targets;
 pub use plane::nearest_on_segment;
 pub use render::{
     Canvas, MAX_SIDE, Mesh, Overlays, RenderError, RenderOptions, STRAIN_LEGEND, Solid,
@@ -49,8 +50,8 @@ pub use render::{
 pub use rules::{RuleEvent, RuleKind};
 pub use script::{MAX_FRAMES, Motion, Script, ScriptError, Selector, Step};
 pub use session::{
-    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, carried_targets, configure,
-    pin_at, pin_of, replay, toggle_pin,
+    Frame, Grab, PartReport, ReplayError, SETTING_NAMES, Session, configure, pin_at, pin_of,
+    replay, toggle_pin,
 };
 pub use solver::{
     FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch, Stop,

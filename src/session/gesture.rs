@@ -119,19 +119,6 @@ impl Grab {
     }
 }
 
-/// The targets of a pin carried to another compilation of the grammar (a parameter changed):
-/// `at`, the targets of an instance whose rest positions (piece-local) are `from`, moved
-/// rigidly onto `to`, the rest positions of the instance it is carried to (same vertices in
-/// the same order): the rigid motion that takes `from` to `at`, applied to `to`. So a pinned
-/// post stays where the user put it, at its new width. `None` when the counts differ.
-pub fn carried_targets(from: &[DVec2], at: &[DVec2], to: &[DVec2]) -> Option<Vec<DVec2>> {
-    if from.len() != at.len() || from.len() != to.len() {
-        return None;
-    }
-    let motion = crate::fit::rigid_motion(from, at)?;
-    Some(to.iter().map(|&p| motion.apply(p)).collect())
-}
-
 /// Pins `instance` where it is (a pinned one stays as it is). `None` if it has no vertices.
 pub fn pin(asm: &mut Assembly, instance: usize) -> Option<HandleId> {
     pin_of(asm, instance).or_else(|| asm.hold_instance(instance, HandleKind::Pin))

@@ -18,7 +18,7 @@ pub mod file;
 mod gesture;
 mod settings;
 
-pub use gesture::{Grab, carried_targets, pin, pin_at, pin_of, toggle_pin, unpin};
+pub use gesture::{Grab, pin, pin_at, pin_of, toggle_pin, unpin};
 pub use settings::{SETTING_NAMES, configure};
 // Only the tests set one setting by name (`clay::testing::apply_setting`).
 #[cfg(any(test, feature = "testing"))]
