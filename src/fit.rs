@@ -1,8 +1,8 @@
 //! Least-squares maps between corresponding point sets: the best rigid motion (2D Procrustes:
 //! posing rigid proxy geometry, placing a junction over the instance it replaces, handles'
 //! rest placement, a pin carried to a recompiled grammar) and a rest state's alignment with its
-//! shape distance (the solver's local step), both from one closed form, and the best affine map (laying new chain elements into a
-//! deformed pose). The one home of these fits, so the solver, the renderer, the rules and the
+//! shape distance (the solver's local step), both from one closed form, and the best affine
+//! map (laying new chain elements into a deformed pose). The one home of these fits, so the solver, the renderer, the rules and the
 //! assembly agree exactly.
 
 use glam::{DMat2, DVec2};
