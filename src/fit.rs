@@ -2,8 +2,8 @@
 //! posing rigid proxy geometry, placing a junction over the instance it replaces, handles'
 //! rest placement, a pin carried to a recompiled grammar) and a rest state's alignment with its
 //! shape distance (the solver's local step), both from one closed form, and the best affine
-//! map (laying new chain elements into a deformed pose). The one home of these fits, so the solver, the renderer, the rules and the
-//! assembly agree exactly.
+//! map (laying new chain elements into a deformed pose). The one home of these fits, so the
+//! solver, the renderer, the rules and the assembly agree exactly.
 
 use glam::{DMat2, DVec2};
 
