@@ -13,7 +13,7 @@ use egui::{Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
-use common::{harness, settle, type_path};
+use common::{ask_path, harness, settle, type_path};
 
 /// The first tower part (a piece part) of the castle.
 fn tower(app: &EditorApp) -> usize {
@@ -535,18 +535,8 @@ fn a_new_session_file_is_suggested_beside_the_grammar_not_in_the_working_folder(
     ] {
         let mut h = harness(app);
         h.step();
-        h.get_by_label("File").click();
-        h.step();
-        h.step();
-        h.get_by_label("Save session").click();
-        for _ in 0..4 {
-            h.step();
-        }
+        let text = ask_path(&mut h, "Save session");
         h.get_by_label("Save session as");
-        let by = egui_kittest::kittest::By::new()
-            .role(egui::accesskit::Role::TextInput)
-            .label_contains("Path (relative");
-        let text = h.get(by).value().unwrap_or_default();
         let suggested = std::path::Path::new(&text);
         assert!(suggested.is_absolute(), "{text}");
         if let Some(folder) = &folder {
@@ -568,19 +558,7 @@ fn a_save_to_a_file_that_exists_asks_before_replacing_it() {
     std::fs::write(&script, demo).unwrap();
     let mut h = harness(EditorApp::open(&grammar));
     h.step();
-    let ask = |h: &mut Harness<'_, EditorApp>| {
-        h.get_by_label("File").click();
-        h.step();
-        h.step();
-        h.get_by_label("Save gestures as script…").click();
-        for _ in 0..4 {
-            h.step();
-        }
-        let by = egui_kittest::kittest::By::new()
-            .role(egui::accesskit::Role::TextInput)
-            .label_contains("Path (relative");
-        h.get(by).value().unwrap_or_default()
-    };
+    let ask = |h: &mut Harness<'_, EditorApp>| ask_path(h, "Save gestures as script…");
     // The suggestion is a name no file has.
     let suggested = ask(&mut h);
     assert_eq!(

@@ -18,7 +18,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::DVec2;
 
-use common::{harness, settle, type_path};
+use common::{ask_path, harness, settle, type_path};
 
 fn wall_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/wall.clay")
@@ -167,18 +167,8 @@ fn the_gestures_saved_as_a_script_replay_into_the_same_sculpt() {
     // File > Save gestures as script..., in the typed-path dialog (no desktop dialog here),
     // which suggests a name beside the grammar that no file has: `wall.script.json` is the
     // bundled demo (issue 48: accepting the suggestion replaced it), so `wall-2.script.json`.
-    h.get_by_label("File").click();
-    h.step();
-    h.step();
-    h.get_by_label("Save gestures as script…").click();
-    for _ in 0..4 {
-        h.step();
-    }
+    let suggested = ask_path(&mut h, "Save gestures as script…");
     h.get_by_label("Save gestures as script");
-    let by = egui_kittest::kittest::By::new()
-        .role(egui::accesskit::Role::TextInput)
-        .label_contains("Path (relative");
-    let suggested = h.get(by).value().unwrap_or_default();
     let grammar_folder = std::path::absolute(wall_path()).unwrap();
     assert!(grammar_folder.with_file_name("wall.script.json").is_file());
     assert_eq!(

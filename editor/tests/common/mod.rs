@@ -39,3 +39,20 @@ pub fn type_path(h: &mut Harness<'_, EditorApp>, path: &std::path::Path, frames:
         h.step();
     }
 }
+
+/// File > `item`, then the typed-path dialog's suggested path (no desktop dialog in tests).
+#[allow(dead_code)] // not every test binary that shares this module opens the dialog
+pub fn ask_path(h: &mut Harness<'_, EditorApp>, item: &str) -> String {
+    use egui_kittest::kittest::Queryable;
+    h.get_by_label("File").click();
+    h.step();
+    h.step();
+    h.get_by_label(item).click();
+    for _ in 0..4 {
+        h.step();
+    }
+    let by = egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::TextInput)
+        .label_contains("Path (relative");
+    h.get(by).value().unwrap_or_default()
+}
