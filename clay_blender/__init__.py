@@ -271,12 +271,18 @@ def build(collection, path, script, params, thickness):
             del collection[stale]
     names = []
     for p in grammar.params:
-        collection[p.name] = float(p.value)
+        # A count (a whole default and whole range ends, as the editor's sliders step) is an
+        # integer property; any other parameter a float (issue 48: `bays` showed 6.0).
+        whole = float(p.default).is_integer() and all(
+            float(x).is_integer() for x in (p.range or ())
+        )
+        kind = int if whole and float(p.value).is_integer() else float
+        collection[p.name] = kind(p.value)
         ui = collection.id_properties_ui(p.name)
-        options = {"default": float(p.default), "description": f"Clay parameter {p.name}"}
+        options = {"default": kind(p.default), "description": f"Clay parameter {p.name}"}
         if p.range is not None:
-            lo, hi = p.range
-            options.update(min=float(lo), max=float(hi), soft_min=float(lo), soft_max=float(hi))
+            lo, hi = (kind(x) for x in p.range)
+            options.update(min=lo, max=hi, soft_min=lo, soft_max=hi)
         ui.update(**options)
         names.append(p.name)
     collection[PARAMS] = json.dumps(names)

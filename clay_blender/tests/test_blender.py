@@ -227,6 +227,9 @@ def test_parameters_are_collection_properties_and_reload_reads_them(tmp_path):
     assert bpy.ops.clay.import_grammar(filepath=str(grammar)) == {"FINISHED"}
     [coll] = clay_collections()
     assert coll["bays"] == 4.0 and coll["width"] == 1.0
+    # A count is an integer property (a whole default and range), a width a float one.
+    assert type(coll["bays"]) is int and type(coll["width"]) is float
+    assert type(coll.id_properties_ui("bays").as_dict()["max"]) is int
     ui = coll.id_properties_ui("bays").as_dict()
     assert (ui["min"], ui["max"], ui["default"]) == (2.0, 12.0, 4.0)
     assert len(instances_of(coll)) == 4
