@@ -8,8 +8,8 @@
 //! named as the glTF's root), placed by `xformOp:translate` at its pivot and
 //! `xformOp:rotateZ` by its turn, and named as its glTF node (`wall_n_4`). Every distinct mesh
 //! is written once, as a prototype under the abstract `class` prim `Prototypes`; each node has a
-//! child `geometry` that references its prototype and is `instanceable`, so a castle of 40
-//! bricks holds one brick. A prototype holds one `Mesh` per fill colour, bound to a
+//! child `geometry` that references its prototype and is `instanceable`, so the wall's eight
+//! bricks are one prototype. A prototype holds one `Mesh` per fill colour, bound to a
 //! `UsdPreviewSurface` material under `Looks` (named as in every output, `fill_9a958cff`;
 //! diffuse colour linear, as glTF's factor). The instance's assembly name, piece, rest state, id
 //! and place in its stretch chain are custom attributes `userProperties:instance`, `:piece`,

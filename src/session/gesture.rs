@@ -106,11 +106,9 @@ impl Grab {
         let held: std::collections::HashSet<usize> = h.vertices.iter().copied().collect();
         let centre = h.target_centre();
         let best = (asm.data().parts.iter().enumerate())
-            .map(|(p, part)| {
-                let shared = part.vertices.iter().filter(|v| held.contains(v)).count();
-                (p, shared, (asm.part_centroid(p) - centre).length())
-            })
-            .filter(|&(_, shared, _)| shared > 0)
+            .map(|(p, part)| (p, part.vertices.iter().filter(|v| held.contains(v)).count()))
+            .filter(|&(_, shared)| shared > 0)
+            .map(|(p, shared)| (p, shared, (asm.part_centroid(p) - centre).length()))
             .max_by(|a, b| a.1.cmp(&b.1).then(b.2.total_cmp(&a.2)));
         if let Some((p, _, _)) = best {
             self.part = Some(p);

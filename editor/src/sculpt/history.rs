@@ -58,16 +58,24 @@ impl Sculpt {
             }
         }
         snapshot.pins = pins;
-        // Rest states of the piece instances that survive, by state name.
-        let state_of = |name: &str| {
-            let i = old.instances.iter().find(|i| i.name == name)?;
-            let piece = old_grammar.pieces.get(i.piece)?;
-            Some((piece.name.clone(), piece.states.get(i.state)?.name.clone()))
-        };
+        // Rest states of the piece instances that survive, by state name: one pass over the
+        // new model's piece parts, the old instances looked up by name.
+        let old_state: std::collections::HashMap<&str, (&str, &str)> = (old.instances.iter())
+            .filter_map(|i| {
+                let piece = old_grammar.pieces.get(i.piece)?;
+                let state = piece.states.get(i.state)?;
+                Some((i.name.as_str(), (piece.name.as_str(), state.name.as_str())))
+            })
+            .collect();
         let mut data = snapshot.data.clone();
-        for k in 0..data.instances.len() {
-            let inst = &data.instances[k];
-            let Some((piece, state)) = state_of(&inst.name) else {
+        for part in &mut data.parts {
+            let clay_dsl::compiled::PartKind::Piece { instance: k } = part.kind else {
+                continue;
+            };
+            let Some(inst) = data.instances.get_mut(k) else {
+                continue;
+            };
+            let Some(&(piece, state)) = old_state.get(inst.name.as_str()) else {
                 continue;
             };
             let Some(p) = snapshot.grammar.pieces.get(inst.piece) else {
@@ -75,15 +83,10 @@ impl Sculpt {
             };
             if p.name == piece
                 && let Some(s) = p.states.iter().position(|st| st.name == state)
+                && s < part.states.len()
             {
-                data.instances[k].state = s;
-                for part in &mut data.parts {
-                    if part.kind == (clay_dsl::compiled::PartKind::Piece { instance: k })
-                        && s < part.states.len()
-                    {
-                        part.active = s;
-                    }
-                }
+                inst.state = s;
+                part.active = s;
             }
         }
         if data.check(&snapshot.grammar).is_ok() {
