@@ -63,7 +63,7 @@ pub struct Script {
     /// The grammar parameters the gestures were made with (`"params": {"bays": 6}`), when
     /// the script says: a gesture grabs what is under a point, so on a model of other counts
     /// it grabs something else and folds the model ([`Script::check_params`]).
-    pub params: std::collections::BTreeMap<String, f64>,
+    pub params: std::collections::BTreeMap<String, clay_dsl::compiled::ParamValue>,
 }
 
 /// A malformed script: which step (if any), where it is and what is wrong.
@@ -353,20 +353,30 @@ impl Script {
                 .map_or(start, |k| k.2);
             let table = v.as_object().ok_or_else(|| {
                 whole(
-                    "\"params\" must be an object of parameter names to numbers".into(),
+                    "\"params\" must be an object of parameter names to values".into(),
                     at,
                 )
             })?;
             for (name, value) in table {
-                match value.as_f64().filter(|x| x.is_finite()) {
-                    Some(x) => params.insert(name.clone(), x),
-                    None => {
-                        return Err(whole(
-                            format!("\"params\": {name} must be a finite number, found {value}"),
-                            at,
-                        ));
-                    }
+                use clay_dsl::compiled::ParamValue;
+                let typed = match value {
+                    Value::Number(_) => value
+                        .as_f64()
+                        .filter(|x| x.is_finite())
+                        .map(ParamValue::Number),
+                    Value::Bool(b) => Some(ParamValue::Bool(*b)),
+                    Value::String(t) => Some(ParamValue::Text(t.clone())),
+                    _ => None,
                 };
+                let Some(typed) = typed else {
+                    return Err(whole(
+                        format!(
+                            "\"params\": {name} must be a finite number, true or false, or a choice in quotes; found {value}"
+                        ),
+                        at,
+                    ));
+                };
+                params.insert(name.clone(), typed);
             }
         }
         let value_at = keys
@@ -405,8 +415,8 @@ impl Script {
     ) -> Result<(), String> {
         let differ: Vec<String> = (self.params.iter())
             .filter_map(
-                |(name, &recorded)| match grammar.params.iter().find(|p| p.name == *name) {
-                    Some(p) if p.value == recorded => None,
+                |(name, recorded)| match grammar.params.iter().find(|p| p.name == *name) {
+                    Some(p) if p.value == *recorded => None,
                     Some(p) => Some(format!("{name} = {recorded} (the grammar has {})", p.value)),
                     None => Some(format!(
                         "{name} = {recorded} (the grammar has no such parameter)"
@@ -488,7 +498,7 @@ impl Script {
             String::new()
         } else {
             let table: serde_json::Map<String, Value> = (self.params.iter())
-                .map(|(n, v)| (n.clone(), Value::from(*v)))
+                .map(|(n, v)| (n.clone(), serde_json::to_value(v).unwrap_or(Value::Null)))
                 .collect();
             format!("\"params\": {}, ", Value::Object(table))
         };
@@ -652,8 +662,8 @@ mod tests {
     fn the_parameters_a_script_says_read_back_and_refuse_other_values() {
         let mut script = Script::parse("{\"steps\": [{\"hold\": {\"frames\": 2}}]}").unwrap();
         assert!(script.params.is_empty());
-        script.params.insert("bays".into(), 6.0);
-        script.params.insert("width".into(), 1.5);
+        script.params.insert("bays".into(), 6.0.into());
+        script.params.insert("width".into(), 1.5.into());
         let text = script.to_json();
         assert!(
             text.starts_with("{\"params\": {\"bays\":6.0,\"width\":1.5}, "),
@@ -677,7 +687,7 @@ mod tests {
         let why = script.check_params(&compile(4.0, 1.5)).unwrap_err();
         assert!(why.contains("bays = 6 (the grammar has 4)"), "{why}");
         assert!(why.contains("--param bays=6 --param width=1.5"), "{why}");
-        script.params.insert("height".into(), 2.0);
+        script.params.insert("height".into(), 2.0.into());
         let why = script.check_params(&compile(6.0, 1.5)).unwrap_err();
         assert!(
             why.contains("height = 2 (the grammar has no such parameter)"),
@@ -688,7 +698,7 @@ mod tests {
         // What is not a table of finite numbers is refused where it is.
         for bad in [
             "{\"params\": [1], \"steps\": []}",
-            "{\"params\": {\"bays\": \"6\"}, \"steps\": []}",
+            "{\"params\": {\"bays\": null}, \"steps\": []}",
         ] {
             let e = Script::parse(bad).unwrap_err();
             assert_eq!(e.position, Some((1, 12)), "{bad}: {e}");

@@ -96,7 +96,7 @@ pub fn load(path: &Path, params: &ParamArgs, settings: &[(&str, &str)]) -> Resul
         params: saved
             .params
             .iter()
-            .map(|(n, v)| (n.clone(), *v))
+            .map(|(n, v)| (n.clone(), v.clone()))
             .chain(params.params.iter().cloned())
             .collect(),
     };

@@ -6,16 +6,17 @@
 use std::path::Path;
 
 use clay_dsl::CompileOptions;
-use clay_dsl::compiled::CompiledGrammar;
+use clay_dsl::compiled::{CompiledGrammar, ParamValue};
 
 /// The `--param` flag, flattened into each subcommand's arguments.
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct ParamArgs {
-    /// Set a grammar parameter (`param NAME = ... in LO..HI`) to a number; repeatable, the
-    /// last value of a name counts. A name the grammar does not declare (E070) or a value
-    /// outside its range (E071) is an error.
+    /// Set a grammar parameter (`param NAME ... = ...`) to a number, `true` or `false` (a
+    /// `bool`) or a choice's name; repeatable, the last value of a name counts. A name the
+    /// grammar does not declare (E070), a value outside its range (E071) or of another type
+    /// (E073: 2.5 for an `int`) is an error.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
-    pub params: Vec<(String, f64)>,
+    pub params: Vec<(String, ParamValue)>,
 }
 
 impl ParamArgs {
@@ -33,8 +34,9 @@ impl ParamArgs {
     }
 }
 
-/// `NAME=VALUE`, a name and a finite number. clap names the flag in its message.
-pub fn parse_param(s: &str) -> Result<(String, f64), String> {
+/// `NAME=VALUE`, a name and a value: a finite number, `true`, `false` or a choice's name (its
+/// type is the grammar's to check). clap names the flag in its message.
+pub fn parse_param(s: &str) -> Result<(String, ParamValue), String> {
     let (name, value) = s
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, found `{s}` (no `=`)"))?;
@@ -49,13 +51,16 @@ pub fn parse_param(s: &str) -> Result<(String, f64), String> {
             "`{name}` is not a parameter name (letters, digits and `_`, not starting with a digit)"
         ));
     }
-    let number: f64 = value
-        .parse()
-        .map_err(|_| format!("{name}={value}: the value must be a number"))?;
-    if !number.is_finite() {
+    if value.is_empty() {
+        return Err(format!(
+            "{name}=: the value must be a number, `true` or `false`, or a choice's name"
+        ));
+    }
+    let parsed = ParamValue::parse(value);
+    if parsed.number().is_some_and(|n| !n.is_finite()) {
         return Err(format!("{name}={value}: the value must be a finite number"));
     }
-    Ok((name.to_string(), number))
+    Ok((name.to_string(), parsed))
 }
 
 /// Compiles the grammar `source` (the file `path`) with these parameters, printing its
@@ -86,8 +91,20 @@ mod tests {
 
     #[test]
     fn a_pair_is_read_and_mistakes_say_what_is_wrong() {
-        assert_eq!(parse_param("bays=8"), Ok(("bays".to_string(), 8.0)));
-        assert_eq!(parse_param(" w = -1.5e0 "), Ok(("w".to_string(), -1.5)));
+        assert_eq!(parse_param("bays=8"), Ok(("bays".to_string(), 8.0.into())));
+        assert_eq!(
+            parse_param(" w = -1.5e0 "),
+            Ok(("w".to_string(), (-1.5).into()))
+        );
+        // A bool and a choice are read as typed; the grammar judges their types (E073).
+        assert_eq!(
+            parse_param("towers=false"),
+            Ok(("towers".to_string(), false.into()))
+        );
+        assert_eq!(
+            parse_param("wall=brick"),
+            Ok(("wall".to_string(), "brick".into()))
+        );
         assert!(parse_param("bays").unwrap_err().contains("no `=`"));
         assert!(
             parse_param("=3")
@@ -100,7 +117,7 @@ mod tests {
                 .contains("not a parameter name")
         );
         assert!(
-            parse_param("bays=lots")
+            parse_param("bays=")
                 .unwrap_err()
                 .contains("must be a number")
         );

@@ -331,7 +331,7 @@ fn a_session_compiles_its_grammar_with_the_parameters_it_was_saved_with() {
         .unwrap()
         .grammar;
     let mut saved = SessionFile::new("posts.clay".into(), grammar.assembly.clone(), vec![], None);
-    saved.params.insert("height".into(), 2.5);
+    saved.params.insert("height".into(), 2.5.into());
     let path = dir.join("tall.json");
     session_file::write(&path, &saved).unwrap();
     let shown = path.to_str().unwrap();

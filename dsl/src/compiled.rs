@@ -135,19 +135,7 @@ impl Default for SolverParams {
     }
 }
 
-/// A grammar parameter (`param NAME = DEFAULT [in LO..HI]`): a number the grammar uses as a
-/// constant and a user may set when compiling it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Param {
-    pub name: String,
-    /// The value this grammar was compiled with: the override given, else the default.
-    pub value: f64,
-    /// The value written in the grammar.
-    pub default: f64,
-    /// The inclusive range `[low, high]` of allowed values, when the grammar declares one;
-    /// without one, any finite number is allowed.
-    pub range: Option<[f64; 2]>,
-}
+pub use crate::param::{Param, ParamKind, ParamValue};
 
 /// A site type and the types it may dock with (symmetric, already closed over).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

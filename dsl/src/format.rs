@@ -395,7 +395,20 @@ impl<'s> Printer<'s> {
                 self.stmt(0, &t, l.span);
             }
             Item::Param(p) => {
-                let mut t = format!("param {} = {}", p.name.name, self.num(&p.value));
+                let ty = match p.ty.as_ref().map(|t| &t.kind) {
+                    None => String::new(),
+                    Some(ParamTypeKind::Named(id)) => format!(": {}", id.name),
+                    Some(ParamTypeKind::Choice(strings)) => {
+                        let all: Vec<String> =
+                            strings.iter().map(|s| format!("\"{}\"", s.value)).collect();
+                        format!(": choice({})", all.join(", "))
+                    }
+                };
+                let value = match &p.value {
+                    ParamDefault::Expr(e) => self.num(e),
+                    ParamDefault::Text(t) => format!("\"{}\"", t.value),
+                };
+                let mut t = format!("param {}{ty} = {value}", p.name.name);
                 if let Some(r) = &p.range {
                     t += &format!(" in {}..{}", self.num(&r.low), self.num(&r.high));
                 }
@@ -718,7 +731,12 @@ impl<'s> Printer<'s> {
 
     fn model(&mut self, m: &ModelBlock) {
         self.open(0, "model", m.span.start, m.keyword.end);
-        for s in &m.stmts {
+        self.model_stmts(1, &m.stmts);
+        self.close(0, m.span);
+    }
+
+    fn model_stmts(&mut self, indent: usize, stmts: &[ModelStmt]) {
+        for s in stmts {
             match s {
                 ModelStmt::Instance(i) => {
                     let t = format!(
@@ -727,7 +745,7 @@ impl<'s> Printer<'s> {
                         i.piece.name,
                         self.placement(&i.at, &i.rotate)
                     );
-                    self.stmt(1, &t, i.span);
+                    self.stmt(indent, &t, i.span);
                 }
                 ModelStmt::Chain(c) => {
                     let mut t = format!(
@@ -740,7 +758,7 @@ impl<'s> Printer<'s> {
                         t += &format!(" along {} -> {}", a.name, b.name);
                     }
                     t += &self.placement(&c.at, &c.rotate);
-                    self.stmt(1, &t, c.span);
+                    self.stmt(indent, &t, c.span);
                 }
                 ModelStmt::Dock(d) => {
                     let t = format!(
@@ -748,10 +766,37 @@ impl<'s> Printer<'s> {
                         Self::instance_site(&d.a),
                         Self::instance_site(&d.b)
                     );
-                    self.stmt(1, &t, d.span);
+                    self.stmt(indent, &t, d.span);
                 }
+                ModelStmt::If(b) => self.if_block(indent, b),
             }
         }
-        self.close(0, m.span);
+    }
+
+    /// `if NAME {`, its statements, and `} else {` with the others when there are any.
+    fn if_block(&mut self, indent: usize, b: &IfBlock) {
+        let header = format!("if {}", b.cond.name);
+        self.open(indent, &header, b.span.start, b.cond.span.end);
+        self.model_stmts(indent + 1, &b.then);
+        match (&b.otherwise, b.else_keyword) {
+            (Some(otherwise), Some(keyword)) if self.src.is_some() => {
+                // Comments between `}` and `else {` go inside the first block, where a
+                // second pass finds them.
+                let brace = self.next_token(keyword.end);
+                self.leading(indent + 1, brace);
+                self.line(indent, "} else {", b.then_close.start, brace + 1, false);
+                self.trailing(brace + 1);
+                self.block_start = true;
+                self.model_stmts(indent + 1, otherwise);
+            }
+            (Some(otherwise), _) => {
+                // A tree without its text (written by a tool): no comments to keep.
+                self.line(indent, "} else {", 0, 0, true);
+                self.block_start = true;
+                self.model_stmts(indent + 1, otherwise);
+            }
+            (None, _) => {}
+        }
+        self.close(indent, b.span);
     }
 }

@@ -24,6 +24,7 @@ mod diagnostic;
 mod format;
 mod input;
 mod line_index;
+mod param;
 mod parse;
 mod source_map;
 mod suggest;

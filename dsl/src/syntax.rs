@@ -122,15 +122,50 @@ pub struct LetDecl {
     pub span: Span,
 }
 
-/// `param NAME = EXPR [in LO..HI]`: a grammar parameter, a constant whose value a user may
-/// override when compiling (within the range, when one is written). Visible like a `let`.
+/// `param NAME [: TYPE] = DEFAULT [in LO..HI]`: a grammar parameter, a constant whose value a
+/// user may override when compiling (within the range, when one is written). Visible like a
+/// `let`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamDecl {
     pub name: Ident,
+    /// The type written after `:`; a number without one.
+    pub ty: Option<ParamTypeDecl>,
     /// The default value.
-    pub value: Expr,
+    pub value: ParamDefault,
     pub range: Option<ParamRange>,
     pub span: Span,
+}
+
+/// A parameter's default: an expression (a number, `true`, `false`) or a string (a choice).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamDefault {
+    Expr(Expr),
+    Text(StringLit),
+}
+
+impl ParamDefault {
+    pub fn span(&self) -> Span {
+        match self {
+            ParamDefault::Expr(e) => e.span,
+            ParamDefault::Text(s) => s.span,
+        }
+    }
+}
+
+/// `: TYPE` after a parameter's name; `span` is the type without the colon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamTypeDecl {
+    pub kind: ParamTypeKind,
+    pub span: Span,
+}
+
+/// The type of a parameter as written.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamTypeKind {
+    /// A type name (`number`, `int`, `bool`, `seed`, or a mistake the compiler reports).
+    Named(Ident),
+    /// `choice("a", "b", ...)`.
+    Choice(Vec<StringLit>),
 }
 
 /// `in LO..HI`: the inclusive range of a parameter's values.
@@ -436,6 +471,39 @@ pub enum ModelStmt {
     Instance(InstanceDecl),
     Chain(ChainDecl),
     Dock(DockDecl),
+    If(IfBlock),
+}
+
+/// `if PARAM { ... } [else { ... }]`: model statements a `bool` parameter switches.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IfBlock {
+    /// The `bool` parameter.
+    pub cond: Ident,
+    pub then: Vec<ModelStmt>,
+    /// The `else` block's statements, when one is written.
+    pub otherwise: Option<Vec<ModelStmt>>,
+    /// The `if` keyword.
+    pub keyword: Span,
+    /// The `}` that closes the first block.
+    pub then_close: Span,
+    /// The `else` keyword, when there is one.
+    pub else_keyword: Option<Span>,
+    pub span: Span,
+}
+
+impl ModelStmt {
+    /// Every statement, those inside `if` blocks too, depth first in source order.
+    pub fn walk<'a>(stmts: &'a [ModelStmt], out: &mut Vec<&'a ModelStmt>) {
+        for s in stmts {
+            out.push(s);
+            if let ModelStmt::If(b) = s {
+                Self::walk(&b.then, out);
+                if let Some(e) = &b.otherwise {
+                    Self::walk(e, out);
+                }
+            }
+        }
+    }
 }
 
 /// `NAME = PIECE [at (x, y)] [rotate DEG]`.

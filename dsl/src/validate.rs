@@ -53,7 +53,8 @@ impl CompiledGrammar {
             }
         }
         for p in &self.params {
-            if !(p.value.is_finite() && p.default.is_finite())
+            let finite = |v: &crate::compiled::ParamValue| v.number().is_none_or(f64::is_finite);
+            if !(finite(&p.value) && finite(&p.default))
                 || p.range
                     .is_some_and(|r| !(r[0].is_finite() && r[1].is_finite()))
             {

@@ -76,7 +76,7 @@ fn there_is_a_fixture_for_every_code() {
 }
 
 /// `// params: bays=20, width=1.5` on the second line.
-fn overrides(bytes: &[u8]) -> Vec<(String, f64)> {
+fn overrides(bytes: &[u8]) -> Vec<(String, clay_dsl::compiled::ParamValue)> {
     let text = String::from_utf8_lossy(bytes);
     let second = text.lines().nth(1).unwrap_or_default();
     let list = second
@@ -85,7 +85,10 @@ fn overrides(bytes: &[u8]) -> Vec<(String, f64)> {
     list.split(", ")
         .map(|pair| {
             let (name, value) = pair.split_once('=').expect("NAME=VALUE");
-            (name.to_string(), value.parse().expect("a number"))
+            (
+                name.to_string(),
+                clay_dsl::compiled::ParamValue::parse(value),
+            )
         })
         .collect()
 }
@@ -100,7 +103,10 @@ fn override_fixtures_report_their_code_at_their_line_and_match_snapshots() {
     check_fixtures("overrides", overrides);
 }
 
-fn check_fixtures(folder: &str, params: fn(&[u8]) -> Vec<(String, f64)>) {
+fn check_fixtures(
+    folder: &str,
+    params: fn(&[u8]) -> Vec<(String, clay_dsl::compiled::ParamValue)>,
+) {
     let files = fixtures_in(folder);
     assert!(!files.is_empty());
     for path in files {

@@ -5,7 +5,7 @@ use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
-use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, SolverParams};
+use clay_dsl::compiled::{AssemblyData, CompiledGrammar, FORMAT_VERSION, ParamValue, SolverParams};
 
 /// The castle example, bundled so the editor opens something useful with no argument.
 pub const CASTLE_SOURCE: &str = include_str!("../../grammars/castle.clay");
@@ -111,7 +111,7 @@ pub struct Compiled {
 pub fn compile(
     source: &str,
     path: &str,
-    params: &[(String, f64)],
+    params: &[(String, ParamValue)],
 ) -> Result<Compiled, Vec<Problem>> {
     let compiled = crate::guard::catching(|| {
         if source.trim_start().starts_with('{') {
@@ -185,7 +185,7 @@ fn compile_json(source: &str, path: &str) -> Result<Compiled, Vec<Problem>> {
 fn compile_clay(
     source: &str,
     path: &str,
-    params: &[(String, f64)],
+    params: &[(String, ParamValue)],
 ) -> Result<Compiled, Vec<Problem>> {
     let options = clay_dsl::CompileOptions {
         params: params.to_vec(),

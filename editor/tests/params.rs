@@ -66,7 +66,9 @@ fn instances(h: &Harness<'_, EditorApp>) -> usize {
 }
 
 fn overrides(h: &Harness<'_, EditorApp>) -> Vec<(String, f64)> {
-    h.state().param_overrides().to_vec()
+    (h.state().param_overrides().iter())
+        .map(|(n, v)| (n.clone(), v.number().expect("a number")))
+        .collect()
 }
 
 /// Rewrites the grammar file by rename (as editors save) and steps until hot reload took it.
@@ -113,7 +115,7 @@ fn a_grammar_parameter_is_set_from_the_panel_and_kept_across_hot_reloads() {
 
     // What the panel emits on release: bays = 6.
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
+        .param_change(ParamChange::Set("bays".into(), 6.0.into()));
     h.step();
     settle(&mut h);
     assert_eq!(instances(&h), 6, "six posts");
@@ -162,13 +164,13 @@ fn a_grammar_parameter_is_set_from_the_panel_and_kept_across_hot_reloads() {
 
     // A value outside the range (a command, not the slider): clamped into it.
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 9.0));
+        .param_change(ParamChange::Set("bays".into(), 9.0.into()));
     h.step();
     assert!(!h.state().stale);
     assert_eq!(overrides(&h), [("bays".to_string(), 5.0)]);
     assert_eq!(instances(&h), 5);
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 3.0));
+        .param_change(ParamChange::Set("bays".into(), 3.0.into()));
     h.step();
     assert_eq!(instances(&h), 3);
 
@@ -209,7 +211,7 @@ fn six_bays(dir: &Path) -> (std::path::PathBuf, Harness<'static, EditorApp>) {
     let mut h = harness(EditorApp::open(&path));
     settle(&mut h);
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
+        .param_change(ParamChange::Set("bays".into(), 6.0.into()));
     h.step();
     assert_eq!(instances(&h), 6);
     (path, h)
@@ -225,7 +227,7 @@ fn opening_another_grammar_clears_the_parameters() {
     let mut h = harness(EditorApp::open(&path));
     settle(&mut h);
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
+        .param_change(ParamChange::Set("bays".into(), 6.0.into()));
     h.step();
     assert_eq!(instances(&h), 6);
     h.state_mut().perform(Action::OpenGrammar(other.clone()));
@@ -268,7 +270,7 @@ fn a_saved_session_keeps_the_parameters_it_was_sculpted_with() {
         .params
         .iter()
         .find(|p| p.name == "bays");
-    assert_eq!(bays.map(|p| p.value), Some(6.0));
+    assert_eq!(bays.map(|p| p.value.clone()), Some(6.0.into()));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -288,7 +290,7 @@ fn saved_gestures_say_the_parameters_to_replay_them_with() {
         .grammar;
     let parsed = clay::Script::parse(&std::fs::read_to_string(&script).unwrap()).unwrap();
     // The script says them too, and refuses the grammar's defaults (issue 48, item 3).
-    assert_eq!(parsed.params.get("bays"), Some(&6.0));
+    assert_eq!(parsed.params.get("bays"), Some(&6.0.into()));
     assert_eq!(parsed.check_params(&grammar), Ok(()));
     let defaults = clay_dsl::compile(&text, "posts.clay", &clay_dsl::CompileOptions::default())
         .unwrap()
@@ -320,7 +322,7 @@ fn the_reset_button_is_on_screen_at_1280_px() {
     assert!(h.state().problems.is_empty(), "{:?}", h.state().problems);
     h.state_mut().param_change(ParamChange::Set(
         "number_of_bays_along_the_fence".into(),
-        6.0,
+        6.0.into(),
     ));
     settle(&mut h);
     let reset = h.get_by_label("reset").rect();
@@ -395,7 +397,7 @@ fn a_count_change_keeps_the_pins_of_the_instances_that_survive() {
 
     // Six bays: both posts are still there; their pins hold them where they were.
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 6.0));
+        .param_change(ParamChange::Set("bays".into(), 6.0.into()));
     settle(&mut h);
     assert_eq!(instances(&h), 6);
     let mut after: Vec<(String, Vec<glam::DVec2>)> = (h.state().sculpt.pins().iter())
@@ -419,7 +421,7 @@ fn a_count_change_keeps_the_pins_of_the_instances_that_survive() {
 
     // Two bays: row[3] is gone, and so is its pin; row[0]'s stays.
     h.state_mut()
-        .param_change(ParamChange::Set("bays".into(), 2.0));
+        .param_change(ParamChange::Set("bays".into(), 2.0.into()));
     settle(&mut h);
     let kept: Vec<String> = (h.state().sculpt.pins().iter())
         .map(|p| name_of(&h, &p.vertices).unwrap())

@@ -7,34 +7,90 @@ use std::sync::Arc;
 
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 
 use clay_dsl::CompileOptions;
-use clay_dsl::compiled::CompiledGrammar;
+use clay_dsl::compiled::{CompiledGrammar, ParamKind, ParamValue};
 
-use crate::convert::{guard, number, path_of, read, type_name};
+use crate::convert::{guard, is_bool, number, path_of, read, type_name};
 use crate::diagnostics::{PyDiagnostic, grammar_error, to_python};
 
-/// A grammar parameter (`param NAME = EXPR in LO..HI`): its value in this compilation, the
-/// value the grammar gives it, and its range (`None`: unbounded).
-#[pyclass(module = "clay", name = "Param", frozen, get_all)]
+/// A grammar parameter (`param NAME [: TYPE] = DEFAULT [in LO..HI]`): its type, its value in
+/// this compilation, the value the grammar gives it, its range (`None`: unbounded) and, for a
+/// `choice`, its choices. Values are Python's: `float` for a number, `int` for an `int` or
+/// `seed`, `bool`, and `str` for a choice.
+#[pyclass(module = "clay", name = "Param", frozen)]
 #[derive(Clone)]
 pub struct PyParam {
+    #[pyo3(get)]
     pub name: String,
-    pub value: f64,
-    pub default: f64,
+    kind: ParamKind,
+    value: ParamValue,
+    default: ParamValue,
+    #[pyo3(get)]
     pub range: Option<(f64, f64)>,
+}
+
+impl PyParam {
+    fn of(p: &clay_dsl::compiled::Param) -> Self {
+        Self {
+            name: p.name.clone(),
+            kind: p.kind.clone(),
+            value: p.value.clone(),
+            default: p.default.clone(),
+            range: p.range.map(|[lo, hi]| (lo, hi)),
+        }
+    }
+
+    fn python<'py>(&self, py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
+        Ok(match v {
+            ParamValue::Number(x) if self.kind.is_whole() => {
+                (*x as i64).into_pyobject(py)?.into_any()
+            }
+            ParamValue::Number(x) => x.into_pyobject(py)?.into_any(),
+            ParamValue::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+            ParamValue::Text(t) => t.into_pyobject(py)?.into_any(),
+        })
+    }
 }
 
 #[pymethods]
 impl PyParam {
+    /// The type: `"number"`, `"int"`, `"bool"`, `"seed"` or `"choice"`.
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.kind.word()
+    }
+
+    #[getter]
+    fn value<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.python(py, &self.value)
+    }
+
+    #[getter]
+    fn default<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.python(py, &self.default)
+    }
+
+    /// A choice's pieces, in order; `None` for another type.
+    #[getter]
+    fn choices(&self) -> Option<Vec<String>> {
+        match &self.kind {
+            ParamKind::Choice { choices } => Some(choices.clone()),
+            _ => None,
+        }
+    }
+
     fn __repr__(&self) -> String {
         let range = self
             .range
             .map_or(String::new(), |(lo, hi)| format!(" in {lo}..{hi}"));
         format!(
-            "Param({} = {}{range}, default {})",
-            self.name, self.value, self.default
+            "Param({}: {} = {}{range}, default {})",
+            self.name,
+            self.kind.word(),
+            self.value,
+            self.default
         )
     }
 }
@@ -66,14 +122,15 @@ pub struct Grammar {
     params: Vec<PyParam>,
 }
 
-/// Parameter overrides from Python: a mapping of names to numbers.
-fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, f64>> {
+/// Parameter overrides from Python: a mapping of names to numbers, bools (a `bool`
+/// parameter) and strings (a `choice`); the grammar checks each against its parameter's type.
+fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, ParamValue>> {
     let Some(params) = params.filter(|p| !p.is_none()) else {
         return Ok(BTreeMap::new());
     };
     let dict = params.cast::<PyDict>().map_err(|_| {
         PyTypeError::new_err(format!(
-            "params must be a dict of names to numbers, found {}",
+            "params must be a dict of names to values, found {}",
             type_name(params)
         ))
     })?;
@@ -85,7 +142,19 @@ fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, f64
                 type_name(&k)
             ))
         })?;
-        let value = number(&v, &format!("params: {name}"))?;
+        let what = format!("params: {name}");
+        let value = if is_bool(&v) {
+            ParamValue::Bool(v.is_truthy()?)
+        } else if let Ok(t) = v.cast::<PyString>() {
+            ParamValue::Text(t.to_string())
+        } else {
+            ParamValue::Number(number(&v, &what).map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "{what} must be a number, a bool or a str, found {}",
+                    type_name(&v)
+                ))
+            })?)
+        };
         out.insert(name, value);
     }
     Ok(out)
@@ -98,9 +167,9 @@ impl Grammar {
         bytes: &[u8],
         path: &str,
         shown_path: Option<String>,
-        params: BTreeMap<String, f64>,
+        params: BTreeMap<String, ParamValue>,
     ) -> PyResult<Self> {
-        let params: Vec<(String, f64)> = params.into_iter().collect();
+        let params: Vec<(String, ParamValue)> = params.into_iter().collect();
         let compiled = py.detach(|| {
             guard("compiling the grammar", || {
                 // Made here: the file system loader it holds stays on this thread.
@@ -115,14 +184,7 @@ impl Grammar {
         // An unknown parameter (E070) or a value outside its range (E071) is a diagnostic
         // like any other: a GrammarError naming the parameter, its range and the known names.
         let compiled = compiled.map_err(|d| grammar_error(py, &d, &text, path))?;
-        let params = (compiled.grammar.params.iter())
-            .map(|p| PyParam {
-                name: p.name.clone(),
-                value: p.value,
-                default: p.default,
-                range: p.range.map(|[lo, hi]| (lo, hi)),
-            })
-            .collect();
+        let params = compiled.grammar.params.iter().map(PyParam::of).collect();
         Ok(Self {
             warnings: to_python(&compiled.warnings, &text, path),
             compiled: Arc::new(compiled.grammar),

@@ -69,7 +69,7 @@ pub struct SavedSession {
     /// grammar is compiled with them before the assembly is checked against it. Absent or
     /// empty: every parameter at its default.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub params: BTreeMap<String, f64>,
+    pub params: BTreeMap<String, clay_dsl::compiled::ParamValue>,
 }
 
 impl SavedSession {
@@ -220,7 +220,7 @@ mod tests {
         let plain = serde_json::to_string(&s).unwrap();
         assert!(!plain.contains("\"params\""), "{plain}");
         assert_eq!(parse(&plain).unwrap().params, BTreeMap::new());
-        s.params.insert("bays".into(), 6.0);
+        s.params.insert("bays".into(), 6.0.into());
         let text = serde_json::to_string(&s).unwrap();
         assert!(text.contains("\"params\":{\"bays\":6.0}"), "{text}");
         assert_eq!(parse(&text).unwrap(), s);

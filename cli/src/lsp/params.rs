@@ -5,7 +5,7 @@
 //! and `let`s, E072, so they fold without the rest of the file, whatever its state).
 
 use clay_dsl::analysis::{Analysis, SymbolKind};
-use clay_dsl::compiled::Param;
+use clay_dsl::compiled::{Param, ParamKind};
 use clay_dsl::format_number;
 use clay_dsl::syntax::{File, Item};
 
@@ -48,21 +48,37 @@ pub fn symbol_param(a: &Analysis, i: usize) -> Option<(&str, &str)> {
         .then_some((text, sym.name.as_str()))
 }
 
-/// `2..12`, or `any finite number` for a parameter declared without a range.
+/// `2..12`, or what a parameter declared without a range takes.
 fn range(p: &Param) -> String {
-    match p.range {
-        Some([low, high]) => format!("`{}..{}`", format_number(low), format_number(high)),
-        None => "any finite number".to_string(),
+    match (&p.kind, p.range) {
+        (_, Some([low, high])) => format!("`{}..{}`", format_number(low), format_number(high)),
+        (ParamKind::Number, None) => "any finite number".to_string(),
+        (ParamKind::Int, None) => "any whole number".to_string(),
+        (ParamKind::Seed, None) => "any whole number from 0".to_string(),
+        (ParamKind::Bool, None) => "`true` or `false`".to_string(),
+        (ParamKind::Choice { choices }, None) => {
+            let all: Vec<String> = choices.iter().map(|c| format!("`{c}`")).collect();
+            format!("one of {}", all.join(", "))
+        }
+    }
+}
+
+/// `parameter`, or `int parameter` (and so on) for a typed one.
+fn kind(p: &Param) -> String {
+    match p.kind {
+        ParamKind::Number => "parameter".to_string(),
+        ref k => format!("{} parameter", k.word()),
     }
 }
 
 /// The hover's paragraph on a parameter (markdown).
 pub fn hover(p: &Param) -> String {
     format!(
-        "\n**parameter**: value `{}`, default `{}`, range {}; set it when compiling \
+        "\n**{}**: value `{}`, default `{}`, range {}; set it when compiling \
          (`clayc run FILE --param {}=VALUE`)\n",
-        format_number(p.value),
-        format_number(p.default),
+        kind(p),
+        p.value,
+        p.default,
         range(p),
         p.name
     )
@@ -71,9 +87,10 @@ pub fn hover(p: &Param) -> String {
 /// A completion's detail for a parameter.
 pub fn detail(p: &Param) -> String {
     format!(
-        "parameter = {} (default {}, range {})",
-        format_number(p.value),
-        format_number(p.default),
+        "{} = {} (default {}, range {})",
+        kind(p),
+        p.value,
+        p.default,
         range(p).trim_matches('`')
     )
 }
@@ -101,7 +118,10 @@ mod tests {
                     piece p { vertex v (a, nowhere) }\nmodel { x = nothing }\n";
         let params = declared(text).unwrap();
         assert_eq!(params.len(), 2);
-        assert_eq!((params[0].value, params[0].default), (3.0, 3.0));
+        assert_eq!(
+            (params[0].value.number(), params[0].default.number()),
+            (Some(3.0), Some(3.0))
+        );
         assert_eq!(params[0].range, Some([0.0, 6.0]));
         assert_eq!((params[1].name.as_str(), params[1].range), ("b", None));
         assert_eq!(declared("piece {").map(|p| p.len()), None);

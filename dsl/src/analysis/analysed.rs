@@ -16,7 +16,7 @@ pub const KEYWORDS: &[&str] = &[
     "polyline", "rigid", "skinned", "fill", "width", "hole", "state", "stretch", "from", "to",
     "min", "max", "variants", "merge", "onto", "into", "within", "cut", "model", "chain", "x",
     "along", "at", "rotate", "dock", "last", "import", "extends", "bend", "mirror", "extrude",
-    "above", "mesh", "param", "in",
+    "above", "mesh", "param", "in", "if", "else", "choice", "true", "false",
 ];
 
 /// One text, analysed.

@@ -120,6 +120,12 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
         .find(|b| b.head.first() == Some(&"piece"))
         .and_then(|b| b.head.get(1).copied());
     let inner = blocks.last().and_then(|b| b.head.first().copied());
+    // `if NAME {` and `} else {` blocks hold model statements.
+    let in_model = blocks.iter().any(|b| b.head.first() == Some(&"model"));
+    let inner = match inner {
+        Some("if" | "}" | "else") if in_model => Some("model"),
+        other => other,
+    };
     let words: Vec<&str> = before.split_whitespace().collect();
     let last = words.last().copied().unwrap_or("");
     let first = words.first().copied().unwrap_or("");
@@ -130,6 +136,12 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
         let owner = owner.split('[').next().unwrap_or(owner);
         let name = &owner[owner.trim_end_matches(is_word).len()..];
         out.sites_of_owner(name);
+    } else if first == "param" && before.ends_with(':') {
+        ["number", "int", "bool", "seed", "choice"]
+            .iter()
+            .for_each(|k| out.keyword(k));
+    } else if inner == Some("model") && last == "if" {
+        out.params_of("bool");
     } else if before.ends_with('[') && inner == Some("model") {
         out.keyword("last");
     } else if before.rfind('[') > before.rfind(']') && piece.is_some() {
@@ -159,6 +171,7 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
         out.of_kind(SymbolKind::Piece);
         if inner == Some("model") && last == "=" {
             out.keyword("chain");
+            out.params_of("choice");
         }
     } else if first == "stretch" && matches!(last, "from" | "to") {
         out.members(words.get(1).copied(), SymbolKind::Site);
@@ -181,7 +194,7 @@ pub(super) fn at(a: &Analysis, offset: usize) -> Vec<Completion> {
                 STATE_KEYWORDS.iter().for_each(|k| out.keyword(k));
                 out.members(piece, SymbolKind::Vertex);
             }
-            Some("model") => out.keyword("dock"),
+            Some("model") => ["dock", "if"].iter().for_each(|k| out.keyword(k)),
             Some("solver") => crate::settings::grammar_names()
                 .for_each(|p| out.push(p, CompletionKind::Parameter, None)),
             Some("stretch") => ["min", "max", "variants"]
@@ -269,6 +282,22 @@ impl Offer<'_> {
             _ => None,
         });
         self.members(piece.as_deref(), SymbolKind::Site);
+    }
+
+    /// The parameters declared with type `ty` (`bool`, `choice`).
+    fn params_of(&mut self, ty: &str) {
+        let a = self.a;
+        for s in (a.symbols().symbols.iter()).filter(|s| s.kind == SymbolKind::Constant) {
+            let decl = a.source(s.full);
+            let typed = decl.starts_with("param")
+                && decl
+                    .split_once(':')
+                    .is_some_and(|(_, t)| t.trim_start().starts_with(ty));
+            if typed {
+                let detail = decl.split_once('=').map(|(_, v)| format!("= {}", v.trim()));
+                self.push(&s.name, CompletionKind::Parameter, detail);
+            }
+        }
     }
 
     /// Constants visible at `offset`, `pi` and the functions.

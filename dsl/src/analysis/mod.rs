@@ -255,7 +255,7 @@ impl Analysis {
     }
 
     /// The text of a span of this analysis, in whichever file it lies.
-    fn source(&self, span: Span) -> &str {
+    pub(super) fn source(&self, span: Span) -> &str {
         let at = self.imported.sources.locate(self.text(), &self.path, span);
         &at.text[at.start..at.end]
     }

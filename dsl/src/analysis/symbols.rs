@@ -135,6 +135,12 @@ impl Symbols {
             Item::Param(p) => {
                 let i = self.push(SymbolKind::Constant, &p.name, p.span, None);
                 scope.constants.entry(p.name.name.clone()).or_insert(i);
+                // A choice stands for its default piece where a piece's name goes.
+                if let (Some(ParamTypeKind::Choice(_)), ParamDefault::Text(t)) =
+                    (p.ty.as_ref().map(|t| &t.kind), &p.value)
+                {
+                    self.symbols[i].piece = Some(t.value.clone());
+                }
             }
             Item::SiteType(t) => {
                 let i = self.push(SymbolKind::SiteType, &t.name, t.span, None);
@@ -185,14 +191,18 @@ impl Symbols {
                 self.push(SymbolKind::Rule, &id, r.span, None);
             }
             Item::Model(m) => {
-                for stmt in &m.stmts {
+                let mut all = Vec::new();
+                ModelStmt::walk(&m.stmts, &mut all);
+                for stmt in all {
                     let (kind, id, piece, full) = match stmt {
                         ModelStmt::Instance(d) => (SymbolKind::Instance, &d.name, &d.piece, d.span),
                         ModelStmt::Chain(d) => (SymbolKind::Chain, &d.name, &d.piece, d.span),
-                        ModelStmt::Dock(_) => continue,
+                        ModelStmt::Dock(_) | ModelStmt::If(_) => continue,
                     };
+                    let chosen = (scope.constants.get(&piece.name))
+                        .and_then(|&c| self.symbols[c].piece.clone());
                     let i = self.push(kind, id, full, None);
-                    self.symbols[i].piece = Some(piece.name.clone());
+                    self.symbols[i].piece = Some(chosen.unwrap_or_else(|| piece.name.clone()));
                     scope.instances.entry(id.name.clone()).or_insert(i);
                 }
             }
@@ -281,7 +291,20 @@ impl Symbols {
         match item {
             Item::Let(l) => self.expr(&l.value, scope),
             Item::Param(p) => {
-                self.expr(&p.value, scope);
+                if let ParamDefault::Expr(e) = &p.value {
+                    self.expr(e, scope);
+                }
+                if let Some(ParamTypeKind::Choice(strings)) = p.ty.as_ref().map(|t| &t.kind) {
+                    for s in strings {
+                        // The name inside the quotes is a use of the piece.
+                        let id = Ident {
+                            name: s.value.clone(),
+                            span: Span::new(s.span.start + 1, s.span.end.saturating_sub(1)),
+                        };
+                        let found = scope.pieces.get(&s.value).copied();
+                        self.use_of(&id, found.as_ref());
+                    }
+                }
                 if let Some(r) = &p.range {
                     self.expr(&r.low, scope);
                     self.expr(&r.high, scope);
@@ -394,15 +417,33 @@ impl Symbols {
                 s.expr(r, scope);
             }
         };
+        // A piece's name, or a choice parameter's (then its default piece has the sites).
+        let piece = |s: &mut Self, id: &Ident| match scope.constants.get(&id.name) {
+            Some(&c) if s.symbols[c].piece.is_some() => {
+                s.use_of(id, Some(&c));
+                let chosen = s.symbols[c].piece.clone().unwrap_or_default();
+                scope.pieces.get(&chosen).copied()
+            }
+            _ => {
+                let found = scope.pieces.get(&id.name).copied();
+                s.use_of(id, found.as_ref());
+                found
+            }
+        };
         match stmt {
+            ModelStmt::If(b) => {
+                let found = scope.constants.get(&b.cond.name).copied();
+                self.use_of(&b.cond, found.as_ref());
+                for s in b.then.iter().chain(b.otherwise.iter().flatten()) {
+                    self.model_stmt(s, scope);
+                }
+            }
             ModelStmt::Instance(d) => {
-                let found = scope.pieces.get(&d.piece.name).copied();
-                self.use_of(&d.piece, found.as_ref());
+                piece(self, &d.piece);
                 placement(self, &d.at, &d.rotate);
             }
             ModelStmt::Chain(d) => {
-                let pi = scope.pieces.get(&d.piece.name).copied();
-                self.use_of(&d.piece, pi.as_ref());
+                let pi = piece(self, &d.piece);
                 self.expr(&d.count, scope);
                 if let Some((f, t)) = &d.along {
                     self.member(scope, pi, f, SymbolKind::Site);

@@ -41,6 +41,11 @@ enum Named {
     },
     /// Declared but broken (already reported): references to it are not reported again.
     Broken,
+    /// Declared only in the branch of an `if` that is off: `cond` would have to be `on`.
+    Elsewhere {
+        cond: String,
+        on: bool,
+    },
 }
 
 /// E014 at `span`: the model would pass `MAX_MODEL_INSTANCES` (reported once per model).
@@ -65,16 +70,27 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
     let mut docks: Vec<DockInfo> = Vec::new();
     let mut names: HashMap<String, (Named, Span)> = HashMap::new();
     let piece_rule = piece_rules(c);
-    let stmts: &[ModelStmt] = model.map_or(&[], |m| &m.stmts);
+    c.check_choices();
+    let mut stmts: Vec<&ModelStmt> = Vec::new();
+    let mut elsewhere: HashMap<String, (Named, Span)> = HashMap::new();
+    active(
+        c,
+        model.map_or(&[], |m| &m.stmts),
+        &mut stmts,
+        &mut elsewhere,
+    );
+    let seed = (c.consts.params.iter())
+        .find(|p| p.kind == ParamKind::Seed)
+        .and_then(|p| Some((p.name.clone(), p.value.number()?)));
     let mut too_many = false;
-    for stmt in stmts {
+    for &stmt in &stmts {
         match stmt {
             ModelStmt::Instance(d) => {
                 if let Some((_, first)) = names.get(&d.name.name) {
                     c.duplicate("instance", &d.name, *first);
                     continue;
                 }
-                let piece = c.resolve_piece(&d.piece);
+                let piece = resolve_model_piece(c, &d.piece);
                 let at = d.at.as_ref().map(|p| c.point(p));
                 let full = insts.len() >= MAX_MODEL_INSTANCES;
                 if full && piece.is_some() && !too_many {
@@ -104,7 +120,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                     continue;
                 }
                 names.insert(d.name.name.clone(), (Named::Broken, d.name.span));
-                let piece = c.resolve_piece(&d.piece);
+                let piece = resolve_model_piece(c, &d.piece);
                 let count = c.whole(&d.count, "the chain length", 1);
                 let at = d.at.as_ref().map(|p| c.point(p));
                 let turn = d.rotate.as_ref().and_then(|r| c.eval(r)).unwrap_or(0.0);
@@ -158,7 +174,16 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                 };
                 let Some((from, to)) = sites else { continue };
                 let first = insts.len();
-                for k in 0..count {
+                let elements = match (&seed, piece_rule[piece]) {
+                    (Some((name, seed)), Some(r)) if c.stretch_rules[r].variants.len() > 1 => {
+                        if let Some(k) = c.consts.table.get_mut(name) {
+                            k.used = true;
+                        }
+                        drawn(&c.stretch_rules[r], count, *seed, first)
+                    }
+                    _ => vec![piece; count],
+                };
+                for (k, &piece) in elements.iter().enumerate() {
                     insts.push(Inst {
                         name: format!("{}[{k}]", d.name.name),
                         piece,
@@ -190,8 +215,11 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
                     (Named::Chain { first, count }, d.name.span),
                 );
             }
-            ModelStmt::Dock(_) => {}
+            ModelStmt::Dock(_) | ModelStmt::If(_) => {}
         }
+    }
+    for (name, e) in elsewhere {
+        names.entry(name).or_insert(e);
     }
     // Docks after all instances: a dock may name an instance declared further down.
     let mut docked: HashMap<InstanceSite, Span> = HashMap::new();
@@ -199,7 +227,7 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
         docked.insert(d.a, d.span);
         docked.insert(d.b, d.span);
     }
-    for stmt in stmts {
+    for &stmt in &stmts {
         let ModelStmt::Dock(d) = stmt else { continue };
         let failed_before = c.dock_failed;
         let a = resolve_instance_site(c, &names, &insts, &d.a);
@@ -276,6 +304,135 @@ pub(super) fn build(c: &mut Compiler, model: Option<&syntax::ModelBlock>) -> Ass
     }
 }
 
+/// The statements `if` blocks switch on, in source order, into `out`; the names the others
+/// declare into `elsewhere` (with the value their switch would need). Expressions in the
+/// statements switched off are still evaluated, so that their constants count as used.
+fn active<'a>(
+    c: &mut Compiler,
+    stmts: &'a [ModelStmt],
+    out: &mut Vec<&'a ModelStmt>,
+    elsewhere: &mut HashMap<String, (Named, Span)>,
+) {
+    for stmt in stmts {
+        let ModelStmt::If(b) = stmt else {
+            out.push(stmt);
+            continue;
+        };
+        let on = c.switch(&b.cond);
+        let otherwise: &'a [ModelStmt] = b.otherwise.as_deref().unwrap_or(&[]);
+        let (taken, skipped) = match on {
+            Some(true) => (&b.then[..], Some((otherwise, false))),
+            Some(false) => (otherwise, Some((&b.then[..], true))),
+            None => {
+                // An `if` on no `bool` (reported): neither branch, and no word about their names.
+                for branch in [&b.then[..], otherwise] {
+                    off(c, branch, elsewhere, &mut |_| Named::Broken);
+                }
+                continue;
+            }
+        };
+        active(c, taken, out, elsewhere);
+        if let Some((branch, needs)) = skipped {
+            let cond = b.cond.name.clone();
+            off(c, branch, elsewhere, &mut |_| Named::Elsewhere {
+                cond: cond.clone(),
+                on: needs,
+            });
+        }
+    }
+}
+
+/// Records the names a switched-off branch declares and touches its expressions.
+fn off(
+    c: &mut Compiler,
+    stmts: &[ModelStmt],
+    elsewhere: &mut HashMap<String, (Named, Span)>,
+    named: &mut dyn FnMut(&str) -> Named,
+) {
+    let mut all = Vec::new();
+    ModelStmt::walk(stmts, &mut all);
+    for stmt in all {
+        let (name, piece, exprs): (_, _, Vec<&syntax::Expr>) = match stmt {
+            ModelStmt::Instance(d) => (&d.name, &d.piece, d.rotate.iter().collect()),
+            ModelStmt::Chain(d) => (
+                &d.name,
+                &d.piece,
+                std::iter::once(&d.count).chain(&d.rotate).collect(),
+            ),
+            ModelStmt::If(b) => {
+                c.switch(&b.cond);
+                continue;
+            }
+            ModelStmt::Dock(_) => continue,
+        };
+        let at = match stmt {
+            ModelStmt::Instance(d) => d.at.as_ref(),
+            ModelStmt::Chain(d) => d.at.as_ref(),
+            _ => None,
+        };
+        for e in exprs
+            .into_iter()
+            .chain(at.into_iter().flat_map(|p| [&p.x, &p.y]))
+        {
+            c.eval(e);
+        }
+        c.chosen_piece(piece);
+        elsewhere
+            .entry(name.name.clone())
+            .or_insert((named(&name.name), name.span));
+    }
+}
+
+/// The piece a model statement names: a piece's name, or a `choice` parameter's, which picks
+/// the piece it is set to.
+fn resolve_model_piece(c: &mut Compiler, id: &syntax::Ident) -> Option<usize> {
+    match c.chosen_piece(id) {
+        Some(chosen) if chosen.name.is_empty() => None,
+        Some(chosen) => c.piece_index.get(&chosen.name).copied(),
+        None => c.resolve_piece(id),
+    }
+}
+
+/// The pieces of a chain of `count` elements drawn with `seed` from its rule's variants: as
+/// many of each as its frequency asks (largest remainders first), in an order the seed
+/// shuffles (with the chain's first instance, so that two chains differ).
+fn drawn(rule: &StretchRule, count: usize, seed: f64, salt: usize) -> Vec<usize> {
+    if rule.variants.is_empty() {
+        return vec![rule.piece; count];
+    }
+    let exact: Vec<f64> = (rule.variants.iter())
+        .map(|v| v.frequency * count as f64)
+        .collect();
+    let mut counts: Vec<usize> = exact.iter().map(|e| e.floor() as usize).collect();
+    let mut order: Vec<usize> = (0..counts.len()).collect();
+    order.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())));
+    for &i in order
+        .iter()
+        .cycle()
+        .take(count.saturating_sub(counts.iter().sum()))
+    {
+        counts[i] += 1;
+    }
+    let mut pieces: Vec<usize> = (rule.variants.iter().zip(&counts))
+        .flat_map(|(v, &n)| std::iter::repeat_n(v.piece, n))
+        .collect();
+    // Fisher-Yates with splitmix64: the order must be the same on every machine and version,
+    // which a general-purpose random crate does not promise.
+    let mut state = (seed as u64) ^ (salt as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    for i in (1..pieces.len()).rev() {
+        let j = (next() % (i as u64 + 1)) as usize;
+        pieces.swap(i, j);
+    }
+    pieces
+}
+
 /// The stretch rule each piece belongs to (as its piece or a variant).
 fn piece_rules(c: &Compiler) -> Vec<Option<usize>> {
     let mut out = vec![None; c.pieces.len()];
@@ -301,6 +458,25 @@ fn resolve_instance_site(
             return None;
         }
         (Some((Named::Broken, _)), _) => return None,
+        (Some((Named::Elsewhere { cond, on }, span)), _) => {
+            let block = if *on { "" } else { "the `else` of " };
+            c.error(
+                Diagnostic::error(
+                    codes::UNKNOWN,
+                    format!(
+                        "instance `{}` is in the model only when `{cond}` is {on}",
+                        p.instance.name
+                    ),
+                    p.instance.span,
+                    format!("`{cond}` is {} here", !on),
+                )
+                .with_secondary(*span, format!("declared in {block}`if {cond}`"))
+                .with_hint(format!(
+                    "move this `dock` into {block}`if {cond} {{ ... }}`, next to the instance"
+                )),
+            );
+            return None;
+        }
         (Some((Named::Single(i), _)), None) => *i,
         (Some((Named::Single(_), _)), Some(ix)) => {
             c.error(

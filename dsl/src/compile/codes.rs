@@ -104,6 +104,9 @@ pub const UNKNOWN_PARAM: &str = "E070";
 pub const PARAM_OUT_OF_RANGE: &str = "E071";
 /// A parameter whose default or range uses another parameter.
 pub const PARAM_NOT_FIXED: &str = "E072";
+/// A parameter value of the wrong type: an unknown type name, a default or an override that
+/// does not fit its type, a `bool` or `choice` used as a number, an `if` on no `bool`.
+pub const PARAM_TYPE: &str = "E073";
 
 /// A piece that nothing uses.
 pub const UNUSED_PIECE: &str = "W001";

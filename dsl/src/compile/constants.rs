@@ -11,12 +11,11 @@
 use std::collections::{HashMap, HashSet};
 
 use super::codes;
-use super::state::{Compiler, Constant, Dependency, Kind, Touch};
-use crate::compiled::Param;
+use super::state::{Compiler, Constant, Kind, Touch};
 use crate::diagnostic::Diagnostic;
 use crate::format::format_number;
 use crate::suggest::closest;
-use crate::syntax::{BinaryOp, Expr, ExprKind, Ident, Item, LetDecl, ParamDecl, Span, UnaryOp};
+use crate::syntax::{BinaryOp, Expr, ExprKind, Ident, Item, LetDecl, Span, UnaryOp};
 
 /// The built-in constants.
 const BUILTIN_CONSTANTS: [(&str, f64); 1] = [("pi", std::f64::consts::PI)];
@@ -83,7 +82,7 @@ impl Compiler {
     }
 
     /// Whether `name` may be declared as a new constant of `kind`; reports why not.
-    fn declare(&mut self, name: &Ident, kind: Kind) -> bool {
+    pub(super) fn declare(&mut self, name: &Ident, kind: Kind) -> bool {
         if let Some(first) = self.consts.table.get(&name.name) {
             let (first_span, first_kind) = (first.span, first.kind);
             if first_kind == kind {
@@ -148,198 +147,10 @@ impl Compiler {
                 visible_from: l.span.end,
                 used: false,
                 kind: Kind::Let,
+                ty: None,
                 depends,
             },
         );
-    }
-
-    fn param_decl(&mut self, p: &ParamDecl) {
-        if !self.declare(&p.name, Kind::Param) {
-            return;
-        }
-        let value = self.param_value(p);
-        self.consts.table.insert(
-            p.name.name.clone(),
-            Constant {
-                value,
-                span: p.name.span,
-                visible_from: p.span.end,
-                used: false,
-                kind: Kind::Param,
-                depends: Some(Dependency {
-                    param: p.name.name.clone(),
-                    decl: p.name.span,
-                }),
-            },
-        );
-    }
-
-    /// A parameter's value: its override, or else its default. `None` (poisoned) after an
-    /// error in its declaration, reported once.
-    fn param_value(&mut self, p: &ParamDecl) -> Option<f64> {
-        // One E072 per parameter, however many of its parts use another one.
-        let mut reported = false;
-        let default = self.fixed(p, &p.value, "default", &mut reported);
-        let range = match &p.range {
-            None => Some(None),
-            Some(r) => {
-                let low = self.fixed(p, &r.low, "range", &mut reported);
-                let high = self.fixed(p, &r.high, "range", &mut reported);
-                low.zip(high).map(Some)
-            }
-        };
-        let (default, range) = (default?, range?);
-        if let (Some((low, high)), Some(r)) = (range, &p.range) {
-            if low > high {
-                self.error(
-                    Diagnostic::error(
-                        codes::OUT_OF_RANGE,
-                        format!(
-                            "the range of parameter `{}` is empty: its low end is above its high end",
-                            p.name.name
-                        ),
-                        r.span,
-                        format!("{} is above {}", format_number(low), format_number(high)),
-                    )
-                    .with_hint(format!(
-                        "write the low end first: `in {}..{}`",
-                        format_number(high),
-                        format_number(low)
-                    )),
-                );
-                return None;
-            }
-            if !(low..=high).contains(&default) {
-                self.error(
-                    Diagnostic::error(
-                        codes::OUT_OF_RANGE,
-                        format!(
-                            "the default of parameter `{}` is outside its range",
-                            p.name.name
-                        ),
-                        p.value.span,
-                        format!(
-                            "{} is not in {}",
-                            format_number(default),
-                            range_text(low, high)
-                        ),
-                    )
-                    .with_secondary(r.span, "the range")
-                    .with_hint(format!(
-                        "make the default a number from {} to {}, or widen the range",
-                        format_number(low),
-                        format_number(high)
-                    )),
-                );
-                return None;
-            }
-        }
-        let range = range.map(|(low, high)| [low, high]);
-        let given = self
-            .consts
-            .overrides
-            .iter()
-            .rev()
-            .find(|(n, _)| *n == p.name.name)
-            .map(|(_, v)| *v);
-        // A rejected override is reported once; the rest of the grammar compiles with the
-        // default, so that nothing else is said about it.
-        let value = match given {
-            None => default,
-            Some(v) => self.checked_override(p, v, range).unwrap_or(default),
-        };
-        self.consts.params.push(Param {
-            name: p.name.name.clone(),
-            value,
-            default,
-            range,
-        });
-        Some(value)
-    }
-
-    /// A part of a parameter's declaration (its default or a bound of its range), which must
-    /// not depend on another parameter (E072).
-    fn fixed(&mut self, p: &ParamDecl, e: &Expr, part: &str, reported: &mut bool) -> Option<f64> {
-        self.consts.touched = None;
-        let value = self.eval(e);
-        let Some(t) = self.consts.touched.take() else {
-            return value;
-        };
-        if std::mem::replace(reported, true) {
-            return None;
-        }
-        let through = if t.used.name == t.dep.param {
-            format!("parameter `{}`", t.dep.param)
-        } else {
-            format!(
-                "`{}`, which depends on parameter `{}`",
-                t.used.name, t.dep.param
-            )
-        };
-        self.error(
-            Diagnostic::error(
-                codes::PARAM_NOT_FIXED,
-                format!("the {part} of parameter `{}` uses {through}", p.name.name),
-                t.used.span,
-                "depends on a parameter",
-            )
-            .with_secondary(
-                t.dep.decl,
-                format!("`{}` is a parameter: a user may set it", t.dep.param),
-            )
-            .with_hint(
-                "a parameter's default and range are fixed: write them with numbers and \
-                 `let` constants that use no parameter",
-            ),
-        );
-        None
-    }
-
-    /// An override of parameter `p` checked against its range (E071).
-    fn checked_override(&mut self, p: &ParamDecl, v: f64, range: Option<[f64; 2]>) -> Option<f64> {
-        let name = &p.name.name;
-        let (message, mut hint) = if !v.is_finite() {
-            (
-                format!(
-                    "parameter `{name}` is set to {}, which is not a finite number",
-                    shown(v)
-                ),
-                "a parameter's value must be a finite number".to_string(),
-            )
-        } else {
-            match range {
-                Some([low, high]) if v < low || v > high => (
-                    format!(
-                        "parameter `{name}` is set to {}, outside its range {}",
-                        shown(v),
-                        range_text(low, high)
-                    ),
-                    String::new(),
-                ),
-                _ => return Some(v),
-            }
-        };
-        if let Some([low, high]) = range {
-            if !hint.is_empty() {
-                hint.push_str("; ");
-            }
-            hint.push_str(&format!(
-                "choose a value of `{name}` from {} to {}",
-                format_number(low),
-                format_number(high)
-            ));
-        }
-        let mut d = Diagnostic::error(
-            codes::PARAM_OUT_OF_RANGE,
-            message,
-            p.name.span,
-            format!("set to {} from outside the file", shown(v)),
-        );
-        if let Some(r) = &p.range {
-            d = d.with_secondary(r.span, "its range");
-        }
-        self.error(d.with_hint(hint));
-        None
     }
 
     /// E070 for each override whose name is no parameter of the grammar (once per name).
@@ -482,6 +293,25 @@ impl Compiler {
         match self.consts.table.get_mut(name) {
             Some(c) if c.visible_from <= id.span.start => {
                 c.used = true;
+                if let Some(k) = c.ty.as_ref().filter(|k| !k.is_numeric()) {
+                    let (word, a_word, span) = (k.word(), k.with_article(), c.span);
+                    let hint = if word == "bool" {
+                        format!("switch model statements with `if {name} {{ ... }}`")
+                    } else {
+                        format!("write `{name}` where a piece's name goes in the model")
+                    };
+                    self.error(
+                        Diagnostic::error(
+                            codes::PARAM_TYPE,
+                            format!("parameter `{name}` is {a_word}, not a number"),
+                            id.span,
+                            "used as a number",
+                        )
+                        .with_secondary(span, format!("declared {a_word} here"))
+                        .with_hint(hint),
+                    );
+                    return Err(Stop);
+                }
                 if let (Some(dep), None) = (&c.depends, &self.consts.touched) {
                     self.consts.touched = Some(Touch {
                         dep: dep.clone(),
@@ -684,7 +514,7 @@ pub(crate) fn constant_values(file: &crate::syntax::File) -> HashMap<String, f64
 }
 
 /// A value as messages show it: the shortest text that reads back, or `inf`, `-inf`, `NaN`.
-fn shown(v: f64) -> String {
+pub(super) fn shown(v: f64) -> String {
     if v.is_finite() {
         format_number(v)
     } else {
@@ -693,7 +523,7 @@ fn shown(v: f64) -> String {
 }
 
 /// `LO..HI` as messages show a range.
-fn range_text(low: f64, high: f64) -> String {
+pub(super) fn range_text(low: f64, high: f64) -> String {
     format!("{}..{}", format_number(low), format_number(high))
 }
 

@@ -18,8 +18,10 @@ mod mesh_files;
 mod meshes;
 
 pub(crate) use constants::{constant_values, functions, is_function};
+mod params;
 mod pieces;
 mod rules;
+mod switches;
 mod usage;
 
 use std::collections::HashMap;
@@ -62,8 +64,9 @@ pub struct CompileOptions<'a> {
     pub loader: &'a dyn Loader,
     /// Values for the grammar's parameters (`param NAME = ...`), by name, replacing their
     /// defaults; of two values for one name the last counts. A name that is not a parameter
-    /// of the grammar is E070; a value outside the parameter's range, or not finite, E071.
-    pub params: Vec<(String, f64)>,
+    /// of the grammar is E070; a value outside the parameter's range, or not finite, E071;
+    /// a value of another type (2.5 for an `int`, 1 for a `bool`), E073.
+    pub params: Vec<(String, ParamValue)>,
 }
 
 impl Default for CompileOptions<'_> {
@@ -85,8 +88,8 @@ impl<'a> CompileOptions<'a> {
     }
 
     /// The same options, with parameter `name` set to `value`.
-    pub fn param(mut self, name: impl Into<String>, value: f64) -> Self {
-        self.params.push((name.into(), value));
+    pub fn param(mut self, name: impl Into<String>, value: impl Into<ParamValue>) -> Self {
+        self.params.push((name.into(), value.into()));
         self
     }
 }
@@ -129,7 +132,38 @@ pub(crate) fn compile_tree(
     source_len: usize,
     path: &str,
     loader: &dyn Loader,
-    params: &[(String, f64)],
+    params: &[(String, ParamValue)],
+) -> Result<Compiled, Diagnostics> {
+    // Only a grammar with typed parameters (or imports, which may declare them) can have
+    // switches: the others compile once, without a copy of their tree.
+    let typed = file.items.iter().any(|i| match i {
+        Item::Import(_) => true,
+        Item::Param(p) => p.ty.is_some(),
+        _ => false,
+    });
+    if !typed {
+        return compile_once(file, source_len, path, loader, params);
+    }
+    let ok = compile_once(file.clone(), source_len, path, loader, params)?;
+    let found = switches::other_value_errors(&ok.grammar.params, params, |values| {
+        compile_once(file.clone(), source_len, path, loader, values).err()
+    });
+    if found.is_empty() {
+        return Ok(ok);
+    }
+    let mut diags = ok.warnings;
+    diags.extend(found);
+    diags.sort();
+    Err(diags)
+}
+
+/// One compilation with the parameter values `params`.
+fn compile_once(
+    file: syntax::File,
+    source_len: usize,
+    path: &str,
+    loader: &dyn Loader,
+    params: &[(String, ParamValue)],
 ) -> Result<Compiled, Diagnostics> {
     let span = file.span;
     let spliced = imports::splice(file, path, source_len, loader);

@@ -108,6 +108,8 @@ pub(crate) struct Constant {
     pub(super) visible_from: usize,
     pub(super) used: bool,
     pub(super) kind: Kind,
+    /// A parameter's type (`None` for a `let`).
+    pub(super) ty: Option<ParamKind>,
     /// The parameter its value depends on (a parameter depends on itself), if any.
     pub(super) depends: Option<Dependency>,
 }
@@ -134,9 +136,11 @@ pub(crate) struct Constants {
     /// Constants already reported as used before their `let`.
     pub(super) early: HashSet<String>,
     /// The values given for parameters, by name, in the order given (the last one counts).
-    pub overrides: Vec<(String, f64)>,
+    pub overrides: Vec<(String, ParamValue)>,
     /// The parameters that compiled, in declaration order, for the compiled grammar.
     pub params: Vec<Param>,
+    /// Each `choice` parameter's strings as written, to check that they name pieces.
+    pub(super) choices: Vec<(String, Vec<crate::syntax::StringLit>)>,
     /// The first parameter the expression being folded depends on.
     pub(super) touched: Option<Touch>,
 }

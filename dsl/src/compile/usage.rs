@@ -2,6 +2,7 @@
 
 use super::codes;
 use super::state::Compiler;
+use crate::compiled::ParamKind;
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, Item, ModelStmt};
 
@@ -54,15 +55,24 @@ impl Usage {
                 _ => {}
             }
         }
-        for stmt in model.map_or(&[][..], |m| &m.stmts) {
+        let mut stmts = Vec::new();
+        ModelStmt::walk(model.map_or(&[][..], |m| &m.stmts), &mut stmts);
+        for stmt in stmts {
             let name = match stmt {
                 ModelStmt::Instance(d) => &d.piece.name,
                 ModelStmt::Chain(d) => &d.piece.name,
-                ModelStmt::Dock(_) => continue,
+                ModelStmt::Dock(_) | ModelStmt::If(_) => continue,
             };
-            match c.piece_index.get(name) {
-                Some(&i) => in_model[i] = true,
-                None => complete = false,
+            // A choice parameter puts each of its pieces in the model, for some value.
+            let names: Vec<&str> = match c.param(name).map(|p| &p.kind) {
+                Some(ParamKind::Choice { choices }) => choices.iter().map(String::as_str).collect(),
+                _ => vec![name.as_str()],
+            };
+            for name in names {
+                match c.piece_index.get(name) {
+                    Some(&i) => in_model[i] = true,
+                    None => complete = false,
+                }
             }
         }
         Self {

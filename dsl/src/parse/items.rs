@@ -19,7 +19,30 @@ impl Lower {
         let span = span_of(&p);
         let ch = kids(p);
         let name = self.name_or(&ch, span);
-        let value = self.expr_or(first(&ch, Rule::expr), span);
+        let ty = first(&ch, Rule::param_type).map(|t| {
+            let tspan = span_of(&t);
+            let tc = kids(t);
+            let kind = match first(&tc, Rule::param_choice) {
+                Some(c) => {
+                    let strings = of(&kids(c), Rule::string);
+                    ParamTypeKind::Choice(
+                        strings
+                            .into_iter()
+                            .map(|s| self.string_or(Some(s), tspan))
+                            .collect(),
+                    )
+                }
+                None => ParamTypeKind::Named(self.name_or(&tc, tspan)),
+            };
+            ParamTypeDecl {
+                kind,
+                span: tc.first().map_or(tspan, span_of),
+            }
+        });
+        let value = match first(&ch, Rule::string) {
+            Some(s) => ParamDefault::Text(self.string_or(Some(s), span)),
+            None => ParamDefault::Expr(self.expr_or(first(&ch, Rule::expr), span)),
+        };
         let range = first(&ch, Rule::param_range).map(|r| {
             let rspan = span_of(&r);
             let bounds = of(&kids(r), Rule::expr);
@@ -34,6 +57,7 @@ impl Lower {
         });
         ParamDecl {
             name,
+            ty,
             value,
             range,
             span,

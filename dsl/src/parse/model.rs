@@ -12,6 +12,16 @@ impl Lower {
         let span = span_of(&p);
         let ch = kids(p);
         let keyword = first(&ch, Rule::kw_model).map_or(span, |k| span_of(&k));
+        let stmts = self.model_stmts(ch);
+        ModelBlock {
+            stmts,
+            keyword,
+            span,
+        }
+    }
+
+    /// The model statements among `ch` (other children are skipped).
+    fn model_stmts(&mut self, ch: Vec<Pair<Rule>>) -> Vec<ModelStmt> {
         let mut stmts = Vec::new();
         for c in ch {
             let cspan = span_of(&c);
@@ -64,14 +74,32 @@ impl Lower {
                         span: cspan,
                     }));
                 }
+                Rule::model_if => {
+                    let then_close = (c.clone().into_inner())
+                        .find(|x| x.as_rule() == Rule::rbrace)
+                        .map_or(cspan, |b| span_of(&b));
+                    let cc = kids(c);
+                    let else_keyword = first(&cc, Rule::model_else)
+                        .and_then(|e| first(&kids(e), Rule::kw_else))
+                        .map(|k| span_of(&k));
+                    let keyword = first(&cc, Rule::kw_if).map_or(cspan, |k| span_of(&k));
+                    let cond = self.name_or(&cc, cspan);
+                    let otherwise = first(&cc, Rule::model_else).map(|e| self.model_stmts(kids(e)));
+                    let then = self.model_stmts(cc);
+                    stmts.push(ModelStmt::If(IfBlock {
+                        cond,
+                        then,
+                        otherwise,
+                        keyword,
+                        then_close,
+                        else_keyword,
+                        span: cspan,
+                    }));
+                }
                 _ => {}
             }
         }
-        ModelBlock {
-            stmts,
-            keyword,
-            span,
-        }
+        stmts
     }
 
     fn placement(&mut self, ch: &[Pair<Rule>]) -> (Option<Point>, Option<Expr>) {

@@ -42,11 +42,12 @@ const grammar = await registry.loadGrammar("source.clay");
 const STATEMENT_KEYWORDS = new Set([
   "import", "let", "param", "solver", "site", "piece", "vertex", "edges", "axis", "polygon", "polyline",
   "mesh", "hole", "state", "stretch", "min", "max", "variants", "merge", "cut", "model", "dock",
+  "if", "else",
 ]);
 // Keywords inside a statement, by the statement's first keyword ("=" for `NAME = ...`).
 const INNER_KEYWORDS = {
   "site type": ["type", "docks"],
-  param: ["in"],
+  param: ["in", "choice"],
   site: ["out"],
   piece: ["extends"],
   polygon: ["rigid", "skinned", "fill", "extrude", "above"],
@@ -360,6 +361,19 @@ test("wall.clay: declarations get keyword and entity name scopes", () => {
   expectScope(wall, "wall = chain", "x", "keyword.other.x.clay");
   expectScope(wall, "wall = chain", "at", "keyword.other.at.clay");
   expectScope(wall, "hysteresis = 0.15", "0.15", "constant.numeric.decimal.clay");
+});
+
+test("typed parameters and if blocks", () => {
+  const line = 'param gate: choice("great", "plain") = "great"';
+  expectScope(fixture, line, "choice", "keyword.other.choice.clay");
+  expectScope(fixture, line, ":", "punctuation.separator.colon.clay");
+  expectScope(fixture, line, '"plain"', "string.quoted.double.clay");
+  expectScope(fixture, "param towers: bool = true", "bool", "storage.type.clay");
+  expectScope(fixture, "param towers: bool = true", "true", "constant.language.boolean.clay");
+  expectScope(fixture, "param bays: int = 6", "int", "storage.type.clay");
+  expectScope(fixture, "if towers {", "if", "keyword.other.if.clay");
+  expectScope(fixture, "if towers {", "towers", "variable.parameter.clay");
+  expectScope(fixture, "} else {", "else", "keyword.other.else.clay");
 });
 
 test("the new syntax: import, extends, bend, mirror", () => {

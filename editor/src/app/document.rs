@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use clay_dsl::compiled::ParamValue;
+
 use crate::compile::{
     self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem, Severity, check_grammar, empty_grammar,
 };
@@ -19,7 +21,7 @@ pub(super) struct LoadedSession {
     /// The grammar's file (`None`: the bundled castle).
     pub(super) grammar_file: Option<PathBuf>,
     /// The grammar's parameters as the session set them.
-    pub(super) params: Vec<(String, f64)>,
+    pub(super) params: Vec<(String, ParamValue)>,
 }
 
 /// Reads a session and rebuilds its sculpt, touching nothing of the editor's.
@@ -34,7 +36,7 @@ pub(super) fn load_session(path: &Path) -> Result<LoadedSession, String> {
         };
     // The parameters as set when it was saved, so the assembly fits the grammar it was made
     // with.
-    let params: Vec<(String, f64)> = s.params.into_iter().collect();
+    let params: Vec<(String, ParamValue)> = s.params.into_iter().collect();
     let compiled = compile::compile(&source, &s.grammar, &params).map_err(|problems| {
         let first = problems.first().map_or(String::new(), |p| p.to_string());
         format!("the session's grammar does not compile: {first}")

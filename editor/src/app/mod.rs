@@ -22,6 +22,7 @@ mod sculpt_view;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use clay_dsl::compiled::ParamValue;
 use egui::Key;
 
 use crate::action::Action;
@@ -128,7 +129,7 @@ pub struct EditorApp {
     pub follow: Option<Follow>,
     /// Values the user set for the grammar's parameters (the Grammar parameters panel), by
     /// name: the open document's, kept across hot reloads, dropped when another grammar opens.
-    param_overrides: Vec<(String, f64)>,
+    param_overrides: Vec<(String, ParamValue)>,
     param_changes: Vec<ParamChange>,
 }
 

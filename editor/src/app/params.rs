@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use clay_dsl::compiled::Param;
+use clay_dsl::compiled::{Param, ParamKind, ParamValue};
 
 use crate::compile::{self, CASTLE_PATH, CASTLE_SOURCE, Compiled, Problem};
 use crate::sculpt::panels::ParamChange;
@@ -19,7 +19,7 @@ impl EditorApp {
     }
 
     /// The values the user set for the grammar's parameters, by name, in the order set.
-    pub fn param_overrides(&self) -> &[(String, f64)] {
+    pub fn param_overrides(&self) -> &[(String, ParamValue)] {
         &self.param_overrides
     }
 
@@ -29,8 +29,9 @@ impl EditorApp {
         let what = match c {
             ParamChange::Set(name, value) => {
                 self.param_overrides.retain(|(n, _)| *n != name);
-                self.param_overrides.push((name.clone(), value));
-                format!("{name} = {value}")
+                let what = format!("{name} = {value}");
+                self.param_overrides.push((name, value));
+                what
             }
             ParamChange::Reset(name) => {
                 self.param_overrides.retain(|(n, _)| *n != name);
@@ -57,8 +58,8 @@ impl EditorApp {
             .retain(|(n, _)| set.iter().any(|p| p.name == *n));
         for p in set {
             match self.param_overrides.iter_mut().find(|(n, _)| *n == p.name) {
-                Some(o) => o.1 = p.value,
-                None => self.param_overrides.push((p.name.clone(), p.value)),
+                Some(o) => o.1 = p.value.clone(),
+                None => self.param_overrides.push((p.name.clone(), p.value.clone())),
             }
         }
     }
@@ -119,14 +120,27 @@ impl EditorApp {
                 ));
                 return false;
             };
-            if let Some([lo, hi]) = p.range
-                && !(lo..=hi).contains(value)
+            let fits = match (&p.kind, &*value) {
+                (ParamKind::Bool, ParamValue::Bool(_)) => true,
+                (ParamKind::Choice { choices }, ParamValue::Text(t)) => choices.contains(t),
+                (k, ParamValue::Number(v)) if k.is_numeric() => !k.is_whole() || v.fract() == 0.0,
+                _ => false,
+            };
+            if !fits {
+                notes.push(format!(
+                    "{name} = {value} is no value of its type `{}` now: dropped",
+                    p.kind.word()
+                ));
+                return false;
+            }
+            if let (Some([lo, hi]), ParamValue::Number(v)) = (p.range, &*value)
+                && !(lo..=hi).contains(v)
             {
-                let clamped = value.clamp(lo, hi);
+                let clamped = v.clamp(lo, hi);
                 notes.push(format!(
                     "{name} = {value} is outside {lo}..{hi} now: clamped to {clamped}"
                 ));
-                *value = clamped;
+                *value = ParamValue::Number(clamped);
             }
             true
         });

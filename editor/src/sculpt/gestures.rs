@@ -152,7 +152,7 @@ impl Sculpt {
         let mut script = self.record.script()?;
         // The parameters the model was made with: the script refuses to replay on others.
         script.params = (self.assembly.grammar().params.iter())
-            .map(|p| (p.name.clone(), p.value))
+            .map(|p| (p.name.clone(), p.value.clone()))
             .collect();
         Ok(script)
     }

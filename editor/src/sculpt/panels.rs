@@ -3,6 +3,7 @@
 //! diagnostics above them are both modes', `crate::diagnostics`). They read state and emit
 //! [`Command`]s; they change nothing themselves.
 
+use clay_dsl::compiled::{ParamKind, ParamValue};
 use egui::{Color32, RichText};
 
 use super::{Command, Sculpt};
@@ -177,19 +178,21 @@ pub fn parameters(ui: &mut egui::Ui, sculpt: &Sculpt, commands: &mut Vec<Command
 /// the frame, keeping the sculpt where the structure allows, as hot reload does.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParamChange {
-    Set(String, f64),
+    Set(String, ParamValue),
     Reset(String),
 }
 
-/// The grammar's parameters: a slider per ranged one (a number field for one without a
-/// range), its default shown and a button back to it. A value is emitted once the slider is
-/// released or the field committed, not on every pointer move: each one recompiles.
+/// The grammar's parameters, each with a widget of its type: a slider per ranged number (an
+/// integer slider for an `int`, a number field without a range), a checkbox per `bool`, a
+/// combo box per `choice`; its default shown and a button back to it. A number is emitted
+/// once the slider is released or the field committed, not on every pointer move: each
+/// value recompiles.
 pub fn grammar_parameters(
     ui: &mut egui::Ui,
     params: &[clay_dsl::compiled::Param],
     changes: &mut Vec<ParamChange>,
 ) {
-    // The reset button first, the slider (with the name) after it, the default under it: at
+    // The reset button first, the widget (with the name) after it, the default under it: at
     // 1280 px the side panel cut off a reset button placed last (issue 48).
     egui::Grid::new("grammar parameters")
         .num_columns(2)
@@ -202,53 +205,13 @@ pub fn grammar_parameters(
                 if reset.clicked() {
                     changes.push(ParamChange::Reset(p.name.clone()));
                 }
-                let id = egui::Id::unique(("grammar parameter", &p.name));
-                let mut v = ui.data(|d| d.get_temp::<f64>(id)).unwrap_or(p.value);
-                let whole = |x: f64| x.fract() == 0.0;
-                let integral =
-                    whole(p.default) && p.range.is_none_or(|[lo, hi]| whole(lo) && whole(hi));
-                let r = match p.range {
-                    Some([lo, hi]) => {
-                        let mut slider = egui::Slider::new(&mut v, lo..=hi)
-                            .text(&p.name)
-                            .update_while_editing(false);
-                        if integral {
-                            slider = slider.step_by(1.0);
-                        }
-                        ui.add(slider)
-                    }
-                    None => {
-                        ui.horizontal(|ui| {
-                            let field = egui::DragValue::new(&mut v)
-                                .speed(if integral { 1.0 } else { 0.01 })
-                                .update_while_editing(false);
-                            let r = ui.add(field);
-                            ui.label(&p.name);
-                            r
-                        })
-                        .inner
-                    }
+                let set = match &p.kind {
+                    ParamKind::Bool => bool_widget(ui, p),
+                    ParamKind::Choice { choices } => choice_widget(ui, p, choices),
+                    _ => number_widget(ui, p),
                 };
-                let r = r.on_hover_text(format!(
-                    "param {} of the grammar{}, default {}: a change recompiles it, keeping \
-                     the sculpt where the structure allows",
-                    p.name,
-                    p.range
-                        .map_or(String::new(), |[lo, hi]| format!(", in {lo}..{hi}")),
-                    p.default
-                ));
-                let released = r.drag_stopped()
-                    || r.clicked()
-                    || (r.changed() && !r.is_pointer_button_down_on());
-                if released {
-                    ui.data_mut(|d| d.remove::<f64>(id));
-                    if v != p.value && v.is_finite() {
-                        changes.push(ParamChange::Set(p.name.clone(), v));
-                    }
-                } else if r.changed() || r.is_pointer_button_down_on() {
-                    ui.data_mut(|d| d.insert_temp(id, v));
-                } else {
-                    ui.data_mut(|d| d.remove::<f64>(id));
+                if let Some(v) = set.filter(|v| *v != p.value) {
+                    changes.push(ParamChange::Set(p.name.clone(), v));
                 }
                 ui.end_row();
                 ui.label("");
@@ -260,6 +223,103 @@ pub fn grammar_parameters(
                 ui.end_row();
             }
         });
+}
+
+/// The hover text of a parameter's widget.
+fn param_hover(p: &clay_dsl::compiled::Param) -> String {
+    format!(
+        "param {}: {} of the grammar{}, default {}: a change recompiles it, keeping the \
+         sculpt where the structure allows",
+        p.name,
+        p.kind.word(),
+        p.range
+            .map_or(String::new(), |[lo, hi]| format!(", in {lo}..{hi}")),
+        p.default
+    )
+}
+
+/// A checkbox; the value when it was clicked.
+fn bool_widget(ui: &mut egui::Ui, p: &clay_dsl::compiled::Param) -> Option<ParamValue> {
+    let mut on = p.value.bool().unwrap_or(false);
+    let r = ui.checkbox(&mut on, &p.name).on_hover_text(param_hover(p));
+    r.changed().then_some(ParamValue::Bool(on))
+}
+
+/// A combo box of the choices; the one picked.
+fn choice_widget(
+    ui: &mut egui::Ui,
+    p: &clay_dsl::compiled::Param,
+    choices: &[String],
+) -> Option<ParamValue> {
+    let current = p.value.text().unwrap_or("").to_string();
+    let mut picked = current.clone();
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_id_salt(("grammar parameter", &p.name))
+            .selected_text(&current)
+            .show_ui(ui, |ui| {
+                for c in choices {
+                    ui.selectable_value(&mut picked, c.clone(), c);
+                }
+            })
+            .response
+            .on_hover_text(param_hover(p));
+        ui.label(&p.name);
+    });
+    (picked != current).then_some(ParamValue::Text(picked))
+}
+
+/// A slider (a number field without a range), whole-numbered for an `int` or `seed` (and for
+/// a number whose default and range are whole); the value once released or committed.
+fn number_widget(ui: &mut egui::Ui, p: &clay_dsl::compiled::Param) -> Option<ParamValue> {
+    let id = egui::Id::unique(("grammar parameter", &p.name));
+    let value = p.value.number().unwrap_or(0.0);
+    let mut v = ui.data(|d| d.get_temp::<f64>(id)).unwrap_or(value);
+    let whole = |x: f64| x.fract() == 0.0;
+    let integral = p.kind.is_whole()
+        || (p.default.number().is_some_and(whole)
+            && p.range.is_none_or(|[lo, hi]| whole(lo) && whole(hi)));
+    let r = match p.range {
+        Some([lo, hi]) => {
+            let mut slider = egui::Slider::new(&mut v, lo..=hi)
+                .text(&p.name)
+                .update_while_editing(false);
+            if integral {
+                slider = slider.step_by(1.0).integer();
+            }
+            ui.add(slider)
+        }
+        None => {
+            ui.horizontal(|ui| {
+                let mut field = egui::DragValue::new(&mut v)
+                    .speed(if integral { 1.0 } else { 0.01 })
+                    .update_while_editing(false);
+                if integral {
+                    field = field.fixed_decimals(0);
+                }
+                if p.kind == ParamKind::Seed {
+                    field = field.range(0.0..=f64::MAX);
+                }
+                let r = ui.add(field);
+                ui.label(&p.name);
+                r
+            })
+            .inner
+        }
+    };
+    let r = r.on_hover_text(param_hover(p));
+    let released =
+        r.drag_stopped() || r.clicked() || (r.changed() && !r.is_pointer_button_down_on());
+    if released {
+        ui.data_mut(|d| d.remove::<f64>(id));
+        // A typed fraction in an integer field is rounded, as the slider does.
+        let v = if integral { v.round() } else { v };
+        return (v.is_finite() && v != value).then_some(ParamValue::Number(v));
+    } else if r.changed() || r.is_pointer_button_down_on() {
+        ui.data_mut(|d| d.insert_temp(id, v));
+    } else {
+        ui.data_mut(|d| d.remove::<f64>(id));
+    }
+    None
 }
 
 /// The rule log, newest first: what the rules did, in the words of the grammar's names. It
