@@ -7,7 +7,9 @@ fifth brick of chain ``wall_n``) with the properties Blender's glTF importer giv
 extras (``instance``, ``piece``, ``state``, ``id``, ``chain``, ``index``); identical instances
 share one mesh with a planar ``UVMap``, one material per fill colour named as in every export
 (``fill_9a958cff``), heights as ``clayc export`` gives them (metres, z up). The grammar's
-parameters become properties of the collection (Properties > Collection > Clay).
+parameters become typed properties of the collection (Properties > Collection > Clay): a
+whole number an integer, a ``bool`` a checkbox, a ``choice`` a menu of its pieces; changing one
+rebuilds the model (a ``depsgraph_update_post`` handler), as Reload does.
 
 Reload (and a parameter change) updates the collection in place: an instance that is still
 there keeps its object, with the user's modifiers, object materials, children and properties;
@@ -32,7 +34,8 @@ import json
 import os
 
 import bpy
-from bpy.props import FloatProperty, StringProperty
+from bpy.app.handlers import persistent
+from bpy.props import EnumProperty, FloatProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 # Custom properties the add-on keeps on a collection it made.
@@ -40,6 +43,11 @@ PATH = "clay_path"
 SCRIPT = "clay_script"
 THICKNESS = "clay_thickness"
 PARAMS = "clay_params"
+# The parameter values the collection was last built with (JSON), a choice's pieces by name
+# (JSON), and the error of the last rebuild a parameter change asked for.
+BUILT = "clay_built"
+CHOICES = "clay_choices"
+ERROR = "clay_error"
 # Custom properties on what the add-on made: an object's export node name (its identity across
 # reloads), the root Empty's mark, a mesh's export mesh name.
 NODE = "clay_node"
@@ -233,9 +241,45 @@ def make_paths_relative(target=None, *_args):
 
 
 def collection_params(collection):
-    """The parameter values set on a collection the add-on made, by name."""
+    """The parameter values set on a collection the add-on made, by name, as their properties
+    hold them: a bool, an int, a float or a str (a choice)."""
     names = json.loads(collection.get(PARAMS, "[]"))
-    return {n: float(collection[n]) for n in names if n in collection}
+    out = {}
+    for n in names:
+        if n in collection:
+            v = collection[n]
+            out[n] = v if isinstance(v, (bool, int, float, str)) else float(v)
+    return out
+
+
+def set_param_property(collection, p):
+    """The collection's property for grammar parameter `p`, of its type: a checkbox for a
+    ``bool``, a text naming a piece for a ``choice`` (the panel offers its pieces in a menu), an
+    integer for an ``int`` or ``seed`` (and for a number whose default and range are whole, as
+    the editor's sliders step), a float otherwise."""
+    description = f"Clay parameter {p.name} ({p.kind})"
+    if p.kind == "bool":
+        collection[p.name] = bool(p.value)
+        collection.id_properties_ui(p.name).update(default=bool(p.default), description=description)
+        return
+    if p.kind == "choice":
+        collection[p.name] = str(p.value)
+        collection.id_properties_ui(p.name).update(description=description)
+        return
+    whole = p.kind in ("int", "seed") or (
+        float(p.default).is_integer()
+        and all(float(x).is_integer() for x in (p.range or ()))
+        and float(p.value).is_integer()
+    )
+    kind = int if whole else float
+    collection[p.name] = kind(p.value)
+    options = {"default": kind(p.default), "description": description}
+    if p.range is not None:
+        lo, hi = (kind(x) for x in p.range)
+        options.update(min=lo, max=hi, soft_min=lo, soft_max=hi)
+    elif p.kind == "seed":
+        options.update(min=0, soft_min=0)
+    collection.id_properties_ui(p.name).update(**options)
 
 
 def build(collection, path, script, params, thickness):
@@ -269,24 +313,53 @@ def build(collection, path, script, params, thickness):
     for stale in json.loads(collection.get(PARAMS, "[]")):
         if stale in collection:
             del collection[stale]
-    names = []
     for p in grammar.params:
-        # A count (a whole default and whole range ends, as the editor's sliders step) is an
-        # integer property; any other parameter a float (issue 48: `bays` showed 6.0).
-        whole = float(p.default).is_integer() and all(
-            float(x).is_integer() for x in (p.range or ())
-        )
-        kind = int if whole and float(p.value).is_integer() else float
-        collection[p.name] = kind(p.value)
-        ui = collection.id_properties_ui(p.name)
-        options = {"default": kind(p.default), "description": f"Clay parameter {p.name}"}
-        if p.range is not None:
-            lo, hi = (kind(x) for x in p.range)
-            options.update(min=lo, max=hi, soft_min=lo, soft_max=hi)
-        ui.update(**options)
-        names.append(p.name)
-    collection[PARAMS] = json.dumps(names)
+        set_param_property(collection, p)
+    collection[PARAMS] = json.dumps([p.name for p in grammar.params])
+    collection[CHOICES] = json.dumps({p.name: p.choices for p in grammar.params if p.choices})
+    collection[BUILT] = json.dumps(collection_params(collection))
+    if ERROR in collection:
+        del collection[ERROR]
     return len(nodes), notes
+
+
+def rebuild(collection):
+    """Builds `collection` again from its stored grammar, script and parameter values."""
+    return build(
+        collection,
+        collection[PATH],
+        collection.get(SCRIPT, ""),
+        collection_params(collection),
+        float(collection.get(THICKNESS, DEFAULT_THICKNESS)),
+    )
+
+
+_rebuilding = False
+
+
+@persistent
+def rebuild_changed(scene=None, depsgraph=None):
+    """After any change (``depsgraph_update_post``): every Clay collection whose parameter
+    properties differ from the values it was built with is rebuilt, as Reload would; an error
+    is kept on the collection (the panel shows it) and the model stays as it was."""
+    global _rebuilding
+    if _rebuilding:
+        return
+    for coll in list(bpy.data.collections):
+        if PATH not in coll:
+            continue
+        values = collection_params(coll)
+        if json.dumps(values) == coll.get(BUILT, json.dumps(values)):
+            continue
+        _rebuilding = True
+        try:
+            rebuild(coll)
+        except Exception as e:
+            # Not tried again until a value changes once more.
+            coll[BUILT] = json.dumps(values)
+            coll[ERROR] = str(e)
+        finally:
+            _rebuilding = False
 
 
 def import_grammar(context, path, script="", thickness=DEFAULT_THICKNESS):
@@ -375,18 +448,52 @@ class CLAY_OT_reload(bpy.types.Operator):
             self.report({"ERROR"}, "Clay: the collection was not imported from a Clay grammar")
             return {"CANCELLED"}
         try:
-            count, notes = build(
-                coll,
-                coll[PATH],
-                coll.get(SCRIPT, ""),
-                collection_params(coll),
-                float(coll.get(THICKNESS, DEFAULT_THICKNESS)),
-            )
+            count, notes = rebuild(coll)
         except Exception as e:
             return report_error(self, e)
         for note in notes:
             self.report({"WARNING"}, f"Clay: {note}")
         self.report({"INFO"}, f"Clay: {count} instances reloaded into {coll.name}")
+        return {"FINISHED"}
+
+
+# Blender keeps no reference to an enum's strings made by a callback: they are kept here.
+_choice_items_cache = []
+
+
+def _choice_items(self, context):
+    coll = bpy.data.collections.get(self.collection)
+    choices = json.loads(coll.get(CHOICES, "{}")).get(self.param, []) if coll else []
+    _choice_items_cache[:] = [(c, c, f"The piece {c}") for c in choices]
+    return _choice_items_cache
+
+
+class CLAY_OT_set_choice(bpy.types.Operator):
+    """Pick the piece of a Clay choice parameter and rebuild the model"""
+
+    bl_idname = "clay.set_choice"
+    bl_label = "Choose a piece"
+    bl_options = {"REGISTER", "UNDO"}
+
+    collection: StringProperty(name="Collection", default="")
+    param: StringProperty(name="Parameter", default="")
+    value: EnumProperty(name="Piece", items=_choice_items)
+
+    def execute(self, context):
+        coll = clay_collection(context, self.collection)
+        if coll is None or self.param not in coll:
+            self.report({"ERROR"}, "Clay: no such Clay collection or parameter")
+            return {"CANCELLED"}
+        before = coll[self.param]
+        coll[self.param] = self.value
+        try:
+            count, notes = rebuild(coll)
+        except Exception as e:
+            coll[self.param] = before
+            return report_error(self, e)
+        for note in notes:
+            self.report({"WARNING"}, f"Clay: {note}")
+        self.report({"INFO"}, f"Clay: {self.param} = {self.value}, {count} instances")
         return {"FINISHED"}
 
 
@@ -408,9 +515,19 @@ class CLAY_PT_collection(bpy.types.Panel):
         layout.label(text=os.path.basename(coll[PATH]), icon="FILE_TEXT")
         if coll.get(SCRIPT):
             layout.label(text=os.path.basename(coll[SCRIPT]), icon="FILE_SCRIPT")
+        choices = json.loads(coll.get(CHOICES, "{}"))
         for name in json.loads(coll.get(PARAMS, "[]")):
-            if name in coll:
+            if name not in coll:
+                continue
+            if name in choices:
+                row = layout.row()
+                row.label(text=name)
+                op = row.operator_menu_enum(CLAY_OT_set_choice.bl_idname, "value", text=str(coll[name]))
+                op.collection, op.param = coll.name, name
+            else:
                 layout.prop(coll, f'["{name}"]', text=name)
+        if coll.get(ERROR):
+            layout.label(text=coll[ERROR].splitlines()[0], icon="ERROR")
         op = layout.operator(CLAY_OT_reload.bl_idname, text="Reload", icon="FILE_REFRESH")
         op.collection = coll.name
 
@@ -419,7 +536,7 @@ def menu_import(self, context):
     self.layout.operator(CLAY_OT_import_grammar.bl_idname, text="Clay grammar (.clay)")
 
 
-CLASSES = (CLAY_OT_import_grammar, CLAY_OT_reload, CLAY_PT_collection)
+CLASSES = (CLAY_OT_import_grammar, CLAY_OT_reload, CLAY_OT_set_choice, CLAY_PT_collection)
 
 
 def register():
@@ -427,9 +544,12 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.TOPBAR_MT_file_import.append(menu_import)
     bpy.app.handlers.save_pre.append(make_paths_relative)
+    bpy.app.handlers.depsgraph_update_post.append(rebuild_changed)
 
 
 def unregister():
+    if rebuild_changed in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(rebuild_changed)
     if make_paths_relative in bpy.app.handlers.save_pre:
         bpy.app.handlers.save_pre.remove(make_paths_relative)
     bpy.types.TOPBAR_MT_file_import.remove(menu_import)

@@ -2,6 +2,7 @@
 CPython 3.11): register, import the castle through the operator, compare with the Python
 package's instances, reload, and render a small picture."""
 
+import json
 import math
 import struct
 from pathlib import Path
@@ -262,6 +263,71 @@ def test_parameters_are_collection_properties_and_reload_reads_them(tmp_path):
     assert "width" not in coll and coll["bays"] == 30.0
     lo, hi = bounds(instances_of(coll))
     assert hi[0] - lo[0] == pytest.approx(30 * 1.0, abs=1e-4)
+
+
+GATED_FENCE = (
+    FENCE.replace("param bays = 4 in 2..12", "param bays: int = 4 in 2..12\nparam gated: bool = true\n"
+                  "param gate: choice(\"gate\", \"arch\") = \"gate\"")
+    .replace("stretch post", '''piece gate {
+    vertex a (0, 0)
+    vertex b (1, 0)
+    vertex c (1, 0.3)
+    vertex d (0, 0.3)
+    edges a-b-c-d-a
+    site east: joint [b, c] out (1, 0)
+    polygon rigid fill #555555 extrude 2 { (0, 0) (1, 0) (1, 0.3) (0, 0.3) }
+}
+
+piece arch extends gate {}
+
+stretch post''')
+    .replace("    fence = chain post x bays\n", "    fence = chain post x bays\n    if gated {\n"
+             "        entry = gate\n        dock entry.east to fence[0].west\n    }\n")
+)
+
+
+def test_typed_parameters_are_typed_properties_and_a_change_rebuilds(tmp_path):
+    """Issue 48, items 1 and 2: an `int` is an integer property, a `bool` a boolean one, a
+    `choice` a text the panel's menu sets; changing a value rebuilds the model on the next
+    update (no Reload), keeping the user's objects; a value the grammar refuses is shown on
+    the collection and the model stays."""
+    fresh_file()
+    grammar = tmp_path / "gated.clay"
+    grammar.write_text(GATED_FENCE)
+    assert bpy.ops.clay.import_grammar(filepath=str(grammar)) == {"FINISHED"}
+    [coll] = clay_collections()
+    assert type(coll["bays"]) is int and type(coll["gated"]) is bool and coll["gate"] == "gate"
+    assert json.loads(coll[clay_blender.CHOICES]) == {"gate": ["gate", "arch"]}
+    pieces = lambda: sorted(o["piece"] for o in instances_of(coll))
+    assert pieces() == ["gate"] + ["post"] * 4
+    marker = bpy.data.objects.new("my marker", None)
+    coll.objects.link(marker)
+
+    def edit(name, value):
+        """As the panel's field does: the value set, the collection tagged for the depsgraph
+        (a script's plain assignment tags nothing), and the update that follows."""
+        coll[name] = value
+        coll.update_tag()
+        bpy.context.view_layer.update()
+
+    # A change is rebuilt on the next update, with no Reload.
+    coll["gated"] = False
+    edit("bays", 6)
+    assert pieces() == ["post"] * 6
+    assert "my marker" in coll.objects
+    # The panel's menu for a choice: the operator sets the piece and rebuilds.
+    edit("gated", True)
+    assert bpy.ops.clay.set_choice(collection=coll.name, param="gate", value="arch") == {"FINISHED"}
+    assert coll["gate"] == "arch" and pieces() == ["arch"] + ["post"] * 6
+    with pytest.raises(TypeError):
+        bpy.ops.clay.set_choice(collection=coll.name, param="gate", value="tower")
+
+    # A value the grammar refuses: kept on the collection as an error, the model unchanged.
+    edit("bays", 40)
+    assert "E071" in coll[clay_blender.ERROR]
+    assert pieces() == ["arch"] + ["post"] * 6
+    edit("bays", 3)
+    assert clay_blender.ERROR not in coll and pieces() == ["arch"] + ["post"] * 3
 
 
 def test_reload_after_a_parameter_change_keeps_the_users_work(tmp_path):

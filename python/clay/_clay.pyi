@@ -69,17 +69,26 @@ def check(path: StrPath) -> list[Diagnostic]:
     """Compiles the grammar at ``path`` and returns its diagnostics (errors and warnings) in
     file order; an empty list when it is clean. Raises OSError when it cannot be read."""
 
+ParamValue = float | int | bool | str
+"""A parameter's value: ``float`` for a number, ``int`` for an ``int`` or ``seed``, ``bool``,
+and ``str`` (a piece's name) for a ``choice``."""
+
 class Param:
-    """A grammar parameter: its value in this compilation, its default and range."""
+    """A grammar parameter: its type, its value in this compilation, its default and range."""
 
     @property
     def name(self) -> str: ...
     @property
-    def value(self) -> float: ...
+    def kind(self) -> Literal["number", "int", "bool", "seed", "choice"]: ...
     @property
-    def default(self) -> float: ...
+    def value(self) -> ParamValue: ...
+    @property
+    def default(self) -> ParamValue: ...
     @property
     def range(self) -> tuple[float, float] | None: ...
+    @property
+    def choices(self) -> list[str] | None:
+        """A ``choice``'s pieces, in order; ``None`` for another type."""
 
 class Piece:
     """A piece of a grammar, its rest states, vertices and docking sites by name."""
@@ -97,16 +106,17 @@ class Grammar:
     """A compiled grammar. Errors raise GrammarError; warnings are kept in ``warnings``."""
 
     @staticmethod
-    def open(path: StrPath, params: Mapping[str, float] | None = None) -> Grammar:
+    def open(path: StrPath, params: Mapping[str, ParamValue] | None = None) -> Grammar:
         """Reads and compiles the grammar at ``path`` (imports are found beside it).
 
-        Raises OSError (unreadable file), GrammarError (errors in the grammar), ValueError
-        (an unknown parameter, or a value outside its range)."""
+        Raises OSError (unreadable file), GrammarError (errors in the grammar, an unknown
+        parameter, a value outside its range, a choice it does not list), TypeError (a value
+        of another type than its parameter's: a str for a number, 2.5 for an ``int``)."""
     @staticmethod
     def parse(
         text: str,
         path: StrPath | None = None,
-        params: Mapping[str, float] | None = None,
+        params: Mapping[str, ParamValue] | None = None,
     ) -> Grammar:
         """Compiles grammar text; ``path`` names it in diagnostics and locates its imports."""
     @property

@@ -124,7 +124,7 @@ pub struct Grammar {
 
 /// Parameter overrides from Python: a mapping of names to numbers, bools (a `bool`
 /// parameter) and strings (a `choice`); the grammar checks each against its parameter's type.
-fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, ParamValue>> {
+fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, Given>> {
     let Some(params) = params.filter(|p| !p.is_none()) else {
         return Ok(BTreeMap::new());
     };
@@ -155,9 +155,60 @@ fn overrides(params: Option<&Bound<'_, PyAny>>) -> PyResult<BTreeMap<String, Par
                 ))
             })?)
         };
-        out.insert(name, value);
+        out.insert(
+            name,
+            Given {
+                value,
+                python_type: type_name(&v),
+            },
+        );
     }
     Ok(out)
+}
+
+/// A parameter value from Python, with its Python type's name for messages.
+struct Given {
+    value: ParamValue,
+    python_type: String,
+}
+
+/// A `TypeError` for a value whose type is not its parameter's (a number for a `bool`, a
+/// fraction for an `int`, a number for a `choice`); a name the grammar does not declare, or a
+/// choice it does not list, is the compiler's to report (E070, E073).
+fn check_types(
+    declared: &[clay_dsl::compiled::Param],
+    given: &BTreeMap<String, Given>,
+) -> PyResult<()> {
+    for (name, g) in given {
+        let Some(p) = declared.iter().find(|p| p.name == *name) else {
+            continue;
+        };
+        let expected = match (&p.kind, &g.value) {
+            (ParamKind::Bool, ParamValue::Bool(_))
+            | (ParamKind::Choice { .. }, ParamValue::Text(_)) => continue,
+            (k, ParamValue::Number(v)) if k.is_numeric() && (!k.is_whole() || v.fract() == 0.0) => {
+                continue;
+            }
+            (ParamKind::Bool, _) => "a bool".to_string(),
+            (ParamKind::Choice { choices }, _) => {
+                let all: Vec<String> = choices.iter().map(|c| format!("'{c}'")).collect();
+                format!("a str, one of {}", all.join(", "))
+            }
+            (ParamKind::Int | ParamKind::Seed, ParamValue::Number(v)) => {
+                return Err(PyTypeError::new_err(format!(
+                    "params: {name} must be a whole number ({} parameter), found {v}",
+                    p.kind.with_article().replace('`', "")
+                )));
+            }
+            (ParamKind::Int | ParamKind::Seed, _) => "an int".to_string(),
+            _ => "a number".to_string(),
+        };
+        return Err(PyTypeError::new_err(format!(
+            "params: {name} must be {expected}, found {}",
+            g.python_type
+        )));
+    }
+    Ok(())
 }
 
 impl Grammar {
@@ -167,19 +218,30 @@ impl Grammar {
         bytes: &[u8],
         path: &str,
         shown_path: Option<String>,
-        params: BTreeMap<String, ParamValue>,
+        given: BTreeMap<String, Given>,
     ) -> PyResult<Self> {
-        let params: Vec<(String, ParamValue)> = params.into_iter().collect();
-        let compiled = py.detach(|| {
-            guard("compiling the grammar", || {
-                // Made here: the file system loader it holds stays on this thread.
-                let options = CompileOptions {
-                    params,
-                    ..CompileOptions::default()
-                };
-                Ok(clay_dsl::decode_utf8(bytes).and_then(|s| clay_dsl::compile(s, path, &options)))
+        let run = |params: Vec<(String, ParamValue)>| {
+            py.detach(|| {
+                guard("compiling the grammar", || {
+                    // Made here: the file system loader it holds stays on this thread.
+                    let options = CompileOptions {
+                        params,
+                        ..CompileOptions::default()
+                    };
+                    Ok(clay_dsl::decode_utf8(bytes)
+                        .and_then(|s| clay_dsl::compile(s, path, &options)))
+                })
             })
-        })?;
+        };
+        // Python's types first: the grammar compiled with its defaults says each
+        // parameter's type (a grammar with errors reports them below, as without values).
+        if !given.is_empty()
+            && let Ok(plain) = run(Vec::new())?
+        {
+            check_types(&plain.grammar.params, &given)?;
+        }
+        let params = given.into_iter().map(|(n, g)| (n, g.value)).collect();
+        let compiled = run(params)?;
         let text = String::from_utf8_lossy(bytes);
         // An unknown parameter (E070) or a value outside its range (E071) is a diagnostic
         // like any other: a GrammarError naming the parameter, its range and the known names.

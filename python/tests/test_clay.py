@@ -712,3 +712,48 @@ def test_a_script_recorded_with_other_parameters_raises_script_params_error(fenc
     ok = clay.Session(clay.Grammar.open(fence, params={"bays": 6}))
     ok.run_script(path)
     assert ok.frames == 10
+
+
+def test_typed_parameters_take_and_give_python_types(grammars):
+    keep = grammars / "keep.clay"
+    g = clay.Grammar.open(keep)
+    by_name = {p.name: p for p in g.params}
+    assert by_name["wall_height"].kind == "number"
+    assert by_name["donjon"].kind == "bool" and by_name["donjon"].value is True
+    gate = by_name["gate"]
+    assert (gate.kind, gate.value, gate.choices) == ("choice", "great_gate", ["great_gate", "gatehouse"])
+    assert repr(gate) == "Param(gate: choice = great_gate, default great_gate)"
+    # A bool switches the donjon off; a choice picks the plainer gate.
+    plain = clay.Grammar.open(keep, params={"donjon": False, "gate": "gatehouse"})
+    s = clay.Session(plain)
+    pieces = {i.piece for i in s.instances}
+    assert "donjon" not in pieces and "gatehouse" in pieces and "great_gate" not in pieces
+    values = {p.name: p.value for p in plain.params}
+    assert values["donjon"] is False and values["gate"] == "gatehouse"
+    # numpy's bool is a bool.
+    assert clay.Grammar.open(keep, params={"donjon": np.bool_(False)}).params[2].value is False
+    # Another type is a TypeError naming what the parameter takes.
+    with pytest.raises(TypeError, match="params: donjon must be a bool, found int"):
+        clay.Grammar.open(keep, params={"donjon": 1})
+    with pytest.raises(TypeError, match="params: gate must be a str, one of 'great_gate', 'gatehouse', found int"):
+        clay.Grammar.open(keep, params={"gate": 2})
+    # A choice the grammar does not list is the grammar's error, with the closest one.
+    with pytest.raises(clay.GrammarError) as caught:
+        clay.Grammar.open(keep, params={"gate": "gatehose"})
+    [d] = caught.value.diagnostics
+    assert d.code == "E073"
+    assert 'did you mean "gatehouse"?' in d.hints
+
+
+def test_an_int_parameter_refuses_a_fraction(tmp_path):
+    text = (
+        "param bays: int = 3 in 2..9\nsite type j\n"
+        "piece b { vertex a (0, 0) vertex c (1, 0) vertex d (1, 1) vertex e (0, 1)\n"
+        "  edges a-c-d-e-a, a-d site west: j [e, a] out (-1, 0) site east: j [c, d] out (1, 0) }\n"
+        "stretch b from west to east\nmodel { w = chain b x bays }\n"
+    )
+    g = clay.Grammar.parse(text, params={"bays": np.int64(5)})
+    assert g.params[0].value == 5 and isinstance(g.params[0].value, int)
+    assert clay.Grammar.parse(text, params={"bays": 6.0}).params[0].value == 6
+    with pytest.raises(TypeError, match=r"params: bays must be a whole number \(an int parameter\), found 2.5"):
+        clay.Grammar.parse(text, params={"bays": 2.5})
