@@ -290,3 +290,45 @@ fn a_script_recorded_with_other_parameters_is_refused_with_the_values_to_use() {
     assert!(ran["pieces"]["brick"].as_u64().unwrap() >= 6, "{ran}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn typed_values_switch_and_pick_and_a_wrong_type_is_e073_at_the_parameter() {
+    // keep.clay: `donjon` a bool, `gate` a choice of two pieces.
+    let out = clayc(&[
+        "run",
+        "grammars/keep.clay",
+        "--json",
+        "--param",
+        "donjon=false",
+        "--param",
+        "gate=gatehouse",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["pieces"]["gatehouse"], 1, "{summary}");
+    assert!(summary["pieces"].get("donjon").is_none(), "{summary}");
+    assert!(summary["pieces"].get("great_gate").is_none(), "{summary}");
+    for (flag, line, says) in [
+        ("gate=gatehose", 24, "did you mean \"gatehouse\"?"),
+        ("donjon=2", 26, "set `donjon` to `true` or `false`"),
+        ("wall_height=tall", 22, "set `wall_height` to a number"),
+    ] {
+        let out = clayc(&[
+            "check",
+            "--format",
+            "json",
+            "grammars/keep.clay",
+            "--param",
+            flag,
+        ]);
+        assert_eq!(out.status.code(), Some(1), "{flag}: {}", stderr(&out));
+        let diags: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(diags.as_array().unwrap().len(), 1, "{flag}: {diags}");
+        assert_eq!(diags[0]["code"], "E073", "{flag}: {diags}");
+        assert_eq!(diags[0]["line"], line, "{flag}: {diags}");
+        let hints: Vec<&str> = (diags[0]["hints"].as_array().unwrap().iter())
+            .map(|h| h.as_str().unwrap())
+            .collect();
+        assert!(hints.contains(&says), "{flag}: {diags}");
+    }
+}

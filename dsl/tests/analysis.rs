@@ -354,3 +354,37 @@ fn an_imported_piece_answers_also_while_the_text_does_not_parse() {
     assert_eq!((place.file, place.span.start), (1, decl));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn typed_parameters_complete_and_resolve() {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/keep.clay"),
+    )
+    .unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/keep.clay");
+    let path = path.to_string_lossy();
+    let a = Analysis::new(&text, &path);
+    assert!(a.diagnostics().is_empty(), "{:?}", a.diagnostics());
+    // After `if ` the bool parameters, after `NAME = ` in the model the choices too.
+    let l = labels(&a, at(&text, "if donjon", 0, 3));
+    assert_eq!(l, vec!["donjon"]);
+    let l = labels(&a, at(&text, "gatehouse = gate", 0, "gatehouse = ".len()));
+    assert!(
+        l.contains(&"gate".to_string()) && l.contains(&"tower".to_string()),
+        "{l:?}"
+    );
+    // After `param NAME: ` the types.
+    let typing = text.replace("param donjon: bool", "param donjon: ");
+    let b = Analysis::new(&typing, &path);
+    let l = labels(&b, at(&typing, "param donjon: ", 0, "param donjon: ".len()));
+    assert_eq!(l, vec!["number", "int", "bool", "seed", "choice"]);
+    // The choice's strings go to their pieces; the `if` to its parameter.
+    let def = a
+        .definition(at(&text, "\"gatehouse\")", 0, 1))
+        .expect("a definition");
+    assert_eq!(def.start, at(&text, "piece gatehouse", 0, 6));
+    let def = a
+        .definition(at(&text, "if donjon", 0, 4))
+        .expect("a definition");
+    assert_eq!(def.start, at(&text, "param donjon", 0, 6));
+}

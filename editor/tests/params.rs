@@ -429,3 +429,48 @@ fn a_count_change_keeps_the_pins_of_the_instances_that_survive() {
     assert_eq!(kept, ["row[0]"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_bool_is_a_checkbox_and_a_choice_a_combo_box_of_its_pieces() {
+    // keep.clay: `donjon` a bool, `gate` a choice of the great gate and the plain gatehouse.
+    let keep = Path::new(env!("CARGO_MANIFEST_DIR")).join("../grammars/keep.clay");
+    let mut h = harness(EditorApp::open(&keep));
+    settle(&mut h);
+    assert!(h.state().problems.is_empty(), "{:?}", h.state().problems);
+    let pieces = |h: &Harness<'_, EditorApp>| -> Vec<String> {
+        let g = h.state().sculpt.grammar().clone();
+        let mut names: Vec<String> = (h.state().sculpt.data().instances.iter())
+            .map(|i| g.pieces[i.piece].name.clone())
+            .filter(|n| n != "wall" && n != "tower")
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(pieces(&h), ["donjon", "great_gate"]);
+    // The checkbox, clicked: the donjon goes.
+    let checkbox = egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::CheckBox)
+        .label("donjon");
+    h.get(checkbox).click();
+    h.step();
+    settle(&mut h);
+    assert_eq!(pieces(&h), ["great_gate"]);
+    let set: Vec<(String, String)> = (h.state().param_overrides().iter())
+        .map(|(n, v)| (n.clone(), v.to_string()))
+        .collect();
+    assert_eq!(set, [("donjon".to_string(), "false".to_string())]);
+    // The combo box shows the chosen piece; opened, it lists both; the other one picked.
+    let combo = egui_kittest::kittest::By::new()
+        .role(egui::accesskit::Role::ComboBox)
+        .label("gate");
+    h.get(combo).click();
+    h.step();
+    h.step();
+    h.get_all_by_label("gatehouse")
+        .next()
+        .expect("listed")
+        .click();
+    h.step();
+    settle(&mut h);
+    assert_eq!(pieces(&h), ["gatehouse"]);
+}

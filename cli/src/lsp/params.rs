@@ -127,4 +127,30 @@ mod tests {
         assert_eq!(declared("piece {").map(|p| p.len()), None);
         assert_eq!(declared("let k = 1\n").map(|p| p.len()), Some(0));
     }
+
+    #[test]
+    fn a_typed_parameter_says_its_type_and_values() {
+        let text =
+            "param t: bool = true\nparam g: choice(\"a\", \"b\") = \"b\"\nparam n: int = 3\n";
+        let params = declared(text).unwrap();
+        let hovers: Vec<String> = params.iter().map(super::hover).collect();
+        assert!(
+            hovers[0].contains(
+                "**bool parameter**: value `true`, default `true`, range `true` or `false`"
+            ),
+            "{hovers:?}"
+        );
+        assert!(
+            hovers[1].contains("value `b`, default `b`, range one of `a`, `b`"),
+            "{hovers:?}"
+        );
+        assert!(
+            hovers[2].contains("**int parameter**: value `3`"),
+            "{hovers:?}"
+        );
+        assert_eq!(
+            super::detail(&params[2]),
+            "int parameter = 3 (default 3, range any whole number)"
+        );
+    }
 }

@@ -253,18 +253,15 @@ fn choice_widget(
 ) -> Option<ParamValue> {
     let current = p.value.text().unwrap_or("").to_string();
     let mut picked = current.clone();
-    ui.horizontal(|ui| {
-        egui::ComboBox::from_id_salt(("grammar parameter", &p.name))
-            .selected_text(&current)
-            .show_ui(ui, |ui| {
-                for c in choices {
-                    ui.selectable_value(&mut picked, c.clone(), c);
-                }
-            })
-            .response
-            .on_hover_text(param_hover(p));
-        ui.label(&p.name);
-    });
+    egui::ComboBox::from_label(&p.name)
+        .selected_text(&current)
+        .show_ui(ui, |ui| {
+            for c in choices {
+                ui.selectable_value(&mut picked, c.clone(), c);
+            }
+        })
+        .response
+        .on_hover_text(param_hover(p));
     (picked != current).then_some(ParamValue::Text(picked))
 }
 
