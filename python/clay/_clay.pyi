@@ -278,7 +278,8 @@ class Session:
     def solver(self) -> dict[str, float]:
         """The grammar's solver block with this session's settings."""
     def export(self, path: StrPath, thickness: float | None = None) -> None:
-        """Writes .glb, .gltf, .obj (+ .mtl) or .usda (USD, Z up) as ``clayc export`` does."""
+        """Writes .glb, .gltf, .obj (+ .mtl) or .usda (USD, Z up) as ``clayc export`` does, or
+        .usdc (USD's binary form) through usd-core's ``pxr`` (ValueError when not installed)."""
     def render_png(
         self,
         size: tuple[int, int] = (1024, 768),

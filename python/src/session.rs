@@ -591,7 +591,8 @@ impl PySession {
     }
 
     /// Writes the model as 3D meshes, as `clayc export` does: `.glb` or `.gltf` (glTF 2.0),
-    /// `.obj` (with its `.mtl` beside it) or `.usda` (USD, Z up), by the path's extension. `thickness` is the height
+    /// `.obj` (with its `.mtl` beside it), `.usda` (USD, Z up) or `.usdc` (USD's binary form,
+    /// through usd-core's `pxr` when installed), by the path's extension. `thickness` is the height
     /// of flat proxy geometry in metres. Raises `ValueError` for another extension, `OSError`
     /// when the file cannot be written.
     #[pyo3(signature = (path, thickness = None))]
@@ -603,6 +604,12 @@ impl PySession {
     ) -> PyResult<()> {
         let path = path_of(path)?;
         let options = export_options(thickness)?;
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("usdc"))
+        {
+            return self.export_usdc(py, &path, &options);
+        }
         let Some(format) = ExportFormat::of_path(&path) else {
             return Err(PyValueError::new_err(format!(
                 "cannot tell the format of `{}`: {}",
@@ -610,21 +617,7 @@ impl PySession {
                 ExportFormat::unknown(&path)
             )));
         };
-        py.detach(|| {
-            guard("the export", || {
-                let scene = {
-                    let st = self.lock()?;
-                    scene(&self.grammar, st.asm.data(), &options)
-                };
-                // the .obj before its .mtl, as `clayc export` writes them
-                clay::write_export(&scene, &path, format).map_err(|e| match e {
-                    ExportFileError::Encode(e) => {
-                        InternalError::new_err(format!("cannot encode the model: {e}"))
-                    }
-                    ExportFileError::Write(at, e) => os_error(&e, &at),
-                })
-            })
-        })
+        self.write(py, &path, format, &options)
     }
 
     /// The model drawn as `clayc render` draws it: PNG bytes of `size=(width, height)`
@@ -791,6 +784,65 @@ impl PySession {
 }
 
 /// `thickness` as `clayc export --thickness` takes it (`ExportOptions::with_thickness`).
+impl PySession {
+    /// Writes the session's scene to `path` in `format`.
+    fn write(
+        &self,
+        py: Python<'_>,
+        path: &Path,
+        format: ExportFormat,
+        options: &ExportOptions,
+    ) -> PyResult<()> {
+        py.detach(|| {
+            guard("the export", || {
+                let scene = {
+                    let st = self.lock()?;
+                    scene(&self.grammar, st.asm.data(), options)
+                };
+                // the .obj before its .mtl, as `clayc export` writes them
+                clay::write_export(&scene, path, format).map_err(|e| match e {
+                    ExportFileError::Encode(e) => {
+                        InternalError::new_err(format!("cannot encode the model: {e}"))
+                    }
+                    ExportFileError::Write(at, e) => os_error(&e, &at),
+                })
+            })
+        })
+    }
+
+    /// `.usdc`, USD's binary crate form, which no Rust crate writes: the `.usda` export,
+    /// converted by usd-core's `pxr` (`Usd.Stage.Export` picks the form by the extension) when
+    /// it is installed; without it a `ValueError` says how to get it.
+    fn export_usdc(&self, py: Python<'_>, path: &Path, options: &ExportOptions) -> PyResult<()> {
+        let usd = py.import("pxr.Usd").map_err(|_| {
+            PyValueError::new_err(format!(
+                "cannot write `{}`: USD's binary form is written through usd-core's `pxr`, which \
+                 is not installed (pip install usd-core); or export .usda",
+                path.display()
+            ))
+        })?;
+        let text = path.with_extension("clay-export.usda");
+        self.write(py, &text, ExportFormat::Usda, options)?;
+        let converted = (|| -> PyResult<bool> {
+            let stage = usd
+                .getattr("Stage")?
+                .call_method1("Open", (text.to_string_lossy().into_owned(),))?;
+            stage
+                .call_method1("Export", (path.to_string_lossy().into_owned(),))?
+                .extract()
+        })();
+        let _ = std::fs::remove_file(&text);
+        if converted? {
+            Ok(())
+        } else {
+            Err(pyo3::exceptions::PyOSError::new_err(format!(
+                "usd-core could not write `{}`",
+                path.display()
+            )))
+        }
+    }
+}
+
 fn export_options(thickness: Option<f64>) -> PyResult<ExportOptions> {
     match thickness {
         None => Ok(ExportOptions::default()),

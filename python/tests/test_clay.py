@@ -757,3 +757,19 @@ def test_an_int_parameter_refuses_a_fraction(tmp_path):
     assert clay.Grammar.parse(text, params={"bays": 6.0}).params[0].value == 6
     with pytest.raises(TypeError, match=r"params: bays must be a whole number \(an int parameter\), found 2.5"):
         clay.Grammar.parse(text, params={"bays": 2.5})
+
+
+def test_a_usdc_export_is_the_usda_in_usds_binary_form(grammars, tmp_path):
+    """Issue 48, item 4: `.usdc` (which no Rust crate writes) through usd-core's pxr: the
+    file is USD's crate form and holds the stage the .usda export holds."""
+    from pxr import Usd
+
+    s = clay.Session(clay.Grammar.open(grammars / "castle.clay"))
+    s.export(tmp_path / "castle.usdc")
+    s.export(tmp_path / "castle.usda")
+    assert (tmp_path / "castle.usdc").read_bytes()[:8] == b"PXR-USDC"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["castle.usda", "castle.usdc"]
+    binary, text = (Usd.Stage.Open(str(tmp_path / f"castle.{e}")) for e in ("usdc", "usda"))
+    paths = lambda stage: [str(p.GetPath()) for p in stage.Traverse()]
+    assert paths(binary) == paths(text) and len(paths(text)) > 40
+    assert binary.GetDefaultPrim().GetName() == "castle"

@@ -48,7 +48,7 @@ impl ExportFormat {
             .is_some_and(|e| e.eq_ignore_ascii_case("usdc") || e.eq_ignore_ascii_case("usd"))
         {
             why.push_str(
-                " (USD's binary form is not written: export .usda and convert it with `usdcat MODEL.usda -o MODEL.usdc`)",
+                " (USD's binary form is not written here: export .usda and convert it with `usdcat MODEL.usda -o MODEL.usdc` from a USD installation, or write it from Python with usd-core installed: `session.export(\"MODEL.usdc\")`)",
             );
         }
         why

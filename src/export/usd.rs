@@ -19,8 +19,8 @@
 //!
 //! Names: prim names must be identifiers; node and mesh names are letters, digits and `_`
 //! already (`names.rs`), so only one that starts with a digit (a grammar file `1st.clay`) gets
-//! a leading `_`. The binary crate form (`.usdc`) is not written: `usdcat model.usda -o
-//! model.usdc` converts it.
+//! a leading `_`. The binary crate form (`.usdc`) is not written here: `usdcat model.usda -o
+//! model.usdc` converts it, and the Python package writes it through usd-core's `pxr`.
 
 use std::fmt::Write as _;
 
