@@ -2,7 +2,7 @@
 //! (`.glb`, `.gltf`), Wavefront OBJ (`.obj` with its `.mtl` beside it) or USD (`.usda`).
 //! docs/export.md.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clay::{ExportFormat, ExportOptions, encode_export, mtl_path, scene};
 
@@ -65,12 +65,16 @@ pub fn export(args: ExportArgs) -> u8 {
     {
         Some(f) => f,
         None if to_stdout => ExportFormat::Glb,
+        None if is_usdc(&args.output) && usdcat().is_some() => ExportFormat::Usda,
         None => {
             errln!(
                 "error: cannot tell the format of `{}`: {}, or pass --format",
                 args.output.display(),
                 ExportFormat::unknown(&args.output)
             );
+            if is_usdc(&args.output) {
+                errln!("hint: with `usdcat` on the PATH, clayc export writes .usdc itself");
+            }
             return IO_ERROR;
         }
     };
@@ -89,6 +93,9 @@ pub fn export(args: ExportArgs) -> u8 {
         ..ExportOptions::default()
     };
     let scene = scene(&grammar, &assembly, &options);
+    if is_usdc(&args.output) && args.format.is_none() {
+        return export_usdc(&scene, &args.output);
+    }
     match encode_export(&scene, format, &args.output) {
         // the .obj first: a failed export leaves the .mtl beside it as it was (issue 47)
         Ok((bytes, materials)) => {
@@ -100,6 +107,66 @@ pub fn export(args: ExportArgs) -> u8 {
         }
         Err(e) => {
             errln!("error: cannot encode the model: {e}");
+            IO_ERROR
+        }
+    }
+}
+
+/// Whether `path` names USD's binary form.
+fn is_usdc(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("usdc"))
+}
+
+/// `usdcat` on the `PATH` (a USD installation: Houdini, Omniverse, a USD build), which
+/// converts the text form to the binary one; no Rust crate writes USD's crate format.
+fn usdcat() -> Option<PathBuf> {
+    let name = if cfg!(windows) {
+        "usdcat.exe"
+    } else {
+        "usdcat"
+    };
+    std::env::split_paths(&std::env::var_os("PATH")?)
+        .map(|dir| dir.join(name))
+        .find(|p| p.is_file())
+}
+
+/// `.usdc`: the `.usda` export written beside the output, converted by `usdcat`, removed.
+fn export_usdc(scene: &clay::Scene, output: &Path) -> u8 {
+    let Some(usdcat) = usdcat() else {
+        return IO_ERROR;
+    };
+    let text = output.with_extension("clay-export.usda");
+    let bytes = match encode_export(scene, ExportFormat::Usda, &text) {
+        Ok((bytes, _)) => bytes,
+        Err(e) => {
+            errln!("error: cannot encode the model: {e}");
+            return IO_ERROR;
+        }
+    };
+    let code = write_output(&text, &bytes);
+    if code != 0 {
+        return code;
+    }
+    let run = std::process::Command::new(&usdcat)
+        .arg(&text)
+        .arg("-o")
+        .arg(output)
+        .output();
+    let _ = std::fs::remove_file(&text);
+    match run {
+        Ok(out) if out.status.success() && output.is_file() => 0,
+        Ok(out) => {
+            errln!(
+                "error: `{}` could not convert the model to `{}`: {}",
+                usdcat.display(),
+                output.display(),
+                String::from_utf8_lossy(&out.stderr).trim()
+            );
+            IO_ERROR
+        }
+        Err(e) => {
+            errln!("error: cannot run `{}`: {e}", usdcat.display());
             IO_ERROR
         }
     }

@@ -30,14 +30,78 @@ fn clayc_export_writes_each_format_and_rejects_an_unknown_one() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains(".glb, .gltf, .obj or .usda"));
     assert!(!dir.join("wall.fbx").exists());
-    // USD's binary form is not written; the refusal says how to make it from the text form.
+    // USD's binary form is not written without `usdcat` on the PATH; the refusal says how to
+    // make it from the text form.
     let usdc = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
         .args(["export", &wall, "-o"])
         .arg(dir.join("wall.usdc"))
+        .env("PATH", &dir)
         .output()
         .unwrap();
     assert_eq!(usdc.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&usdc.stderr).contains("usdcat MODEL.usda -o MODEL.usdc"));
+    assert!(!dir.join("wall.usdc").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 48: with `usdcat` on the PATH, `-o MODEL.usdc` writes the `.usda` beside it, has
+/// `usdcat IN -o OUT` convert it, and leaves only the output. (A stand-in `usdcat` that marks
+/// what it was given: CI has no USD installation.)
+#[cfg(unix)]
+#[test]
+fn a_usdc_export_goes_through_usdcat_on_the_path() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = std::env::temp_dir().join(format!("clay-usdcat-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("bin")).unwrap();
+    let usdcat = dir.join("bin/usdcat");
+    std::fs::write(
+        &usdcat,
+        "#!/bin/sh\n[ \"$2\" = -o ] || exit 3\n{ printf 'PXR-USDC\\n'; cat \"$1\"; } > \"$3\"\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&usdcat, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let wall = format!("{}/../grammars/wall.clay", env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("wall.usdc"))
+        .env(
+            "PATH",
+            format!("{}:/usr/bin:/bin", dir.join("bin").display()),
+        )
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let written = std::fs::read_to_string(dir.join("wall.usdc")).unwrap();
+    assert!(
+        written.starts_with("PXR-USDC\n#usda 1.0"),
+        "{}",
+        &written[..40]
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "the .usda went: {left:?}");
+    // A converter that fails: its message, exit 2, no output.
+    std::fs::write(&usdcat, "#!/bin/sh\necho 'cannot read it' >&2\nexit 1\n").unwrap();
+    std::fs::remove_file(dir.join("wall.usdc")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+        .args(["export", &wall, "-o"])
+        .arg(dir.join("wall.usdc"))
+        .env(
+            "PATH",
+            format!("{}:/usr/bin:/bin", dir.join("bin").display()),
+        )
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read it"));
     assert!(!dir.join("wall.usdc").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
