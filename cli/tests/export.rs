@@ -62,15 +62,18 @@ fn a_usdc_export_goes_through_usdcat_on_the_path() {
     .unwrap();
     std::fs::set_permissions(&usdcat, std::fs::Permissions::from_mode(0o755)).unwrap();
     let wall = format!("{}/../grammars/wall.clay", env!("CARGO_MANIFEST_DIR"));
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
-        .args(["export", &wall, "-o"])
-        .arg(dir.join("wall.usdc"))
-        .env(
-            "PATH",
-            format!("{}:/usr/bin:/bin", dir.join("bin").display()),
-        )
-        .output()
-        .unwrap();
+    let export = || {
+        std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
+            .args(["export", &wall, "-o"])
+            .arg(dir.join("wall.usdc"))
+            .env(
+                "PATH",
+                format!("{}:/usr/bin:/bin", dir.join("bin").display()),
+            )
+            .output()
+            .unwrap()
+    };
+    let out = export();
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -91,15 +94,7 @@ fn a_usdc_export_goes_through_usdcat_on_the_path() {
     // A converter that fails: its message, exit 2, no output.
     std::fs::write(&usdcat, "#!/bin/sh\necho 'cannot read it' >&2\nexit 1\n").unwrap();
     std::fs::remove_file(dir.join("wall.usdc")).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clayc"))
-        .args(["export", &wall, "-o"])
-        .arg(dir.join("wall.usdc"))
-        .env(
-            "PATH",
-            format!("{}:/usr/bin:/bin", dir.join("bin").display()),
-        )
-        .output()
-        .unwrap();
+    let out = export();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read it"));
     assert!(!dir.join("wall.usdc").exists());

@@ -380,8 +380,9 @@ impl Compiler {
     ) -> Option<ParamValue> {
         let name = &p.name.name;
         let label = format!("set to {} from outside the file", shown_value(&given));
-        let wrong = |expected: String| {
-            Diagnostic::error(
+        // The error, its hints in order (what the parameter takes last).
+        let wrong = |hints: Vec<String>| {
+            let d = Diagnostic::error(
                 codes::PARAM_TYPE,
                 format!(
                     "parameter `{name}` is {}, and {} is not one",
@@ -390,8 +391,8 @@ impl Compiler {
                 ),
                 p.name.span,
                 label.clone(),
-            )
-            .with_hint(expected)
+            );
+            hints.into_iter().fold(d, Diagnostic::with_hint)
         };
         match kind {
             ParamKind::Bool => {
@@ -401,7 +402,7 @@ impl Compiler {
                     _ => None,
                 };
                 if on.is_none() {
-                    self.error(wrong(format!("set `{name}` to `true` or `false`")));
+                    self.error(wrong(vec![format!("set `{name}` to `true` or `false`")]));
                 }
                 return on.map(ParamValue::Bool);
             }
@@ -410,18 +411,18 @@ impl Compiler {
                 if choices.contains(&text) {
                     return Some(ParamValue::Text(text));
                 }
-                let mut d = wrong(String::new());
-                d.hints.clear();
-                if let Some(c) = closest(&text, choices.iter().map(String::as_str)) {
-                    d = d.with_hint(format!("did you mean \"{c}\"?"));
-                }
-                self.error(d.with_hint(format!("the choices are {}", quoted(choices))));
+                let mut hints: Vec<String> = closest(&text, choices.iter().map(String::as_str))
+                    .map(|c| format!("did you mean \"{c}\"?"))
+                    .into_iter()
+                    .collect();
+                hints.push(format!("the choices are {}", quoted(choices)));
+                self.error(wrong(hints));
                 return None;
             }
             _ => {}
         }
         let Some(v) = given.number() else {
-            self.error(wrong(format!("set `{name}` to a number")));
+            self.error(wrong(vec![format!("set `{name}` to a number")]));
             return None;
         };
         let (message, mut hint) = if !v.is_finite() {
@@ -438,7 +439,7 @@ impl Compiler {
             } else {
                 ""
             };
-            self.error(wrong(format!("set `{name}` to a whole number{from}")));
+            self.error(wrong(vec![format!("set `{name}` to a whole number{from}")]));
             return None;
         } else {
             match range {
@@ -475,8 +476,46 @@ impl Compiler {
     /// reporting a name that is no `bool` parameter, or silently when the parameter is
     /// poisoned (its declaration's error was reported).
     pub(super) fn switch(&mut self, id: &Ident) -> Option<bool> {
-        self.switch_param(id, "a `bool` parameter", |k| *k == ParamKind::Bool)
-            .and_then(|v| v.bool())
+        const WHAT: &str = "a `bool` parameter";
+        match self.consts.table.get_mut(&id.name) {
+            Some(c) if c.ty == Some(ParamKind::Bool) => {
+                c.used = true;
+                return self.param(&id.name).and_then(|p| p.value.bool());
+            }
+            Some(c) => {
+                c.used = true;
+                let (span, ty) = (c.span, c.ty.clone());
+                let is = match ty {
+                    Some(k) => format!("{} parameter", k.with_article()),
+                    None => "a `let` constant".to_string(),
+                };
+                self.error(
+                    Diagnostic::error(
+                        codes::PARAM_TYPE,
+                        format!("`{}` is {is}, not {WHAT}", id.name),
+                        id.span,
+                        format!("expected {WHAT}"),
+                    )
+                    .with_secondary(span, "declared here")
+                    .with_hint(format!(
+                        "an `if` switches on a parameter declared `param {}: bool = true`",
+                        id.name
+                    )),
+                );
+                return None;
+            }
+            None => {}
+        }
+        if self.consts.declared.contains_key(&id.name) {
+            return None; // declared, but its declaration failed (reported there)
+        }
+        let bools: Vec<String> = (self.consts.params.iter())
+            .filter(|p| p.kind == ParamKind::Bool)
+            .map(|p| p.name.clone())
+            .collect();
+        let ident = id.clone();
+        self.unknown("parameter", &ident, bools.iter().map(String::as_str), None);
+        None
     }
 
     /// The piece a `choice` parameter named `id` picks, when `id` names one (as an ident at
@@ -527,53 +566,6 @@ impl Compiler {
     /// The compiled parameter called `name`, when its declaration compiled.
     pub(super) fn param(&self, name: &str) -> Option<&Param> {
         self.consts.params.iter().find(|p| p.name == name)
-    }
-
-    fn switch_param(
-        &mut self,
-        id: &Ident,
-        what: &str,
-        fits: impl Fn(&ParamKind) -> bool,
-    ) -> Option<ParamValue> {
-        match self.consts.table.get_mut(&id.name) {
-            Some(c) if c.ty.as_ref().is_some_and(&fits) => {
-                c.used = true;
-                return self.param(&id.name).map(|p| p.value.clone());
-            }
-            Some(c) => {
-                c.used = true;
-                let (span, ty) = (c.span, c.ty.clone());
-                let is = match ty {
-                    Some(k) => format!("{} parameter", k.with_article()),
-                    None => "a `let` constant".to_string(),
-                };
-                self.error(
-                    Diagnostic::error(
-                        codes::PARAM_TYPE,
-                        format!("`{}` is {is}, not {what}", id.name),
-                        id.span,
-                        format!("expected {what}"),
-                    )
-                    .with_secondary(span, "declared here")
-                    .with_hint(format!(
-                        "an `if` switches on a parameter declared `param {}: bool = true`",
-                        id.name
-                    )),
-                );
-                return None;
-            }
-            None => {}
-        }
-        if self.consts.declared.contains_key(&id.name) {
-            return None; // declared, but its declaration failed (reported there)
-        }
-        let bools: Vec<String> = (self.consts.params.iter())
-            .filter(|p| fits(&p.kind))
-            .map(|p| p.name.clone())
-            .collect();
-        let ident = id.clone();
-        self.unknown("parameter", &ident, bools.iter().map(String::as_str), None);
-        None
     }
 }
 
