@@ -354,3 +354,18 @@ fn arcs_through_a_free_hub_share_the_turn_as_the_holds_ask() {
     assert_eq!(arcs, [2, 3], "{}", run.repro());
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 4.2, 5.1: a pentagon of free hubs (two held) whose sides of 7 are led in one frame to
+/// where sides of 3 rest. The free hubs' loop has a family of relaxed lengths (the far three
+/// sides 3 + t, 3 - 0.618 t, 3 + t all close), and the relaxation stopped at t = 2: sides 5,
+/// 1.76 and 5, which round to 5, 2 and 5 and rest strained (energy 2.7e-3, strain 0.023).
+/// The counts that close the loop (`solver/closure.rs`) are 3, 3 and 3.
+#[test]
+fn a_pentagon_shrunk_in_one_frame_closes_with_the_counts_that_fit() {
+    let run = replay("pentagon_shrunk");
+    let sides: Vec<usize> = (0..5)
+        .map(|l| run.chain_count(&format!("l{l}x0")))
+        .collect();
+    assert_eq!(sides, [3, 3, 3, 3, 3], "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}

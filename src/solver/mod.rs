@@ -16,6 +16,7 @@ mod chains;
 mod cholesky;
 mod chunks;
 mod clock;
+mod closure;
 mod config;
 mod evaluate;
 pub(crate) mod follow;

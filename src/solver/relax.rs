@@ -16,6 +16,7 @@
 use clay_dsl::compiled::{Part, PartKind, STRETCH_TWO};
 use glam::DVec2;
 
+use super::closure::counts_that_close;
 use super::global_step::Pass;
 use super::growth::ChainLength;
 use super::local::{self, StretchEnds};
@@ -130,6 +131,15 @@ impl Solver {
         let hysteresis = self.config.hysteresis;
         let mut f = warm.to_vec();
         let forced = self.relaxed_piece_states(asm, &families, &mut f)?;
+        // the straight chains round loops: the counts that close them (`closure.rs`)
+        let closing = counts_that_close(
+            asm,
+            &f,
+            &relaxed_lengths(asm, &families, &f),
+            &held_elements(asm),
+            hysteresis,
+        );
+        let relaxed = f.clone();
         let mut found: Vec<(Vec<Option<usize>>, Vec<DVec2>)> = Vec::new();
         for pick in [Pick::Nearest, Pick::Furthest] {
             let Some((decided, g, first)) = self.round_counts(asm, &families, &forced, &f, pick)?
@@ -164,6 +174,14 @@ impl Solver {
             {
                 alternatives.push(p);
             }
+        }
+        if !closing.is_empty() {
+            alternatives.push(Proposal {
+                counts: closing,
+                states: self.relaxed_states(&data.parts, &forced, &relaxed),
+                pose: relaxed,
+                then_lengths: false,
+            });
         }
         // a chain of turning elements: the count its ends' turn asks for (`turns.rs`)
         for counts in counts_from_turns(asm, &f, hysteresis) {

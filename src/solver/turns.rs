@@ -65,6 +65,12 @@ fn element_step(part: &StretchPart) -> Option<RigidMotion> {
     rigid_motion(&from, &to)
 }
 
+/// Whether the elements of `rule`'s chain run straight on from each other (turning by less
+/// than [`STRAIGHT`]): a chain whose count its length decides, not its turn.
+pub(super) fn chain_is_straight(rule: &StretchRule) -> bool {
+    element_step(&rule.part).is_some_and(|s| s.rotation.to_angle().abs() < STRAIGHT)
+}
+
 /// The positions, in the part's vertex order, of element 0's `from` site and element 1's
 /// `to` site of a two-element part (the chain's ends when the part is its first or last).
 struct EndSites {
