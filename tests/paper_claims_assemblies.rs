@@ -79,6 +79,18 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(config(16, 27))]
+
+    /// Round trip (paper 5.1): led to another rest configuration over any number of frames,
+    /// held, and led back over any number: at rest, with the start's lengths on every link
+    /// the held hubs fix (loops of free hubs included).
+    #[test]
+    fn sec5_1_morphed_and_back(m in morphs(), frames in strategy::frames(), back in strategy::frames()) {
+        holds(claims::round_trip(&m, frames, back))?;
+    }
+}
+
+proptest! {
     #![proptest_config(config(16, 23))]
 
     /// Relaxation (paper 4, 5.1): released, an assembly (loops included) is at rest within
