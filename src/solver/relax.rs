@@ -110,11 +110,11 @@ impl Family {
 
 impl Solver {
     /// The relaxation from `warm` (the displayed pose; the handles gathered this frame), and
-    /// what it proposes (empty when it changes nothing), up to three alternatives. Its
-    /// chains' lengths are rounded in rounds (`Solver::round_counts`), twice: deciding in
-    /// each round, besides the chains nearly whole, the one nearest a whole count, and then
-    /// the one furthest from it; and the first round's lengths each rounded on their own (a
-    /// loop that only closes evenly). The session keeps the one the model rests best with.
+    /// what it proposes (empty when it changes nothing). Its chains' lengths are rounded in
+    /// rounds (`Solver::round_counts`), and the first round's lengths each on their own (a
+    /// loop that only closes evenly); the straight chains round loops get the counts that
+    /// close them (`closure.rs`), the turning ones the counts their turns ask for
+    /// (`turns.rs`). The session keeps the one the model rests best with.
     pub(super) fn relax(
         &mut self,
         asm: &Assembly,
@@ -140,21 +140,14 @@ impl Solver {
             hysteresis,
         );
         let relaxed = f.clone();
-        let mut found: Vec<(Vec<Option<usize>>, Vec<DVec2>)> = Vec::new();
-        for pick in [Pick::Nearest, Pick::Furthest] {
-            let Some((decided, g, first)) = self.round_counts(asm, &families, &forced, &f, pick)?
-            else {
-                return Ok(Vec::new());
-            };
-            found.push((decided, g));
-            if pick == Pick::Nearest {
-                let mut each = vec![None; data.chains.len()];
-                for r in relaxed_lengths(asm, &families, &first) {
-                    each[r.chain] = Some(r.decide(hysteresis));
-                }
-                found.push((each, first));
-            }
+        let Some((decided, g, first)) = self.round_counts(asm, &families, &forced, &f)? else {
+            return Ok(Vec::new());
+        };
+        let mut each = vec![None; data.chains.len()];
+        for r in relaxed_lengths(asm, &families, &first) {
+            each[r.chain] = Some(r.decide(hysteresis));
         }
+        let found = [(decided, g), (each, first)];
         let mut alternatives: Vec<Proposal> = Vec::new();
         for (decided, f) in found {
             let lengths = relaxed_lengths(asm, &families, &f);
@@ -197,10 +190,10 @@ impl Solver {
 
     /// Counts for every chain, decided in rounds from the relaxation at `start`: each round
     /// relaxes with the chains decided so far held at their counts, then decides the chains
-    /// whose lengths are nearly whole (within [`DECIDED`] of a count) and one more, the
-    /// [`Pick`] (with the chains in series with it: `rounding.rs`), so that a change the
-    /// relaxation spreads over chains in series or round a loop ends whole in one of them
-    /// rather than split and lost. Returns the counts, the last round's pose and the first
+    /// whose lengths are nearly whole (within [`DECIDED`] of a count) and one more, the one
+    /// nearest a whole count (with the chains in series with it: `rounding.rs`), so that a
+    /// change the relaxation spreads over chains in series or round a loop ends whole in one
+    /// of them rather than split and lost. Returns the counts, the last round's pose and the first
     /// round's; `None` when the relaxation left the finite numbers.
     fn round_counts(
         &mut self,
@@ -208,7 +201,6 @@ impl Solver {
         families: &[Option<Family>],
         forced: &[(usize, usize)],
         start: &[DVec2],
-        pick: Pick,
     ) -> Result<Option<Rounded>, SolverError> {
         let data = asm.data();
         let held = held_elements(asm);
@@ -229,11 +221,7 @@ impl Solver {
                 .iter()
                 .filter(|r| decided[r.chain].is_none())
                 .collect();
-            let doubts = open.iter().map(|r| r.doubt());
-            let Some(chosen) = (match pick {
-                Pick::Nearest => doubts.min_by(f64::total_cmp),
-                Pick::Furthest => doubts.max_by(f64::total_cmp),
-            }) else {
+            let Some(chosen) = open.iter().map(|r| r.doubt()).min_by(f64::total_cmp) else {
                 break;
             };
             for r in &open {
@@ -597,16 +585,6 @@ type States = Vec<(usize, usize)>;
 /// What [`Solver::round_counts`] decides: every chain's count (`None`: left as it is), the
 /// last round's relaxed pose and the first round's.
 type Rounded = (Vec<Option<usize>>, Vec<DVec2>, Vec<DVec2>);
-
-/// Which chain a round of [`Solver::round_counts`] decides besides the nearly whole ones.
-#[derive(Clone, Copy, PartialEq, Debug)]
-enum Pick {
-    /// The one nearest a whole count.
-    Nearest,
-    /// The one furthest from a whole count: in a family of rest configurations (a loop of
-    /// free hubs), the chain that took up the change, the others relaxed to their counts.
-    Furthest,
-}
 
 /// Rounds of [`Solver::relaxed_piece_states`]: each keeps at most one piece part's state.
 const STATE_ROUNDS: usize = 3;
