@@ -111,8 +111,7 @@ impl Family {
 impl Solver {
     /// The relaxation from `warm` (the displayed pose; the handles gathered this frame), and
     /// what it proposes (empty when it changes nothing). Its chains' lengths are rounded in
-    /// rounds (`Solver::round_counts`), and the first round's lengths each on their own (a
-    /// loop that only closes evenly); the straight chains round loops get the counts that
+    /// rounds (`Solver::round_counts`); the straight chains round loops get the counts that
     /// close them (`closure.rs`), the turning ones the counts their turns ask for
     /// (`turns.rs`). The session keeps the one the model rests best with.
     pub(super) fn relax(
@@ -140,14 +139,10 @@ impl Solver {
             hysteresis,
         );
         let relaxed = f.clone();
-        let Some((decided, g, first)) = self.round_counts(asm, &families, &forced, &f)? else {
+        let Some((decided, g)) = self.round_counts(asm, &families, &forced, &f)? else {
             return Ok(Vec::new());
         };
-        let mut each = vec![None; data.chains.len()];
-        for r in relaxed_lengths(asm, &families, &first) {
-            each[r.chain] = Some(r.decide(hysteresis));
-        }
-        let found = [(decided, g), (each, first)];
+        let found = [(decided, g)];
         let mut alternatives: Vec<Proposal> = Vec::new();
         for (decided, f) in found {
             let lengths = relaxed_lengths(asm, &families, &f);
@@ -193,8 +188,8 @@ impl Solver {
     /// whose lengths are nearly whole (within [`DECIDED`] of a count) and one more, the one
     /// nearest a whole count (with the chains in series with it: `rounding.rs`), so that a
     /// change the relaxation spreads over chains in series or round a loop ends whole in one
-    /// of them rather than split and lost. Returns the counts, the last round's pose and the first
-    /// round's; `None` when the relaxation left the finite numbers.
+    /// of them rather than split and lost. Returns the counts and the last round's pose;
+    /// `None` when the relaxation left the finite numbers.
     fn round_counts(
         &mut self,
         asm: &Assembly,
@@ -207,7 +202,6 @@ impl Solver {
         let hysteresis = self.config.hysteresis;
         let series = runs(asm.grammar(), data, &held);
         let mut f = start.to_vec();
-        let mut first: Option<Vec<DVec2>> = None;
         let mut decided: Vec<Option<usize>> = vec![None; data.chains.len()];
         loop {
             let fixed = fixed_scales(asm, &decided, &held);
@@ -215,7 +209,6 @@ impl Solver {
             if f.iter().any(|p| !p.is_finite()) {
                 return Ok(None);
             }
-            first.get_or_insert_with(|| f.clone());
             let lengths = relaxed_lengths(asm, families, &f);
             let open: Vec<&Relaxed> = lengths
                 .iter()
@@ -250,8 +243,7 @@ impl Solver {
                 }
             }
         }
-        let first = first.unwrap_or_else(|| f.clone());
-        Ok(Some((decided, f, first)))
+        Ok(Some((decided, f)))
     }
 
     /// The piece parts' states the relaxation keeps, judged by its energy, and `f` relaxed
@@ -582,9 +574,9 @@ impl Rest {
 /// Piece parts and the states the relaxation holds them in, `(part, state)`.
 type States = Vec<(usize, usize)>;
 
-/// What [`Solver::round_counts`] decides: every chain's count (`None`: left as it is), the
-/// last round's relaxed pose and the first round's.
-type Rounded = (Vec<Option<usize>>, Vec<DVec2>, Vec<DVec2>);
+/// What [`Solver::round_counts`] decides: every chain's count (`None`: left as it is), and
+/// the last round's relaxed pose.
+type Rounded = (Vec<Option<usize>>, Vec<DVec2>);
 
 /// Rounds of [`Solver::relaxed_piece_states`]: each keeps at most one piece part's state.
 const STATE_ROUNDS: usize = 3;
