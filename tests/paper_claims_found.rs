@@ -369,3 +369,17 @@ fn a_pentagon_shrunk_in_one_frame_closes_with_the_counts_that_fit() {
     assert_eq!(sides, [3, 3, 3, 3, 3], "{}", run.repro());
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 4, 5.1, relaxation: a stadium of two hubs, each side an arc of four 45-degree
+/// elements and a straight wall of six, pulled out to walls of eleven (the arcs grew to 17
+/// with the pull) and let go. Relaxed, it kept arcs of 4 and 3: seven elements turn by 315
+/// degrees, which no lengths close, and the loop rested strained (energy 0.18, strain 0.22).
+/// A loop no held piece is on turns by a whole turn, so its arcs' counts are proposed
+/// together from the loop's turn (`closure.rs::free_loops`, `turns.rs`): eight arc elements.
+#[test]
+fn a_stadium_let_go_closes_its_turn_with_eight_arc_elements() {
+    let run = replay("stadium_let_go");
+    let arcs = run.chain_count("l0x0") + run.chain_count("l1x0");
+    assert_eq!(arcs, 8, "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}

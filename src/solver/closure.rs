@@ -107,6 +107,71 @@ pub(super) fn counts_that_close(
         .collect()
 }
 
+/// A step round a loop of free pieces ([`free_loops`]).
+#[derive(Debug, PartialEq)]
+pub(super) enum LoopStep {
+    /// A chain, `1.0` run from its first element to its last, `-1.0` the other way.
+    Chain(usize, f64),
+    /// A piece, entered at one site and left at another.
+    Piece {
+        instance: usize,
+        enter: usize,
+        leave: usize,
+    },
+}
+
+/// The independent loops of the piece graph that no held piece is on (a ring of hubs and
+/// arcs let go): each as its chains and the pieces between them, each entered and left at
+/// its sites. Its turns add up to a whole turn, which is what its turning chains' counts
+/// must match together (`turns.rs`). A loop through a body of several pieces docked
+/// together is left out (no one site enters it).
+pub(super) fn free_loops(asm: &Assembly, pose: &[DVec2], held: &[u64]) -> Vec<Vec<LoopStep>> {
+    let Some(graph) = PieceGraph::of(asm.grammar(), asm.data(), pose, held) else {
+        return Vec::new();
+    };
+    let mut loops = Vec::new();
+    'cycles: for cycle in graph.cycles() {
+        // per body on the loop: the site it is arrived at, the one it is left by
+        let mut at: std::collections::HashMap<usize, [Option<Option<InstanceSite>>; 2]> =
+            Default::default();
+        for &(c, sign) in &cycle {
+            let Some((near, far)) = graph.ends[c] else {
+                continue 'cycles;
+            };
+            let [n, f] = graph.docked[c];
+            let (leave, arrive) = if sign > 0.0 {
+                ((near, n), (far, f))
+            } else {
+                ((far, f), (near, n))
+            };
+            at.entry(leave.0).or_default()[1] = Some(leave.1);
+            at.entry(arrive.0).or_default()[0] = Some(arrive.1);
+        }
+        if at.contains_key(&graph.ground) {
+            continue;
+        }
+        let mut steps: Vec<LoopStep> = (cycle.iter())
+            .map(|&(c, s)| LoopStep::Chain(c, s))
+            .collect();
+        for sites in at.values() {
+            match *sites {
+                // two chains docked end to end: no piece between them
+                [Some(None), Some(None)] => {}
+                [Some(Some(a)), Some(Some(b))] if a.instance == b.instance => {
+                    steps.push(LoopStep::Piece {
+                        instance: a.instance,
+                        enter: a.site,
+                        leave: b.site,
+                    });
+                }
+                _ => continue 'cycles,
+            }
+        }
+        loops.push(steps);
+    }
+    loops
+}
+
 /// The pieces between chains as rigid bodies (the held ones a single ground) and the chains
 /// as the edges between them, with each straight chain's direction in the pose.
 struct PieceGraph {
@@ -116,6 +181,9 @@ struct PieceGraph {
     /// Per chain: its unit direction in the pose when it is straight and no handle holds
     /// one of its elements (the chains whose counts may change here).
     direction: Vec<Option<DVec2>>,
+    /// Per chain: the piece site its near and far ends dock to (`None`: another chain's end,
+    /// or nothing).
+    docked: Vec<[Option<InstanceSite>; 2]>,
     bodies: usize,
     ground: usize,
 }
@@ -168,6 +236,7 @@ impl PieceGraph {
             sites.push((near, far));
         }
         let mut direction = Vec::with_capacity(chains);
+        let mut docked = vec![[None; 2]; chains];
         for (c, chain) in data.chains.iter().enumerate() {
             let rule = grammar.stretch_rules.get(chain.rule)?;
             let piece = grammar.pieces.get(rule.piece)?;
@@ -186,7 +255,10 @@ impl PieceGraph {
                 };
                 let to = match end_at.get(other) {
                     Some(&e) => e,
-                    None if chain_of.get(other.instance)?.is_none() => other.instance,
+                    None if chain_of.get(other.instance)?.is_none() => {
+                        docked[c][usize::from(far_end)] = Some(*other);
+                        other.instance
+                    }
                     None => continue,
                 };
                 union(&mut parent, end_node(c, far_end), to);
@@ -216,6 +288,7 @@ impl PieceGraph {
         Some(Self {
             ends,
             direction,
+            docked,
             bodies: parent.len(),
             ground: root(&mut parent, ground),
         })

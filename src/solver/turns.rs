@@ -12,6 +12,7 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
+use super::closure::{LoopStep, free_loops};
 use super::rounding::{chain_of, held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
@@ -222,7 +223,26 @@ pub(super) fn counts_from_turns(
         .collect();
     let held = held_elements(asm);
     let series = runs(asm.grammar(), data, &held);
-    let paths = held_paths(data, &held);
+    let mut paths = held_paths(data, &held);
+    // a loop no held piece is on turns by a whole turn (a ring let go)
+    for steps in free_loops(asm, pose, &held) {
+        paths.push(
+            (steps.into_iter())
+                .map(|s| match s {
+                    LoopStep::Chain(c, sign) => Step::Chain(c, sign),
+                    LoopStep::Piece {
+                        instance,
+                        enter,
+                        leave,
+                    } => Step::Piece {
+                        instance,
+                        enter,
+                        leave,
+                    },
+                })
+                .collect(),
+        );
+    }
     // each path's turn off its rest: its chains' and free pieces' misfits added up
     let alongs: Vec<Option<f64>> = (paths.iter())
         .map(|path| {
