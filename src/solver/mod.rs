@@ -26,6 +26,7 @@ mod growth;
 mod handles;
 mod layout;
 pub(crate) mod local;
+mod loops;
 mod measure;
 mod pass1;
 mod pass2;

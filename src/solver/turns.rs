@@ -12,7 +12,7 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
-use super::closure::{LoopStep, free_loops};
+use super::loops::{LoopStep, free_loops};
 use super::rounding::{chain_of, held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
