@@ -25,21 +25,28 @@ const NEAR: f64 = 1e-4;
 /// The most lattice points [`closest`] visits before it gives up.
 const VISITS: usize = 200_000;
 
-/// Counts for the straight chains in loops of the piece graph (held pieces one ground) that
-/// close them best, when they close better than the chains' own counts by the hysteresis
-/// margin (paper 4.3): `(chain, first, count)` changes, as the relaxation proposes them.
-/// `lengths` are the relaxed chains' at `pose`.
-pub(super) fn counts_that_close(
+/// The whole counts that close the loops of the piece graph best, against the counts
+/// the chains have ([`closing`]).
+pub(super) struct Closing {
+    /// `(chain, first, count)` changes, as the relaxation proposes them (empty: the counts
+    /// the chains have close best).
+    pub(super) changes: Vec<(usize, usize, usize)>,
+    /// The loops' misfit (metres squared) with those counts, and with the chains' own.
+    pub(super) misfit: f64,
+    pub(super) now: f64,
+}
+
+/// The counts for the straight chains in loops of the piece graph (held pieces one ground)
+/// that close them best. `lengths` are the relaxed chains' at `pose`. `None` without a loop
+/// through a straight chain.
+pub(super) fn closing(
     asm: &Assembly,
     pose: &[DVec2],
     lengths: &[Relaxed],
     held: &[u64],
-    hysteresis: f64,
-) -> Vec<(usize, usize, usize)> {
+) -> Option<Closing> {
     let (data, grammar) = (asm.data(), asm.grammar());
-    let Some(graph) = PieceGraph::of(grammar, data, pose, held) else {
-        return Vec::new();
-    };
+    let graph = PieceGraph::of(grammar, data, pose, held)?;
     let cycles = graph.cycles();
     // the variables: the relaxed straight chains some loop runs through
     let straight = |chain: usize| {
@@ -52,7 +59,7 @@ pub(super) fn counts_that_close(
         .filter(|r| cycles.iter().any(|c| c.iter().any(|&(k, _)| k == r.chain)))
         .collect();
     if vars.is_empty() {
-        return Vec::new();
+        return None;
     }
     let index = |chain: usize| vars.iter().position(|r| r.chain == chain);
     // the misfit's quadratic form over the counts, in metres squared
@@ -95,18 +102,15 @@ pub(super) fn counts_that_close(
     let bounds: Vec<(i64, i64)> = (vars.iter())
         .map(|r| (r.min.max(1) as i64, r.max.map_or(i64::MAX, |v| v as i64)))
         .collect();
-    let Some(best) = closest(&qn, &x, &bounds) else {
-        return Vec::new();
-    };
+    let best = closest(&qn, &x, &bounds)?;
     let then: Vec<f64> = best.iter().map(|&n| n as f64).collect();
-    if best.iter().zip(&vars).all(|(&n, r)| n as usize == r.count)
-        || misfit(&then) >= (1.0 - hysteresis) * now
-    {
-        return Vec::new();
-    }
-    (vars.iter().zip(&best))
-        .filter_map(|(r, &n)| r.towards(n as usize))
-        .collect()
+    Some(Closing {
+        changes: (vars.iter().zip(&best))
+            .filter_map(|(r, &n)| r.towards(n as usize))
+            .collect(),
+        misfit: misfit(&then),
+        now,
+    })
 }
 
 /// The whole numbers within `bounds` that minimise `(n - x)^T q (n - x)` for a positive

@@ -16,7 +16,7 @@
 use clay_dsl::compiled::{Part, PartKind, STRETCH_TWO};
 use glam::DVec2;
 
-use super::closure::counts_that_close;
+use super::closure::closing;
 use super::global_step::Pass;
 use super::growth::ChainLength;
 use super::local::{self, StretchEnds};
@@ -129,48 +129,26 @@ impl Solver {
             .collect();
         let hysteresis = self.config.hysteresis;
         let mut f = warm.to_vec();
-        let forced = self.relaxed_piece_states(asm, &families, &mut f)?;
+        let (forced, tied) = self.relaxed_piece_states(asm, &families, &mut f)?;
         // the straight chains round loops: the counts that close them (`closure.rs`)
-        let closing = counts_that_close(
-            asm,
-            &f,
-            &relaxed_lengths(asm, &families, &f),
-            &held_elements(asm),
-            hysteresis,
-        );
-        let relaxed = f.clone();
+        let closes = self.counts_that_close(asm, &families, (&forced, &f), tied);
         let Some((decided, g)) = self.round_counts(asm, &families, &forced, &f)? else {
             return Ok(Vec::new());
         };
-        let found = [(decided, g)];
         let mut alternatives: Vec<Proposal> = Vec::new();
-        for (decided, f) in found {
-            let lengths = relaxed_lengths(asm, &families, &f);
-            let counts: Vec<(usize, usize, usize)> = (lengths.iter())
+        let rounded = Proposal {
+            counts: (relaxed_lengths(asm, &families, &g).iter())
                 .filter_map(|r| decided[r.chain].and_then(|want| r.towards(want)))
-                .collect();
-            let p = Proposal {
-                counts,
-                states: self.relaxed_states(&data.parts, &forced, &f),
-                pose: f,
-                then_lengths: false,
-            };
-            if !p.is_empty()
-                && !alternatives
-                    .iter()
-                    .any(|q| q.counts == p.counts && q.states == p.states)
-            {
-                alternatives.push(p);
-            }
+                .collect(),
+            states: self.relaxed_states(&data.parts, &forced, &g),
+            pose: g,
+            then_lengths: false,
+        };
+        if !rounded.is_empty() {
+            alternatives.push(rounded);
         }
-        if !closing.is_empty() {
-            alternatives.push(Proposal {
-                counts: closing,
-                states: self.relaxed_states(&data.parts, &forced, &relaxed),
-                pose: relaxed,
-                then_lengths: false,
-            });
-        }
+        let same = |p: &Proposal, q: &Proposal| p.counts == q.counts && p.states == q.states;
+        alternatives.extend(closes.filter(|p| !alternatives.iter().any(|q| same(p, q))));
         // a chain of turning elements: the count its ends' turn asks for (`turns.rs`)
         for counts in counts_from_turns(asm, &f, hysteresis) {
             alternatives.push(Proposal {
@@ -259,14 +237,15 @@ impl Solver {
         asm: &Assembly,
         families: &[Option<Family>],
         f: &mut Vec<DVec2>,
-    ) -> Result<Vec<(usize, usize)>, SolverError> {
+    ) -> Result<(States, Vec<Assigned>), SolverError> {
         let parts = &asm.data().parts;
         let free = vec![None; parts.len()];
         let mut forced: Vec<(usize, usize)> = Vec::new();
         let mut energy = self.relax_from(asm, families, &free, &forced, f)?;
         let margin = 1.0 - self.config.hysteresis;
+        // every assignment relaxed: (relaxed objective, the states, the relaxed pose)
+        let mut tried: Vec<(f64, States, Vec<DVec2>)> = Vec::new();
         for _ in 0..STATE_ROUNDS {
-            // (relaxed objective, the states kept, the relaxed pose)
             let mut best: Option<(f64, States, Vec<DVec2>)> = None;
             for m in self.state_candidates(parts, &forced, f) {
                 let mut trial: Vec<(usize, usize)> = (forced.iter().copied())
@@ -276,8 +255,9 @@ impl Solver {
                 let mut g = f.clone();
                 let e = self.relax_from(asm, families, &free, &trial, &mut g)?;
                 if e < margin * energy && best.as_ref().is_none_or(|b| e < b.0) {
-                    best = Some((e, trial, g));
+                    best = Some((e, trial.clone(), g.clone()));
                 }
+                tried.push((e, trial, g));
             }
             let Some((e, trial, g)) = best else {
                 break;
@@ -286,15 +266,65 @@ impl Solver {
             energy = e;
             *f = g;
         }
-        Ok(forced)
+        // the others that relax as well as the kept one: a turn taken by another piece
+        let tied = (tried.into_iter())
+            .filter(|(e, states, _)| {
+                *states != forced && (*e * margin <= energy || !self.strained(*e))
+            })
+            .map(|(_, states, g)| (states, g))
+            .collect();
+        Ok((forced, tied))
     }
 
-    /// The moves a round of [`Solver::relaxed_piece_states`] tries, each a list of (piece
-    /// part, state): up to [`STATE_TRIES`] single switches of parts not yet `forced`, to
-    /// another state than the part's in the relaxation at `f`, the nearest (by the squared
-    /// shape distance the local step compares, less the current state's) first; and every
-    /// bent part back in its first state (a bend and its mirror kept on two links of a tree,
-    /// which only close together: one put back alone fits worse).
+    /// What the counts that close the loops propose (`closure.rs`): with the piece states the
+    /// relaxation kept (`kept`: the states and the relaxed pose), or with another assignment
+    /// that relaxes as well (`tied`) when its whole counts close better by the hysteresis
+    /// margin. Counts free, a turn's share moved from one bendable piece to another closes as
+    /// well, and only the whole counts tell them apart: a tree whose far hub is led where a
+    /// bend on its last link rests, the bend taken by a piece on its first, rested at strain
+    /// 0.04 (generated morph case 658).
+    fn counts_that_close(
+        &self,
+        asm: &Assembly,
+        families: &[Option<Family>],
+        (forced, f): (&States, &[DVec2]),
+        tied: Vec<Assigned>,
+    ) -> Option<Proposal> {
+        let held = held_elements(asm);
+        let parts = &asm.data().parts;
+        let margin = 1.0 - self.config.hysteresis;
+        let kept = closing(asm, f, &relaxed_lengths(asm, families, f), &held)?;
+        let now = kept.now;
+        let mut best = (
+            kept.misfit,
+            Proposal {
+                counts: kept.changes,
+                states: self.relaxed_states(parts, forced, f),
+                pose: f.to_vec(),
+                then_lengths: false,
+            },
+        );
+        for (states, g) in tied {
+            let Some(other) = closing(asm, &g, &relaxed_lengths(asm, families, &g), &held) else {
+                continue;
+            };
+            if other.misfit < margin * best.0 {
+                let states = self.relaxed_states(parts, &states, &g);
+                best = (
+                    other.misfit,
+                    Proposal {
+                        counts: other.changes,
+                        states,
+                        pose: g,
+                        then_lengths: true,
+                    },
+                );
+            }
+        }
+        let (misfit, proposal) = best;
+        (misfit < margin * now && !proposal.is_empty()).then_some(proposal)
+    }
+
     fn state_candidates(
         &self,
         parts: &[Part],
@@ -327,9 +357,32 @@ impl Solver {
             }
         }
         out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let state_of = |pi: usize| {
+            (forced.iter().chain(&now))
+                .find(|x| x.0 == pi)
+                .map_or(parts[pi].active, |x| x.1)
+        };
+        // hand-offs: a bent piece part back in its first state and a straight one taking a
+        // bent state (the turn taken by another piece on the path: counts free, both
+        // assignments close, and only the whole counts tell them apart)
+        let bent: Vec<usize> = (parts.iter().enumerate())
+            .filter(|(pi, p)| {
+                matches!(p.kind, PartKind::Piece { .. }) && p.states.len() > 1 && state_of(*pi) != 0
+            })
+            .map(|(pi, _)| pi)
+            .take(HAND_OFF_FROM)
+            .collect();
+        let mut hand_offs: Vec<Vec<(usize, usize)>> = Vec::new();
+        for &a in &bent {
+            let takers = (out.iter())
+                .filter(|&&(_, pi, state)| pi != a && state != 0 && state_of(pi) == 0)
+                .take(HAND_OFF_TO);
+            hand_offs.extend(takers.map(|&(_, pi, state)| vec![(a, 0), (pi, state)]));
+        }
         let mut moves: Vec<Vec<(usize, usize)>> = (out.into_iter().take(STATE_TRIES))
             .map(|(_, pi, state)| vec![(pi, state)])
             .collect();
+        moves.extend(hand_offs);
         let back: Vec<(usize, usize)> = (parts.iter().enumerate())
             .filter(|(pi, p)| {
                 matches!(p.kind, PartKind::Piece { .. })
@@ -574,12 +627,20 @@ impl Rest {
 /// Piece parts and the states the relaxation holds them in, `(part, state)`.
 type States = Vec<(usize, usize)>;
 
+/// Piece states the relaxation was run with, and its relaxed pose.
+type Assigned = (States, Vec<DVec2>);
+
 /// What [`Solver::round_counts`] decides: every chain's count (`None`: left as it is), and
 /// the last round's relaxed pose.
 type Rounded = (Vec<Option<usize>>, Vec<DVec2>);
 
 /// Rounds of [`Solver::relaxed_piece_states`]: each keeps at most one piece part's state.
 const STATE_ROUNDS: usize = 3;
+
+/// Bent piece parts that hand their turn to another in a round of
+/// [`Solver::relaxed_piece_states`], and the straight parts' states each is handed to.
+const HAND_OFF_FROM: usize = 2;
+const HAND_OFF_TO: usize = 6;
 
 /// Alternative piece states [`Solver::relaxed_piece_states`] relaxes with in a round.
 const STATE_TRIES: usize = 4;
