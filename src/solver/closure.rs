@@ -34,6 +34,18 @@ pub(super) struct Closing {
     /// The loops' misfit (metres squared) with those counts, and with the chains' own.
     pub(super) misfit: f64,
     pub(super) now: f64,
+    /// The shortest element's length (metres) of the chains counted.
+    pub(super) shortest: f64,
+}
+
+impl Closing {
+    /// Whether counts whose loops' misfit is `misfit` close better than the chains' own by
+    /// the hysteresis margin in elements (paper 4.3, as a chain's count from its length): a
+    /// shortest element's `hysteresis` nearer, so that a handle moved by less than that from
+    /// a rest configuration changes no count.
+    pub(super) fn better(&self, misfit: f64, hysteresis: f64) -> bool {
+        misfit.sqrt() + hysteresis * self.shortest <= self.now.sqrt()
+    }
 }
 
 /// The counts for the straight chains in loops of the piece graph (held pieces one ground)
@@ -110,6 +122,7 @@ pub(super) fn closing(
             .collect(),
         misfit: misfit(&then),
         now,
+        shortest: vars.iter().map(|r| r.element).fold(f64::INFINITY, f64::min),
     })
 }
 

@@ -293,12 +293,11 @@ impl Solver {
         let held = held_elements(asm);
         let parts = &asm.data().parts;
         let margin = 1.0 - self.config.hysteresis;
-        let kept = closing(asm, f, &relaxed_lengths(asm, families, f), &held)?;
-        let now = kept.now;
+        let mut kept = closing(asm, f, &relaxed_lengths(asm, families, f), &held)?;
         let mut best = (
             kept.misfit,
             Proposal {
-                counts: kept.changes,
+                counts: std::mem::take(&mut kept.changes),
                 states: self.relaxed_states(parts, forced, f),
                 pose: f.to_vec(),
                 then_lengths: false,
@@ -322,7 +321,7 @@ impl Solver {
             }
         }
         let (misfit, proposal) = best;
-        (misfit < margin * now && !proposal.is_empty()).then_some(proposal)
+        (kept.better(misfit, self.config.hysteresis) && !proposal.is_empty()).then_some(proposal)
     }
 
     fn state_candidates(
