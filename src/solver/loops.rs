@@ -15,10 +15,12 @@ use crate::assembly::Assembly;
 /// last).
 pub(super) type Cycle = Vec<(usize, f64)>;
 
-/// A step round a loop of free pieces ([`free_loops`]).
+/// A step of a path between held pieces or round a loop of free ones (`turns.rs`,
+/// [`free_loops`]).
 #[derive(Debug, PartialEq)]
-pub(super) enum LoopStep {
-    /// A chain, `1.0` run from its first element to its last, `-1.0` the other way.
+pub(super) enum Step {
+    /// A chain, with `1.0` where the path runs from its first element to its last and
+    /// `-1.0` the other way.
     Chain(usize, f64),
     /// A piece, entered at one site and left at another.
     Piece {
@@ -33,14 +35,15 @@ pub(super) enum LoopStep {
 /// its sites. Its turns add up to a whole turn, which is what its turning chains' counts
 /// must match together (`turns.rs`). A loop through a body of several pieces docked
 /// together is left out (no one site enters it).
-pub(super) fn free_loops(asm: &Assembly, pose: &[DVec2], held: &[u64]) -> Vec<Vec<LoopStep>> {
+pub(super) fn free_loops(asm: &Assembly, pose: &[DVec2], held: &[u64]) -> Vec<Vec<Step>> {
     let Some(graph) = PieceGraph::of(asm.grammar(), asm.data(), pose, held) else {
         return Vec::new();
     };
     let mut loops = Vec::new();
     'cycles: for cycle in graph.cycles() {
         // per body on the loop: the site it is arrived at, the one it is left by
-        let mut at: std::collections::HashMap<usize, [Option<Option<InstanceSite>>; 2]> =
+        // (ordered: the turns are summed in this order, the same in every run)
+        let mut at: std::collections::BTreeMap<usize, [Option<Option<InstanceSite>>; 2]> =
             Default::default();
         for &(c, sign) in &cycle {
             let Some((near, far)) = graph.ends[c] else {
@@ -58,15 +61,13 @@ pub(super) fn free_loops(asm: &Assembly, pose: &[DVec2], held: &[u64]) -> Vec<Ve
         if at.contains_key(&graph.ground) {
             continue;
         }
-        let mut steps: Vec<LoopStep> = (cycle.iter())
-            .map(|&(c, s)| LoopStep::Chain(c, s))
-            .collect();
+        let mut steps: Vec<Step> = (cycle.iter()).map(|&(c, s)| Step::Chain(c, s)).collect();
         for sites in at.values() {
             match *sites {
                 // two chains docked end to end: no piece between them
                 [Some(None), Some(None)] => {}
                 [Some(Some(a)), Some(Some(b))] if a.instance == b.instance => {
-                    steps.push(LoopStep::Piece {
+                    steps.push(Step::Piece {
                         instance: a.instance,
                         enter: a.site,
                         leave: b.site,

@@ -12,7 +12,7 @@ use clay_dsl::compiled::{
 };
 use glam::DVec2;
 
-use super::loops::{LoopStep, free_loops};
+use super::loops::{Step, free_loops};
 use super::rounding::{chain_of, held_elements, runs};
 use crate::assembly::Assembly;
 use crate::fit::{RigidMotion, align, rigid_motion};
@@ -225,24 +225,7 @@ pub(super) fn counts_from_turns(
     let series = runs(asm.grammar(), data, &held);
     let mut paths = held_paths(data, &held);
     // a loop no held piece is on turns by a whole turn (a ring let go)
-    for steps in free_loops(asm, pose, &held) {
-        paths.push(
-            (steps.into_iter())
-                .map(|s| match s {
-                    LoopStep::Chain(c, sign) => Step::Chain(c, sign),
-                    LoopStep::Piece {
-                        instance,
-                        enter,
-                        leave,
-                    } => Step::Piece {
-                        instance,
-                        enter,
-                        leave,
-                    },
-                })
-                .collect(),
-        );
-    }
+    paths.extend(free_loops(asm, pose, &held));
     // each path's turn off its rest: its chains' and free pieces' misfits added up
     let alongs: Vec<Option<f64>> = (paths.iter())
         .map(|path| {
@@ -458,20 +441,6 @@ fn from_turn(c: usize, t: &ChainTurn, off: f64, hysteresis: f64) -> Option<(usiz
         .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
     let m = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5)?;
     Some((c, t.first, m))
-}
-
-/// A step of a path between held pieces ([`held_paths`]).
-#[derive(Debug)]
-enum Step {
-    /// A chain, with `1.0` where the path runs from its first element to its last and
-    /// `-1.0` the other way.
-    Chain(usize, f64),
-    /// A free piece, entered at one site and left at another.
-    Piece {
-        instance: usize,
-        enter: usize,
-        leave: usize,
-    },
 }
 
 /// The steps of the path between each two pieces the handles hold (of stable ids `held`,
