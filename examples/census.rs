@@ -12,6 +12,7 @@
 #[path = "../tests/generated/mod.rs"]
 mod generated;
 
+use std::io::Write as _;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -111,7 +112,7 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             }
             Err(why) => {
-                println!("case {k}: {why}");
+                let _ = writeln!(std::io::stdout(), "case {k}: {why}");
                 ExitCode::FAILURE
             }
         };
@@ -130,7 +131,8 @@ fn main() -> ExitCode {
                     if let Err(why) = case(&property, seed, k) {
                         failed.fetch_add(1, Ordering::Relaxed);
                         let first = why.lines().next().unwrap_or("");
-                        println!("case {k}: {first}");
+                        // a closed pipe (`| head`) ends the report, not the run in a panic
+                        let _ = writeln!(std::io::stdout(), "case {k}: {first}");
                     }
                 }
             });

@@ -277,7 +277,7 @@ impl Solver {
     }
 
     /// What the counts that close the loops propose (`closure.rs`): with the piece states the
-    /// relaxation kept (`kept`: the states and the relaxed pose), or with another assignment
+    /// relaxation kept (`forced`, relaxed to `f`), or with another assignment
     /// that relaxes as well (`tied`) when its whole counts close better by the hysteresis
     /// margin. Counts free, a turn's share moved from one bendable piece to another closes as
     /// well, and only the whole counts tell them apart: a tree whose far hub is led where a
@@ -384,12 +384,7 @@ impl Solver {
         moves.extend(hand_offs);
         let back: Vec<(usize, usize)> = (parts.iter().enumerate())
             .filter(|(pi, p)| {
-                matches!(p.kind, PartKind::Piece { .. })
-                    && p.states.len() > 1
-                    && (forced.iter().chain(&now))
-                        .find(|x| x.0 == *pi)
-                        .map_or(p.active, |x| x.1)
-                        != 0
+                matches!(p.kind, PartKind::Piece { .. }) && p.states.len() > 1 && state_of(*pi) != 0
             })
             .map(|(pi, _)| (pi, 0))
             .collect();
