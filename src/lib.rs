@@ -54,7 +54,8 @@ pub use session::{
     replay, toggle_pin,
 };
 pub use solver::{
-    FrameReport, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch, Stop,
+    FrameReport, Judged, PhaseTimes, Solver, SolverConfig, SolverError, SolverKind, StateSwitch,
+    Stop,
 };
 pub use summary::{FrameMs, Summary};
 

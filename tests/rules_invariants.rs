@@ -3,7 +3,7 @@
 
 use std::collections::HashSet;
 
-use clay::{RuleKind, StateSwitch, testing::cut, testing::replace, testing::stretch};
+use clay::{Judged, RuleKind, StateSwitch, testing::cut, testing::replace, testing::stretch};
 use clay_dsl::compiled::{AssemblyData, CompiledGrammar, PartKind};
 use glam::DVec2;
 use proptest::prelude::*;
@@ -115,13 +115,13 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             part: pi,
             from: 0,
             to: 1,
-            energy: None,
+            judged: Judged::Shape,
         },
         StateSwitch {
             part: pi,
             from: 1,
             to: 2,
-            energy: None,
+            judged: Judged::Shape,
         },
     ];
     let events = replace::replacement_events(&g, &mut d, &switches, &[]);
@@ -141,13 +141,13 @@ fn a_piece_part_switching_state_shows_it_and_reports_one_replace_event() {
             part: pi,
             from: 2,
             to: 0,
-            energy: None,
+            judged: Judged::Shape,
         },
         StateSwitch {
             part: pi,
             from: 0,
             to: 2,
-            energy: None,
+            judged: Judged::Shape,
         },
     ];
     assert!(replace::replacement_events(&g, &mut d, &back, &[]).is_empty());

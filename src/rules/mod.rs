@@ -34,7 +34,7 @@ use clay_dsl::compiled::CompiledGrammar;
 use glam::DVec2;
 
 use crate::assembly::Assembly;
-use crate::solver::{FrameReport, Proposal, StateSwitch};
+use crate::solver::{FrameReport, Judged, Proposal, StateSwitch};
 
 /// Runs the rules on a live assembly after each solver frame, and the cut operation.
 #[derive(Clone, Debug, Default)]
@@ -184,11 +184,13 @@ impl Rules {
             .filter_map(|&(part, to)| {
                 let p = parts.get_mut(part)?;
                 let from = std::mem::replace(&mut p.active, to);
+                // judged by energy, whose figures the session adds once it has them
+                // (`Session::try_proposals`): not by shape, so no shape figure
                 Some(StateSwitch {
                     part,
                     from,
                     to,
-                    energy: None,
+                    judged: Judged::Proposal,
                 })
             })
             .collect();

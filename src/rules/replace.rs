@@ -10,8 +10,8 @@ use glam::DVec2;
 
 use super::rewrite::{RuleEvent, RuleKind};
 use crate::figure::rests_better;
-use crate::solver::StateSwitch;
 use crate::solver::local::{Switching, VertexParts, judge};
+use crate::solver::{Judged, StateSwitch};
 
 /// Sets each piece part's instance to the part's active state and returns one event per
 /// instance that ends the frame in a different state than it started. `switches` are the
@@ -26,11 +26,11 @@ pub fn replacement_events(
 ) -> Vec<RuleEvent> {
     // First `from` per part: the state it had when the frame began.
     let mut began: BTreeMap<usize, usize> = BTreeMap::new();
-    // The energies of the last try that switched the part (a switch judged by energy).
-    let mut tried: BTreeMap<usize, Option<[f64; 2]>> = BTreeMap::new();
+    // What decided the part's last switch.
+    let mut decided_by: BTreeMap<usize, Judged> = BTreeMap::new();
     for s in switches {
         began.entry(s.part).or_insert(s.from);
-        tried.insert(s.part, s.energy);
+        decided_by.insert(s.part, s.judged);
     }
     let mut events = Vec::new();
     let pose = if decided.len() == data.positions.len() {
@@ -70,11 +70,15 @@ pub fn replacement_events(
         let judged = judge(pi, part, pose, how);
         let misfit = |s: usize| judged.distances.get(s).copied().unwrap_or(f64::NAN);
         let better = 1.0 - misfit(to) / misfit(from);
-        let why = match tried.get(&pi).copied().flatten() {
+        let why = match decided_by.get(&pi).copied().unwrap_or(Judged::Shape) {
             // a try's switch: the figures that decided it
-            Some([before, after]) => format!(": {}", rests_better(before, after)),
-            None if better.is_finite() => format!(", {:.0}% closer to its shape", 100.0 * better),
-            None => String::new(),
+            Judged::Energy([before, after]) => format!(": {}", rests_better(before, after)),
+            // a proposal's: the session adds the energies that decided it
+            Judged::Proposal => String::new(),
+            Judged::Shape if better.is_finite() => {
+                format!(", {:.0}% closer to its shape", 100.0 * better)
+            }
+            Judged::Shape => String::new(),
         };
         events.push(RuleEvent {
             kind: RuleKind::Replace,

@@ -11,7 +11,7 @@ use clay_dsl::compiled::Part;
 use glam::DVec2;
 
 use super::config::cone_cosine;
-use super::report::StateSwitch;
+use super::report::{Judged, StateSwitch};
 use super::state::Solver;
 use super::{chunks, growth, local};
 
@@ -73,7 +73,7 @@ impl Solver {
                         part: i,
                         from: part.active,
                         to: state,
-                        energy: None,
+                        judged: Judged::Shape,
                     });
                     part.active = state;
                 }
@@ -177,7 +177,7 @@ impl Solver {
                     part: i,
                     from: part.active,
                     to: chosen.state,
-                    energy: None,
+                    judged: Judged::Shape,
                 });
                 part.active = chosen.state;
             }

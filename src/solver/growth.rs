@@ -26,7 +26,7 @@ use std::collections::BTreeMap;
 use clay_dsl::compiled::{Part, PartKind, STRETCH_ONE, STRETCH_THREE};
 use glam::DVec2;
 
-use super::report::StateSwitch;
+use super::report::{Judged, StateSwitch};
 
 /// Keeps, for every chain and each of `three` and `one`, only the best of the parts that
 /// entered that state during the frame and are still in it (see the module doc): `claims` and
@@ -83,7 +83,7 @@ pub fn one_per_chain(
                 part: s.part,
                 from: s.to,
                 to: s.from,
-                energy: None,
+                judged: Judged::Shape,
             });
         }
     }
@@ -170,7 +170,7 @@ mod tests {
                     part,
                     from: STRETCH_TWO,
                     to,
-                    energy: None,
+                    judged: Judged::Shape,
                 }
             })
             .collect()
@@ -227,7 +227,7 @@ mod tests {
             part,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
-            energy: None,
+            judged: Judged::Shape,
         };
         // part 0 switched in an earlier iteration of the frame and now claims 3; part 1
         // claims 5 in this step: part 0 switches back
@@ -262,7 +262,7 @@ mod tests {
             part,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
-            energy: None,
+            judged: Judged::Shape,
         };
         let mut switches = vec![switch(0), switch(1)];
         assert!(one_per_chain(
@@ -285,7 +285,7 @@ mod tests {
             part: 2,
             from: STRETCH_TWO,
             to: STRETCH_THREE,
-            energy: None,
+            judged: Judged::Shape,
         }];
         assert!(!one_per_chain(
             &mut parts,
@@ -307,13 +307,13 @@ mod tests {
                 part: 0,
                 from: STRETCH_TWO,
                 to: STRETCH_ONE,
-                energy: None,
+                judged: Judged::Shape,
             },
             StateSwitch {
                 part: 1,
                 from: STRETCH_TWO,
                 to: STRETCH_THREE,
-                energy: None,
+                judged: Judged::Shape,
             },
         ];
         assert!(!one_per_chain(

@@ -43,13 +43,14 @@ pub use clock::Stop;
 pub use config::{SolverConfig, SolverKind};
 pub use measure::{bbox, bbox_diagonal, edge_strain, elastic_energy, max_edge_strain};
 // Names only the tests use, re-exported as `clay::testing::X`.
-pub use report::{FrameReport, PhaseTimes, Proposal, SolverError, StateSwitch};
+pub use report::{FrameReport, Judged, PhaseTimes, Proposal, SolverError, StateSwitch};
 pub use state::Solver;
 #[cfg(any(test, feature = "testing"))]
 pub use {follow::Components, measure::edge_strains};
 
 use std::time::{Duration, Instant};
 
+use clay_dsl::compiled::PartKind;
 use glam::DVec2;
 
 use crate::assembly::Assembly;

@@ -9,10 +9,22 @@ pub struct StateSwitch {
     pub part: usize,
     pub from: usize,
     pub to: usize,
-    /// Switched by a try of other states, judged by energy (`docs/solver.md`, "A held model
-    /// that stops strained tries other states"): the model's energy without the switch and
-    /// with it, settled alike. `None`: the local step's choice, by shape.
-    pub energy: Option<[f64; 2]>,
+    /// What decided it.
+    pub judged: Judged,
+}
+
+/// What decided a [`StateSwitch`]: what the rule log says of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Judged {
+    /// The local step's choice, by shape.
+    Shape,
+    /// A try of other states, by energy (`docs/solver.md`, "A held model that stops strained
+    /// tries other states"): the model's energy without the switch and with it, settled
+    /// alike.
+    Energy([f64; 2]),
+    /// A relaxation's proposal, by energies its caller states (the session's
+    /// `try_proposals`, which adds them to the events it keeps).
+    Proposal,
 }
 
 /// What one frame did.

@@ -12,7 +12,7 @@ use glam::DVec2;
 
 use super::clock::Stop;
 use super::global_step::Pass;
-use super::report::{FrameReport, SolverError, StateSwitch};
+use super::report::{FrameReport, Judged, SolverError, StateSwitch};
 use super::state::Solver;
 use super::{chunks, layout, local};
 use crate::assembly::{Assembly, Handle};
@@ -153,7 +153,7 @@ impl Solver {
                     part: pi,
                     from,
                     to,
-                    energy,
+                    judged: energy.map_or(Judged::Shape, Judged::Energy),
                 });
                 self.work.kept_by_trial.push(pi);
             }
