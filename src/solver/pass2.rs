@@ -18,7 +18,7 @@ use super::clock::{Stop, ms_since};
 use super::config::SolverConfig;
 use super::global_step::Pass;
 use super::report::{FrameReport, SolverError};
-use super::state::Solver;
+use super::state::{Rested, Solver};
 use crate::assembly::{Assembly, Handle};
 
 impl Solver {
@@ -192,7 +192,12 @@ impl Solver {
         // still and strained, other states not yet tried: the next frame tries them
         // (`settling`), so this one is not the last (a host that stops at convergence, as the
         // editor does, would never run it)
-        let trial_due = !self.work.tried && self.strained(terms.elastic);
+        let strained = self.strained(terms.elastic);
+        let trial_due = !self.work.tried && strained;
+        // at rest where the handles hold it (pass 2 stopped short of them is not)
+        if !strained && !self.strained(terms.handle) {
+            self.work.rested = Some(Rested::of(asm));
+        }
         report.converged =
             report.complete && report.switches.is_empty() && !trial_due && (settled || converged);
         // the shown pose is kept; the one shown before is the next frame's warm-start buffer

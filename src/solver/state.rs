@@ -16,7 +16,7 @@ use super::config::{SolverConfig, SolverKind};
 use super::global::Pattern;
 use super::growth::ChainLength;
 use super::report::SolverError;
-use super::{anderson, cg, follow, local, rest_cache, units};
+use super::{anderson, cg, follow, local, measure, rest_cache, units};
 use crate::assembly::Assembly;
 
 /// The solver for one live assembly. Keeps the sparsity pattern, the symbolic factorisation
@@ -133,6 +133,11 @@ impl Solver {
         self.l2_factor.invalidate();
         self.work.l2_diagonal.clear();
         self.generation = Some(asm.generation());
+        // a model loaded or rebuilt at rest rested there: a small move of the handles
+        // from it is elastic
+        if !self.strained(measure::elastic_energy(asm, &self.config)) {
+            self.work.rested = Some(Rested::of(asm));
+        }
         self.work.tried = false;
         self.work.kept_by_trial.clear();
         Ok(())
@@ -205,6 +210,30 @@ pub(super) struct Work {
     /// The parts whose states a try switched (by energy) since the handles or the structure
     /// last changed: pass 1 (by shape) does not switch them back meanwhile.
     pub(super) kept_by_trial: Vec<usize>,
+    /// Where the model last rested: what a small move is measured from ([`Rested`]).
+    pub(super) rested: Option<Rested>,
+}
+
+/// A pose the model rested in: its structure (the assembly's generation), its parts'
+/// states and its vertices' positions. While the structure and states are these, handles
+/// whose targets are less than the hysteresis in elements from these positions are answered
+/// elastically: the relaxation proposes nothing (`trials.rs`).
+#[derive(Debug)]
+pub(super) struct Rested {
+    pub(super) generation: u64,
+    pub(super) states: Vec<usize>,
+    pub(super) pose: Vec<DVec2>,
+}
+
+impl Rested {
+    /// `asm` as it is.
+    pub(super) fn of(asm: &Assembly) -> Self {
+        Self {
+            generation: asm.generation(),
+            states: asm.data().parts.iter().map(|p| p.active).collect(),
+            pose: asm.data().positions.clone(),
+        }
+    }
 }
 
 /// The evaluation of the pose pass 2 starts from (the displayed pose after rigid following),
