@@ -196,7 +196,7 @@ impl Solver {
         let trial_due = !self.work.tried && strained;
         // at rest where the handles hold it (pass 2 stopped short of them is not)
         if !strained && !self.strained(terms.handle) {
-            self.work.rested = Some(Rested::of(asm));
+            self.work.rested = Some(Rested::of(asm, self.work.rested.as_ref()));
         }
         report.converged =
             report.complete && report.switches.is_empty() && !trial_due && (settled || converged);

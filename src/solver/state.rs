@@ -8,7 +8,7 @@
 //! them in order. The state lives in its own file so that those children share it as
 //! siblings: none imports its parent. Its fields are `pub(super)`, the solver's own.
 
-use clay_dsl::compiled::Part;
+use clay_dsl::compiled::{Part, PartKind};
 use glam::DVec2;
 
 use super::cholesky::{NumericFactor, SymbolicFactor};
@@ -136,7 +136,7 @@ impl Solver {
         // a model loaded or rebuilt at rest rested there: a small move of the handles
         // from it is elastic
         if !self.strained(measure::elastic_energy(asm, &self.config)) {
-            self.work.rested = Some(Rested::of(asm));
+            self.work.rested = Some(Rested::of(asm, self.work.rested.as_ref()));
         }
         self.work.tried = false;
         self.work.kept_by_trial.clear();
@@ -223,15 +223,22 @@ pub(super) struct Rested {
     pub(super) generation: u64,
     pub(super) states: Vec<usize>,
     pub(super) pose: Vec<DVec2>,
+    /// Its shortest element's length (metres): what a small move is measured in.
+    pub(super) shortest: f64,
 }
 
 impl Rested {
-    /// `asm` as it is.
-    pub(super) fn of(asm: &Assembly) -> Self {
+    /// `asm` as it is; its shortest element as `before` measured it, for the same structure.
+    pub(super) fn of(asm: &Assembly, before: Option<&Rested>) -> Self {
+        let shortest = match before {
+            Some(r) if r.generation == asm.generation() => r.shortest,
+            _ => shortest_element(asm),
+        };
         Self {
             generation: asm.generation(),
             states: asm.data().parts.iter().map(|p| p.active).collect(),
             pose: asm.data().positions.clone(),
+            shortest,
         }
     }
 }
@@ -290,4 +297,38 @@ impl Work {
         };
         self.start.valid == key && self.shown == warm && states()
     }
+}
+
+/// The shortest element's length (metres) of `asm`: a stretch part's element, or a piece
+/// with alternative states, from its first site to its second (0 when it has neither).
+fn shortest_element(asm: &Assembly) -> f64 {
+    let grammar = asm.grammar();
+    let data = asm.data();
+    let length = |part: &Part| -> Option<f64> {
+        match part.kind {
+            PartKind::Stretch { .. } => {
+                let (one, three) = (part.states.first()?, part.states.get(2)?);
+                local::StretchEnds::find(&one.positions, &three.positions).map(|e| e.element)
+            }
+            PartKind::Piece { instance } if part.states.len() > 1 => {
+                let piece = grammar.pieces.get(data.instances.get(instance)?.piece)?;
+                let rest = &piece.states.first()?.positions;
+                let centre = |site: usize| -> Option<DVec2> {
+                    let vs = &piece.sites.get(site)?.vertices;
+                    let sum = vs
+                        .iter()
+                        .map(|&v| rest.get(v).copied())
+                        .sum::<Option<DVec2>>()?;
+                    Some(sum / vs.len().max(1) as f64)
+                };
+                Some(centre(0)?.distance(centre(1)?))
+            }
+            PartKind::Piece { .. } => None,
+        }
+    };
+    let shortest = (data.parts.iter())
+        .filter_map(length)
+        .filter(|l| l.is_finite() && *l > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if shortest.is_finite() { shortest } else { 0.0 }
 }

@@ -28,10 +28,11 @@ impl Solver {
         warm: &mut [DVec2],
         report: &mut FrameReport,
     ) -> Result<(), SolverError> {
+        let little = self.moved_little(asm);
         let settling = self.settling(report);
         self.work.last_targets.clone_from(&self.work.handle_sum);
         self.proposals = None;
-        if settling && self.moved_little(asm) {
+        if settling && little {
             // the elastic answer to a small move from rest: nothing to try
             self.work.tried = true;
         } else if settling {
@@ -50,14 +51,17 @@ impl Solver {
         Ok(())
     }
 
-    /// Whether the model rested with the structure and states it has and its handles' targets
-    /// are from where their vertices rested by less than the hysteresis times its shortest
-    /// element (paper 4.3, in elements, as a chain's count from its length): its strain is
-    /// the elastic answer to a small move, and neither a try nor the relaxation runs (a tree
-    /// moved 3 cm from rest was restructured into another rest configuration, its energy
-    /// 8.6e-6 against 2.7e-6; one moved 8 mm had a bend state switched by a try, its energy
-    /// 2.6e-7 before). Needed by `sec4_3_small_moves_switch_nothing`.
-    fn moved_little(&self, asm: &Assembly) -> bool {
+    /// Whether the model is held, rested with the structure and states it has, and its
+    /// handles' targets have stayed nearer where their vertices rested than the hysteresis
+    /// times its shortest element ever since (paper 4.3, in elements, as a chain's count from
+    /// its length): its strain is the elastic answer to a small move, and neither a try nor
+    /// the relaxation runs (a tree moved 3 cm from rest was restructured into another rest
+    /// configuration, its energy 8.6e-6 against 2.7e-6; one moved 8 mm had a bend state
+    /// switched by a try, its energy 2.6e-7 before). A model whose handles went further, or
+    /// whose structure or states changed, has left that rest until it rests again: pushed
+    /// past its `min` and brought back, it may be folded far from it. Needed by
+    /// `sec4_3_small_moves_switch_nothing`.
+    fn moved_little(&mut self, asm: &Assembly) -> bool {
         let w = &self.work;
         let Some(r) = &w.rested else {
             return false;
@@ -72,7 +76,12 @@ impl Solver {
             .filter(|((c, _), _)| **c > 0.0)
             .map(|((c, sum), at)| (*sum / *c).distance(*at))
             .fold(0.0, f64::max);
-        same && moved < self.config.hysteresis * shortest_element(asm)
+        let held = w.handle_count.iter().any(|&c| c > 0.0);
+        let near = same && moved < self.config.hysteresis * r.shortest;
+        if !near {
+            self.work.rested = None;
+        }
+        near && held
     }
 
     /// Whether this frame tries other rest states ([`Solver::try_states`]): the handles
@@ -315,37 +324,3 @@ const SETTLE_ITERATIONS: usize = 60;
 /// A model whose energy fell by less than this factor's complement over a frame (5%)
 /// creeps, held or free: it tries other states and the rest layout without waiting to stop.
 const CREEP: f64 = 0.95;
-
-/// The shortest element's length (metres) of `asm`: a stretch part's element, or a piece
-/// with alternative states, from its first site to its second (0 when it has neither).
-fn shortest_element(asm: &Assembly) -> f64 {
-    let grammar = asm.grammar();
-    let data = asm.data();
-    let length = |part: &Part| -> Option<f64> {
-        match part.kind {
-            PartKind::Stretch { .. } => {
-                let (one, three) = (part.states.first()?, part.states.get(2)?);
-                local::StretchEnds::find(&one.positions, &three.positions).map(|e| e.element)
-            }
-            PartKind::Piece { instance } if part.states.len() > 1 => {
-                let piece = grammar.pieces.get(data.instances.get(instance)?.piece)?;
-                let rest = &piece.states.first()?.positions;
-                let centre = |site: usize| -> Option<DVec2> {
-                    let vs = &piece.sites.get(site)?.vertices;
-                    let sum = vs
-                        .iter()
-                        .map(|&v| rest.get(v).copied())
-                        .sum::<Option<DVec2>>()?;
-                    Some(sum / vs.len().max(1) as f64)
-                };
-                Some(centre(0)?.distance(centre(1)?))
-            }
-            PartKind::Piece { .. } => None,
-        }
-    };
-    let shortest = (data.parts.iter())
-        .filter_map(length)
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if shortest.is_finite() { shortest } else { 0.0 }
-}
