@@ -12,6 +12,7 @@
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
+use clay_dsl::compiled::PartKind;
 use glam::DVec2;
 
 pub mod file;
@@ -266,9 +267,16 @@ impl Session {
             else {
                 continue;
             };
-            if proposal.then_lengths {
+            if proposal.then_lengths && !asm.data().chains.is_empty() {
                 // the counts a turn asks for, with the lengths they then ask for
-                for then in solver.relaxed_after(&trial) {
+                let parts = &asm.data().parts;
+                let kept: Vec<usize> = (proposal.states.iter())
+                    .filter_map(|&(part, _)| match parts[part].kind {
+                        PartKind::Piece { instance } => Some(instance),
+                        PartKind::Stretch { .. } => None,
+                    })
+                    .collect();
+                for then in solver.relaxed_after(&trial, &kept) {
                     if let Some((after, trial, more, _)) =
                         restructured(rules, &trial, &then, settle)
                     {

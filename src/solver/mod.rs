@@ -105,11 +105,19 @@ impl Solver {
 
     /// What the relaxation proposes for `asm` as it is (after a frame of this solver on it),
     /// its turns' proposals aside: the lengths a restructured copy then asks for
-    /// ([`Proposal::then_lengths`]). Empty when the relaxation fails.
-    pub(crate) fn relaxed_after(&mut self, asm: &Assembly) -> Vec<Proposal> {
+    /// ([`Proposal::then_lengths`]), with the states of the pieces in `kept` (instances: the
+    /// turn's own choice) left as they are: were they switched back, one proposal would
+    /// switch a piece out and back in a single step. Empty when the relaxation fails.
+    pub(crate) fn relaxed_after(&mut self, asm: &Assembly, kept: &[usize]) -> Vec<Proposal> {
         let warm = asm.data().positions.clone();
         let mut found = self.relax(asm, &warm).unwrap_or_default();
+        let parts = &asm.data().parts;
+        let keeps = |&(part, _): &(usize, usize)| matches!(parts[part].kind, PartKind::Piece { instance } if kept.contains(&instance));
         found.retain(|p| !p.then_lengths);
+        for p in &mut found {
+            p.states.retain(|s| !keeps(s));
+        }
+        found.retain(|p| !p.is_empty());
         found
     }
 

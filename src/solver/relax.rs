@@ -150,10 +150,22 @@ impl Solver {
         let same = |p: &Proposal, q: &Proposal| p.counts == q.counts && p.states == q.states;
         alternatives.extend(closes.filter(|p| !alternatives.iter().any(|q| same(p, q))));
         // a chain of turning elements: the count its ends' turn asks for (`turns.rs`)
-        for counts in counts_from_turns(asm, &f, hysteresis) {
+        for (counts, taken) in counts_from_turns(asm, &f, hysteresis) {
+            // the relaxed states, a piece's taken in another where the turn asks for it
+            let taken: Option<Vec<(usize, usize)>> = (taken.iter())
+                .map(|&(instance, state)| Some((asm.piece_part(instance)?, state)))
+                .collect();
+            let Some(taken) = taken else {
+                continue;
+            };
+            let mut states = self.relaxed_states(&data.parts, &forced, &f);
+            states.retain(|s| taken.iter().all(|t| t.0 != s.0));
+            let active = |&(part, state): &(usize, usize)| data.parts[part].active == state;
+            states.extend(taken.into_iter().filter(|t| !active(t)));
+            states.sort_unstable();
             alternatives.push(Proposal {
                 counts,
-                states: self.relaxed_states(&data.parts, &forced, &f),
+                states,
                 pose: f.clone(),
                 then_lengths: true,
             });

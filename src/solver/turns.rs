@@ -5,12 +5,11 @@
 //! lengths cannot see this (a ring of thirteen squeezed into twelve's circle keeps its
 //! length); the turn between the chain's end sites can.
 
-use std::cmp::Ordering;
-
 use clay_dsl::compiled::{
     AssemblyData, CompiledGrammar, Part, PartKind, STRETCH_TWO, StretchPart, StretchRule,
 };
 use glam::DVec2;
+use std::cmp::Ordering;
 
 use super::loops::{Step, free_loops};
 use super::rounding::{chain_of, held_elements, runs};
@@ -24,6 +23,19 @@ const STRAIGHT: f64 = 1e-3;
 /// The most elements a whole turn more adds to a chain in one proposal ([`from_turn`]):
 /// twelve 30-degree wedges, or 64 elements of 5.6 degrees.
 const WHOLE_TURN_MOST: usize = 64;
+
+/// A proposal of [`counts_from_turns`]: counts (`(chain, first, count)`, as a
+/// [`Proposal`]'s) and piece states (`(instance, state)`).
+///
+/// [`Proposal`]: super::report::Proposal
+pub(super) type Turned = (Vec<(usize, usize, usize)>, Vec<(usize, usize)>);
+
+/// Counts whose turns miss the held one within this (in element turns) miss alike.
+const ALIKE_TURN: f64 = 1e-3;
+
+/// Counts whose ends' distance apart at rest misses the pose's within this (in elements'
+/// lengths) miss alike.
+const ALIKE_CHORD: f64 = 1e-3;
 
 /// The centre of points.
 fn centre(ps: &[DVec2]) -> DVec2 {
@@ -183,6 +195,12 @@ impl ChainTurn {
         d.is_finite().then_some(d)
     }
 
+    /// How far an element carries its sites' centres at rest.
+    fn element_length(&self) -> f64 {
+        let last = centre(&self.rest_last(2));
+        last.distance(centre(&self.rest_last(3)))
+    }
+
     /// How far apart its first and last sites' centres are in the pose.
     fn span(&self) -> f64 {
         centre(&self.to).distance(centre(&self.from))
@@ -204,11 +222,7 @@ impl ChainTurn {
 /// there, not here.
 ///
 /// [`Proposal`]: super::report::Proposal
-pub(super) fn counts_from_turns(
-    asm: &Assembly,
-    pose: &[DVec2],
-    hysteresis: f64,
-) -> Vec<Vec<(usize, usize, usize)>> {
+pub(super) fn counts_from_turns(asm: &Assembly, pose: &[DVec2], hysteresis: f64) -> Vec<Turned> {
     let data = asm.data();
     let mut parts: Vec<Vec<(usize, &Part)>> = vec![Vec::new(); data.chains.len()];
     for p in &data.parts {
@@ -276,7 +290,7 @@ pub(super) fn counts_from_turns(
             }
         }
         for off in offs {
-            if let Some(change) = from_turn(c, t, off, hysteresis).map(|x| vec![x])
+            if let Some(change) = from_turn(c, t, off, hysteresis).map(|x| (vec![x], vec![]))
                 && !out.contains(&change)
             {
                 out.push(change);
@@ -286,9 +300,9 @@ pub(super) fn counts_from_turns(
     // the same turn between the holds split otherwise between a path's turning chains
     for (path, along) in paths.iter().zip(&alongs) {
         if let Some(along) = along {
-            for counts in splits(path, &turns, *along) {
-                if !out.contains(&counts) {
-                    out.push(counts);
+            for turned in splits(asm, path, &turns, *along) {
+                if !out.contains(&turned) {
+                    out.push(turned);
                 }
             }
         }
@@ -335,25 +349,25 @@ pub(super) fn counts_from_turns(
         if let Some(counts) = counts.map(|c| c.into_iter().filter(changed).collect::<Vec<_>>())
             && !counts.is_empty()
         {
-            out.push(counts);
+            out.push((counts, Vec::new()));
         }
     }
     out
 }
 
-/// Counts for two or more of the turning chains on a held `path` (its turn `along` off its
-/// rest), each one element more, fewer or as it is, that leave the path's turn as near its
-/// rest as any such counts do and as the counts it has: the turn between two holds fixes
-/// how many elements' turns the path takes, not how they are shared, and one element
-/// moved from an arc to another through a free hub moves the hub (a tree whose arcs of 3
-/// and 2 rest only as 2 and 3 when its far hub is led round: strain 0.03 at 3 and 2, the
-/// same turn). At most [`SPLIT_CHAINS`] turning chains, [`SPLIT_MOST`] proposals, fewest
-/// changes first; one chain alone is [`from_turn`]'s. The session judges each by energy.
-fn splits(
-    path: &[Step],
-    turns: &[Option<ChainTurn>],
-    along: f64,
-) -> Vec<Vec<(usize, usize, usize)>> {
+/// Counts for the turning chains on a held `path` (its turn `along` off its rest), each one
+/// element more, fewer or as it is, and its pieces' states ([`piece_takes`]), two changes or
+/// more, that leave the path's turn as near its rest as any such changes do and as it is: the turn between two holds fixes how much the path turns, not how its
+/// turning chains and pieces share it. One element moved from an arc to another through a
+/// free hub moves the hub (a tree whose arcs of 3 and 2 rest only as 2 and 3 when its far
+/// hub is led round: strain 0.03 at 3 and 2, the same turn); an arc of 20-degree elements
+/// one longer with a 10-degree bend piece mirrored turns as far as one shorter with the bend
+/// as it was, and only one of them closes whole (generated morph case 334: 5 and the bend
+/// mirrored rested at strain 0.025 where 4 and the bend rest). At most [`SPLIT_CHAINS`]
+/// turning chains, [`SPLIT_MOST`] proposals, fewest changes first; one change alone is
+/// [`from_turn`]'s (a chain) or the relaxation's (a piece, `relax.rs`). The session judges each by
+/// energy, with the lengths it then asks for.
+fn splits(asm: &Assembly, path: &[Step], turns: &[Option<ChainTurn>], along: f64) -> Vec<Turned> {
     let on: Vec<(&ChainTurn, f64, usize)> = (path.iter())
         .filter_map(|s| match *s {
             Step::Chain(d, sign) => turns[d]
@@ -363,20 +377,37 @@ fn splits(
             Step::Piece { .. } => None,
         })
         .collect();
-    if on.len() < 2 || on.len() > SPLIT_CHAINS {
+    // each other state of each piece on the path: (instance, state, how much more it turns)
+    let others: Vec<(usize, usize, f64)> = (path.iter())
+        .filter_map(|s| match *s {
+            Step::Piece {
+                instance,
+                enter,
+                leave,
+            } => Some(piece_states(asm, (instance, enter, leave))),
+            Step::Chain(..) => None,
+        })
+        .flatten()
+        .collect();
+    if on.len() > SPLIT_CHAINS || others.len() > SPLIT_STATES || on.len() + others.len() < 2 {
         return Vec::new();
     }
-    let smallest = on
-        .iter()
-        .map(|c| c.0.theta.abs())
+    // the unit misses are read in: the smallest element's turn, or piece state's change
+    let unit = (on.iter().map(|c| c.0.theta.abs()))
+        .chain(others.iter().map(|o| o.2.abs()))
+        .filter(|&x| x >= STRAIGHT)
         .fold(f64::INFINITY, f64::min);
-    // the path's misfit, in the smallest element's turns, with each chain changed by `by`
-    let miss = |by: &[i64]| {
+    if !unit.is_finite() {
+        return Vec::new();
+    }
+    // the path's misfit, in units, with each chain changed by `by` and the piece states
+    // `taken` (indices into `others`)
+    let miss = |(by, taken): &(Vec<i64>, Vec<usize>)| {
         let turned: f64 = (on.iter().zip(by))
             .map(|(c, &k)| c.1 * k as f64 * c.0.theta)
             .sum();
-        let x = wrap(along - turned).abs() / smallest;
-        (x * 1e6).round() / 1e6
+        let more: f64 = taken.iter().map(|&o| others[o].2).sum();
+        wrap(along - turned - more).abs() / unit
     };
     let allowed = |by: &[i64]| {
         (on.iter().zip(by)).all(|(c, &k)| {
@@ -384,26 +415,127 @@ fn splits(
             m >= c.0.min as i64 && c.0.max.is_none_or(|x| m <= x as i64)
         })
     };
+    let changes = |(by, taken): &(Vec<i64>, Vec<usize>)| {
+        by.iter().map(|k| k.unsigned_abs()).sum::<u64>() + taken.len() as u64
+    };
     let mut all: Vec<Vec<i64>> = vec![Vec::new()];
     for _ in 0..on.len() {
         all = (all.into_iter())
             .flat_map(|v| (-1..=1).map(move |k| [v.clone(), vec![k]].concat()))
             .collect();
     }
-    all.retain(|by| by.iter().filter(|&&k| k != 0).count() >= 2 && allowed(by));
-    let least = all.iter().map(|by| miss(by)).fold(f64::INFINITY, f64::min);
-    let now = miss(&vec![0; on.len()]);
-    all.retain(|by| miss(by) <= least.min(now));
-    all.sort_by_key(|by| by.iter().map(|k| k.abs()).sum::<i64>());
+    // the pieces' states: for each turn they can add up to, the fewest changes that do
+    let takes = piece_takes(asm, &others, unit);
+    let mut all: Vec<(Vec<i64>, Vec<usize>)> = (all.into_iter())
+        .flat_map(|by| takes.iter().map(move |t| (by.clone(), t.clone())))
+        .collect();
+    // a piece's other state with one turning chain taking up the rest of the turn, however
+    // many elements that is (a bend of 45 degrees handed on as 20 and two more 15-degree
+    // arc elements)
+    for o in 0..others.len() {
+        for i in 0..on.len() {
+            let t = on[i].0;
+            let turn = (std::f64::consts::TAU / t.theta.abs())
+                .ceil()
+                .min(WHOLE_TURN_MOST as f64);
+            let by = |k: i64| (0..on.len()).map(|j| if j == i { k } else { 0 }).collect();
+            let best = (-(t.count as i64)..=turn as i64)
+                .map(|k| (by(k), vec![o]))
+                .min_by(|x, y| {
+                    (miss(x), changes(x))
+                        .partial_cmp(&(miss(y), changes(y)))
+                        .unwrap_or(Ordering::Equal)
+                });
+            all.extend(best);
+        }
+    }
+    all.retain(|x| allowed(&x.0) && changes(x) >= 2);
+    all.sort();
+    all.dedup();
+    // alike within ALIKE_TURN: a piece's bend read from nine digits is not an exact
+    // multiple of an element's turn
+    let least = all.iter().map(&miss).fold(f64::INFINITY, f64::min);
+    let now = miss(&(vec![0; on.len()], Vec::new()));
+    all.retain(|x| miss(x) <= least.min(now) + ALIKE_TURN);
+    all.sort_by_key(changes);
     (all.iter().take(SPLIT_MOST))
-        .map(|by| {
-            (on.iter().zip(by))
+        .map(|(by, taken)| {
+            let counts = (on.iter().zip(by))
                 .filter(|(_, k)| **k != 0)
                 .map(|(c, &k)| (c.2, c.0.first, (c.0.count as i64 + k) as usize))
-                .collect()
+                .collect();
+            let states = taken.iter().map(|&o| (others[o].0, others[o].1));
+            (counts, states.collect())
         })
         .collect()
 }
+
+/// Most other piece states on one held path [`splits`] tries taking.
+const SPLIT_STATES: usize = 64;
+
+/// The other states `others` (`(instance, state, how much more it turns)`, each piece's
+/// together) the pieces of a path can take, at most one each, as indices into `others`:
+/// for each turn they add up to (alike within [`ALIKE_TURN`] of `unit`) and each change in
+/// how many pieces are in which state, the [`TAKES_EACH`] with the fewest changes, at most
+/// [`TAKES_MOST`] in all. The same states shared otherwise among the same pieces are left
+/// to the tries (a bend handed to a neighbour, `trials.rs`). A street's three 15-degree bends
+/// turn as one 45-degree bend does, three changes away (issue 46: led along the 45-degree
+/// bend path it rested at strain 0.03 in three `l15`s).
+fn piece_takes(asm: &Assembly, others: &[(usize, usize, f64)], unit: f64) -> Vec<Vec<usize>> {
+    let instances = &asm.data().instances;
+    let kind = |instance: usize, state: usize| (instances.get(instance).map(|x| x.piece), state);
+    // how many pieces more (or fewer) are in each state, by piece: (piece, state, more)
+    let net = |taken: &[usize]| {
+        let mut more: Vec<((Option<usize>, usize), i64)> = Vec::new();
+        for &o in taken {
+            let (instance, state, _) = others[o];
+            let now = instances.get(instance).map_or(usize::MAX, |x| x.state);
+            for (k, by) in [(kind(instance, state), 1), (kind(instance, now), -1)] {
+                match more.iter_mut().find(|m| m.0 == k) {
+                    Some(m) => m.1 += by,
+                    None => more.push((k, by)),
+                }
+            }
+        }
+        more.retain(|m| m.1 != 0);
+        more.sort_unstable();
+        more
+    };
+    let key = |sum: f64| (sum / unit / ALIKE_TURN).round() as i64;
+    let mut found: Vec<(f64, Vec<usize>)> = vec![(0.0, Vec::new())];
+    let mut i = 0;
+    while i < others.len() {
+        let instance = others[i].0;
+        let n = others[i..].iter().take_while(|o| o.0 == instance).count();
+        let mut next = found.clone();
+        for (sum, taken) in &found {
+            for (o, other) in others.iter().enumerate().skip(i).take(n) {
+                next.push((sum + other.2, [taken.clone(), vec![o]].concat()));
+            }
+        }
+        // fewest changes first: each turn's and state count's first TAKES_EACH stay
+        next.sort_by_key(|(_, taken)| taken.len());
+        let mut each: std::collections::HashMap<_, usize> = Default::default();
+        next.retain(|(sum, taken)| {
+            let seen = each.entry((key(*sum), net(taken))).or_default();
+            *seen += 1;
+            *seen <= TAKES_EACH
+        });
+        next.truncate(TAKES_MOST);
+        found = next;
+        i += n;
+    }
+    (found.into_iter())
+        .map(|f| f.1)
+        .filter(|taken| taken.is_empty() || !net(taken).is_empty())
+        .collect()
+}
+
+/// Most assignments of a path's piece states [`piece_takes`] keeps for one turn.
+const TAKES_EACH: usize = 4;
+
+/// Most assignments of a path's piece states [`piece_takes`] keeps.
+const TAKES_MOST: usize = 1024;
 
 /// Most turning chains on one held path whose shares of its turn [`splits`] tries.
 const SPLIT_CHAINS: usize = 4;
@@ -417,37 +549,48 @@ const SPLIT_MOST: usize = 4;
 fn from_turn(c: usize, t: &ChainTurn, off: f64, hysteresis: f64) -> Option<(usize, usize, usize)> {
     let n = t.count;
     // how far `m` elements' turn is from the one held, in element turns
-    // (to a millionth: counts a whole turn apart miss alike, not by rounding)
-    let miss = |m: usize| {
-        let x = wrap(off - (m as f64 - n as f64) * t.theta).abs() / t.theta.abs();
-        (x * 1e6).round() / 1e6
-    };
-    // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
-    // as in the pose among them, then the fewest elements (a whole loop more closes as
-    // well, and no one wants it: a stadium's arcs grown by pass 1 during a slow pull
-    // went on to 12 where 4 rest, 8 of them a loop)
-    let key = |m: usize| {
-        let chord = t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
-        ((miss(m) * 1e6).round(), (chord * 1e6).round(), m)
-    };
+    let miss = |m: usize| wrap(off - (m as f64 - n as f64) * t.theta).abs() / t.theta.abs();
+    // how far `m` elements' ends are apart at rest from how far they are in the pose
+    let chord = |m: usize| t.chord(m).map_or(f64::INFINITY, |x| (x - t.span()).abs());
     // up to a whole turn more than it has (and twice its count), a whole turn being at most
     // WHOLE_TURN_MOST elements: with elements that turn by thousandths of a radian it is
     // hundreds, and a misfit the relaxation spread reads as one of them (a fuzzed grammar's
     // chain of 8 was proposed 172, and judging it took seconds)
     let turn = ((std::f64::consts::TAU / t.theta.abs()).ceil() as usize).min(WHOLE_TURN_MOST);
     let hi = t.max.unwrap_or(usize::MAX).min((2 * n).max(n + turn) + 2);
-    let best = (t.min..=hi)
-        .filter(|&m| m != n)
-        .min_by(|&x, &y| key(x).partial_cmp(&key(y)).unwrap_or(Ordering::Equal));
-    let m = best.filter(|&m| miss(m) < (1.0 - hysteresis) * miss(n) && miss(m) < 0.5)?;
+    let counts: Vec<usize> = (t.min..=hi).filter(|&m| m != n).collect();
+    // counts a whole turn apart miss alike: the one whose ends are as far apart at rest
+    // as in the pose among them, then the fewest elements (a whole loop more closes as
+    // well, and no one wants it: a stadium's arcs grown by pass 1 during a slow pull
+    // went on to 12 where 4 rest, 8 of them a loop). Alike within tolerances, not to the
+    // last bit: an element's turn read from a grammar's nine digits is a whole turn in 36
+    // only to 1e-7, and 41 ten-degree arcs, their chord carried through 39 steps, beat 5
+    // by a rounding (generated morph case 3563 was proposed 41 where 5 rest)
+    let best_miss = counts
+        .iter()
+        .map(|&m| miss(m))
+        .fold(f64::INFINITY, f64::min);
+    let near: Vec<usize> = (counts.iter().copied())
+        .filter(|&m| miss(m) <= best_miss + ALIKE_TURN)
+        .collect();
+    let best_chord = near.iter().map(|&m| chord(m)).fold(f64::INFINITY, f64::min);
+    let alike = ALIKE_CHORD * t.element_length();
+    let best = (near.into_iter())
+        .filter(|&m| chord(m) <= best_chord + alike)
+        .min();
+    // better than its own by the hysteresis margin, and not alike: a ring a hand moved by
+    // centimetres misses by 1e-7 of a turn, and a whole turn more by less
+    let better = |m: usize| miss(m) + ALIKE_TURN < (1.0 - hysteresis) * miss(n);
+    let m = best.filter(|&m| better(m) && miss(m) < 0.5)?;
     Some((c, t.first, m))
 }
 
 /// The steps of the path between each two pieces the handles hold (of stable ids `held`,
 /// chain elements aside), through the docks. The turns along a path add up to the turn
 /// between its ends' holds, whatever free pieces lie between (a tree's hubs): what its
-/// turning chains' counts must match together. The fewest instances' path where several
-/// join the same two.
+/// turning chains' counts and its pieces' states must match together (a path of pieces
+/// alone too: a street of bendable segments held at both ends). The fewest instances' path
+/// where several join the same two.
 fn held_paths(data: &AssemblyData, held: &[u64]) -> Vec<Vec<Step>> {
     let chain_of = chain_of(data);
     // each instance's docked neighbours: (neighbour, own site, neighbour's site)
@@ -515,12 +658,42 @@ fn held_paths(data: &AssemblyData, held: &[u64]) -> Vec<Vec<Step>> {
                     }
                 }
             }
-            if path.iter().any(|s| matches!(s, Step::Chain(..))) {
+            if !path.is_empty() {
                 paths.push(path);
             }
         }
     }
     paths
+}
+
+/// Each other rest state of piece `instance`: `(instance, state, how much more it turns
+/// from site `enter` to site `leave` than in its state now)` (radians).
+fn piece_states(
+    asm: &Assembly,
+    (instance, enter, leave): (usize, usize, usize),
+) -> Vec<(usize, usize, f64)> {
+    let grammar = asm.grammar();
+    let Some(x) = asm.data().instances.get(instance) else {
+        return Vec::new();
+    };
+    let Some(piece) = grammar.pieces.get(x.piece) else {
+        return Vec::new();
+    };
+    let turn = |state: usize| -> Option<f64> {
+        let rest = &piece.states.get(state)?.positions;
+        let angle = |site: usize| {
+            let vs = &piece.sites.get(site)?.vertices;
+            site_angle(&[*rest.get(*vs.first()?)?, *rest.get(*vs.last()?)?])
+        };
+        Some(angle(leave)? - angle(enter)?)
+    };
+    let Some(now) = turn(x.state) else {
+        return Vec::new();
+    };
+    (0..piece.states.len())
+        .filter(|&s| s != x.state)
+        .filter_map(|s| Some((instance, s, wrap(turn(s)? - now))))
+        .collect()
 }
 
 /// How far (radians) free piece `instance`'s turn from site `enter` to site `leave` is from
@@ -577,7 +750,7 @@ mod tests {
         }
         let pose = asm.data().positions.clone();
         let proposals = counts_from_turns(&asm, &pose, 0.15);
-        for (chain, _, count) in proposals.into_iter().flatten() {
+        for (chain, _, count) in proposals.into_iter().flat_map(|p| p.0) {
             let n = asm.data().chains[chain].instances.len();
             let most = (2 * n).max(n + super::WHOLE_TURN_MOST) + 2;
             assert!(count <= most, "chain {chain} of {n} proposed {count}");
