@@ -217,7 +217,7 @@ pub(super) struct Work {
 /// A pose the model rested in: its structure (the assembly's generation), its parts'
 /// states and its vertices' positions. While the structure and states are these, handles
 /// whose targets are less than the hysteresis in elements from these positions are answered
-/// elastically: the relaxation proposes nothing (`trials.rs`).
+/// elastically: neither a try nor the relaxation runs (`trials.rs`, `Solver::moved_little`).
 #[derive(Debug)]
 pub(super) struct Rested {
     pub(super) generation: u64,

@@ -355,15 +355,15 @@ pub(super) fn counts_from_turns(asm: &Assembly, pose: &[DVec2], hysteresis: f64)
     out
 }
 
-/// Counts for the turning chains on a held `path` (its turn `along` off its rest), each one
-/// element more, fewer or as it is, and its pieces' states ([`piece_takes`]), two changes or
-/// more, that leave the path's turn as near its rest as any such changes do and as it is: the turn between two holds fixes how much the path turns, not how its
-/// turning chains and pieces share it. One element moved from an arc to another through a
-/// free hub moves the hub (a tree whose arcs of 3 and 2 rest only as 2 and 3 when its far
-/// hub is led round: strain 0.03 at 3 and 2, the same turn); an arc of 20-degree elements
-/// one longer with a 10-degree bend piece mirrored turns as far as one shorter with the bend
-/// as it was, and only one of them closes whole (generated morph case 334: 5 and the bend
-/// mirrored rested at strain 0.025 where 4 and the bend rest). At most [`SPLIT_CHAINS`]
+/// Counts for the turning chains on a held `path` (its turn `along` off its rest), each one element
+/// more, fewer or as it is, and its pieces' states ([`piece_takes`]), two changes or more, that
+/// leave the path's turn as near its rest as any such changes do and as it is: the turn between two
+/// holds fixes how much the path turns, not how its turning chains and pieces share it. One element
+/// moved from an arc to another through a free hub moves the hub (a tree whose arcs of 3 and 2 rest
+/// only as 2 and 3 when its far hub is led round: strain 0.03 at 3 and 2, the same turn); an arc of
+/// 20-degree elements one longer with a 10-degree bend piece mirrored turns as far as one shorter
+/// with the bend as it was, and only one of them closes whole (generated morph case 334: 5 and the
+/// bend mirrored rested at strain 0.025 where 4 and the bend rest). At most [`SPLIT_CHAINS`]
 /// turning chains, [`SPLIT_MOST`] proposals, fewest changes first; one change alone is
 /// [`from_turn`]'s (a chain) or the relaxation's (a piece, `relax.rs`). The session judges each by
 /// energy, with the lengths it then asks for.
