@@ -228,7 +228,8 @@ impl Session {
     /// Tries what the solver's relaxation proposed (`relax.rs`: a held model that stopped
     /// strained, `docs/solver.md`), each alternative on a copy of `asm`: the rules
     /// restructure it, it settles by least squares with its states fixed, and the one with
-    /// the lowest energy replaces `asm` when that is below `(1 - hysteresis)` times the energy
+    /// the lowest energy (of those at rest, the fewest elements and states changed:
+    /// [`changes`]) replaces `asm` when that is below `(1 - hysteresis)` times the energy
     /// of `asm` as it is, settled the same way (or `energy`, the frame's, if lower: paper 4.2,
     /// 4.3: the structure changes where a rest state fits better, judged by energy).
     /// Every alternative is tried, whatever the frame's budget: what a frame does must not
@@ -255,9 +256,22 @@ impl Session {
             return Vec::new();
         };
         let energy = report.energy.min(energy);
+        let solver = &self.solver;
+        // two at rest are alike: the fewer changes win (their energies differ by rounding
+        // alone, and which is lower changed with a far chain added to the model)
+        let rank = |e: f64, changed: usize| (!solver.strained(e)).then_some(changed);
         let mut best: Option<(f64, Assembly, Vec<RuleEvent>)> = None;
         let mut keep = |found: (f64, Assembly, Vec<RuleEvent>)| {
-            if best.as_ref().is_none_or(|b| found.0 < b.0) {
+            let better = best.as_ref().is_none_or(|b| {
+                match (
+                    rank(found.0, changes(asm, &found.1)),
+                    rank(b.0, changes(asm, &b.1)),
+                ) {
+                    (Some(x), Some(y)) => (x, found.0) < (y, b.0),
+                    _ => found.0 < b.0,
+                }
+            });
+            if better {
                 best = Some(found);
             }
         };
@@ -430,6 +444,21 @@ fn restructured(
     let mut solver = Solver::new(settle);
     let report = solver.frame(&mut trial).ok()?;
     Some((report.energy, trial, events, solver))
+}
+
+/// How far `b`'s structure is from `a`'s: the elements each chain gained or lost and the
+/// piece instances (by stable id) in another state.
+fn changes(a: &Assembly, b: &Assembly) -> usize {
+    let (a, b) = (a.data(), b.data());
+    let elements: usize = (a.chains.iter().zip(&b.chains))
+        .map(|(x, y)| x.instances.len().abs_diff(y.instances.len()))
+        .sum();
+    let states: std::collections::HashMap<u64, usize> =
+        a.instances.iter().map(|i| (i.id, i.state)).collect();
+    let switched = (b.instances.iter())
+        .filter(|i| states.get(&i.id).is_some_and(|&s| s != i.state))
+        .count();
+    elements + switched
 }
 
 /// Least-squares iterations that settle a restructured model before it is judged

@@ -112,7 +112,7 @@ impl Solver {
 
     /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
     /// squared (what [`Solver::try_states`] tries to lower).
-    pub(super) fn strained(&self, elastic: f64) -> bool {
+    pub(crate) fn strained(&self, elastic: f64) -> bool {
         let edge = self.units.smallest_edge();
         elastic > 1e-6 * edge * edge
     }
