@@ -534,3 +534,17 @@ fn sides_a_morph_leaves_alone_keep_their_counts() {
     }
     check::at_rest(&run, 1e-6).unwrap();
 }
+
+/// Paper 4.3 and locality: an arc of seven 45-degree elements between two hubs, its far hub
+/// led round to where nine rest, with a chain of 16 m elements far away. The small-move
+/// gate measured the shortest element over straight stretch elements only: the arc's were
+/// left out, the far chain's 16 m made the 1 m lead a small move, and nothing was tried
+/// (seven elements at strain 0.45, energy 0.92; alone, nine at rest; found by
+/// `far_pieces_change_nothing_in_an_assembly`, case 261 of seed 4242). An element that
+/// turns measures its chord.
+#[test]
+fn an_arc_led_round_grows_whatever_lies_far_away() {
+    let run = replay("arc_beside_a_far_chain");
+    assert_eq!(run.chain_count("l0x0"), 9, "{}", run.repro());
+    assert!(run.max_strain() <= 1e-3, "{}", run.repro());
+}
