@@ -7,7 +7,7 @@
 //! ```text
 //! cargo run --release --example census -- morph 1000 [--seed 4242] [--show K]
 //! ```
-//! Properties: morph, speed, round, pulled, relax, states, small.
+//! Properties: morph, speed, round, pulled, relax, states, small, determinism, far.
 
 #[path = "../tests/generated/mod.rs"]
 mod generated;
@@ -73,6 +73,8 @@ fn case(property: &str, seed: u64, k: u64) -> Result<(), String> {
             claims::pulled_and_back(&m, by, draw.frames(), draw.frames())
         }
         "relax" => claims::relaxation(&m, draw.frames()),
+        "determinism" => claims::deterministic(&m, draw.frames()),
+        "far" => claims::far_pieces_change_nothing(&m, draw.frames()),
         "states" => {
             let frames = 8 + draw.next() % 233;
             let push = DVec2::new(

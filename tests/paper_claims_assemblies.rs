@@ -142,3 +142,20 @@ proptest! {
         holds(more::rigid(&g.text(), at, by, strategy::round(degrees), frames))?;
     }
 }
+
+proptest! {
+    #![proptest_config(config(8, 27))]
+
+    /// The same morph twice gives bit-identical positions and the same rule events.
+    #[test]
+    fn determinism_of_an_assembly(m in morphs(), frames in strategy::frames()) {
+        holds(claims::deterministic(&m, frames))?;
+    }
+
+    /// A claim does not depend on how large the rest of the model is: a morph with a chain of
+    /// elements ten times the longest part far away ends with the same elements and states.
+    #[test]
+    fn far_pieces_change_nothing_in_an_assembly(m in morphs(), frames in strategy::frames()) {
+        holds(claims::far_pieces_change_nothing(&m, frames))?;
+    }
+}
