@@ -14,7 +14,7 @@ use glam::DVec2;
 use super::growth::ChainLength;
 use super::report::FrameReport;
 use super::state::Solver;
-use super::{layout, local};
+use super::{layout, local, turns};
 use crate::assembly::Assembly;
 
 impl Solver {
@@ -203,6 +203,16 @@ impl Solver {
             };
             let grow_above = count as f64 + wait;
             let mut allowed = 1 << STRETCH_TWO;
+            if !turns::chain_is_straight(rule) {
+                // a chain of turning elements (an arc) is counted by its turn, in the
+                // relaxation (`turns.rs`), not by its length: pulled straighter, its elements
+                // stretch, and one inserted turns the arc further where the holds keep its
+                // turn (a ring of two hubs pulled out over 240 frames curled an arc a whole
+                // turn more, 4 elements to 12, at rest; over 30, it kept 4)
+                w.stretch
+                    .push(Some(local::StretchContext { reference, allowed }));
+                continue;
+            }
             if count > rule.min.max(1) && !both_held && length <= shrink_below {
                 allowed |= 1 << STRETCH_ONE;
             }

@@ -96,7 +96,8 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
             claim: 0,
         };
     };
-    if let Some(ctx) = how.context(pi, part)
+    let ctx = how.context(pi, part);
+    if let Some(ctx) = ctx
         && let Some(sums) = state_sums(part, positions)
     {
         return decide_stretch(sums, active, hysteresis, ctx);
@@ -114,7 +115,8 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
     let mut best = (active, judge(&current.positions));
     let judged_here = best.1;
     for (j, state) in part.states.iter().enumerate() {
-        if j == active {
+        // a stretch part takes only the states its rule can honour now
+        if j == active || ctx.is_some_and(|c| !c.allows(j)) {
             continue;
         }
         let a = judge(&state.positions);

@@ -404,7 +404,13 @@ impl RestCache {
         let pose = &pose[..m];
         let rest = &self.rest[shape.rest as usize..][..count * m];
         let pp = &self.pp[shape.pp as usize..][..count];
-        if let Some(ctx) = how.context(pi, part)
+        let ctx = how.context(pi, part);
+        if ctx.is_some() && self.ends[s.shape as usize].is_none() {
+            // a stretch part that does not stretch straight (an arc's): the states its rule
+            // can honour, judged by shape
+            return choose_state(pi, part, positions, how);
+        }
+        if let Some(ctx) = ctx
             && let Some(ends) = &self.ends[s.shape as usize]
         {
             let mut sums = StateSums {
