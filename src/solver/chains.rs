@@ -141,6 +141,10 @@ impl Solver {
         let lengths = self.chain_lengths(asm, start);
         let rest_chords = self.rest_chords(asm, start, &lengths);
         let reversal = self.config.reversal;
+        // per stretch rule: whether its chain runs straight (else an arc, counted by its turn)
+        let straight: Vec<bool> = (grammar.stretch_rules.iter())
+            .map(turns::chain_is_straight)
+            .collect();
         let w = &mut self.work;
         let held_ids: Vec<u64> = asm
             .handles()
@@ -203,7 +207,7 @@ impl Solver {
             };
             let grow_above = count as f64 + wait;
             let mut allowed = 1 << STRETCH_TWO;
-            if !turns::chain_is_straight(rule) {
+            if !straight.get(c.rule).copied().unwrap_or(true) {
                 // a chain of turning elements (an arc) is counted by its turn, in the
                 // relaxation (`turns.rs`), not by its length: pulled straighter, its elements
                 // stretch, and one inserted turns the arc further where the holds keep its
