@@ -165,14 +165,14 @@ fn through(
 /// The counts of a run of chains in series (`run`, their relaxed lengths): of the counts
 /// within [`SPREAD`] of each one's nearest and within its rule's bounds, those whose lengths
 /// add up nearest the run's relaxed length, the fewest elements changed among equals. When
-/// none of those fits within [`CLOSE`] of its shortest element, every count that fits in the run's
-/// length is searched, and the fewest changes within [`CLOSE`] of the best fit win: elements of
-/// several lengths may fit a length only in a count far from the current ones (a wall of
-/// 0.949 m bricks and 2.509 m windows: 18.577 m is 9 and 4, nothing near 14 and 2), and
-/// nearly as well in others (0.78 m and 1.705 m elements: 16.615 m is 6 and 7 exactly, 17
-/// and 2 to 5.5 cm, a strain the model keeps: generated pulled case 748). Kept only
-/// when that misfit is below `(1 - hysteresis)` of the current counts' (paper 4.3). `None` for
-/// a run too long to search (more than [`LONGEST_RUN`] chains).
+/// none of those fits within [`CLOSE`] of its shortest element, every count that fits in the
+/// run's length is searched, and the fewest changes within [`CLOSE`] of the best fit win:
+/// elements of several lengths may fit a length only in a count far from the current ones (a
+/// wall of 0.949 m bricks and 2.509 m windows: 18.577 m is 9 and 4, nothing near 14 and 2),
+/// and nearly as well in others (0.78 m and 1.705 m elements: 16.615 m is 6 and 7 exactly, 17
+/// and 2 to 5.5 cm, a strain the model keeps: generated pulled case 748). Kept only when that
+/// misfit is below `(1 - hysteresis)` of the current counts' (paper 4.3). `None` for a run
+/// too long to search (more than [`LONGEST_RUN`] chains).
 pub(super) fn decide_run(run: &[&Relaxed], hysteresis: f64) -> Option<Vec<usize>> {
     if run.len() > LONGEST_RUN {
         return None;

@@ -110,8 +110,9 @@ impl Solver {
         still && (stopped || creeping) && untried && self.strained(self.work.start.elastic)
     }
 
-    /// Whether an elastic energy is not at rest: above a millionth of the mean rest edge
-    /// squared (what [`Solver::try_states`] tries to lower).
+    /// Whether an elastic energy is not at rest: above a millionth of the shortest rest edge
+    /// squared (what [`Solver::try_states`] tries to lower; the session's choice among
+    /// proposals that rest).
     pub(crate) fn strained(&self, elastic: f64) -> bool {
         let edge = self.units.smallest_edge();
         elastic > 1e-6 * edge * edge
