@@ -259,20 +259,16 @@ impl Session {
         let solver = &self.solver;
         // two at rest are alike: the fewer changes win (their energies differ by rounding
         // alone, and which is lower changed with a far chain added to the model)
-        let rank = |e: f64, changed: usize| (!solver.strained(e)).then_some(changed);
-        let mut best: Option<(f64, Assembly, Vec<RuleEvent>)> = None;
-        let mut keep = |found: (f64, Assembly, Vec<RuleEvent>)| {
-            let better = best.as_ref().is_none_or(|b| {
-                match (
-                    rank(found.0, changes(asm, &found.1)),
-                    rank(b.0, changes(asm, &b.1)),
-                ) {
-                    (Some(x), Some(y)) => (x, found.0) < (y, b.0),
-                    _ => found.0 < b.0,
-                }
+        let rank = |e: f64, trial: &Assembly| (!solver.strained(e)).then(|| changes(asm, trial));
+        let mut best: Option<(f64, Option<usize>, Assembly, Vec<RuleEvent>)> = None;
+        let mut keep = |(e, trial, events): (f64, Assembly, Vec<RuleEvent>)| {
+            let r = rank(e, &trial);
+            let better = best.as_ref().is_none_or(|b| match (r, b.1) {
+                (Some(x), Some(y)) => (x, e) < (y, b.0),
+                _ => e < b.0,
             });
             if better {
-                best = Some(found);
+                best = Some((e, r, trial, events));
             }
         };
         for proposal in proposals {
@@ -300,7 +296,7 @@ impl Session {
             }
             keep((after, trial, events));
         }
-        let Some((after, trial, mut events)) = best else {
+        let Some((after, _, trial, mut events)) = best else {
             return Vec::new();
         };
         let better = after < (1.0 - config.hysteresis) * energy;
