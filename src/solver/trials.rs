@@ -200,6 +200,28 @@ impl Solver {
         Ok(unfolded)
     }
 
+    /// `asm`'s parts laid at rest in their active states from its displayed pose and moved
+    /// onto its handles, as [`Solver::try_states`] lays them to leave a fold: where a
+    /// restructured model settles from when the rules' layout left it folded (an arc's
+    /// inserted element turned against its neighbours). The solver's last frame must have run
+    /// on `asm` as it is; `None` otherwise or when the layout leaves the finite numbers.
+    pub(crate) fn rest_layout_of(&self, asm: &Assembly) -> Option<Vec<DVec2>> {
+        let w = &self.work;
+        let pose = &asm.data().positions;
+        if w.handle_count.len() != pose.len() || w.handle_sum.len() != pose.len() {
+            return None;
+        }
+        let laid = layout::rest_layout(
+            &asm.data().parts,
+            &w.vertex_parts,
+            &self.components,
+            pose,
+            &w.handle_count,
+            &w.handle_sum,
+        );
+        laid.iter().all(|p| p.is_finite()).then_some(laid)
+    }
+
     /// The moves [`Solver::try_states`] tries, each a list of `(part, state)`: the few
     /// single switches whose state is nearest (by its shape distance at `warm` against the
     /// active one's), every bent piece part's state handed to each straight neighbour, and
