@@ -156,17 +156,8 @@ impl Solver {
         for (p, &a) in parts.iter_mut().zip(&actives) {
             p.active = a;
         }
-        let w = &self.work;
-        let laid = layout::rest_layout(
-            parts,
-            &w.vertex_parts,
-            &self.components,
-            warm,
-            &w.handle_count,
-            &w.handle_sum,
-        );
         let mut unfolded = None;
-        if laid.iter().all(|p| p.is_finite()) {
+        if let Some(laid) = self.rest_layout_at(parts, warm) {
             let e = self.settle(parts, handles, &laid, ITERATIONS, &actives, &[])?;
             if e < (1.0 - hysteresis) * baseline && best.as_ref().is_none_or(|b| e < b.0) {
                 best = Some((e, parts.iter().map(|p| p.active).collect()));
@@ -206,13 +197,19 @@ impl Solver {
     /// inserted element turned against its neighbours). The solver's last frame must have run
     /// on `asm` as it is; `None` otherwise or when the layout leaves the finite numbers.
     pub(crate) fn rest_layout_of(&self, asm: &Assembly) -> Option<Vec<DVec2>> {
+        self.rest_layout_at(&asm.data().parts, &asm.data().positions)
+    }
+
+    /// `parts` laid at rest in their active states from `pose` and moved onto the handles
+    /// (`layout::rest_layout`, with the last frame's components and handle targets); `None`
+    /// when those are of another model or the layout leaves the finite numbers.
+    fn rest_layout_at(&self, parts: &[Part], pose: &[DVec2]) -> Option<Vec<DVec2>> {
         let w = &self.work;
-        let pose = &asm.data().positions;
         if w.handle_count.len() != pose.len() || w.handle_sum.len() != pose.len() {
             return None;
         }
         let laid = layout::rest_layout(
-            &asm.data().parts,
+            parts,
             &w.vertex_parts,
             &self.components,
             pose,
