@@ -644,6 +644,17 @@ impl Morph {
     /// takes one at least. Starts with the
     /// first mover grabbed ([`Morph::hold_steps`]) and ends with the last one grabbed.
     pub fn lead(&self, from: &Config, to: &Config, frames: u64) -> Vec<String> {
+        self.lead_with(from, to, frames, false)
+    }
+
+    /// [`Morph::lead`] one frame a step: a drag over several frames becomes one drag a
+    /// frame to the points it passes (the same gesture), so that what happens in each frame
+    /// can be read in that frame's poses.
+    pub fn lead_by_frame(&self, from: &Config, to: &Config, frames: u64) -> Vec<String> {
+        self.lead_with(from, to, frames, true)
+    }
+
+    fn lead_with(&self, from: &Config, to: &Config, frames: u64, by_frame: bool) -> Vec<String> {
         let g = &self.graph;
         let n = frames.clamp(1, 40);
         let mut steps = Vec::new();
@@ -670,7 +681,14 @@ impl Morph {
                     (_, true) => share.max(1),
                     (_, false) => 1,
                 };
-                steps.push(step::drag_to(g.centroid(m, next[m]), f));
+                let (a, b) = (g.centroid(m, at[m]), g.centroid(m, next[m]));
+                if by_frame && f > 1 {
+                    for k in 1..=f {
+                        steps.push(step::drag_to(a.lerp(b, k as f64 / f as f64), 1));
+                    }
+                } else {
+                    steps.push(step::drag_to(b, f));
+                }
             }
             at = next;
         }
@@ -1461,16 +1479,16 @@ pub mod claims {
         check::at_rest(&run, 1e-6).map_err(|e| format!("{e}\n{}", m.describe()))
     }
 
-    /// The turn (degrees) from instance `i`'s west site to its east site in `pose`: 0 for a
-    /// straight bendable piece, its bend angle in a bent state.
-    fn site_turn(run: &Run, i: usize, pose: &[DVec2]) -> Option<f64> {
-        let data = run.asm.data();
-        let inst = &data.instances[i];
-        let piece = &run.grammar.pieces[inst.piece];
+    /// The turn (degrees) from `piece`'s west site to its east site, its vertices (by index
+    /// in the piece) at `at`: 0 for a straight bendable piece, its bend angle in a bent state.
+    fn site_turn(
+        piece: &clay_dsl::compiled::Piece,
+        at: impl Fn(usize) -> Option<DVec2>,
+    ) -> Option<f64> {
         let dir = |name: &str| -> Option<DVec2> {
             let site = piece.sites.iter().find(|s| s.name == name)?;
             let (&a, &b) = (site.vertices.first()?, site.vertices.last()?);
-            Some(*pose.get(inst.vertices[b])? - *pose.get(inst.vertices[a])?)
+            Some(at(b)? - at(a)?)
         };
         let (w, e) = (dir("west")?, dir("east")?);
         Some((-w).angle_to(e).to_degrees())
@@ -1489,48 +1507,67 @@ pub mod claims {
     ) -> Result<(), String> {
         let mut run = Run::new(&m.graph.text());
         run.steps(&m.hold_steps());
-        let h = run.session.config().hysteresis;
-        let bendable = &m.graph.bendables[0];
-        let mut why = Vec::new();
         // the morph, then the last mover pushed (by `push` elements' length) and turned
-        let mut steps = m.lead(&m.graph.start, &m.end, frames);
+        let mut steps = m.lead_by_frame(&m.graph.start, &m.end, frames);
         let length = m.graph.shortest();
-        for k in 1..=10 {
-            let _ = k;
+        for _ in 0..10 {
             steps.push(step::rotate(turn / 10.0, 0));
-            steps.push(step::drag(push * length / 10.0, 3));
-        }
-        for s in steps {
-            let before: Vec<(u64, usize)> = (run.asm.data().instances.iter())
-                .map(|i| (i.id, i.state))
-                .collect();
-            run.step(&s);
-            if !s.contains("\"drag\"") {
-                continue;
-            }
-            let pose = run.session.solver().pass1_pose().to_vec();
-            for (i, inst) in run.asm.data().instances.iter().enumerate() {
-                let was = before.iter().find(|b| b.0 == inst.id).map(|b| b.1);
-                let Some(was) = was.filter(|&w| w != inst.state) else {
-                    continue;
-                };
-                let Some(t) = site_turn(&run, i, &pose) else {
-                    continue;
-                };
-                let (old, new) = (bendable.turn(was), bendable.turn(inst.state));
-                // paper 4.3's margin is on the squared distance in shape space
-                if (t - new).powi(2) >= (1.0 - h) * (t - old).powi(2) {
-                    why.push(format!(
-                        "{} switched from {old} to {new} degrees at a turn of {t:.2}",
-                        inst.name
-                    ));
-                }
+            // a frame a step: each switch is read in the pass-1 pose of the frame it happened in
+            for _ in 0..3 {
+                steps.push(step::drag(push * length / 30.0, 1));
             }
         }
+        let mut why = switches_against_the_turn(&mut run, &steps);
         if !why.is_empty() {
             why.push(m.describe());
         }
         check::verdict(why, &run)
+    }
+
+    /// Runs `steps` (a frame each at most) on `run` and says of every piece with `west` and
+    /// `east` sites that switches in a frame where a handle moves, when the turn between its
+    /// sites in that frame's pass-1 pose is not nearer its new state's turn than its old
+    /// one's by the hysteresis margin (on the squared difference, as paper 4.3's on squared
+    /// shape distances). The states' turns come from the grammar's rest positions.
+    pub fn switches_against_the_turn(run: &mut Run, steps: &[String]) -> Vec<String> {
+        let h = run.session.config().hysteresis;
+        let mut why = Vec::new();
+        for s in steps {
+            // the instances pass 1 ran on: the frame's rules may renumber the vertices after it
+            let before = run.asm.data().instances.clone();
+            run.step(s);
+            if !s.contains("\"drag\"") {
+                continue;
+            }
+            let pose = run.session.solver().pass1_pose().to_vec();
+            for inst in &run.asm.data().instances {
+                let Some(was) = before.iter().find(|b| b.id == inst.id) else {
+                    continue;
+                };
+                if was.state == inst.state {
+                    continue;
+                }
+                let piece = &run.grammar.pieces[was.piece];
+                let rest = |j: usize| {
+                    let state = piece.states.get(j)?;
+                    site_turn(piece, |k| state.positions.get(k).copied())
+                };
+                let here = site_turn(piece, |k| pose.get(*was.vertices.get(k)?).copied());
+                let (Some(t), Some(old), Some(new)) = (here, rest(was.state), rest(inst.state))
+                else {
+                    continue;
+                };
+                if (t - new).powi(2) >= (1.0 - h) * (t - old).powi(2) {
+                    why.push(format!(
+                        "{} switched from {:.0} to {:.0} degrees at a turn of {t:.2}",
+                        inst.name,
+                        old + 0.0,
+                        new + 0.0
+                    ));
+                }
+            }
+        }
+        why
     }
 
     /// From rest, a handle moved by less than the hysteresis times the shortest element's
