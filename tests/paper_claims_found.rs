@@ -156,8 +156,9 @@ fn a_far_chain_of_long_elements_changes_nothing() {
 /// 0.2 m deep with quarter-turn states, the fence pushed in 0.3 m (a squeeze, no turn) keeps
 /// the post straight, as it keeps a post 1 m deep. Judged on its sites' vertices alone, the
 /// thin post's squeeze read as nearer its bent state (whose sites are closer) and it flipped
-/// between `right` and `base` 151 times in 330 frames; the sites are now judged spread to the
-/// part's size (`solver::local::Boundary`).
+/// between `right` and `base` 151 times in 330 frames. Its sites were then judged spread to
+/// the part's size; now a piece whose states differ in the turn between its sites is judged by
+/// that turn (`solver::local::SiteTurns`).
 #[test]
 fn a_thin_corner_pushed_gently_stays_straight() {
     let thin = fixture("thin_corner.clay");
@@ -172,6 +173,42 @@ fn a_thin_corner_pushed_gently_stays_straight() {
         assert_eq!(run.fired(RuleKind::Replace), 0, "{}", run.repro());
         assert_eq!(run.states("post"), ["base"], "{}", run.repro());
     }
+}
+
+/// Replays `tests/fixtures/found/<name>` (a frame a step) and says which switches of a piece
+/// with `west` and `east` sites the turn between them in the frame's pass-1 pose does not call
+/// for (`claims::switches_against_the_turn`).
+fn switches_against_the_turn(name: &str) -> (Run, Vec<String>) {
+    let script = fixture(&format!("{name}.json"));
+    let script: serde_json::Value = serde_json::from_str(&script).unwrap();
+    let steps: Vec<String> = (script["steps"].as_array().unwrap().iter())
+        .map(|s| s.to_string())
+        .collect();
+    let mut run = Run::new(&fixture(&format!("{name}.clay")));
+    let why = generated::assembly::claims::switches_against_the_turn(&mut run, &steps);
+    (run, why)
+}
+
+/// Paper 4.3, states follow the shape whatever the proportions (issue 46; generated states
+/// case 1452): a bend piece 3.62 m long and 1.01 m deep, squeezed in a model strained at 0.48,
+/// took its -75-degree state with its sites turned 1.9 degrees, then its -20, then `base` (three
+/// replacements, each "closer to its shape": its squeezed sites were nearer the bent states'
+/// shorter chord). A piece whose states differ in the turn between its sites is now judged by
+/// that turn (`solver::local::SiteTurns`).
+#[test]
+fn a_deep_bend_piece_squeezed_keeps_its_state() {
+    let (run, why) = switches_against_the_turn("deep_bend_squeezed");
+    assert!(why.is_empty(), "{why:?}\n{}", run.repro());
+}
+
+/// Paper 4.3 in the pose that decides (generated states case 2477): a bend piece switched to
+/// its 20-degree state at an iterate of pass 1 where its sites turned just over the margin,
+/// and pass 1 ended with them at 9.95 degrees, nearer `base`. A piece's switch in pass 1 now
+/// stands only if the pose the pass ends in still calls for it (`Solver::confirm_switches`).
+#[test]
+fn a_bend_switched_within_pass_1_holds_only_where_the_pass_ends() {
+    let (run, why) = switches_against_the_turn("bend_switched_mid_pass");
+    assert!(why.is_empty(), "{why:?}\n{}", run.repro());
 }
 
 /// Paper 5.1, Fig. 9 (issue 46, the hero example): the castle, its south-west tower pinned and

@@ -75,6 +75,19 @@ pub fn replacement_events(
             Judged::Energy([before, after]) => format!(": {}", rests_better(before, after)),
             // a proposal's: the session adds the energies that decided it
             Judged::Proposal => String::new(),
+            // judged by the turn between its sites: the turns that decided
+            Judged::Shape if judged.turns.is_some() => {
+                let (turn, states) = judged.turns.clone().unwrap_or_default();
+                let of = |s: usize| states.get(s).copied().unwrap_or(f64::NAN);
+                format!(
+                    ", its sites turn {turn:.1} degrees from `{}`'s, `{}` {:.1} and `{}` {:.1}",
+                    name(0),
+                    name(to),
+                    of(to),
+                    name(from),
+                    of(from)
+                )
+            }
             Judged::Shape if better.is_finite() => {
                 format!(", {:.0}% closer to its shape", 100.0 * better)
             }

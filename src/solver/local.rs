@@ -111,20 +111,20 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
         };
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
-    let judge = |rest: &[DVec2]| judged(part, positions, boundary.as_ref(), rest);
-    let mut best = (active, judge(&current.positions));
+    let judge = |j: usize| judged(part, positions, boundary.as_ref(), j);
+    let mut best = (active, judge(active));
     let judged_here = best.1;
-    for (j, state) in part.states.iter().enumerate() {
+    for j in 0..part.states.len() {
         // a stretch part takes only the states its rule can honour now
         if j == active || ctx.is_some_and(|c| !c.allows(j)) {
             continue;
         }
-        let a = judge(&state.positions);
-        if a.distance < best.1.distance {
-            best = (j, a);
+        let d = judge(j);
+        if d < best.1 {
+            best = (j, d);
         }
     }
-    let (state, _) = with_hysteresis(active, judged_here, best, hysteresis);
+    let state = switched(active, judged_here, best, hysteresis);
     let rotation = if state == active {
         here.rotation
     } else {
@@ -137,45 +137,106 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
     }
 }
 
-/// How well rest shape `rest` of `part` fits the pose: on the `boundary` vertices
-/// ([`boundary_of`]), each docking site spread to the part's size, when there are such, else
-/// on all of the part's vertices.
-fn judged(
-    part: &Part,
-    positions: &[DVec2],
-    boundary: Option<&Boundary>,
-    rest: &[DVec2],
-) -> Alignment {
+/// How far rest state `j` of `part` is from the pose: on the `boundary` vertices
+/// ([`boundary_of`], [`Boundary::distance`]) when there are such, else its shape distance
+/// over all of the part's vertices.
+fn judged(part: &Part, positions: &[DVec2], boundary: Option<&Boundary>, j: usize) -> f64 {
+    let rest = &part.states[j].positions;
     match boundary {
-        Some(b) => b.align(&b.points(|k| rest[k]), |k| positions[part.vertices[k]]),
-        None => align(rest, &part.vertices, positions),
+        Some(b) => b.distance(j, &b.points(|k| rest[k]), |k| positions[part.vertices[k]]),
+        None => align(rest, &part.vertices, positions).distance,
     }
 }
 
 /// The vertices of a piece part with alternative rest states that it shares with other
-/// parts ([`boundary_of`]), grouped by the parts they are shared with (one group per docking
-/// site), each group spread about its centre to the part's own size.
-///
-/// Why spread: the states of a part that bends differ in the turn between its sites and in
-/// the distance between them. A site as narrow as a thin piece (a fence corner 0.2 m deep and
-/// 1 m long) turned by a quarter moves its vertices a tenth of a metre, less than a squeeze
-/// moves them, so a gentle push read as a bend and the corner snapped to 90 degrees (the
-/// deep piece stayed straight). Spread to the distance between the sites, a turn weighs as
-/// much as a move whatever the piece's depth: what `sec4_3_states_follow_the_shape` asks.
+/// parts ([`boundary_of`]): where it meets its neighbours, judged on their shape, or on the
+/// turn between its two docking sites ([`SiteTurns`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Boundary {
     /// Local indices of the shared vertices.
     local: Vec<usize>,
-    /// Per entry of `local`: its group.
-    group: Vec<usize>,
-    /// Per group: the factor its vertices are spread by about their centre (at least 1).
-    spread: Vec<f64>,
+    /// Two docking sites whose turn differs between every two states: the states are judged
+    /// by that turn alone ([`SiteTurns`]).
+    turns: Option<SiteTurns>,
+}
+
+/// The turn between a piece part's two docking sites, by which its states are judged when
+/// they all differ in it (by [`TURNS_APART`] at least): a bendable piece's `bend` states and
+/// their mirrors. Each site's rotation is its least-squares rotation from the part's first
+/// state onto the pose (or onto another state); the turn is the second site's rotation less
+/// the first's, so it is measured from the first state's turn.
+///
+/// Why: judged on shape, a piece whose states differ in turn also reads a squeeze or a
+/// stretch between its sites as nearer a state whose sites are nearer or further apart. A
+/// deep piece (3.6 m long, 1 m deep) squeezed in a strained model took its 75-degree state at
+/// a turn of 1.9 degrees between its sites, and a thin fence corner pushed gently took its
+/// quarter turn. Paper 4.3 asks that small changes of the input give small changes of the
+/// output; the turn is what a bend state is, whatever the piece's proportions.
+#[derive(Clone, Debug, PartialEq)]
+struct SiteTurns {
+    /// Per site: the indices into [`Boundary::local`] of its vertices.
+    sites: [Vec<usize>; 2],
+    /// Per site: the first state's positions of its vertices.
+    first: [Vec<DVec2>; 2],
+    /// Per state: its turn from the first state's, as a unit complex number.
+    of_state: Vec<DVec2>,
+}
+
+/// How far apart (radians) every two states' turns between the sites must be for a part to
+/// be judged by its turn: one degree; closer states differ in something else.
+pub const TURNS_APART: f64 = std::f64::consts::PI / 180.0;
+
+impl SiteTurns {
+    /// The turns of `part`'s states between the two `groups` (indices into `local`) of its
+    /// shared vertices; `None` when a site has fewer than two vertices, a state gives a site
+    /// no rotation, or two states turn alike.
+    fn new(part: &Part, local: &[usize], groups: [Vec<usize>; 2]) -> Option<Self> {
+        let at = |j: usize, g: usize| -> Option<Vec<DVec2>> {
+            (groups[g].iter())
+                .map(|&i| part.states[j].positions.get(local[i]).copied())
+                .collect()
+        };
+        if groups.iter().any(|g| g.len() < 2) {
+            return None;
+        }
+        let first = [at(0, 0)?, at(0, 1)?];
+        let of_state = (0..part.states.len())
+            .map(|j| turn_between(&first, [&at(j, 0)?, &at(j, 1)?]))
+            .collect::<Option<Vec<DVec2>>>()?;
+        let apart = (0..of_state.len())
+            .all(|a| (0..a).all(|b| angle_between(of_state[a], of_state[b]).abs() >= TURNS_APART));
+        apart.then_some(Self {
+            sites: groups,
+            first,
+            of_state,
+        })
+    }
+
+    /// The pose's turn between the sites (`at` by local vertex index), from the first
+    /// state's; `None` when a site has collapsed to a point.
+    fn of_pose(&self, local: &[usize], at: impl Fn(usize) -> DVec2) -> Option<DVec2> {
+        let pose =
+            |g: usize| -> Vec<DVec2> { self.sites[g].iter().map(|&i| at(local[i])).collect() };
+        turn_between(&self.first, [&pose(0), &pose(1)])
+    }
+}
+
+/// The second site's rotation from `first[1]` onto `to[1]` less the first site's, as a unit
+/// complex number.
+fn turn_between(first: &[Vec<DVec2>; 2], to: [&[DVec2]; 2]) -> Option<DVec2> {
+    let a = crate::fit::rigid_rotation(&first[0], to[0])?;
+    let b = crate::fit::rigid_rotation(&first[1], to[1])?;
+    DVec2::new(a.dot(b), a.perp_dot(b)).try_normalize()
+}
+
+/// The angle (radians, in [-pi, pi]) from unit complex number `a` to `b`.
+fn angle_between(a: DVec2, b: DVec2) -> f64 {
+    a.perp_dot(b).atan2(a.dot(b))
 }
 
 impl Boundary {
-    /// Groups `local` (indices into `part.vertices`) by the parts sharing each vertex; each
-    /// group's spread is the first state's distance of the groups' centres from their mean
-    /// over the group's own radius (root mean squares), or 1 when the group is as wide.
+    /// Groups `local` (indices into `part.vertices`) by the parts sharing each vertex (a
+    /// docking site each); with two, the turns between them ([`SiteTurns`]).
     fn new(part: &Part, local: Vec<usize>, shared: &VertexParts) -> Self {
         let mut keys: Vec<&[usize]> = Vec::new();
         let group: Vec<usize> = (local.iter())
@@ -187,26 +248,13 @@ impl Boundary {
                 })
             })
             .collect();
-        let first = &part.states[0].positions;
-        let centres = centres(&group, keys.len(), |i| first[local[i]]);
-        let mean = centres.iter().copied().sum::<DVec2>() / centres.len() as f64;
-        let size = rms(centres.iter().map(|&c| c - mean));
-        let spread = (0..keys.len())
-            .map(|g| {
-                let own = (0..local.len()).filter(|&i| group[i] == g);
-                let radius = rms(own.map(|i| first[local[i]] - centres[g]));
-                if radius > 0.0 && size > radius {
-                    size / radius
-                } else {
-                    1.0
-                }
+        let turns = (keys.len() == 2)
+            .then(|| {
+                let of = |g: usize| (0..local.len()).filter(|&i| group[i] == g).collect();
+                SiteTurns::new(part, &local, [of(0), of(1)])
             })
-            .collect();
-        Self {
-            local,
-            group,
-            spread,
-        }
+            .flatten();
+        Self { local, turns }
     }
 
     /// Local indices of the shared vertices.
@@ -214,45 +262,42 @@ impl Boundary {
         &self.local
     }
 
-    /// The boundary's points of `at` (by local vertex index), each group spread about its
-    /// centre by its factor.
+    /// The boundary's points of `at` (by local vertex index).
     pub fn points(&self, at: impl Fn(usize) -> DVec2) -> Vec<DVec2> {
-        let raw: Vec<DVec2> = self.local.iter().map(|&k| at(k)).collect();
-        let centres = centres(&self.group, self.spread.len(), |i| raw[i]);
-        (raw.iter().zip(&self.group))
-            .map(|(&p, &g)| centres[g] + (p - centres[g]) * self.spread[g])
-            .collect()
+        self.local.iter().map(|&k| at(k)).collect()
     }
 
-    /// How well `rest` (a state's [`Boundary::points`]) fits the pose `at` gives.
-    pub fn align(&self, rest: &[DVec2], at: impl Fn(usize) -> DVec2) -> Alignment {
-        crate::fit::align_points(rest, &self.points(at))
+    /// How far state `j` (`rest`: its [`Boundary::points`]) is from the pose `at` gives: the
+    /// squared difference (radians) of their turns between the sites when the part is judged
+    /// by its turn ([`SiteTurns`]) and the pose's sites have one, else the shape distance of
+    /// the points.
+    pub fn distance(&self, j: usize, rest: &[DVec2], at: impl Fn(usize) -> DVec2) -> f64 {
+        if let Some(t) = &self.turns
+            && let Some(turn) = t.of_pose(&self.local, &at)
+            && let Some(&state) = t.of_state.get(j)
+        {
+            return angle_between(state, turn).powi(2);
+        }
+        crate::fit::align_points(rest, &self.points(at)).distance
     }
-}
 
-/// The centre of each of `groups` groups of the points `at(i)`, `group[i]` naming point
-/// `i`'s.
-fn centres(group: &[usize], groups: usize, at: impl Fn(usize) -> DVec2) -> Vec<DVec2> {
-    let mut sum = vec![DVec2::ZERO; groups];
-    let mut count = vec![0usize; groups];
-    for (i, &g) in group.iter().enumerate() {
-        sum[g] += at(i);
-        count[g] += 1;
+    /// The turns (degrees) between the sites, from the first state's, of the pose `at` gives
+    /// and of each state, when the part is judged by its turn ([`SiteTurns`]).
+    pub fn turns(&self, at: impl Fn(usize) -> DVec2) -> Option<(f64, Vec<f64>)> {
+        let t = self.turns.as_ref()?;
+        let pose = t.of_pose(&self.local, at)?;
+        let degrees = |u: DVec2| angle_between(DVec2::X, u).to_degrees();
+        Some((
+            degrees(pose),
+            t.of_state.iter().map(|&u| degrees(u)).collect(),
+        ))
     }
-    (sum.iter().zip(&count))
-        .map(|(&s, &n)| s / n.max(1) as f64)
-        .collect()
-}
-
-/// The root mean square length of `vectors` (0 for none).
-fn rms(vectors: impl Iterator<Item = DVec2>) -> f64 {
-    let (sum, n) = vectors.fold((0.0, 0usize), |(s, n), v| (s + v.length_squared(), n + 1));
-    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
 }
 
 /// The vertices of a piece part with alternative rest states that it shares with other parts,
-/// when there are at least two and fewer than all (paper 5.1, replacement: "the shape of the
-/// boundary vertices determines which piece to insert"), as a [`Boundary`]. The others belong
+/// when there are at least two and fewer than all, or all when the part is judged by the turn
+/// between its sites ([`SiteTurns`]) (paper 5.1, replacement: "the shape of the boundary
+/// vertices determines which piece to insert"), as a [`Boundary`]. The others belong
 /// to the part alone and take whichever state it takes, so they decide nothing: judged with
 /// them, a segment whose ends are where its bent state puts them reads as no nearer that
 /// state than its straight one, its middle still where the straight state's elasticity holds
@@ -264,7 +309,7 @@ pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Boundary> {
     let ks: Vec<usize> = (0..part.vertices.len())
         .filter(|&k| shared.of(part.vertices[k]).len() >= 2)
         .collect();
-    if ks.len() < 2 || ks.len() == part.vertices.len() {
+    if ks.len() < 2 {
         return None;
     }
     // the states must differ there: a part docked by one site has that site's shape in
@@ -285,7 +330,13 @@ pub fn boundary_of(part: &Part, shared: &VertexParts) -> Option<Boundary> {
             align(&first, &indices, &other).distance > 1e-9 * scale
         })
     });
-    differ.then(|| Boundary::new(part, ks, shared))
+    if !differ {
+        return None;
+    }
+    let every = ks.len() == part.vertices.len();
+    let b = Boundary::new(part, ks, shared);
+    // every vertex shared: judged on its shape, unless by its turn
+    (!every || b.turns.is_some()).then_some(b)
 }
 
 /// A stretch part's sums over its centred pose for its three states (as [`align`] forms
@@ -543,6 +594,9 @@ pub struct Judgement {
     pub available: Vec<bool>,
     /// For a stretch part: the state its length calls for, and its length in elements.
     pub candidate: Option<(usize, f64)>,
+    /// For a piece part judged by the turn between its sites ([`Boundary::distance`]): that
+    /// turn in the pose and each state's, in degrees from the first state's.
+    pub turns: Option<(f64, Vec<f64>)>,
 }
 
 /// The [`Judgement`] of part `pi` (`part`) at `positions`, as [`choose_state`] makes it.
@@ -556,16 +610,19 @@ pub fn judge(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Jud
             distances: view.distances.to_vec(),
             available: (0..n).map(|j| ctx.allows(j)).collect(),
             candidate: Some((view.candidate, view.length)),
+            turns: None,
         };
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
-    let distances = (part.states.iter())
-        .map(|st| judged(part, positions, boundary.as_ref(), &st.positions).distance)
+    let distances = (0..n)
+        .map(|j| judged(part, positions, boundary.as_ref(), j))
         .collect();
+    let turns = boundary.and_then(|b| b.turns(|k| positions[part.vertices[k]]));
     Judgement {
         distances,
         available: vec![true; n],
         candidate: None,
+        turns,
     }
 }
 
@@ -578,10 +635,20 @@ pub fn with_hysteresis(
     best: (usize, Alignment),
     hysteresis: f64,
 ) -> (usize, DVec2) {
-    if best.0 != active && best.1.distance < (1.0 - hysteresis) * here.distance {
-        (best.0, best.1.rotation)
-    } else {
+    if switched(active, here.distance, (best.0, best.1.distance), hysteresis) == active {
         (active, here.rotation)
+    } else {
+        (best.0, best.1.rotation)
+    }
+}
+
+/// Paper 4.3 on distances: `best.0` when it is not `active` and its distance `best.1` is
+/// below `(1 - hysteresis)` times the active state's `here`, else `active`.
+pub fn switched(active: usize, here: f64, best: (usize, f64), hysteresis: f64) -> usize {
+    if best.0 != active && best.1 < (1.0 - hysteresis) * here {
+        best.0
+    } else {
+        active
     }
 }
 

@@ -73,6 +73,7 @@ impl Solver {
         let mut converged = iterations == 0;
         let mut last_iteration = Duration::ZERO;
         let mut result = Ok(());
+        let first_switch = report.switches.len();
         for it in 0..iterations {
             if it >= MIN_PASS1_ITERATIONS && stop.before(false, it, last_iteration) {
                 report.complete = false;
@@ -107,6 +108,9 @@ impl Solver {
                 converged = true;
                 break;
             }
+        }
+        if result.is_ok() {
+            self.confirm_switches(parts, &f, first_switch, &mut report.switches);
         }
         *pose = f;
         self.work.next = next;

@@ -9,7 +9,8 @@ use glam::DVec2;
 
 use super::local::{
     self as local, Chosen, PartMeasure, StateSums, StretchEnds, Switching, VertexParts,
-    boundary_of, choose_state, decide_stretch, normalised_or, part_rotation, with_hysteresis,
+    boundary_of, choose_state, decide_stretch, normalised_or, part_rotation, switched,
+    with_hysteresis,
 };
 use crate::fit::{distance_of, finish, rotation_of};
 
@@ -486,16 +487,16 @@ impl RestCache {
         let verts = &self.vertices[s.vertex as usize..];
         let n = b.judged.local().len();
         let at = |k: usize| positions[verts[k] as usize];
-        let judge = |j: usize| b.judged.align(&b.rest[j * n..][..n], at);
+        let judge = |j: usize| b.judged.distance(j, &b.rest[j * n..][..n], at);
         let here = judge(active);
         let mut best = (active, here);
         for j in (0..b.states()).filter(|&j| j != active) {
-            let a = judge(j);
-            if a.distance < best.1.distance {
-                best = (j, a);
+            let d = judge(j);
+            if d < best.1 {
+                best = (j, d);
             }
         }
-        let (state, _) = with_hysteresis(active, here, best, hysteresis);
+        let state = switched(active, here, best, hysteresis);
         let m = pose.len();
         let (dot, cross) = products(&rest[state * m..][..m], pose);
         Chosen {
