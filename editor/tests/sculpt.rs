@@ -195,6 +195,36 @@ fn the_inspector_explains_the_active_state() {
     }
 }
 
+/// A piece whose states differ in the turn between its sites is judged by that turn, and the
+/// inspector says so: each state's turn and the pose's (`bend.clay`: a street of six roads
+/// with quarter-turn `left` and `right` states, straight at rest).
+#[test]
+fn the_inspector_explains_a_bend_by_its_turn() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../grammars/bend.clay");
+    let text = std::fs::read_to_string(path).unwrap();
+    let c = compile(&text, path, &[]).expect("bend.clay compiles");
+    let mut s = Sculpt::new(c.grammar);
+    settle(&mut s);
+    // an inner road: docked by both sites
+    let parts = &s.data().parts;
+    let judged: Vec<_> = (0..parts.len())
+        .filter_map(|p| s.inspect(p))
+        .filter(|r| r.why.turns.is_some())
+        .collect();
+    assert_eq!(judged.len(), 4, "the four inner roads of six");
+    for r in judged {
+        let (turn, states) = r.why.turns.clone().unwrap();
+        assert!(turn.abs() < 1e-6, "straight at rest: {turn}");
+        let want = [0.0, 90.0, -90.0];
+        assert!(
+            states.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
+            "{states:?}"
+        );
+        assert!(r.why.at_rest);
+        assert_eq!(r.why.states[r.why.active].0, "base");
+    }
+}
+
 #[test]
 fn cutting_a_connection_is_one_undoable_step() {
     let mut s = castle();

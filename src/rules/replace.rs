@@ -76,16 +76,15 @@ pub fn replacement_events(
             // a proposal's: the session adds the energies that decided it
             Judged::Proposal => String::new(),
             // judged by the turn between its sites: the turns that decided
-            Judged::Shape if judged.turns.is_some() => {
-                let (turn, states) = judged.turns.clone().unwrap_or_default();
-                let of = |s: usize| states.get(s).copied().unwrap_or(f64::NAN);
+            Judged::Shape if let Some(turns) = by_turn(&judged.turns, to, from) => {
                 format!(
-                    ", its sites turn {turn:.1} degrees from `{}`'s, `{}` {:.1} and `{}` {:.1}",
+                    ", its sites turn {:.1} degrees from `{}`'s, `{}` {:.1} and `{}` {:.1}",
+                    turns[0],
                     name(0),
                     name(to),
-                    of(to),
+                    turns[1],
                     name(from),
-                    of(from)
+                    turns[2]
                 )
             }
             Judged::Shape if better.is_finite() => {
@@ -108,6 +107,14 @@ pub fn replacement_events(
         });
     }
     events
+}
+
+/// The pose's turn between a piece's sites and states `to`'s and `from`'s, when it is judged
+/// by that turn and all three are finite.
+fn by_turn(turns: &Option<(f64, Vec<f64>)>, to: usize, from: usize) -> Option<[f64; 3]> {
+    let (turn, states) = turns.as_ref()?;
+    let t = [*turn, *states.get(to)?, *states.get(from)?];
+    t.iter().all(|x| x.is_finite()).then_some(t)
 }
 
 fn centroid(positions: &[DVec2], vertices: &[usize]) -> DVec2 {

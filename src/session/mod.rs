@@ -49,10 +49,14 @@ pub struct PartReport {
     pub part: usize,
     /// The active state's index in `states`.
     pub active: usize,
-    /// Every rest state's name with the shape-space distance the state choice compares
-    /// (squared: a piece part's over the vertices it shares with other parts, a stretch
-    /// part's in its chain's frame) to the current pose.
+    /// Every rest state's name with the distance the state choice compares to the current
+    /// pose: the squared shape-space distance (a piece part's over the vertices it shares
+    /// with other parts, a stretch part's in its chain's frame), or for a piece judged by the
+    /// turn between its sites (`turns`), the squared difference of the turns in radians.
     pub states: Vec<(String, f64)>,
+    /// For a piece judged by the turn between its two docking sites: that turn in the pose
+    /// and each state's, in degrees from the first state's.
+    pub turns: Option<(f64, Vec<f64>)>,
     /// Per rest state: whether it may become active now (a stretch part's `one` at its
     /// chain's `min`, say, may not).
     pub available: Vec<bool>,
@@ -393,6 +397,12 @@ impl Session {
                 .map(|&v| data.positions[v])
                 .collect::<Vec<_>>(),
         );
+        // judged by its turn: at rest within a thousandth of a radian
+        let rest_within = if judged.turns.is_some() {
+            1e-6
+        } else {
+            1e-6 * size * size
+        };
         Some(PartReport {
             part,
             active,
@@ -400,8 +410,9 @@ impl Session {
             switch_below: (1.0 - hysteresis) * d_active,
             available: judged.available,
             candidate: judged.candidate,
-            at_rest: d_active <= 1e-6 * size * size,
+            at_rest: d_active <= rest_within,
             states,
+            turns: judged.turns,
         })
     }
 

@@ -40,6 +40,14 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
     if let Some((_, length)) = report.why.candidate {
         ui.label(format!("its two elements span {length:.2} elements"));
     }
+    let turns = report.why.turns.as_ref();
+    if let Some((turn, _)) = turns {
+        let first = report.why.states.first().map_or("?", |s| s.0.as_str());
+        crate::prose::label(
+            ui,
+            &format!("judged by the turn between its sites: {turn:.1} degrees from `{first}`'s"),
+        );
+    }
     if report.why.states.len() > 1 {
         let best_other = report
             .why
@@ -80,9 +88,16 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
     }
     egui::Grid::new("states").striped(true).show(ui, |ui| {
         ui.label("rest state");
-        ui.label("misfit (m²)").on_hover_text(
-            "shape-space distance from the current pose, squared, after the best rotation",
-        );
+        if turns.is_some() {
+            ui.label("turn (degrees)")
+                .on_hover_text("the state's turn between its sites, from the first state's");
+            ui.label("misfit (rad²)")
+                .on_hover_text("the difference between the state's turn and the pose's, squared");
+        } else {
+            ui.label("misfit (m²)").on_hover_text(
+                "shape-space distance from the current pose, squared, after the best rotation",
+            );
+        }
         ui.end_row();
         for (i, (name, d)) in report.why.states.iter().enumerate() {
             let text = if i == report.why.active {
@@ -91,6 +106,10 @@ pub fn inspector(ui: &mut egui::Ui, sculpt: &Sculpt, part: Option<usize>) {
                 RichText::new(name)
             };
             ui.label(text);
+            if let Some((_, of_state)) = turns {
+                let turn = of_state.get(i).filter(|t| t.is_finite());
+                ui.label(turn.map_or("-".to_string(), |t| format!("{t:.1}")));
+            }
             ui.label(format!("{d:.4}"));
             ui.end_row();
         }
