@@ -111,7 +111,10 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
         };
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
-    let judge = |j: usize| judged(part, positions, boundary.as_ref(), j);
+    let turn = boundary
+        .as_ref()
+        .and_then(|b| b.pose_turn(|k| positions[part.vertices[k]]));
+    let judge = |j: usize| judged(part, positions, boundary.as_ref(), turn, j);
     let mut best = (active, judge(active));
     let judged_here = best.1;
     for j in 0..part.states.len() {
@@ -138,12 +141,20 @@ pub fn choose_state(pi: usize, part: &Part, positions: &[DVec2], how: Switching)
 }
 
 /// How far rest state `j` of `part` is from the pose: on the `boundary` vertices
-/// ([`boundary_of`], [`Boundary::distance`]) when there are such, else its shape distance
+/// ([`boundary_of`], [`Boundary::distance_at`]) when there are such, else its shape distance
 /// over all of the part's vertices.
-fn judged(part: &Part, positions: &[DVec2], boundary: Option<&Boundary>, j: usize) -> f64 {
+fn judged(
+    part: &Part,
+    positions: &[DVec2],
+    boundary: Option<&Boundary>,
+    turn: Option<DVec2>,
+    j: usize,
+) -> f64 {
     let rest = &part.states[j].positions;
+    let at = |k: usize| positions[part.vertices[k]];
     match boundary {
-        Some(b) => b.distance(j, &b.points(|k| rest[k]), |k| positions[part.vertices[k]]),
+        Some(b) if turn.is_some() => b.distance_at(j, &[], turn, at),
+        Some(b) => b.distance_at(j, &b.points(|k| rest[k]), None, at),
         None => align(rest, &part.vertices, positions).distance,
     }
 }
@@ -213,11 +224,25 @@ impl SiteTurns {
     }
 
     /// The pose's turn between the sites (`at` by local vertex index), from the first
-    /// state's; `None` when a site has collapsed to a point.
+    /// state's; `None` when a site has collapsed to a point. As [`turn_between`], without
+    /// gathering the points (it runs for every such part in every local step).
     fn of_pose(&self, local: &[usize], at: impl Fn(usize) -> DVec2) -> Option<DVec2> {
-        let pose =
-            |g: usize| -> Vec<DVec2> { self.sites[g].iter().map(|&i| at(local[i])).collect() };
-        turn_between(&self.first, [&pose(0), &pose(1)])
+        let rotation = |g: usize| {
+            let (first, site) = (&self.first[g], &self.sites[g]);
+            let q = |k: usize| at(local[site[k]]);
+            let inv = 1.0 / first.len() as f64;
+            let pc = first.iter().copied().sum::<DVec2>() * inv;
+            let qc = (0..site.len()).map(q).sum::<DVec2>() * inv;
+            let (mut dot, mut cross) = (0.0, 0.0);
+            for (k, &p) in first.iter().enumerate() {
+                let (a, b) = (p - pc, q(k) - qc);
+                dot += a.dot(b);
+                cross += a.perp_dot(b);
+            }
+            DVec2::new(dot, cross).try_normalize()
+        };
+        let (a, b) = (rotation(0)?, rotation(1)?);
+        DVec2::new(a.dot(b), a.perp_dot(b)).try_normalize()
     }
 }
 
@@ -267,14 +292,25 @@ impl Boundary {
         self.local.iter().map(|&k| at(k)).collect()
     }
 
+    /// The pose's turn between the sites when the part is judged by its turn and the pose's
+    /// sites have one ([`SiteTurns`]), once for all states.
+    pub fn pose_turn(&self, at: impl Fn(usize) -> DVec2) -> Option<DVec2> {
+        self.turns.as_ref()?.of_pose(&self.local, at)
+    }
+
     /// How far state `j` (`rest`: its [`Boundary::points`]) is from the pose `at` gives: the
     /// squared difference (radians) of their turns between the sites when the part is judged
-    /// by its turn ([`SiteTurns`]) and the pose's sites have one, else the shape distance of
-    /// the points.
-    pub fn distance(&self, j: usize, rest: &[DVec2], at: impl Fn(usize) -> DVec2) -> f64 {
-        if let Some(t) = &self.turns
-            && let Some(turn) = t.of_pose(&self.local, &at)
-            && let Some(&state) = t.of_state.get(j)
+    /// by its turn and the pose's sites have one (`turn`, [`Boundary::pose_turn`]; `rest` is
+    /// not read then), else the shape distance of the points.
+    pub fn distance_at(
+        &self,
+        j: usize,
+        rest: &[DVec2],
+        turn: Option<DVec2>,
+        at: impl Fn(usize) -> DVec2,
+    ) -> f64 {
+        if let Some(turn) = turn
+            && let Some(&state) = self.turns.as_ref().and_then(|t| t.of_state.get(j))
         {
             return angle_between(state, turn).powi(2);
         }
@@ -594,7 +630,7 @@ pub struct Judgement {
     pub available: Vec<bool>,
     /// For a stretch part: the state its length calls for, and its length in elements.
     pub candidate: Option<(usize, f64)>,
-    /// For a piece part judged by the turn between its sites ([`Boundary::distance`]): that
+    /// For a piece part judged by the turn between its sites ([`Boundary::distance_at`]): that
     /// turn in the pose and each state's, in degrees from the first state's.
     pub turns: Option<(f64, Vec<f64>)>,
 }
@@ -614,8 +650,11 @@ pub fn judge(pi: usize, part: &Part, positions: &[DVec2], how: Switching) -> Jud
         };
     }
     let boundary = how.shared.and_then(|vp| boundary_of(part, vp));
+    let turn = boundary
+        .as_ref()
+        .and_then(|b| b.pose_turn(|k| positions[part.vertices[k]]));
     let distances = (0..n)
-        .map(|j| judged(part, positions, boundary.as_ref(), j))
+        .map(|j| judged(part, positions, boundary.as_ref(), turn, j))
         .collect();
     let turns = boundary.and_then(|b| b.turns(|k| positions[part.vertices[k]]));
     Judgement {

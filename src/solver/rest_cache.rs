@@ -487,7 +487,8 @@ impl RestCache {
         let verts = &self.vertices[s.vertex as usize..];
         let n = b.judged.local().len();
         let at = |k: usize| positions[verts[k] as usize];
-        let judge = |j: usize| b.judged.distance(j, &b.rest[j * n..][..n], at);
+        let turn = b.judged.pose_turn(at);
+        let judge = |j: usize| b.judged.distance_at(j, &b.rest[j * n..][..n], turn, at);
         let here = judge(active);
         let mut best = (active, here);
         for j in (0..b.states()).filter(|&j| j != active) {
