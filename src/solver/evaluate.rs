@@ -242,7 +242,7 @@ impl Solver {
     /// Paper 4.3 in the pose pass 1 hands the rules: a piece part that switched by shape in
     /// this pass (`switches[first..]`) keeps its new state only if that state is nearer the
     /// last pose `f` than the one it began the pass in by the hysteresis margin; else the
-    /// part goes back to that one and its switches leave the list. Returns whether any did.
+    /// part goes back to that one and its switches leave the list.
     ///
     /// Why: each iteration's local step judges the pose before that iteration's solve, so a
     /// part could switch at an iterate just past the margin and the pass end just short of
@@ -255,7 +255,7 @@ impl Solver {
         f: &[DVec2],
         first: usize,
         switches: &mut Vec<StateSwitch>,
-    ) -> bool {
+    ) {
         let mut began: Vec<(usize, usize)> = Vec::new();
         for s in switches.iter().skip(first) {
             let piece = matches!(parts[s.part].kind, PartKind::Piece { .. });
@@ -264,7 +264,7 @@ impl Solver {
             }
         }
         if began.is_empty() {
-            return false;
+            return;
         }
         let how = local::Switching {
             hysteresis: 0.0,
@@ -281,19 +281,22 @@ impl Solver {
             let judged = local::judge(pi, &parts[pi], f, how);
             let d = |j: usize| judged.distances.get(j).copied().unwrap_or(f64::NAN);
             // NaN keeps the switch: nothing to judge it by
-            if d(to) >= (1.0 - h) * d(from) {
+            let (here, there) = (d(from), d(to));
+            if !here.is_nan()
+                && !there.is_nan()
+                && local::switched(from, here, (to, there), h) == from
+            {
                 parts[pi].active = from;
                 undo.push(pi);
             }
         }
         if undo.is_empty() {
-            return false;
+            return;
         }
         let mut step = switches.split_off(first);
         step.retain(|s| !undo.contains(&s.part));
         switches.append(&mut step);
         self.evaluate_fixed(parts, f);
-        true
     }
 }
 
