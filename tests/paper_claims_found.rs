@@ -211,6 +211,38 @@ fn a_bend_switched_within_pass_1_holds_only_where_the_pass_ends() {
     assert!(why.is_empty(), "{why:?}\n{}", run.repro());
 }
 
+/// Paper 4.3, 5.1, round trip (generated round case 8649): two hubs joined by a run of six
+/// bricks, a small free hub and six more, then a bend piece to a third hub, which is turned
+/// 60 degrees and led back. Out, the bend took its 60-degree state and the run lost three
+/// bricks; back, the bend went straight by its turn, and in every frame after, pass 1 flipped
+/// it to its mirrored state and back within its iterations. The flip stayed in the frame's
+/// switches, so no frame counted as still: the held model tried nothing and was never
+/// relaxed, its hubs stretched to strain 2.5 for 240 frames. A part that ends pass 1 in the
+/// state it began it in switched nothing (`Solver::confirm_switches`).
+#[test]
+fn a_bend_flipped_there_and_back_in_pass_1_lets_the_held_model_rest() {
+    let run = replay("bend_flipped_and_back");
+    assert_eq!(run.count("e0"), 12, "{}", run.repro());
+    assert_eq!(run.states("k0"), ["base"], "{}", run.repro());
+    assert_at_rest(&run);
+}
+
+/// Paper 4.2, 5.1, morph to a rest configuration (generated morph case 7384): a tree whose
+/// held path runs through a straight chain, an arc of four 45-degree elements (`min 2`) and
+/// a bend piece; its far hub teleported and turned 225 degrees, where the arc of nine rests
+/// with the bend straight. The bend took 60 degrees and the arc shrank to two, 15 degrees
+/// short (energy 0.014). The turn proposals (`turns.rs`, `splits`) take a piece's other state
+/// with one arc taking up the rest of the turn, the fewest elements that do: the bend
+/// straight and the arc one element fewer, below its `min`, which was then dropped, and with
+/// it the whole turn more (seven elements) that fits within the rule.
+#[test]
+fn a_bend_given_back_to_an_arc_at_its_min_takes_a_whole_turn_more() {
+    let run = replay("bend_back_to_an_arc_at_its_min");
+    assert_eq!(run.chain_count("l0x1"), 9, "{}", run.repro());
+    assert_eq!(run.chain_count("l0x0"), 8, "{}", run.repro());
+    check::at_rest(&run, 1e-6).unwrap();
+}
+
 /// Paper 5.1, Fig. 9 (issue 46, the hero example): the castle, its south-west tower pinned and
 /// the north-east one dragged to 1.5x and to 0.75x its size, grows and shrinks its walls to the
 /// counts a rectangle of rest walls has there (counts from lengths: 18 m x 12 m between tower

@@ -242,13 +242,18 @@ impl Solver {
     /// Paper 4.3 in the pose pass 1 hands the rules: a piece part that switched by shape in
     /// this pass (`switches[first..]`) keeps its new state only if that state is nearer the
     /// last pose `f` than the one it began the pass in by the hysteresis margin; else the
-    /// part goes back to that one and its switches leave the list.
+    /// part goes back to that one. A part that ends the pass in the state it began it in,
+    /// so, or having switched there and back, switched nothing: its switches leave the list.
     ///
     /// Why: each iteration's local step judges the pose before that iteration's solve, so a
     /// part could switch at an iterate just past the margin and the pass end just short of
     /// it: a bend piece took its 20-degree state with its sites turned 9.95 degrees in the
     /// pose that decided the frame, 7 of 10^4 generated cases of
-    /// `sec4_3_states_follow_the_shape` (`tests/paper_claims_assemblies.rs`).
+    /// `sec4_3_states_follow_the_shape` (`tests/paper_claims_assemblies.rs`). And a switch
+    /// there and back within the pass, left in the list, made every frame one that switched:
+    /// a held model never converged, tried nothing and was never relaxed (generated round
+    /// case 8649: a bend piece flipped to its mirror and back in every frame's pass 1, the
+    /// model held at strain 2.5 for 240 frames).
     pub(super) fn confirm_switches(
         &mut self,
         parts: &mut [Part],
@@ -258,13 +263,9 @@ impl Solver {
     ) {
         let mut began: Vec<(usize, usize)> = Vec::new();
         for s in switches.iter().skip(first) {
-            let piece = matches!(parts[s.part].kind, PartKind::Piece { .. });
-            if piece && s.judged == Judged::Shape && !began.iter().any(|b| b.0 == s.part) {
+            if !began.iter().any(|b| b.0 == s.part) {
                 began.push((s.part, s.from));
             }
-        }
-        if began.is_empty() {
-            return;
         }
         let how = local::Switching {
             hysteresis: 0.0,
@@ -273,9 +274,19 @@ impl Solver {
         };
         let h = self.config.hysteresis;
         let mut undo = Vec::new();
+        let mut reverted = false;
         for (pi, from) in began {
             let to = parts[pi].active;
             if to == from {
+                undo.push(pi);
+                continue;
+            }
+            let by_shape = switches.iter().skip(first).any(|s| {
+                s.part == pi
+                    && s.judged == Judged::Shape
+                    && matches!(parts[pi].kind, PartKind::Piece { .. })
+            });
+            if !by_shape {
                 continue;
             }
             let judged = local::judge(pi, &parts[pi], f, how);
@@ -288,6 +299,7 @@ impl Solver {
             {
                 parts[pi].active = from;
                 undo.push(pi);
+                reverted = true;
             }
         }
         if undo.is_empty() {
@@ -296,7 +308,9 @@ impl Solver {
         let mut step = switches.split_off(first);
         step.retain(|s| !undo.contains(&s.part));
         switches.append(&mut step);
-        self.evaluate_fixed(parts, f);
+        if reverted {
+            self.evaluate_fixed(parts, f);
+        }
     }
 }
 

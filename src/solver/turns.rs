@@ -438,9 +438,14 @@ fn splits(asm: &Assembly, path: &[Step], turns: &[Option<ChainTurn>], along: f64
             let turn = (std::f64::consts::TAU / t.theta.abs())
                 .ceil()
                 .min(WHOLE_TURN_MOST as f64);
-            let by = |k: i64| (0..on.len()).map(|j| if j == i { k } else { 0 }).collect();
+            let by = |k: i64| -> Vec<i64> {
+                (0..on.len()).map(|j| if j == i { k } else { 0 }).collect()
+            };
+            // among the counts the chain's rule allows: the nearest fit below its `min`
+            // hid the whole turn more that fits within it
             let best = (-(t.count as i64)..=turn as i64)
                 .map(|k| (by(k), vec![o]))
+                .filter(|x| allowed(&x.0))
                 .min_by(|x, y| {
                     (miss(x), changes(x))
                         .partial_cmp(&(miss(y), changes(y)))
