@@ -243,6 +243,18 @@ fn a_bend_given_back_to_an_arc_at_its_min_takes_a_whole_turn_more() {
     check::at_rest(&run, 1e-6).unwrap();
 }
 
+/// Paper 4.3 (generated states case 1111): a tree dragged slowly, a bend piece on a path with
+/// an arc. The relaxation proposed new arc counts together with the bend at -10 degrees,
+/// read in the relaxed pose where least squares spread the turn; settled with the new counts
+/// the model did not bend it (its sites turned 0.0 degrees), and the next pass 1 switched it
+/// back, twice. A proposal whose settled model would switch one of its pieces again is tried
+/// without that piece's state (`Session::try_proposals`, `Solver::switched_again`).
+#[test]
+fn a_proposed_bend_the_settled_model_does_not_take_is_not_proposed() {
+    let (run, why) = switches_against_the_turn("proposed_bend_switched_back");
+    assert!(why.is_empty(), "{why:?}\n{}", run.repro());
+}
+
 /// Paper 5.1, Fig. 9 (issue 46, the hero example): the castle, its south-west tower pinned and
 /// the north-east one dragged to 1.5x and to 0.75x its size, grows and shrinks its walls to the
 /// counts a rectangle of rest walls has there (counts from lengths: 18 m x 12 m between tower

@@ -275,8 +275,8 @@ impl Session {
             }
         };
         for proposal in proposals {
-            let Some((after, trial, events, mut solver)) =
-                restructured(rules, asm, proposal, settle)
+            let Some((after, trial, events, mut solver, proposal)) =
+                restructured_standing(rules, asm, proposal, settle)
             else {
                 continue;
             };
@@ -449,6 +449,43 @@ fn restructured(
     }
     let (energy, trial, solver) = settled(trial, settle)?;
     Some((energy, trial, events, solver))
+}
+
+/// [`restructured`], and when the settled model would switch a piece the proposal switched
+/// again (`Solver::switched_again`: paper 4.3 in its pose), the proposal without those
+/// pieces' states instead (the proposal tried is returned). A relaxation reads a piece's
+/// state in the relaxed pose, where least squares spread the turn; settled with it, the
+/// model may not bend that way, and the next frame's pass 1 switched the piece back
+/// (generated states case 1111: a bend to -10 degrees with its sites turned 0.0, twice).
+fn restructured_standing(
+    rules: &mut Rules,
+    asm: &Assembly,
+    proposal: &crate::solver::Proposal,
+    settle: SolverConfig,
+) -> Option<(
+    f64,
+    Assembly,
+    Vec<RuleEvent>,
+    Solver,
+    crate::solver::Proposal,
+)> {
+    let (after, trial, events, solver) = restructured(rules, asm, proposal, settle)?;
+    let again = solver.switched_again(&trial, asm);
+    if again.is_empty() {
+        return Some((after, trial, events, solver, proposal.clone()));
+    }
+    let data = asm.data();
+    let mut standing = proposal.clone();
+    standing
+        .states
+        .retain(|&(part, _)| match data.parts.get(part).map(|p| &p.kind) {
+            Some(PartKind::Piece { instance }) => {
+                (data.instances.get(*instance)).is_none_or(|x| !again.contains(&x.id))
+            }
+            _ => true,
+        });
+    let (after, trial, events, solver) = restructured(rules, asm, &standing, settle)?;
+    Some((after, trial, events, solver, standing))
 }
 
 /// `asm` settled by a solver of config `settle` (states fixed): its energy, the settled

@@ -14,6 +14,7 @@ use super::config::cone_cosine;
 use super::report::{Judged, StateSwitch};
 use super::state::Solver;
 use super::{chunks, growth, local};
+use crate::assembly::Assembly;
 
 impl Solver {
     /// Each part's rotation onto `f` with its active state (states fixed), into
@@ -311,6 +312,61 @@ impl Solver {
         if reverted {
             self.evaluate_fixed(parts, f);
         }
+    }
+
+    /// The piece instances (by stable id) of `asm` in another state than `before` gave them
+    /// that paper 4.3 would switch again in `asm`'s pose: another state nearer it than their
+    /// own by the hysteresis margin, as pass 1 judges. This solver's last frame must have run
+    /// on `asm` (its shared vertices are `asm`'s).
+    ///
+    /// Why: a relaxation proposes a piece's state from the relaxed pose, where least squares
+    /// spread the turn, and the model settled with it may not bend that way: the next
+    /// frame's pass 1 switched it back, and the proposal came again (generated states case
+    /// 1111: a bend piece to -10 degrees and back, its sites turned 0.0 degrees, twice).
+    pub(crate) fn switched_again(&self, asm: &Assembly, before: &Assembly) -> Vec<u64> {
+        let was: std::collections::HashMap<u64, usize> = (before.data().instances.iter())
+            .map(|x| (x.id, x.state))
+            .collect();
+        let data = asm.data();
+        let mut again = Vec::new();
+        for (pi, part) in data.parts.iter().enumerate() {
+            let PartKind::Piece { instance } = part.kind else {
+                continue;
+            };
+            let Some(x) = data.instances.get(instance) else {
+                continue;
+            };
+            let switched = was.get(&x.id).is_some_and(|&s| s != part.active);
+            if switched && !self.stands(pi, part, &data.positions) {
+                again.push(x.id);
+            }
+        }
+        again
+    }
+
+    /// Whether part `pi` keeps its active state in pose `f` as pass 1 judges it (paper 4.3:
+    /// no other state nearer by the hysteresis margin). This solver's shared vertices must be
+    /// those of the parts'.
+    fn stands(&self, pi: usize, part: &Part, f: &[DVec2]) -> bool {
+        if part.states.len() < 2 {
+            return true;
+        }
+        let how = local::Switching {
+            hysteresis: 0.0,
+            stretch: &[],
+            shared: Some(&self.work.vertex_parts),
+        };
+        let judged = local::judge(pi, part, f, how);
+        let Some(&here) = judged.distances.get(part.active) else {
+            return true;
+        };
+        let best = (judged.distances.iter().copied().enumerate())
+            .filter(|(_, d)| d.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        !here.is_finite()
+            || best.is_none_or(|b| {
+                local::switched(part.active, here, b, self.config.hysteresis) == part.active
+            })
     }
 }
 
