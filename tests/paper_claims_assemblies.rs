@@ -119,9 +119,10 @@ proptest! {
     }
 
     /// Paper 4.3: from rest, a handle moved by less than the hysteresis times the shortest
-    /// element's length switches nothing.
+    /// element's length switches nothing (the fraction drawn below 0.999, so that rounded to
+    /// three decimals it stays below 1: a move of exactly that length is not a small one).
     #[test]
-    fn sec4_3_small_moves_switch_nothing(m in morphs(), fraction in 0.0f64..1.0, degrees in -180.0f64..180.0) {
+    fn sec4_3_small_moves_switch_nothing(m in morphs(), fraction in 0.0f64..0.999, degrees in -180.0f64..180.0) {
         holds(claims::small_moves_switch_nothing(&m, strategy::round(fraction), strategy::round(degrees)))?;
     }
 
