@@ -255,20 +255,6 @@ fn a_proposed_bend_the_settled_model_does_not_take_is_not_proposed() {
     assert!(why.is_empty(), "{why:?}\n{}", run.repro());
 }
 
-/// Paper 4.2, 5.1, morph to a rest configuration (generated morph case 2304): a hub held at
-/// the end of two arcs of two 45-degree elements, a free hub between them, turned 315
-/// degrees in three frames, where arcs of 8 and 3 rest. The relaxation proposed the whole
-/// turn in one arc, 9 and 2, which keeps the turn but moves the free hub, settled at energy
-/// 0.51, and was dropped; the model rested at 0.023 with nothing fired. A turn proposal's
-/// settled copy is now relaxed once more with turns' proposals too (`Solver::relaxed_after`).
-#[test]
-fn a_turn_taken_by_one_of_two_arcs_is_shared_through_their_hub() {
-    let run = replay("turn_shared_through_a_hub");
-    assert_eq!(run.chain_count("l0x0"), 8, "{}", run.repro());
-    assert_eq!(run.chain_count("l1x0"), 3, "{}", run.repro());
-    check::at_rest(&run, 1e-6).unwrap();
-}
-
 /// Paper 5.1, Fig. 9 (issue 46, the hero example): the castle, its south-west tower pinned and
 /// the north-east one dragged to 1.5x and to 0.75x its size, grows and shrinks its walls to the
 /// counts a rectangle of rest walls has there (counts from lengths: 18 m x 12 m between tower

@@ -290,8 +290,8 @@ impl Session {
                     })
                     .collect();
                 for then in solver.relaxed_after(&trial, &kept) {
-                    if let Some((after, trial, more, ..)) =
-                        restructured_standing(rules, &trial, &then, settle)
+                    if let Some((after, trial, more, _)) =
+                        restructured(rules, &trial, &then, settle)
                     {
                         keep((after, trial, [events.clone(), more].concat()));
                     }

@@ -103,20 +103,17 @@ impl Solver {
         }
     }
 
-    /// What the relaxation proposes for `asm` as it is (after a frame of this solver on it):
-    /// what a restructured copy then asks for ([`Proposal::then_lengths`]), with the states
-    /// of the pieces in `kept` (instances: the turn's own choice) left as they are: were
-    /// they switched back, one proposal would switch a piece out and back in a single step.
-    /// The lengths its straight chains then ask for, and its turns' proposals too: a turn
-    /// taken by one arc of two through a free hub moves the hub, and an element moved from
-    /// that arc to the other keeps the turn and puts it back (generated morph case 2304: a
-    /// hub turned 315 degrees, arcs of 2 and 2 where 8 and 3 rest, proposed 9 and 2, which
-    /// settled at energy 0.51, and nothing else). Empty when the relaxation fails.
+    /// What the relaxation proposes for `asm` as it is (after a frame of this solver on it),
+    /// its turns' proposals aside: the lengths a restructured copy then asks for
+    /// ([`Proposal::then_lengths`]), with the states of the pieces in `kept` (instances: the
+    /// turn's own choice) left as they are: were they switched back, one proposal would
+    /// switch a piece out and back in a single step. Empty when the relaxation fails.
     pub(crate) fn relaxed_after(&mut self, asm: &Assembly, kept: &[usize]) -> Vec<Proposal> {
         let warm = asm.data().positions.clone();
         let mut found = self.relax(asm, &warm).unwrap_or_default();
         let parts = &asm.data().parts;
         let keeps = |&(part, _): &(usize, usize)| matches!(parts[part].kind, PartKind::Piece { instance } if kept.contains(&instance));
+        found.retain(|p| !p.then_lengths);
         for p in &mut found {
             p.states.retain(|s| !keeps(s));
         }
